@@ -1,0 +1,53 @@
+"""Timing helpers shared by the benchmarks: medians of repeated runs, ratios against a peer."""
+
+from __future__ import annotations
+
+import os
+import statistics
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+
+
+@dataclass(frozen=True)
+class Result:
+    """One benchmark line: ``ours`` against ``peer`` (both medians, in ``unit``)."""
+
+    name: str
+    ours: float
+    peer: float | None
+    unit: str
+    peer_name: str = ""
+    higher_is_better: bool = False
+    note: str = ""
+
+    @property
+    def ratio(self) -> float | None:
+        """How many times better ours is than the peer (>1 = ours better)."""
+        if self.peer is None or self.ours == 0 or self.peer == 0:
+            return None
+        return self.ours / self.peer if self.higher_is_better else self.peer / self.ours
+
+
+def median_time(fn: Callable[[], object], repeat: int = 7, number: int = 1, warmup: int = 1) -> float:
+    """Median wall time of ``number`` calls of ``fn`` over ``repeat`` runs, per call (s)."""
+    for _ in range(warmup):
+        fn()
+    samples = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(number):
+            fn()
+        samples.append((time.perf_counter() - t0) / number)
+    return statistics.median(samples)
+
+
+def print_results(results: list[Result]) -> None:
+    for r in results:
+        peer = f"{r.peer:.4g} {r.unit} ({r.peer_name})" if r.peer is not None else "-"
+        ratio = f"x{r.ratio:.2f} vs peer" if r.ratio is not None else ""
+        note = f"  [{r.note}]" if r.note else ""
+        print(f"- {r.name}: {r.ours:.4g} {r.unit} | peer {peer} | {ratio}{note}")

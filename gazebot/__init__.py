@@ -1,0 +1,43 @@
+"""gazebot: robot gaze behaviors for human-to-robot object handovers.
+
+Entry points: :class:`GazeEngine` (embed in a robot stack), the ``gazebot`` command line, and the
+packages ``phases``, ``behaviors``, ``kinematics``, ``render``, ``drivers``, ``sim`` and ``study``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from gazebot.types import (
+    Event,
+    EventKind,
+    GazeCommand,
+    GazeContext,
+    GazeTarget,
+    Phase,
+    TrackingFrame,
+)
+
+if TYPE_CHECKING:
+    from gazebot.engine import GazeEngine
+
+__all__ = [
+    "Event",
+    "EventKind",
+    "GazeCommand",
+    "GazeContext",
+    "GazeEngine",
+    "GazeTarget",
+    "Phase",
+    "TrackingFrame",
+]
+__version__ = "0.1.0"
+
+
+def __getattr__(name: str):
+    # The engine pulls in Pinocchio; import it only when asked for.
+    if name == "GazeEngine":
+        from gazebot.engine import GazeEngine
+
+        return GazeEngine
+    raise AttributeError(f"module 'gazebot' has no attribute {name!r}")

@@ -1,0 +1,5 @@
+import sys
+
+from gazebot.cli import main
+
+sys.exit(main())

@@ -1,0 +1,55 @@
+"""The ``gazebot`` command line: one module per command group, each with ``register(subparsers)``.
+
+Angles on the command line are in degrees unless an option says otherwise; everything inside is SI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from gazebot.config import ConfigError
+
+# Command groups, in the order ``gazebot --help`` lists them.
+COMMAND_MODULES = (
+    "demo",
+    "phases",
+    "behaviors",
+    "annotations",
+    "ik",
+    "render",
+    "sim",
+    "run",
+    "study",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="gazebot",
+        description="Robot gaze behavior engine for human-to-robot handovers.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for name in COMMAND_MODULES:
+        module = importlib.import_module(f"gazebot.cli.{name}")
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        result = args.func(args)
+    except (ConfigError, ValueError, FileNotFoundError) as exc:
+        print(f"gazebot: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    return int(result or 0)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

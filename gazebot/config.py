@@ -1,0 +1,76 @@
+"""Loading YAML configuration into pydantic models with errors that name file, field and expectation.
+
+Every package validates its own YAML through :func:`load_model`; nothing reads YAML by hand.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, TypeVar
+
+import yaml
+from pydantic import BaseModel, ValidationError
+
+M = TypeVar("M", bound=BaseModel)
+
+
+class ConfigError(ValueError):
+    """A configuration file (or value) is malformed.
+
+    The message names the file, the field (dotted path) and what was expected.
+    """
+
+    def __init__(self, source: str | Path, field: str, expected: str, got: Any = None):
+        self.source = str(source)
+        self.field = field
+        self.expected = expected
+        self.got = got
+        msg = f"{self.source}: field '{field}': expected {expected}"
+        if got is not None:
+            msg += f", got {got!r}"
+        super().__init__(msg)
+
+
+def configs_dir() -> Path:
+    """The directory holding the shipped configuration (``configs/`` of the repo or the wheel)."""
+    here = Path(__file__).resolve().parent
+    for cand in (here.parent / "configs", here / "_configs"):
+        if cand.is_dir():
+            return cand
+    raise FileNotFoundError("gazebot's configs/ directory was not found beside the package")
+
+
+def read_yaml(path: str | Path) -> Any:
+    """Parse a YAML file; a syntax error becomes a :class:`ConfigError` naming line and column."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(path, "<file>", "a readable YAML file", str(exc)) from exc
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "<document>"
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ConfigError(path, where, "valid YAML", problem) from exc
+
+
+def validate(model: type[M], data: Any, source: str | Path = "<config>") -> M:
+    """Validate ``data`` against ``model``; the first error becomes a :class:`ConfigError`."""
+    try:
+        return model.model_validate(data if data is not None else {})
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        field = ".".join(str(p) for p in err["loc"]) or "<root>"
+        expected = err["msg"]
+        if expected.startswith("Input should be "):
+            expected = expected[len("Input should be ") :]
+        elif expected.startswith("Value error, "):
+            expected = expected[len("Value error, ") :]
+        raise ConfigError(source, field, expected, err.get("input")) from exc
+
+
+def load_model(model: type[M], path: str | Path) -> M:
+    """Read the YAML file at ``path`` and validate it as ``model``."""
+    return validate(model, read_yaml(path), path)

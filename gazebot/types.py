@@ -1,0 +1,187 @@
+"""Values that flow between gazebot's stages.
+
+Data flows one way: ``TrackingFrame`` -> phases (``Event``) -> behavior (``GazeTarget``) ->
+kinematics -> ``GazeCommand``. All quantities are SI (m, s, rad); points are in the robot base
+frame unless a name says otherwise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import numpy as np
+
+NAN3 = np.full(3, np.nan)
+
+
+def as_point(value: Any) -> np.ndarray:
+    """Return ``value`` as a float (3,) array; ``None`` becomes all-NaN (a missing sample)."""
+    if value is None:
+        return NAN3.copy()
+    arr = np.asarray(value, dtype=float).reshape(-1)
+    if arr.shape != (3,):
+        raise ValueError(f"expected a 3D point, got shape {arr.shape}")
+    return arr
+
+
+def is_valid_point(p: np.ndarray | None) -> bool:
+    """True when ``p`` is a finite 3D point."""
+    return p is not None and bool(np.all(np.isfinite(p)))
+
+
+class Phase(str, Enum):
+    """Handover phase as seen by the receiver (seed section 6.2).
+
+    ``idle`` is before a handover starts, ``done`` after it ended (until the next reach).
+    """
+
+    IDLE = "idle"
+    REACH = "reach"
+    TRANSFER = "transfer"
+    RETREAT = "retreat"
+    DONE = "done"
+
+
+class EventKind(str, Enum):
+    """Kinds of events the behavior layer reacts to.
+
+    Phase events come from ``gazebot.phases``; robot events come from the robot's own
+    controller (``GazeEngine.notify``), e.g. the planned duration of its reach.
+    """
+
+    REACH_STARTED = "reach_started"
+    TRANSFER_STARTED = "transfer_started"
+    RETREAT_STARTED = "retreat_started"
+    HANDOVER_DONE = "handover_done"
+    TRACKING_LOST = "tracking_lost"
+    TRACKING_RESTORED = "tracking_restored"
+    ROBOT_REACH_STARTED = "robot_reach_started"
+    ROBOT_REACH_ENDED = "robot_reach_ended"
+    ROBOT_GRASPED = "robot_grasped"
+    ROBOT_RETREAT_STARTED = "robot_retreat_started"
+    ROBOT_RETREAT_ENDED = "robot_retreat_ended"
+
+
+@dataclass(frozen=True)
+class Event:
+    """Something that happened in a handover.
+
+    Attributes:
+        kind: What happened.
+        t: Estimated time the thing happened (s). For online phase events this can be earlier
+            than ``detected_at`` (the detector back-dates a phase start it confirms late).
+        detected_at: Time the event became known (s).
+        info: Extra data, e.g. ``{"planned_duration": 1.2}`` for robot motions or
+            ``{"expected_end": 3.4}`` for a phase whose end is predicted.
+    """
+
+    kind: EventKind
+    t: float
+    detected_at: float
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"kind": self.kind.value, "t": self.t, "detected_at": self.detected_at, **self.info}
+
+
+@dataclass(frozen=True)
+class TrackingFrame:
+    """One sample of tracked points (robot base frame, m) at time ``t`` (s).
+
+    A missing point is all-NaN. ``gripper_closed`` and ``load_share`` are optional evidence the
+    robot reports for the transfer phase (seed section 4.3): the gripper state and the share of
+    the object's weight the robot carries (0..1).
+    """
+
+    t: float
+    giver_hand: np.ndarray = field(default_factory=NAN3.copy)
+    receiver_hand: np.ndarray = field(default_factory=NAN3.copy)
+    giver_face: np.ndarray = field(default_factory=NAN3.copy)
+    gripper_closed: bool | None = None
+    load_share: float | None = None
+
+    @classmethod
+    def make(
+        cls,
+        t: float,
+        giver_hand: Any = None,
+        receiver_hand: Any = None,
+        giver_face: Any = None,
+        gripper_closed: bool | None = None,
+        load_share: float | None = None,
+    ) -> TrackingFrame:
+        """Build a frame from anything array-like; ``None`` means missing."""
+        return cls(
+            t=float(t),
+            giver_hand=as_point(giver_hand),
+            receiver_hand=as_point(receiver_hand),
+            giver_face=as_point(giver_face),
+            gripper_closed=gripper_closed,
+            load_share=load_share,
+        )
+
+
+@dataclass(frozen=True)
+class GazeTarget:
+    """Where the behavior wants the robot to look.
+
+    ``kind`` is one of ``face``, ``hand``, ``object``, ``handover_location``, ``rest`` or a
+    named point; ``point`` is its current position (base frame, m), NaN if unknown.
+    """
+
+    kind: str
+    point: np.ndarray
+
+
+@dataclass(frozen=True)
+class GazeContext:
+    """What a behavior sees at one tick: the phase, its timing and the points it may look at.
+
+    Attributes:
+        t: Current time (s).
+        phase: Current handover phase.
+        phase_start: When the current phase started (s).
+        expected_phase_end: Predicted end of the current phase (s); NaN when unknown.
+        points: Current 3D points by target name (base frame, m): at least ``face``, ``hand``,
+            ``object``, ``handover_location`` and ``rest``; NaN where unknown.
+    """
+
+    t: float
+    phase: Phase
+    phase_start: float
+    expected_phase_end: float
+    points: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class GazeCommand:
+    """The engine's output for one tick.
+
+    Attributes:
+        t: Time of the tracking frame this answers (s).
+        phase: Current handover phase.
+        target: Gaze target kind (``face``, ``hand``, ...).
+        target_point: The 3D point looked at (base frame, m).
+        head: Head joint goals by joint name (rad), always finite and within limits.
+        eye_yaw: Eye yaw on the display (rad, + = robot's left).
+        eye_pitch: Eye pitch on the display (rad, + = down).
+        residual: Angle between the final line of sight (head + eyes) and the target (rad).
+        events: Events that fired during this tick.
+    """
+
+    t: float
+    phase: Phase
+    target: str
+    target_point: np.ndarray
+    head: dict[str, float]
+    eye_yaw: float
+    eye_pitch: float
+    residual: float = 0.0
+    events: tuple[Event, ...] = ()
+
+    def is_finite(self) -> bool:
+        vals = [self.eye_yaw, self.eye_pitch, *self.head.values()]
+        return all(math.isfinite(v) for v in vals)

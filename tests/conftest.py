@@ -1,0 +1,40 @@
+"""Shared test fixtures.
+
+Off-screen back ends are chosen here so tests run on a machine without a screen.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+
+REPO = Path(__file__).resolve().parents[1]
+# Reference data lives beside the repo (never inside it); a user's clone does not have it.
+SHARED_DATA = Path(os.environ.get("GAZEBOT_SHARED_DATA", REPO.parent / "shared" / "data"))
+
+
+@pytest.fixture(scope="session")
+def annotations_dir() -> Path:
+    """The human-human gaze annotations (288 handovers), or a skip saying where they were looked for."""
+    path = SHARED_DATA / "handover-gaze-annotations"
+    if not path.is_dir():
+        pytest.skip(
+            f"reference data not present at {path} (set GAZEBOT_SHARED_DATA to the folder "
+            "holding handover-gaze-annotations/ to run this test)"
+        )
+    return path
+
+
+@pytest.fixture(scope="session")
+def seed_text() -> str:
+    """The seed dissertation text, or a skip saying where it was looked for."""
+    path = SHARED_DATA.parent / "seed" / "handover-dissertation-excerpt.txt"
+    if not path.is_file():
+        pytest.skip(f"seed text not present at {path}")
+    return path.read_text(encoding="utf-8")
