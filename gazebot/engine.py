@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from gazebot.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
+from gazebot.config import ConfigError
 from gazebot.kinematics import GazeController, GazeShiftConfig, RobotModel
 from gazebot.phases import PhaseConfig, PhaseDetector, load_phase_config
 from gazebot.types import (
@@ -24,6 +25,10 @@ from gazebot.types import (
     TrackingFrame,
     is_valid_point,
 )
+
+
+# Targets the engine fills from tracking each tick; all others come from the robot config.
+_TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
 
 
 @dataclass
@@ -58,6 +63,15 @@ class GazeEngine:
         shifts: GazeShiftConfig | None = None,
         seed: int = 0,
     ) -> None:
+        missing = behavior.targets() - set(robot.points) - _TRACKED_TARGETS
+        if missing:
+            raise ConfigError(
+                f"behavior '{behavior.name}'",
+                "targets",
+                f"points the robot '{robot.name}' defines ({', '.join(sorted(robot.points))}) "
+                f"or tracked ones ({', '.join(sorted(_TRACKED_TARGETS))})",
+                sorted(missing),
+            )
         self.robot = robot
         self.behavior_spec = behavior
         self.detector = PhaseDetector(phases or PhaseConfig())

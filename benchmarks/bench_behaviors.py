@@ -1,0 +1,202 @@
+"""Behavior machine and annotation tools against plain peers measured in the same run.
+
+- machine tick: ``BehaviorMachine.target`` over a whole handover at 100 Hz (events included) for
+  ``face-hand-face``, against a hand-written if/else implementation of the same timing;
+- annotation loading: ``load_annotations`` (validating, reporting oddities) on the first 64 real
+  files against a raw openpyxl read of the same cells (read-only, stop at the first empty frame);
+- replay: one behavior over all annotated handovers, reusing one machine (``reset``) against
+  building a machine per handover.
+
+The annotation timings need the reference data (``GAZEBOT_SHARED_DATA`` or ``../shared/data``);
+without it they are left out.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.common import Result, median_time
+from gazebot.behaviors import BehaviorMachine, load_behavior
+from gazebot.types import Event, EventKind, GazeContext, GazeTarget, Phase
+
+_REPO = Path(__file__).resolve().parents[1]
+_DATA = Path(os.environ.get("GAZEBOT_SHARED_DATA", _REPO.parent / "shared" / "data"))
+_ANNOTATIONS = _DATA / "handover-gaze-annotations"
+
+# One handover: reach 0-1 s, transfer 1-1.6 s, retreat 1.6-2.6 s, done; ticks at 100 Hz.
+_PHASES = [(Phase.REACH, 0.0, 1.0), (Phase.TRANSFER, 1.0, 1.6), (Phase.RETREAT, 1.6, 2.6)]
+_EVENTS = {
+    0: [Event(EventKind.REACH_STARTED, 0.0, 0.0)],
+    100: [Event(EventKind.TRANSFER_STARTED, 1.0, 1.0)],
+    160: [Event(EventKind.RETREAT_STARTED, 1.6, 1.6)],
+    260: [Event(EventKind.HANDOVER_DONE, 2.6, 2.6)],
+}
+
+
+def _contexts() -> list[GazeContext]:
+    out = []
+    for i in range(300):
+        t = i / 100.0
+        phase, start, end = Phase.DONE, 2.6, math.nan
+        for p, a, b in _PHASES:
+            if a <= t < b:
+                phase, start, end = p, a, b
+        hand = np.array([1.0 - 0.2 * t, 0.0, 1.0])
+        points = {
+            "face": np.array([1.0, 0.0, 1.6]),
+            "hand": hand,
+            "object": hand,
+            "handover_location": np.array([0.6, 0.0, 1.0]),
+            "rest": np.array([0.4, 0.0, 0.8]),
+        }
+        out.append(GazeContext(t, phase, start, end, points))
+    return out
+
+
+class PlainFaceHandFace:
+    """The peer: face-hand-face (6.4.2) as a hand-written if/else, same halfway rule."""
+
+    def __init__(self, reach_s: float = 0.8, retreat_s: float = 1.05) -> None:
+        self.defaults = {Phase.REACH: reach_s, Phase.RETREAT: retreat_s}
+        self.phase = Phase.IDLE
+        self.shifted = False
+
+    def handle(self, event: Event) -> None:
+        new = {
+            EventKind.REACH_STARTED: Phase.REACH,
+            EventKind.TRANSFER_STARTED: Phase.TRANSFER,
+            EventKind.RETREAT_STARTED: Phase.RETREAT,
+            EventKind.HANDOVER_DONE: Phase.DONE,
+        }.get(event.kind)
+        if new is not None and new is not self.phase:
+            self.phase, self.shifted = new, False
+
+    def target(self, ctx: GazeContext) -> GazeTarget:
+        if ctx.phase in (Phase.REACH, Phase.RETREAT) and not self.shifted:
+            end = ctx.expected_phase_end
+            if not math.isfinite(end) or end <= ctx.phase_start:
+                end = ctx.phase_start + self.defaults[ctx.phase]
+            self.shifted = ctx.t >= ctx.phase_start + 0.5 * (end - ctx.phase_start)
+        if ctx.phase is Phase.REACH:
+            kind = "hand" if self.shifted else "face"
+        elif ctx.phase is Phase.TRANSFER:
+            kind = "hand"
+        elif ctx.phase is Phase.RETREAT:
+            kind = "face" if self.shifted else "hand"
+        else:
+            kind = "face"
+        return GazeTarget(kind, ctx.points[kind])
+
+
+def _run(machine, contexts: list[GazeContext]) -> list[str]:
+    kinds = []
+    for i, ctx in enumerate(contexts):
+        for event in _EVENTS.get(i, ()):
+            machine.handle(event)
+        kinds.append(machine.target(ctx).kind)
+    return kinds
+
+
+def _machine_results() -> list[Result]:
+    contexts = _contexts()
+    spec = load_behavior("face-hand-face")
+    machine = BehaviorMachine(spec)
+
+    def ours() -> list[str]:
+        machine.reset(0)
+        return _run(machine, contexts)
+
+    def peer() -> list[str]:
+        return _run(PlainFaceHandFace(), contexts)
+
+    if ours() != peer():
+        raise AssertionError("the peer must produce the same gaze as the machine")
+    n = len(contexts)
+    t_ours = median_time(ours, repeat=7, number=5) / n
+    t_peer = median_time(peer, repeat=7, number=5) / n
+    t_build = median_time(lambda: BehaviorMachine(spec), repeat=5, number=3)
+    return [
+        Result(
+            "face-hand-face tick (target + events)",
+            t_ours * 1e6,
+            t_peer * 1e6,
+            "us/tick",
+            "hand-written if/else",
+            note=f"{n} ticks per handover; machine construction {t_build * 1e3:.2f} ms",
+        )
+    ]
+
+
+def _raw_openpyxl(files: list[Path]) -> list[list[tuple]]:
+    import openpyxl
+
+    out = []
+    for path in files:
+        wb = openpyxl.load_workbook(path, read_only=True, data_only=True)
+        rows = wb.worksheets[0].iter_rows(values_only=True)
+        next(rows)
+        cells = []
+        for row in rows:
+            if row[0] is None:
+                break
+            cells.append(row[:5])
+        wb.close()
+        out.append(cells)
+    return out
+
+
+def _annotation_results() -> list[Result]:
+    if not _ANNOTATIONS.is_dir():
+        return []
+    from gazebot.annotations import load_annotations, replay
+    from gazebot.annotations.loader import annotation_files, load_handover
+    from gazebot.annotations.replay import replay_handover
+
+    files = annotation_files(_ANNOTATIONS)[:64]
+
+    def ours() -> list:
+        return [load_handover(p) for p in files]
+
+    t_ours = median_time(ours, repeat=3, warmup=1)
+    t_peer = median_time(lambda: _raw_openpyxl(files), repeat=3, warmup=1)
+    results = [
+        Result(
+            "annotation loading (64 xlsx files)",
+            t_ours * 1e3 / len(files),
+            t_peer * 1e3 / len(files),
+            "ms/file",
+            "raw openpyxl read-only loop",
+            note="ours normalises labels and reports oddities",
+        )
+    ]
+    annotations = load_annotations(_ANNOTATIONS)
+    spec = load_behavior("hand-face")
+    frames = sum(h.n_frames for h in annotations.handovers)
+
+    def fresh() -> list:
+        return [
+            replay_handover(h, spec, "receiver", seed=k)
+            for k, h in enumerate(annotations.handovers)
+        ]
+
+    t_reuse = median_time(lambda: replay(annotations, spec, "receiver"), repeat=3)
+    t_fresh = median_time(fresh, repeat=3)
+    results.append(
+        Result(
+            f"replay hand-face over {len(annotations)} handovers",
+            t_reuse * 1e6 / frames,
+            t_fresh * 1e6 / frames,
+            "us/frame",
+            "new machine per handover",
+            note=f"{frames} frames",
+        )
+    )
+    return results
+
+
+def run() -> list[Result]:
+    return _machine_results() + _annotation_results()

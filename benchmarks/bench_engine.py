@@ -1,0 +1,53 @@
+"""Engine step cost: the full pipeline (phases -> behavior -> IK + gaze shifts) per tracking frame,
+against a hand-written peer of the kind labs write today (a distance rule for the phase, fixed
+face/hand switch, closed-form atan2 pan/tilt), measured in the same run."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from benchmarks.common import Result, median_time
+from gazebot import GazeEngine
+from tests.test_engine import handover_frames
+
+
+def _hand_written_peer(frames):
+    """Face until the hands are within 0.3 m, then the hand; atan2 pan/tilt toward the target."""
+    state = {"i": 0}
+
+    def step():
+        f = frames[state["i"] % len(frames)]
+        state["i"] += 1
+        d = float(np.linalg.norm(f.giver_hand - f.receiver_hand))
+        target = f.giver_hand if d < 0.3 else f.giver_face
+        pan = math.atan2(target[1], target[0])
+        tilt = math.atan2(-(target[2] - 1.0), math.hypot(target[0], target[1]))
+        return min(max(pan, -0.9), 0.9), tilt
+
+    return step
+
+
+def run() -> list[Result]:
+    frames = handover_frames(rate=120.0)
+    results = []
+    for robot in ("sawyer", "jaco2"):
+        engine = GazeEngine.from_config(robot=robot, behavior="face-hand-face")
+        state = {"i": 0}
+
+        def step(engine=engine, state=state):
+            i = state["i"]
+            if i % len(frames) == 0:
+                engine.reset()
+            engine.step(frames[i % len(frames)])
+            state["i"] = i + 1
+
+        n = len(frames)
+        ours = median_time(step, repeat=7, number=n) * 1e6
+        peer = median_time(_hand_written_peer(frames), repeat=7, number=n) * 1e6
+        results.append(
+            Result(f"engine.step, {robot}, face-hand-face, 120 Hz handover", ours, peer, "us/step",
+                   "hand-written distance rule + atan2")
+        )
+    return results

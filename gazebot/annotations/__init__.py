@@ -1,0 +1,48 @@
+"""The human-human handover gaze annotations (seed section 6.2): loading, patterns, replay.
+
+- :mod:`~gazebot.annotations.loader`: read the published xlsx layout, reporting oddities.
+- :mod:`~gazebot.annotations.rules`: how ``Own Hand`` and ``Other`` frames count.
+- :mod:`~gazebot.annotations.reach` / :mod:`~gazebot.annotations.three_phase`: the seed's
+  reach-phase (6.3.1) and three-phase (6.4.2) gaze patterns.
+- :mod:`~gazebot.annotations.summary`: pattern shares beside the seed's published ones.
+- :mod:`~gazebot.annotations.replay`: run behaviors along the annotated phases and score them.
+"""
+
+from gazebot.annotations.loader import (
+    AnnotatedHandover,
+    AnnotationSet,
+    LoadIssue,
+    load_annotations,
+    load_handover,
+)
+from gazebot.annotations.reach import REACH_PATTERNS, classify_reach, reach_pattern
+from gazebot.annotations.replay import ReplayResult, replay, replay_handover
+from gazebot.annotations.rules import DEFAULT_RULE, GazeRule
+from gazebot.annotations.summary import Summary, plot_summary, summarize
+from gazebot.annotations.three_phase import (
+    THREE_PHASE_PATTERNS,
+    classify_three_phase,
+    three_phase_pattern,
+)
+
+__all__ = [
+    "DEFAULT_RULE",
+    "REACH_PATTERNS",
+    "THREE_PHASE_PATTERNS",
+    "AnnotatedHandover",
+    "AnnotationSet",
+    "GazeRule",
+    "LoadIssue",
+    "ReplayResult",
+    "Summary",
+    "classify_reach",
+    "classify_three_phase",
+    "load_annotations",
+    "load_handover",
+    "plot_summary",
+    "reach_pattern",
+    "replay",
+    "replay_handover",
+    "summarize",
+    "three_phase_pattern",
+]

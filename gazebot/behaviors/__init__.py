@@ -1,0 +1,27 @@
+"""Gaze behaviors: what the robot looks at in each handover phase.
+
+- :mod:`~gazebot.behaviors.spec`: the YAML format (:class:`BehaviorSpec`, segments ``{phase, at,
+  target}``).
+- :mod:`~gazebot.behaviors.machine`: :class:`BehaviorMachine`, the state machine that runs a spec
+  online (phase events in, gaze target out).
+- :mod:`~gazebot.behaviors.registry`: :func:`load_behavior` and :func:`list_behaviors` (built-ins in
+  ``configs/behaviors/`` plus user folders).
+- :mod:`~gazebot.behaviors.human`: the data-driven ``human-receiver`` timing model.
+"""
+
+from gazebot.behaviors.machine import BehaviorMachine
+from gazebot.behaviors.registry import BehaviorInfo, behavior_path, list_behaviors, load_behavior
+from gazebot.behaviors.spec import AtEvent, AtFraction, AtNever, BehaviorSpec, Segment
+
+__all__ = [
+    "AtEvent",
+    "AtFraction",
+    "AtNever",
+    "BehaviorInfo",
+    "BehaviorMachine",
+    "BehaviorSpec",
+    "Segment",
+    "behavior_path",
+    "list_behaviors",
+    "load_behavior",
+]

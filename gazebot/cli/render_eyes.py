@@ -1,0 +1,80 @@
+"""``gazebot render eyes``: draw the robot's eyes for one gaze (degrees here) into a PNG/JPEG."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser(
+        "eyes",
+        help="render the head-screen eyes for one eye yaw/pitch into an image",
+        description=(
+            "Render the eyes shown on the robot's head screen. Positive yaw = the robot looks to "
+            "its left (pupils move right in the image); positive pitch = looking down."
+        ),
+    )
+    parser.add_argument(
+        "--robot", default="sawyer", help="robot name or robot YAML (sawyer, jaco2)"
+    )
+    parser.add_argument(
+        "--style", default=None, help="eye style name or YAML (default: the robot's)"
+    )
+    parser.add_argument(
+        "--yaw", type=float, default=0.0, help="eye yaw, degrees (+ = robot's left)"
+    )
+    parser.add_argument("--pitch", type=float, default=0.0, help="eye pitch, degrees (+ = down)")
+    parser.add_argument(
+        "--blink", type=float, default=0.0, help="lid closure 0 (open) .. 1 (closed)"
+    )
+    parser.add_argument(
+        "--distance", type=float, default=None, help="target distance, m (vergence)"
+    )
+    parser.add_argument("--width", type=int, default=None, help="image width, px (default: screen)")
+    parser.add_argument(
+        "--height", type=int, default=None, help="image height, px (default: screen)"
+    )
+    parser.add_argument("--out", default="eyes.png", help="output image (.png or .jpg)")
+    parser.add_argument("--json", action="store_true", help="print a JSON summary to stdout")
+    parser.set_defaults(func=handler)
+
+
+def handler(args: argparse.Namespace) -> int:
+    import cv2
+
+    from gazebot.render import EyeRenderer
+
+    for name in ("yaw", "pitch", "blink"):
+        if not math.isfinite(getattr(args, name)):
+            raise ValueError(f"--{name} must be a finite number, got {getattr(args, name)}")
+    if not 0.0 <= args.blink <= 1.0:
+        raise ValueError(f"--blink must be in 0..1, got {args.blink}")
+    out = Path(args.out)
+    if out.suffix.lower() not in (".png", ".jpg", ".jpeg"):
+        raise ValueError(f"--out must end in .png, .jpg or .jpeg, got {out}")
+    renderer = EyeRenderer.for_robot(
+        args.robot, width=args.width, height=args.height, style=args.style
+    )
+    img = renderer.render(
+        math.radians(args.yaw), math.radians(args.pitch), blink=args.blink, distance=args.distance
+    )
+    if out.parent and not out.parent.is_dir():
+        raise FileNotFoundError(f"output folder does not exist: {out.parent}")
+    if not cv2.imwrite(str(out), img[..., ::-1]):
+        raise ValueError(f"could not write the image {out}")
+    summary = {
+        "out": str(out),
+        "robot": args.robot,
+        "style": renderer.style.name,
+        "width": renderer.width,
+        "height": renderer.height,
+        "yaw_deg": args.yaw,
+        "pitch_deg": args.pitch,
+        "blink": args.blink,
+        "distance_m": args.distance,
+    }
+    print(json.dumps(summary) if args.json else f"wrote {out} ({renderer.width}x{renderer.height})")
+    return 0

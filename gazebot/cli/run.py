@@ -1,0 +1,116 @@
+"""``gazebot run``: the gaze engine node alone, driving any robot that speaks gazebot's keys on
+the Zenoh bus (the simulator of ``gazebot sim`` or a real robot's bridge)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+from gazebot.cli.sim import add_bus_arguments, bus_config, positive
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "run",
+        help="run the gaze engine node against a robot on the Zenoh bus",
+        description="Subscribe to a robot's tracking, run the gaze engine and publish head "
+        "commands, eye state (rendered eye frames while someone subscribes), events and a "
+        "heartbeat.",
+    )
+    p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
+    p.add_argument("--behavior", default="face-hand-face", help="behavior name or YAML file")
+    p.add_argument("--phases", default=None, help="phase config YAML (default configs/phases.yaml)")
+    p.add_argument("--seed", type=int, default=0, help="seed of behavior timings and blinks")
+    p.add_argument("--duration", type=positive, default=None,
+                   help="seconds to run (default: until Ctrl-C)")
+    p.add_argument("--hold-timeout", type=positive, default=0.25,
+                   help="s without tracking before holding the gaze (default 0.25)")
+    p.add_argument("--face-timeout", type=positive, default=1.0,
+                   help="s without tracking before looking at the last face (default 1.0)")
+    p.add_argument("--no-resync", action="store_true",
+                   help="do not catch up with a handover under way at start")
+    p.add_argument("--no-eye-frames", action="store_true",
+                   help="never render eye frames (eye state is always published)")
+    p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
+    add_bus_arguments(p, listens_by_default=False)
+    p.set_defaults(func=handle)
+
+
+class LazyEyeRenderer:
+    """Builds the robot's eye renderer on first use (only when someone wants frames)."""
+
+    def __init__(self, robot: str) -> None:
+        self.robot = robot
+        self._renderer: Any = None
+
+    def render(self, yaw: float, pitch: float, blink: float = 0.0) -> Any:
+        if self._renderer is None:
+            from gazebot.render import EyeRenderer
+
+            self._renderer = EyeRenderer.for_robot(self.robot)
+        return self._renderer.render(yaw, pitch, blink=blink)
+
+
+def build_engine_node(
+    robot: str,
+    behavior: str,
+    driver: Any,
+    seed: int = 0,
+    phases: str | None = None,
+    config: Any = None,
+    eye_frames: bool = True,
+) -> Any:
+    """A :class:`~gazebot.drivers.engine_node.EngineNode` running ``GazeEngine.from_config``."""
+    from gazebot.drivers.engine_node import EngineNode
+    from gazebot.engine import GazeEngine
+
+    engine = GazeEngine.from_config(robot=robot, behavior=behavior, phases=phases, seed=seed)
+    try:
+        from gazebot.render import BlinkModel
+
+        blink = BlinkModel(seed)
+    except ImportError:  # eyes package absent: the eyes never blink
+        blink = None
+    renderer = LazyEyeRenderer(engine.robot.name) if eye_frames else None
+    return EngineNode(engine, driver, config, blink=blink, eye_renderer=renderer)
+
+
+def handle(args: argparse.Namespace) -> int:
+    from gazebot.drivers.engine_node import EngineNodeConfig
+    from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+
+    if args.face_timeout < args.hold_timeout:
+        raise ValueError("--face-timeout must be >= --hold-timeout")
+    cfg = bus_config(args, listens_by_default=False)
+    node_cfg = EngineNodeConfig(
+        hold_timeout=args.hold_timeout, face_timeout=args.face_timeout, resync=not args.no_resync
+    )
+    driver = ZenohRobotDriver.open(cfg, "engine")
+    try:
+        node = build_engine_node(args.robot, args.behavior, driver, seed=args.seed,
+                                 phases=args.phases, config=node_cfg,
+                                 eye_frames=not args.no_eye_frames)
+        print(
+            f"gazebot run: {args.behavior} on {node.engine.robot.name} at gazebot/{cfg.robot_id}/ "
+            f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})",
+            file=sys.stderr,
+        )
+        try:
+            node.run(duration=args.duration)
+        except KeyboardInterrupt:
+            pass
+        summary = {
+            "frames": node.frames_processed,
+            "commands": node.commands_sent,
+            "phase": node.phase,
+            "tracking": node.tracking,
+            "peers": driver.peers(),
+            "dropped": driver.dropped(),
+            "tracking_skipped": driver.tracking_skipped,
+        }
+    finally:
+        driver.close()
+    print(json.dumps(summary) if args.json else "\n".join(f"{k}: {v}" for k, v in summary.items()))
+    return 0

@@ -1,0 +1,196 @@
+"""``gazebot sim``: a MuJoCo handover simulation as a node on the Zenoh bus (optionally with the
+gaze engine in the same process)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import threading
+from typing import Any
+
+from gazebot.drivers.session import DEFAULT_ENDPOINT, EPHEMERAL_ENDPOINT, BusConfig
+
+
+def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool) -> None:
+    """``--id``, ``--listen``, ``--connect``, ``--multicast``: how the node joins the bus.
+
+    By default the robot side (``gazebot sim``) listens on ``tcp/127.0.0.1:7447`` and engine
+    nodes (``gazebot run``) connect to it, listening on an ephemeral port so that other
+    connected nodes reach them too.
+    """
+    listen_default = DEFAULT_ENDPOINT if listens_by_default else EPHEMERAL_ENDPOINT
+    connect_default = "none" if listens_by_default else DEFAULT_ENDPOINT
+    parser.add_argument("--id", default="sim", help="robot id: keys live under gazebot/<id>/")
+    parser.add_argument(
+        "--listen",
+        action="append",
+        metavar="EP",
+        help=f"endpoint to listen on, repeatable (default: {listen_default})",
+    )
+    parser.add_argument(
+        "--connect",
+        action="append",
+        metavar="EP",
+        help=f"peer or router endpoint to connect to, repeatable (default: {connect_default})",
+    )
+    parser.add_argument(
+        "--multicast", action="store_true", help="enable multicast scouting (off by default)"
+    )
+
+
+def bus_config(args: argparse.Namespace, listens_by_default: bool) -> BusConfig:
+    """The :class:`BusConfig` of parsed ``add_bus_arguments`` options."""
+    listen = args.listen if args.listen is not None else (
+        [DEFAULT_ENDPOINT] if listens_by_default else [EPHEMERAL_ENDPOINT])
+    connect = args.connect if args.connect is not None else (
+        [] if listens_by_default else [DEFAULT_ENDPOINT])
+    return BusConfig(
+        robot_id=args.id,
+        listen=tuple(listen),
+        connect=tuple(connect),
+        multicast_scouting=args.multicast,
+    )
+
+
+def positive(value: str) -> float:
+    try:
+        x = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {value!r}") from None
+    if not x > 0 or x != x:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {value!r}")
+    return x
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "sim",
+        help="run a simulated robot (MuJoCo) on the Zenoh bus",
+        description="Simulate a handover in MuJoCo and serve it on the bus: tracking at 120 Hz, "
+        "joint states, robot events, heartbeat; obeys head, eye and arm commands.",
+    )
+    p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
+    p.add_argument("--scene", default="default", help="scene name in configs/scenes/ or YAML")
+    p.add_argument("--seed", type=int, default=0, help="seed of the giver and the tracking noise")
+    p.add_argument("--with-engine", action="store_true", help="run a gaze engine in-process too")
+    p.add_argument("--behavior", default="face-hand-face", help="behavior for --with-engine")
+    p.add_argument("--headless", action="store_true", help="no window")
+    p.add_argument(
+        "--eye-frames",
+        action="store_true",
+        help="show the engine's rendered eye frames on the display (gazebot/<id>/eyes/frame) "
+        "instead of drawing the eyes from the eye state",
+    )
+    p.add_argument("--duration", type=positive, default=None,
+                   help="simulated seconds to run (default: until Ctrl-C)")
+    p.add_argument("--speed", type=positive, default=1.0,
+                   help="simulated seconds per real second (default 1: real time)")
+    p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
+    add_bus_arguments(p, listens_by_default=True)
+    p.set_defaults(func=handle)
+
+
+class PygameView:
+    """A window showing the observer camera (needs a display)."""
+
+    def __init__(self, width: int = 640, height: int = 480) -> None:
+        import os
+
+        os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+        import pygame
+
+        self.pygame = pygame
+        self.size = (width, height)
+        try:
+            pygame.display.init()
+            driver = pygame.display.get_driver()
+            if driver in ("dummy", "offscreen"):
+                raise pygame.error(f"no display (SDL video driver {driver!r})")
+            self.screen = pygame.display.set_mode(self.size)
+        except pygame.error as exc:
+            pygame.display.quit()
+            raise ValueError(f"cannot open a window ({exc}); use --headless") from exc
+        pygame.display.set_caption("gazebot sim")
+
+    def __call__(self, sim: Any) -> bool:
+        pg = self.pygame
+        for event in pg.event.get():
+            if event.type == pg.QUIT:
+                return False
+        img = sim.render("observer", *self.size)
+        self.screen.blit(pg.surfarray.make_surface(img.swapaxes(0, 1)), (0, 0))
+        pg.display.flip()
+        return True
+
+    def close(self) -> None:
+        self.pygame.display.quit()
+
+
+def handle(args: argparse.Namespace) -> int:
+    from gazebot.drivers.sim_node import SimNode, SimNodeConfig
+    from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
+    from gazebot.sim import HandoverSimulation
+
+    cfg = bus_config(args, listens_by_default=True)
+    view = sim = endpoint = driver = engine_node = thread = None
+    stop = threading.Event()
+    summary: dict[str, Any] = {}
+    try:
+        view = None if args.headless else PygameView()
+        sim = HandoverSimulation(args.robot, args.scene, seed=args.seed)
+        endpoint = ZenohRobotEndpoint.open(cfg, "sim", eye_frames=args.eye_frames)
+        node = SimNode(sim, endpoint, SimNodeConfig(speed=args.speed), view=view)
+        node.publish_state()
+        if args.with_engine:
+            from gazebot.cli.run import build_engine_node
+            from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+
+            driver = ZenohRobotDriver(endpoint.session, cfg.keys, "engine")
+            engine_node = build_engine_node(args.robot, args.behavior, driver, seed=args.seed)
+            thread = threading.Thread(target=engine_node.run, kwargs={"stop": stop},
+                                      name="engine-node", daemon=True)
+            thread.start()
+            # Start the handover once the engine listens (and has taken the head pose).
+            if not engine_node.ready.wait(10.0):
+                raise ValueError("the in-process engine node did not start within 10 s")
+        print(
+            f"gazebot sim: robot {sim.robot.name} scene {args.scene} on gazebot/{cfg.robot_id}/ "
+            f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})"
+            + (f", engine '{args.behavior}' in-process" if args.with_engine else ""),
+            file=sys.stderr,
+        )
+        try:
+            rtf = node.run(duration=args.duration)
+        except KeyboardInterrupt:
+            rtf = float("nan")
+        summary = {
+            "robot": sim.robot.name,
+            "scene": args.scene,
+            "t": round(sim.t, 4),
+            "ticks": node.ticks,
+            "real_time_factor": round(rtf, 3) if rtf == rtf else None,
+            "handover_done": bool(sim.done),
+            "applied": node.applied,
+            "rejected": node.rejected,
+            "dropped": endpoint.dropped(),
+        }
+    finally:
+        stop.set()
+        if thread is not None:
+            thread.join(timeout=5)
+        if engine_node is not None and summary:
+            summary["engine"] = {
+                "frames": engine_node.frames_processed,
+                "commands": engine_node.commands_sent,
+                "phase": engine_node.phase,
+            }
+        for closable in (driver, endpoint, sim, view):  # sim before the window: shared GL
+            if closable is not None:
+                closable.close()
+    print(json.dumps(summary) if args.json else _text(summary))
+    return 0
+
+
+def _text(summary: dict[str, Any]) -> str:
+    return "\n".join(f"{k}: {v}" for k, v in summary.items())

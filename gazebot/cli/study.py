@@ -1,0 +1,251 @@
+"""``gazebot study plan|render|analyze|fit-wins``: run a pairwise video study end to end."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser("study", help="plan, render and analyze a pairwise gaze video study")
+    study = parser.add_subparsers(dest="study_command", metavar="STUDY_COMMAND")
+    study.required = True
+
+    p = study.add_parser("plan", help="write a counterbalanced session plan (CSV)")
+    p.add_argument(
+        "--behaviors",
+        default="hand-face,face-hand-face,hand",
+        help="comma-separated behavior names (default: the seed's three)",
+    )
+    p.add_argument("--condition", required=True, choices=["object-size", "fragility", "posture"])
+    p.add_argument(
+        "--participants",
+        type=int,
+        required=True,
+        help="a multiple of the block size 2*g*(g-1) (12 for three behaviors)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="randomisation seed")
+    p.add_argument("--robot", default="sawyer")
+    p.add_argument("--video-seed", type=int, default=0, help="seed of every rendered handover")
+    p.add_argument(
+        "--scene",
+        action="append",
+        default=[],
+        metavar="LEVEL=SCENE",
+        help="render a level in another scene (default: the shipped scene of the level)",
+    )
+    p.add_argument("--out", required=True, type=Path)
+    p.add_argument("--json", action="store_true", help="print the balance summary as JSON")
+    p.set_defaults(func=_plan)
+
+    r = study.add_parser("render", help="render a plan's videos, pair videos and questionnaires")
+    r.add_argument("plan", type=Path)
+    r.add_argument("--out", required=True, type=Path)
+    r.add_argument("--width", type=int, default=640)
+    r.add_argument("--height", type=int, default=480)
+    r.add_argument("--fps", type=int, default=30)
+    r.add_argument("--workers", type=int, default=None, help="processes (default: CPU cores)")
+    r.add_argument("--card-seconds", type=float, default=1.5, help="title card duration (s)")
+    r.add_argument(
+        "--renderer",
+        choices=["mujoco", "synthetic"],
+        default="mujoco",
+        help="synthetic: labelled flat clips for a quick dry run",
+    )
+    r.add_argument(
+        "--code-version",
+        default=None,
+        help="pin the cache key's code version (default: a hash of gazebot's sources and configs)",
+    )
+    r.add_argument("--no-progress", action="store_true")
+    r.set_defaults(func=_render)
+
+    a = study.add_parser("analyze", help="Bradley-Terry analysis of a responses CSV")
+    a.add_argument("responses", type=Path)
+    a.add_argument("--json", action="store_true")
+    a.add_argument(
+        "--plot",
+        type=Path,
+        default=None,
+        help="PNG like the seed's Figure 6.3 (one file per level if several)",
+    )
+    a.add_argument("--margin", type=float, default=0.1, help="equivalence margin (proportion)")
+    a.add_argument(
+        "--behaviors", default=None, help="comma-separated order of the behaviors in the output"
+    )
+    a.add_argument(
+        "--bias-unit",
+        choices=["participant", "session"],
+        default="participant",
+        help="one value per participant (default) or per session (like the seed) in the bias test",
+    )
+    a.set_defaults(func=_analyze)
+
+    f = study.add_parser("fit-wins", help="Bradley-Terry fit of a win-count matrix CSV")
+    f.add_argument("wins", type=Path)
+    f.add_argument(
+        "--participants",
+        type=float,
+        required=True,
+        help="n: every pair compared n times (cell(i,j) + cell(j,i) = n)",
+    )
+    f.add_argument("--json", action="store_true")
+    f.set_defaults(func=_fit_wins)
+
+
+def _plan(args: argparse.Namespace) -> int:
+    from gazebot.study.plan import check_balance, make_plan, write_plan
+
+    behaviors = [b.strip() for b in args.behaviors.split(",") if b.strip()]
+    scenes = {}
+    for item in args.scene:
+        level, sep, scene = item.partition("=")
+        if not sep or not level or not scene:
+            raise ValueError(f"--scene expects LEVEL=SCENE, got {item!r}")
+        scenes[level] = scene
+    plan = make_plan(
+        behaviors, args.condition, args.participants, args.seed, args.robot, scenes, args.video_seed
+    )
+    write_plan(plan, args.out)
+    report = check_balance(plan)
+    summary = {
+        "out": str(args.out),
+        "participants": args.participants,
+        "sessions_per_participant": len(plan) // args.participants,
+        "position_balanced": report.position_balanced,
+        "carryover_balanced": report.carryover_balanced,
+    }
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        print(
+            f"wrote {len(plan)} sessions for {args.participants} participants to {args.out} "
+            f"(position balanced: {report.position_balanced}, "
+            f"carry-over balanced: {report.carryover_balanced})"
+        )
+    return 0
+
+
+def _render(args: argparse.Namespace) -> int:
+    import os
+
+    os.environ.setdefault("MUJOCO_GL", "egl")  # off-screen rendering in every worker
+    from gazebot.study.plan import read_plan
+    from gazebot.study.render import default_renderer, render_study
+    from gazebot.study.synthetic import render_synthetic_video
+
+    plan = read_plan(args.plan)
+    if args.renderer == "synthetic":
+        fn = render_synthetic_video
+    else:
+        from gazebot.config import configs_dir
+
+        # Fail before starting workers: an unknown scene would only surface inside a worker.
+        for scene in sorted({s.scene for s in plan}):
+            if not (configs_dir() / "scenes" / f"{scene}.yaml").is_file() and not (
+                scene.endswith((".yaml", ".yml")) and Path(scene).is_file()
+            ):
+                raise ValueError(
+                    f"{args.plan}: unknown scene {scene!r} (no configs/scenes/{scene}.yaml)"
+                )
+        fn = default_renderer()
+    rep = render_study(
+        plan,
+        args.out,
+        fn,
+        args.width,
+        args.height,
+        args.fps,
+        args.workers,
+        args.card_seconds,
+        code_version_str=args.code_version,
+        progress=not args.no_progress,
+    )
+    print(
+        f"{len(rep.videos)} handover videos ({len(rep.rendered)} rendered, "
+        f"{len(rep.videos) - len(rep.rendered)} cached), {len(rep.pairs)} pair videos, "
+        f"{sum(len(v) for v in rep.sessions.values())} session files; "
+        f"response sheet {rep.questionnaire_csv}"
+    )
+    return 0
+
+
+def _analyze(args: argparse.Namespace) -> int:
+    from gazebot.study.analysis import analyze, read_responses
+
+    order = [b.strip() for b in args.behaviors.split(",")] if args.behaviors else None
+    result = analyze(
+        read_responses(args.responses),
+        margin=args.margin,
+        behaviors=order,
+        bias_unit=args.bias_unit,
+    )
+    if args.plot is not None:
+        from gazebot.study.plots import plot_preferences
+
+        for level, measures in result.per_level.items():
+            out = args.plot
+            if len(result.per_level) > 1:
+                out = args.plot.with_name(f"{args.plot.stem}-{level or 'all'}{args.plot.suffix}")
+            plot_preferences(measures, out, title=level)
+    if args.json:
+        print(json.dumps(result.to_json()))
+        return 0
+    for level, measures in result.per_level.items():
+        print(f"## level: {level or '(single scenario)'}")
+        for m, r in measures.items():
+            ps = ", ".join(f"{c}={v:.2f}" for c, v in r.fit.as_dict().items())
+            print(
+                f"  {m}: P_i {ps}; chi2={r.chi2.chi2:.2f} df={r.chi2.df} "
+                f"p={r.chi2.p_value:.3g} (n={r.participants})"
+            )
+    for m, b in result.bias.items():
+        print(f"first/second bias {m}: S={b.s:.1f} p={b.p_value:.2f}")
+    for c in result.comparisons:
+        print(
+            f"{c.measure} {c.behavior_i} vs {c.behavior_j}: {c.level_a} {c.proportion_a:.2f} "
+            f"vs {c.level_b} {c.proportion_b:.2f}, z={c.difference.z:.2f} "
+            f"p={c.difference.p_value:.2f}, equivalence p={c.equivalence.p_value:.2f}"
+        )
+    return 0
+
+
+def _fit_wins(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from gazebot.study.analysis import read_win_matrix
+    from gazebot.study.bradley_terry import fit_bradley_terry
+    from gazebot.study.stats import bradley_terry_chi2
+
+    names, w = read_win_matrix(args.wins)
+    n = args.participants
+    totals = w + w.T
+    iu = np.triu_indices(len(names), k=1)
+    bad = [
+        (names[i], names[j], totals[i, j])
+        for i, j in zip(*iu, strict=True)
+        if abs(totals[i, j] - n) > 1e-6 * max(1.0, n)
+    ]
+    if bad:
+        i, j, t = bad[0]
+        raise ValueError(
+            f"{args.wins}: cells ({i}, {j}) + ({j}, {i}) = {t:g}, expected "
+            f"--participants {n:g} (every participant compares every pair once)"
+        )
+    fit = fit_bradley_terry(w, names)
+    chi = bradley_terry_chi2(fit.wins, fit.p, n)
+    out = {
+        "conditions": names,
+        "p": [float(v) for v in fit.p],
+        "chi2": chi.chi2,
+        "df": chi.df,
+        "p_value": chi.p_value,
+    }
+    if args.json:
+        print(json.dumps(out))
+    else:
+        for c, v, a in zip(names, fit.p, fit.wins, strict=True):
+            print(f"{c}: a_i={a:g} P_i={v:.2f}")
+        print(f"chi2={chi.chi2:.3f} df={chi.df} p={chi.p_value:.3g}")
+    return 0

@@ -1,0 +1,97 @@
+"""The ``RobotDriver`` interface: the engine's view of one robot, whatever carries the data.
+
+A driver sends head commands, eye state or eye frames and arm commands, and reads the robot's
+joint state, the tracking samples and the events of the other nodes. Concrete kinds:
+:class:`~gazebot.drivers.zenoh_driver.ZenohRobotDriver` (any robot bridge that speaks the keys
+of :mod:`gazebot.drivers.keys`) and :class:`~gazebot.drivers.sim_driver.SimRobotDriver`
+(an in-process :class:`gazebot.sim.HandoverSimulation`, no bus).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+from gazebot.drivers.payloads import (
+    ArmCommandMsg,
+    EventMsg,
+    EyeFrameMsg,
+    EyeStateMsg,
+    HeadCommandMsg,
+    JointStateMsg,
+    StatusMsg,
+    TrackingMsg,
+)
+
+
+class RobotDriver(ABC):
+    """One robot as the gaze engine sees it.
+
+    Attributes:
+        node: This side's node name (the ``source`` of the events it publishes).
+    """
+
+    node: str = "engine"
+
+    # -- commands --------------------------------------------------------------------------
+    @abstractmethod
+    def send_head(self, msg: HeadCommandMsg) -> None:
+        """Send head joint goals (rad)."""
+
+    @abstractmethod
+    def send_eyes(self, msg: EyeStateMsg) -> None:
+        """Send the eye direction and blink for the robot's display to draw."""
+
+    def send_eye_frame(self, msg: EyeFrameMsg) -> None:  # noqa: B027 - optional capability
+        """Send a rendered display image (only when :meth:`wants_eye_frames`)."""
+
+    def wants_eye_frames(self) -> bool:
+        """True when the robot wants rendered display images rather than eye state only."""
+        return False
+
+    @abstractmethod
+    def send_arm(self, msg: ArmCommandMsg) -> None:
+        """Send an arm goal (or hand the arm back to the robot's own controller)."""
+
+    # -- state -----------------------------------------------------------------------------
+    @abstractmethod
+    def wait_tracking(self, timeout: float) -> TrackingMsg | None:
+        """The oldest unread tracking sample, waiting up to ``timeout`` s for one; ``None`` if
+        none arrived. A driver keeps a short backlog and drops the oldest beyond it, so a slow
+        engine lags by a bounded time."""
+
+    @abstractmethod
+    def joint_state(self) -> JointStateMsg | None:
+        """The latest joint state, ``None`` before the first one."""
+
+    # -- events and status -----------------------------------------------------------------
+    @abstractmethod
+    def poll_events(self) -> list[EventMsg]:
+        """Events other nodes published since the last call (oldest first)."""
+
+    @abstractmethod
+    def publish_event(self, msg: EventMsg) -> None:
+        """Publish one of this node's events."""
+
+    def event_history(self, timeout: float = 1.0) -> list[EventMsg]:
+        """Events the other nodes have seen (e.g. after a restart), oldest first."""
+        return []
+
+    def publish_status(self, msg: StatusMsg) -> None:  # noqa: B027 - optional capability
+        """Publish this node's heartbeat."""
+
+    def peers(self) -> dict[str, bool]:
+        """Other nodes seen so far and whether they are alive."""
+        return {}
+
+    def dropped(self) -> dict[str, int]:
+        """Malformed payloads dropped so far, by key."""
+        return {}
+
+    def close(self) -> None:  # noqa: B027 - nothing to release by default
+        """Release the driver's resources (idempotent)."""
+
+    def __enter__(self) -> RobotDriver:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,404 @@
+"""The engine node: runs a :class:`gazebot.engine.GazeEngine` on the tracking a robot driver
+delivers and sends back head commands, eye state (and frames when asked), events and heartbeats.
+
+Faults (each pinned by ``tests/drivers``):
+
+* tracking stops: after ``hold_timeout`` the node holds the gaze (no new head goals; event
+  ``tracking_stale``, status ``tracking: hold``); after ``face_timeout`` it looks at the last known
+  face position (event ``tracking_timeout`` with ``info.face``, head commands with
+  ``mode: last_face``, status ``tracking: lost``) until samples return (``tracking_resumed``).
+* engine restart: at start the node takes the head pose from the joint state and replays the
+  current handover's phase and robot events from the other nodes' event history
+  (``GazeEngine.resync``), then reports ``engine_resynced``.
+* robot gone: the loop keeps running; ``peer_lost``/``peer_restored`` events and the status'
+  ``peers`` and ``state: degraded`` report it.
+* malformed payloads: dropped by the driver, counted in the status' ``dropped``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Literal, Protocol
+
+import numpy as np
+
+from gazebot.drivers.base import RobotDriver
+from gazebot.drivers.payloads import (
+    EventMsg,
+    EyeFrameMsg,
+    EyeStateMsg,
+    HeadCommandMsg,
+    StatusMsg,
+    TrackingMsg,
+    category_of,
+    jsonable,
+    point_or_none,
+)
+from gazebot.types import Event, EventKind, GazeCommand, is_valid_point
+
+log = logging.getLogger("gazebot.drivers")
+
+TrackingState = Literal["waiting", "ok", "hold", "lost"]
+
+
+class EngineLike(Protocol):
+    """What the node needs of :class:`gazebot.engine.GazeEngine`."""
+
+    robot: Any  # .name, .head_joints, .points
+    gaze: Any  # .update(t, point) -> state with .head, .eye_yaw, .eye_pitch, .residual
+    behavior: Any  # .state
+
+    def step(self, frame: Any) -> GazeCommand: ...
+    def notify(self, event: Event) -> None: ...
+    def resync(self, events: list[Event]) -> None: ...
+    def reset(self, head: Any = None) -> None: ...
+
+
+@dataclass(frozen=True)
+class EngineNodeConfig:
+    """Timing of the engine node (s, Hz).
+
+    Attributes:
+        hold_timeout: Silence of the tracking after which the gaze is held.
+        face_timeout: Silence after which the node looks at the last known face.
+        fallback_rate: Head command rate while looking at the last face.
+        heartbeat_period: Period of the status heartbeat.
+        resync: Catch up with a handover under way at start (events + joint state).
+        resync_timeout: How long to wait at start for the joint state and the event history.
+        eye_frame_rate: Maximum rate of rendered eye frames (only while someone subscribes).
+    """
+
+    hold_timeout: float = 0.25
+    face_timeout: float = 1.0
+    fallback_rate: float = 30.0
+    heartbeat_period: float = 0.5
+    resync: bool = True
+    resync_timeout: float = 1.0
+    eye_frame_rate: float = 30.0
+
+    def __post_init__(self) -> None:
+        for name in ("hold_timeout", "face_timeout", "fallback_rate", "heartbeat_period",
+                     "resync_timeout", "eye_frame_rate"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(
+                    f"EngineNodeConfig.{name} must be a positive number, got {value!r}"
+                )
+        if self.face_timeout < self.hold_timeout:
+            raise ValueError("EngineNodeConfig.face_timeout must be >= hold_timeout")
+
+
+def current_handover(events: Sequence[Event]) -> list[Event]:
+    """The events of the handover under way: those after the last ``handover_done`` (or just
+    that ``handover_done`` when nothing followed it), oldest first."""
+    ordered = sorted(events, key=lambda e: e.t)
+    done = [i for i, e in enumerate(ordered) if e.kind == EventKind.HANDOVER_DONE]
+    if not done:
+        return ordered
+    last = done[-1]
+    return ordered[last:] if last == len(ordered) - 1 else ordered[last + 1 :]
+
+
+class EngineNode:
+    """Drive one robot with one engine.
+
+    Args:
+        engine: The gaze engine (``GazeEngine`` or anything with its interface).
+        driver: The robot (``ZenohRobotDriver`` over the bus, ``SimRobotDriver`` in process).
+        config: Timeouts and rates.
+        blink: Optional blink model with ``update(t, gaze_shift_rad) -> 0..1``.
+        eye_renderer: Optional renderer with ``render(yaw, pitch, blink) -> (H, W, 3) uint8``,
+            used only while the robot wants eye frames.
+        clock: Monotonic clock (s).
+    """
+
+    def __init__(
+        self,
+        engine: EngineLike,
+        driver: RobotDriver,
+        config: EngineNodeConfig | None = None,
+        *,
+        blink: Any = None,
+        eye_renderer: Any = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.engine = engine
+        self.driver = driver
+        self.config = config or EngineNodeConfig()
+        self.blink = blink
+        self.eye_renderer = eye_renderer
+        self.clock = clock
+        self.tracking: TrackingState = "waiting"
+        self.commands_sent = 0
+        self.frames_processed = 0
+        self.unsafe_commands = 0
+        self._started = clock()
+        self._seq = {"head": 0, "eyes": 0, "frame": 0, "event": 0, "status": 0}
+        self._last_frame_wall = math.nan
+        self._last_t = math.nan
+        self._last_face: np.ndarray | None = None
+        self._last_fallback = -math.inf
+        self._last_beat = -math.inf
+        self._last_eye_frame = -math.inf
+        self._last_gaze: tuple[float, float] | None = None
+        self._behavior_state: str | None = None
+        self._target: str | None = None
+        self._peers: dict[str, bool] = {}
+        self._skip_events: set[tuple[str, int, float]] = set()
+        self.ready = threading.Event()  # set once started (and resynchronised)
+
+    # -- helpers ---------------------------------------------------------------------------
+    def _next(self, name: str) -> int:
+        self._seq[name] += 1
+        return self._seq[name] - 1
+
+    def emit(self, kind: str, t: float | None = None, category: str | None = None,
+             **info: Any) -> EventMsg:
+        """Publish one of the node's own events (fault, behavior, node)."""
+        t = self._now_t() if t is None else t
+        t = t if math.isfinite(t) else 0.0
+        msg = EventMsg(
+            seq=self._next("event"),
+            source=self.driver.node,
+            category=category or category_of(kind),
+            kind=kind,
+            t=t,
+            detected_at=t,
+            stamp=time.time(),
+            info=jsonable(info),
+        )
+        self.driver.publish_event(msg)
+        log.info("event %s %s", kind, msg.info)
+        return msg
+
+    def _now_t(self) -> float:
+        """Robot time now: the last sample's time plus the wall time since it arrived."""
+        if not math.isfinite(self._last_t):
+            return 0.0
+        return self._last_t + max(0.0, self.clock() - self._last_frame_wall)
+
+    @property
+    def phase(self) -> str:
+        phase = getattr(self.engine, "phase", None)
+        return str(getattr(phase, "value", phase)) if phase is not None else "idle"
+
+    # -- start -----------------------------------------------------------------------------
+    def start(self) -> int:
+        """Announce the node and, if configured, resynchronise with a handover under way.
+        Returns the number of events replayed."""
+        self.emit("node_started", category="node", robot=getattr(self.engine.robot, "name", ""))
+        replayed = self.resync() if self.config.resync else 0
+        self.ready.set()
+        return replayed
+
+    def resync(self) -> int:
+        """Take the head pose from the joint state and replay the current handover's events
+        from the other nodes' history. Returns the number of events replayed."""
+        deadline = self.clock() + self.config.resync_timeout
+        joints = self.driver.joint_state()
+        while joints is None and self.clock() < deadline:
+            time.sleep(0.005)
+            joints = self.driver.joint_state()
+        head = None
+        if joints is not None:
+            names = list(getattr(self.engine.robot, "head_joints", []))
+            head = {n: joints.position[n] for n in names if n in joints.position} or None
+        history = self.driver.event_history(timeout=max(0.05, deadline - self.clock()))
+        self._skip_events = {(m.source, m.seq, m.stamp) for m in history}
+        events = [e for m in history if m.category in ("phase", "robot")
+                  if (e := m.to_event()) is not None]
+        replay = current_handover(events)
+        self.engine.reset(head)
+        if replay:
+            self.engine.resync(replay)
+        self.emit(
+            "engine_resynced",
+            t=replay[-1].t if replay else 0.0,
+            category="node",
+            events=len(replay),
+            phase=self.phase,
+            head_from_joint_state=head is not None,
+        )
+        return len(replay)
+
+    # -- loop ------------------------------------------------------------------------------
+    def run(self, duration: float | None = None, stop: threading.Event | None = None) -> None:
+        """:meth:`start`, then :meth:`tick` until ``stop`` is set or ``duration`` s passed."""
+        self.start()
+        end = math.inf if duration is None else self.clock() + duration
+        try:
+            while not (stop is not None and stop.is_set()) and self.clock() < end:
+                self.tick()
+        finally:
+            self.shutdown()
+
+    def shutdown(self) -> None:
+        """Report that the node stops (event and a last heartbeat)."""
+        try:
+            self.emit("node_stopped", category="node")
+            self._heartbeat(stopping=True)
+        except Exception:  # the bus may already be gone
+            log.debug("could not report the node's stop", exc_info=True)
+
+    def _wait_budget(self) -> float:
+        now = self.clock()
+        budget = min(0.05, max(0.0, self._last_beat + self.config.heartbeat_period - now))
+        if self.tracking == "lost":
+            due = self._last_fallback + 1 / self.config.fallback_rate
+            budget = min(budget, max(0.0, due - now))
+        return budget
+
+    def tick(self) -> None:
+        """Wait briefly for a tracking sample and answer it, or handle the silence."""
+        msg = self.driver.wait_tracking(self._wait_budget())
+        for ev in self.driver.poll_events():
+            if (ev.source, ev.seq, ev.stamp) in self._skip_events:
+                continue
+            if ev.category == "robot" and (event := ev.to_event()) is not None:
+                self.engine.notify(event)
+        if msg is not None:
+            self.on_tracking(msg)
+        else:
+            self.on_silence()
+        self._check_peers()
+        if self.clock() - self._last_beat >= self.config.heartbeat_period:
+            self._heartbeat()
+
+    def on_tracking(self, msg: TrackingMsg) -> None:
+        """Step the engine with one sample and send the command."""
+        now = self.clock()
+        if self.tracking in ("hold", "lost"):
+            self.emit("tracking_resumed", t=msg.t, silence=now - self._last_frame_wall)
+        self.tracking = "ok"
+        self._last_frame_wall = now
+        self._last_t = msg.t
+        frame = msg.to_frame()
+        if is_valid_point(frame.giver_face):
+            self._last_face = frame.giver_face
+        cmd = self.engine.step(frame)
+        self.frames_processed += 1
+        for event in cmd.events:
+            if category_of(event.kind.value) == "phase":
+                self.driver.publish_event(
+                    EventMsg.from_event(event, self.driver.node, self._next("event"), time.time())
+                )
+        self._send(cmd, answers=msg.seq, mode="behavior")
+        state = str(getattr(self.engine.behavior, "state", ""))
+        if state != self._behavior_state:
+            self._behavior_state = state
+            self.emit("behavior_state", t=cmd.t, category="behavior", state=state)
+        if cmd.target != self._target:
+            self._target = cmd.target
+            self.emit("gaze_target", t=cmd.t, category="behavior", target=cmd.target,
+                      point=point_or_none(cmd.target_point))
+
+    def on_silence(self) -> None:
+        """No sample arrived: hold the gaze, then look at the last face."""
+        if self.tracking == "waiting":
+            return
+        now = self.clock()
+        silence = now - self._last_frame_wall
+        if self.tracking == "ok" and silence >= self.config.hold_timeout:
+            self.tracking = "hold"
+            self.emit("tracking_stale", silence=silence, last_t=self._last_t)
+        if self.tracking == "hold" and silence >= self.config.face_timeout:
+            self.tracking = "lost"
+            self.emit("tracking_timeout", silence=silence, face=point_or_none(self._face()))
+        if self.tracking == "lost" and now - self._last_fallback >= 1 / self.config.fallback_rate:
+            self._last_fallback = now
+            self._look_at_last_face()
+
+    def _face(self) -> np.ndarray:
+        if self._last_face is not None:
+            return self._last_face
+        points = getattr(self.engine.robot, "points", {}) or {}
+        return np.asarray(points.get("face", (1.0, 0.0, 1.5)), float)
+
+    def _look_at_last_face(self) -> None:
+        face = self._face()
+        t = self._now_t()
+        state = self.engine.gaze.update(t, face)
+        cmd = GazeCommand(
+            t=t,
+            phase=getattr(self.engine, "phase", "idle"),
+            target="face",
+            target_point=face,
+            head=dict(state.head),
+            eye_yaw=float(state.eye_yaw),
+            eye_pitch=float(state.eye_pitch),
+            residual=float(getattr(state, "residual", 0.0)),
+        )
+        self._send(cmd, answers=None, mode="last_face")
+
+    def _send(self, cmd: GazeCommand, answers: int | None, mode: str) -> None:
+        if not cmd.is_finite():
+            # Never forward a non-finite goal: keep the previous one.
+            self.unsafe_commands += 1
+            log.error("engine produced a non-finite command at t=%.3f; not sent", cmd.t)
+            return
+        stamp = time.time()
+        self.driver.send_head(
+            HeadCommandMsg.from_command(cmd, self._next("head"), stamp, answers, mode)
+        )
+        shift = 0.0
+        if self._last_gaze is not None:
+            shift = math.hypot(cmd.eye_yaw - self._last_gaze[0], cmd.eye_pitch - self._last_gaze[1])
+        self._last_gaze = (cmd.eye_yaw, cmd.eye_pitch)
+        blink = 0.0
+        if self.blink is not None:
+            blink = float(np.clip(self.blink.update(cmd.t, shift), 0.0, 1.0))
+        self.driver.send_eyes(
+            EyeStateMsg(seq=self._next("eyes"), t=cmd.t, stamp=stamp, yaw=cmd.eye_yaw,
+                        pitch=cmd.eye_pitch, blink=blink)
+        )
+        now = self.clock()
+        if (
+            self.eye_renderer is not None
+            and now - self._last_eye_frame >= 1 / self.config.eye_frame_rate
+            and self.driver.wants_eye_frames()
+        ):
+            self._last_eye_frame = now
+            img = self.eye_renderer.render(cmd.eye_yaw, cmd.eye_pitch, blink=blink)
+            frame = EyeFrameMsg.from_image(img, self._next("frame"), cmd.t, stamp)
+            self.driver.send_eye_frame(frame)
+        self.commands_sent += 1
+
+    def _check_peers(self) -> None:
+        peers = self.driver.peers()
+        for node, alive in peers.items():
+            before = self._peers.get(node)
+            if before is None and not alive or before and not alive:
+                self.emit("peer_lost", peer=node)
+            elif before is False and alive:
+                self.emit("peer_restored", peer=node)
+        self._peers = peers
+
+    def _heartbeat(self, stopping: bool = False) -> StatusMsg:
+        self._last_beat = self.clock()
+        peers = self.driver.peers()
+        degraded = not all(peers.values()) or self.tracking in ("hold", "lost")
+        msg = StatusMsg(
+            node=self.driver.node,
+            seq=self._next("status"),
+            stamp=time.time(),
+            uptime=max(0.0, self.clock() - self._started),
+            state="stopping" if stopping else ("degraded" if degraded else "ok"),
+            tracking=self.tracking,
+            peers=peers,
+            dropped=self.driver.dropped(),
+            phase=self.phase,
+            info={
+                "frames": self.frames_processed,
+                "commands": self.commands_sent,
+                "unsafe_commands": self.unsafe_commands,
+                "behavior": self._behavior_state,
+                "target": self._target,
+            },
+        )
+        self.driver.publish_status(msg)
+        return msg

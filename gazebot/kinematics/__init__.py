@@ -1,0 +1,30 @@
+"""Gaze kinematics: robot head models, look-at IK, display eyes and human-like gaze shifts.
+
+Entry points: :meth:`RobotModel.load`, :func:`solve_ik` (one look-at solve) and
+:class:`GazeController` (timed neck + eye commands for a stream of targets).
+"""
+
+from gazebot.kinematics.config import RobotConfig, load_robot_config
+from gazebot.kinematics.controller import GazeController, HeadEyeState
+from gazebot.kinematics.eyes import DisplayEyes, eye_angles, eye_direction
+from gazebot.kinematics.look_at import IKConfig, LookAtSolution, solve_ik
+from gazebot.kinematics.robot import GazePose, RobotModel
+from gazebot.kinematics.shifts import GazeShiftConfig, MinJerkTrajectory, min_jerk
+
+__all__ = [
+    "DisplayEyes",
+    "GazeController",
+    "GazePose",
+    "GazeShiftConfig",
+    "HeadEyeState",
+    "IKConfig",
+    "LookAtSolution",
+    "MinJerkTrajectory",
+    "RobotConfig",
+    "RobotModel",
+    "eye_angles",
+    "eye_direction",
+    "load_robot_config",
+    "min_jerk",
+    "solve_ik",
+]

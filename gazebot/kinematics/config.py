@@ -1,0 +1,141 @@
+"""The robot YAML (``configs/robots/<name>.yaml``): a pydantic model, degrees at the surface.
+
+The YAML is shared: the simulation reads ``mjcf``, ``head_joints``, ``arm_joints``,
+``arm_home_deg``, ``arm_handover_deg`` and ``gripper_actuator``; the eye renderer reads
+``display`` and ``eyes``; the gaze engine reads everything else. Joint position limits are not
+repeated here: the MJCF is their single source.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from gazebot.config import ConfigError, configs_dir, load_model
+from gazebot.kinematics.shifts import GazeShiftConfig
+
+REQUIRED_POINTS = ("face", "handover_location", "rest")
+
+
+class DisplayConfig(BaseModel):
+    """The head screen."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    width_px: int = Field(gt=0)
+    height_px: int = Field(gt=0)
+    diagonal_in: float = Field(gt=0.0)
+
+
+class EyeConfig(BaseModel):
+    """Range and speed of the eyes drawn on the display (degrees).
+
+    Yaw is about the gaze frame's +z (positive = robot's left), pitch about +y (positive = down).
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    yaw_range_deg: tuple[float, float]
+    pitch_range_deg: tuple[float, float]
+    velocity_limit_deg_s: float = Field(600.0, gt=0.0)
+
+    @field_validator("yaw_range_deg", "pitch_range_deg")
+    @classmethod
+    def _range(cls, value: tuple[float, float]) -> tuple[float, float]:
+        lo, hi = value
+        if not (-89.0 <= lo <= 0.0 <= hi <= 89.0 and lo < hi):
+            raise ValueError("[min, max] degrees with -89 <= min <= 0 <= max <= 89")
+        return value
+
+
+Point = tuple[float, float, float]
+
+
+class RobotConfig(BaseModel):
+    """A robot for gazebot: its MJCF, head and arm joints, poses, eyes and default points."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    name: str = Field(min_length=1)
+    mjcf: str = Field(min_length=1)
+    gaze_site: str = "gaze"
+    gripper_site: str = "gripper"
+    gripper_actuator: str = "gripper"
+    eye_style: str = Field(min_length=1)
+    display: DisplayConfig
+    head_joints: list[str] = Field(min_length=1)
+    head_velocity_limits_deg_s: dict[str, float]
+    head_rest_deg: dict[str, float] = Field(default_factory=dict)
+    arm_joints: list[str] = Field(min_length=1)
+    arm_home_deg: dict[str, float]
+    arm_handover_deg: dict[str, float]
+    eyes: EyeConfig
+    shifts: GazeShiftConfig = Field(default_factory=GazeShiftConfig)
+    points: dict[str, Point]
+
+    @model_validator(mode="after")
+    def _consistent(self) -> RobotConfig:
+        head = set(self.head_joints)
+        if len(head) != len(self.head_joints):
+            raise ValueError("head_joints without duplicates")
+        if head & set(self.arm_joints):
+            raise ValueError("head_joints and arm_joints to be disjoint")
+        missing = head - set(self.head_velocity_limits_deg_s)
+        if missing:
+            raise ValueError(f"head_velocity_limits_deg_s for every head joint (missing {missing})")
+        if any(not v > 0.0 for v in self.head_velocity_limits_deg_s.values()):
+            raise ValueError("positive head velocity limits")
+        unknown = set(self.head_rest_deg) - head
+        if unknown:
+            raise ValueError(f"head_rest_deg only for head joints (unknown {unknown})")
+        for key in ("arm_home_deg", "arm_handover_deg"):
+            pose = getattr(self, key)
+            if set(pose) != set(self.arm_joints):
+                raise ValueError(f"{key} with exactly the arm joints {self.arm_joints}")
+        missing_points = [p for p in REQUIRED_POINTS if p not in self.points]
+        if missing_points:
+            raise ValueError(f"points including {missing_points}")
+        return self
+
+
+def robot_config_path(name_or_yaml: str | Path) -> Path:
+    """``"sawyer"`` -> ``configs/robots/sawyer.yaml``; a ``.yaml`` path is returned as is."""
+    path = Path(name_or_yaml)
+    if path.suffix in (".yaml", ".yml"):
+        if not path.is_file():
+            raise FileNotFoundError(f"robot file not found: {path}")
+        return path
+    folder = configs_dir() / "robots"
+    path = folder / f"{name_or_yaml}.yaml"
+    if not path.is_file():
+        known = ", ".join(sorted(p.stem for p in folder.glob("*.yaml"))) or "none"
+        raise FileNotFoundError(f"unknown robot {str(name_or_yaml)!r} (known: {known})")
+    return path
+
+
+def load_robot_config(name_or_yaml: str | Path) -> tuple[RobotConfig, Path]:
+    """Load and validate a robot YAML by name or path; returns the config and its file.
+
+    Raises:
+        FileNotFoundError: no such robot / file.
+        ConfigError: the YAML is malformed (names file, field and expectation).
+    """
+    path = robot_config_path(name_or_yaml)
+    return load_model(RobotConfig, path), path
+
+
+def resolve_mjcf(config: RobotConfig, yaml_path: Path | None) -> Path:
+    """The MJCF file of ``config``: absolute, beside the YAML, or in ``gazebot/assets/robots/``."""
+    assets = Path(__file__).resolve().parents[1] / "assets" / "robots"
+    raw = Path(config.mjcf)
+    candidates = [raw] if raw.is_absolute() else []
+    if yaml_path is not None and not raw.is_absolute():
+        candidates.append(yaml_path.parent / raw)
+    candidates += [assets / raw, assets / raw.name]
+    for cand in candidates:
+        if cand.is_file():
+            return cand
+    raise ConfigError(
+        yaml_path or "<robot config>", "mjcf", f"an existing MJCF file (looked in {assets})", raw
+    )

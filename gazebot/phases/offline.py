@@ -1,0 +1,387 @@
+"""Offline segmentation of a whole recording into reach, transfer and retreat.
+
+With the whole recording at hand the seed's rule (section 7.2.5) applies as written: transfer is
+where the hands are within ``transfer_distance_margin`` (20 cm) of their minimum distance and their
+relative speed is below ``transfer_speed_max`` (15 cm/s). Steps:
+
+1. Resample onto a uniform grid (``offline_rate``), bridging gaps up to ``max_gap_hold``;
+   zero-lag Gaussian smoothing (``smoothing``); velocities by central differences.
+2. Every dip of the hands' distance at least ``min_approach`` deep is a handover candidate; its
+   minimum is the seed's "minimum distance" (so a recording may hold several handovers).
+3. Within a dip, the seed rule's run around the minimum is the transfer core; runs separated by
+   blips shorter than ``min_transfer`` while the speed stays below ``transfer_exit_speed``, or by
+   tracking gaps, are merged (hysteresis). No handover: a core shorter than ``min_transfer``, a
+   minimum farther than ``contact_distance_max``, or a dip the giver's hand did not reach into
+   (e.g. a robot gripper returning home near a resting giver).
+4. Boundaries are refined with the minimum-jerk profile: the seed's 15 cm/s is crossed on the
+   tail of the approach, before contact, so the transfer starts where the relative speed
+   settles below ``settle_speed``, pushed on by the parabolic-tail extrapolation of the two
+   crossings (``stop_extrapolation``); the release is back-dated from where the hands' relative
+   position has left the held pose by ``release_distance`` with ``t0 = t - 3 x / v``, as the
+   hands leave rest along a minimum-jerk start (``x ~ (t - t0)^3``). If the release falls in a
+   tracking gap of the receiver, the giver's own motion onset dates it. A refinement that would
+   shrink a transfer below ``min_transfer`` is dropped for the rule's own run.
+5. The reach starts at the giver's motion onset before the transfer (speed above
+   ``reach_onset_speed``, back-dated the same way); the retreat ends when the giver's hand is
+   back at rest (the mirror image), when the next reach starts, or when the data end.
+
+The robot's gripper/load-share columns are not used offline: at low sampling rates their first
+sample after the release is later than the back-dated kinematic estimate (the online detector
+uses them, where they arrive before the motion shows).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gazebot.phases.config import PhaseConfig
+from gazebot.phases.segment import Segment
+from gazebot.phases.trajectory import Trajectory
+from gazebot.types import Phase
+
+
+@dataclass(frozen=True)
+class Signals:
+    """The smoothed signals the segmentation works on (uniform grid, NaN where unknown).
+
+    Attributes:
+        t: Grid times (N,) s.
+        giver: Giver hand positions (N, 3) m.
+        receiver: Receiver hand positions (N, 3) m.
+        giver_v: Giver hand velocities (N, 3) m/s.
+        rel: Relative position receiver - giver (N, 3) m.
+        rel_v: Relative velocity (N, 3) m/s.
+        distance: Hands' distance (N,) m.
+        rel_speed: Relative speed (N,) m/s.
+        giver_speed: Giver hand speed (N,) m/s.
+    """
+
+    t: np.ndarray
+    giver: np.ndarray
+    receiver: np.ndarray
+    giver_v: np.ndarray
+    rel: np.ndarray
+    rel_v: np.ndarray
+    distance: np.ndarray
+    rel_speed: np.ndarray
+    giver_speed: np.ndarray
+
+
+def _resample(t: np.ndarray, p: np.ndarray, grid: np.ndarray, max_gap: float) -> np.ndarray:
+    """Linear interpolation of the valid rows of ``p`` onto ``grid``; NaN inside long gaps."""
+    ok = np.isfinite(p).all(axis=1)
+    out = np.full((grid.shape[0], 3), np.nan)
+    if np.count_nonzero(ok) < 2:
+        return out
+    tv, pv = t[ok], p[ok]
+    for k in range(3):
+        out[:, k] = np.interp(grid, tv, pv[:, k])
+    j = np.searchsorted(tv, grid, side="right")
+    inside = (j > 0) & (j < tv.shape[0])
+    gap = np.full(grid.shape[0], np.inf)
+    gap[inside] = tv[j[inside]] - tv[j[inside] - 1]
+    exact = np.isin(grid, tv)
+    out[(gap > max_gap + 1e-9) & ~exact] = np.nan
+    return out
+
+
+def _gauss(x: np.ndarray, sigma: float) -> np.ndarray:
+    """Gaussian smoothing of the columns of ``x`` (edges padded with the end values)."""
+    radius = max(1, int(math.ceil(3.0 * sigma)))
+    k = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
+    k /= k.sum()
+    pad = np.pad(x, ((radius, radius),) + ((0, 0),) * (x.ndim - 1), mode="edge")
+    if x.ndim == 1:
+        return np.convolve(pad, k, mode="valid")
+    return np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(x.shape[1])], axis=1)
+
+
+def _smooth(x: np.ndarray, sigma: float) -> np.ndarray:
+    """NaN-aware Gaussian smoothing along axis 0 (normalised convolution), zero lag."""
+    m = np.isfinite(x).all(axis=1)
+    if sigma <= 0 or x.shape[0] < 2:
+        return x
+    num = _gauss(np.where(m[:, None], x, 0.0), sigma)
+    den = _gauss(m.astype(float), sigma)
+    out = num / np.maximum(den, 1e-12)[:, None]
+    out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
+    return out
+
+
+def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
+    """Resample, smooth and differentiate the hands of ``trajectory`` (sorted by time)."""
+    t = trajectory.t
+    dt = 1.0 / config.offline_rate
+    if t.shape[0] < 2:
+        grid = t.copy()
+    else:
+        grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
+    g = _resample(t, trajectory.giver_hand, grid, config.max_gap_hold)
+    r = _resample(t, trajectory.receiver_hand, grid, config.max_gap_hold)
+    # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
+    # corners at every sample that would otherwise show up as speed spikes.
+    med_dt = float(np.median(np.diff(t))) if t.shape[0] > 1 else dt
+    sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
+    g = _smooth(g, sigma_s / dt)
+    r = _smooth(r, sigma_s / dt)
+    if grid.shape[0] >= 2:
+        gv = np.gradient(g, dt, axis=0)
+        rv = np.gradient(r, dt, axis=0)
+    else:
+        gv = np.full_like(g, np.nan)
+        rv = np.full_like(r, np.nan)
+    rel = r - g
+    rel_v = rv - gv
+    return Signals(
+        t=grid,
+        giver=g,
+        receiver=r,
+        giver_v=gv,
+        rel=rel,
+        rel_v=rel_v,
+        distance=np.linalg.norm(rel, axis=1),
+        rel_speed=np.linalg.norm(rel_v, axis=1),
+        giver_speed=np.linalg.norm(gv, axis=1),
+    )
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Inclusive index ranges of the True runs of ``mask``."""
+    if mask.size == 0:
+        return []
+    padded = np.concatenate([[False], mask, [False]])
+    edges = np.flatnonzero(padded[1:] != padded[:-1])
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def _dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
+    """Dips of ``d`` at least ``depth`` deep on both sides, as ``(left, minimum, right)`` index
+    triples (left/right: the highest points between neighbouring dips). The recording's ends
+    count as high ground, so a recording that starts or ends mid-handover keeps its dip.
+    NaN samples are skipped."""
+    out: list[tuple[int, int, int]] = []
+    idx = np.flatnonzero(np.isfinite(d))
+    if idx.size == 0:
+        return out
+    vals = d[idx].tolist()
+    left = int(idx[0])
+    going_down = True
+    lo_v, lo_i = math.inf, -1
+    hi_v, hi_i = -math.inf, -1
+    for i, v in zip(idx.tolist(), vals, strict=True):
+        if going_down:
+            if v < lo_v:
+                lo_v, lo_i = v, i
+            elif v >= lo_v + depth:
+                going_down = False
+                hi_v, hi_i = v, i
+        else:
+            if v > hi_v:
+                hi_v, hi_i = v, i
+            elif v <= hi_v - depth:
+                out.append((left, lo_i, hi_i))
+                left = hi_i
+                going_down = True
+                lo_v, lo_i = v, i
+    if going_down:
+        if lo_i >= 0:
+            out.append((left, lo_i, int(idx[-1])))
+    else:
+        out.append((left, lo_i, hi_i if hi_i >= 0 else int(idx[-1])))
+    return out
+
+
+@dataclass(frozen=True)
+class _Transfer:
+    start: int
+    end: int
+    t_start: float
+    t_end: float
+
+
+def _find_transfers(s: Signals, c: PhaseConfig) -> list[_Transfer]:
+    d = s.distance
+    n = d.shape[0]
+    if n < 3 or not np.isfinite(d).any():
+        return []
+    dt = 1.0 / c.offline_rate
+    out: list[_Transfer] = []
+    rs = np.where(np.isfinite(s.rel_speed), s.rel_speed, np.inf)
+    min_len = max(1, int(round(c.min_transfer / dt)))
+    for lo, p, hi in _dips(d, c.min_approach):
+        if not np.isfinite(d[p]):
+            continue
+        dmin = d[p]
+        near = np.zeros(n, dtype=bool)
+        near[lo : hi + 1] = d[lo : hi + 1] <= dmin + c.transfer_distance_margin
+        rule = near & (rs < c.transfer_speed_max)
+        soft = near & (rs < c.transfer_exit_speed)
+        runs = _runs(rule)
+        if not runs:
+            continue
+        # Hysteresis: merge rule runs split by short blips that stay under the exit speed.
+        merged: list[list[int]] = [list(runs[0])]
+        unknown = ~np.isfinite(s.rel_speed)
+        for a, b in runs[1:]:
+            gap = slice(merged[-1][1] + 1, a)
+            # Merge across a short blip under the exit speed, or across a tracking gap with
+            # nothing but such samples (a dropout inside a transfer does not end it).
+            ok = soft[gap] | unknown[gap]
+            if ok.all() and np.count_nonzero(~unknown[gap]) < min_len:
+                merged[-1][1] = b
+            else:
+                merged.append([a, b])
+        # The run holding the minimum, else the longest one.
+        core = next((m for m in merged if m[0] <= p <= m[1]), None)
+        if core is None:
+            core = max(merged, key=lambda m: m[1] - m[0])
+        a, b = core
+        if b - a + 1 < min_len or dmin > c.contact_distance_max:
+            continue
+        # The giver must have reached: a receiver (robot) returning home to a resting giver
+        # also makes a dip.
+        if not np.nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed:
+            continue
+        if out and a <= out[-1].end:
+            continue  # same transfer seen from a neighbouring dip
+        t_start = _refine_start(s, c, a, b)
+        t_end = _refine_end(s, c, a, b, t_start)
+        if t_end - t_start < c.min_transfer:
+            # The refinement assumes clean minimum-jerk edges; when it collapses a short
+            # transfer (fast giver, sparse samples) the seed rule's own run stands.
+            t_start, t_end = float(s.t[a]), float(s.t[b])
+        out.append(_Transfer(a, b, t_start, t_end))
+    return out
+
+
+def _refine_start(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
+    """Where the approach stops: the relative speed settles after the seed-rule crossing."""
+    dt = 1.0 / c.offline_rate
+    stop = min(b, a + int(c.max_refine / dt))
+    seg = s.rel_speed[a : stop + 1]
+    below = np.flatnonzero(seg < c.settle_speed)
+    if below.size == 0:
+        return float(s.t[a])
+    # On the minimum-jerk tail the speed falls as (t_stop - t)^2: the times it crosses the
+    # seed's threshold and the settle speed extrapolate to the stop (scaled down: smoothing and
+    # the (1 - t/T)^2 factor make the real tail flatter than a parabola).
+    t_a, t_s = float(s.t[a]), float(s.t[a + below[0]])
+    ratio = math.sqrt(c.transfer_speed_max / c.settle_speed) - 1.0
+    return t_s + min(c.stop_extrapolation * (t_s - t_a) / ratio, c.max_refine)
+
+
+def _refine_end(s: Signals, c: PhaseConfig, a: int, b: int, t_start: float) -> float:
+    """Back-date the release from the rule's exit with the minimum-jerk start ``3 x / v``."""
+    settled = (s.t[a : b + 1] >= t_start) & (s.rel_speed[a : b + 1] < c.settle_speed)
+    idx = np.flatnonzero(settled) + a
+    if idx.size == 0:
+        idx = np.arange(a, b + 1)
+    held = np.nanmedian(s.rel[idx], axis=0)
+    # Follow the exit until the separation is unmistakable, then extrapolate back.
+    n = s.t.shape[0]
+    j = b
+    while j + 1 < n and np.linalg.norm(s.rel[j] - held) < c.release_distance:
+        if not np.isfinite(s.rel_speed[j + 1]):
+            # The release is hidden in a tracking gap of the receiver: fall back on the
+            # giver's own motion onset, when the giver's hand is seen.
+            return max(_giver_onset_after(s, c, j), t_start)
+        j += 1
+    sep = float(np.linalg.norm(s.rel[j] - held))
+    v = float(s.rel_speed[j])
+    back = 3.0 * sep / v if v > 1e-6 and math.isfinite(sep) else 0.0
+    t_end = float(s.t[j]) - min(back, c.max_refine)
+    return max(t_end, t_start)
+
+
+def _giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float:
+    """Start of the giver's first motion after grid index ``j`` (``t[j]`` if none is seen)."""
+    v = s.giver_speed[j:]
+    fast = np.flatnonzero(v >= c.reach_onset_speed)
+    if fast.size == 0:
+        return float(s.t[j])
+    i = j + int(fast[0])
+    x = float(np.linalg.norm(s.giver[i] - s.giver[j]))
+    back = 3.0 * x / float(v[fast[0]]) if math.isfinite(x) else 0.0
+    return max(float(s.t[i]) - min(back, c.max_refine), float(s.t[j]))
+
+
+def _onset_before(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
+    """Start of the giver's reach before grid index ``hi`` (not before index ``lo``): the
+    fastest motion in the window (small adjustments near the receiver may follow it)."""
+    v = s.giver_speed[lo : hi + 1]
+    if hi <= lo or not np.nanmax(v, initial=0.0) >= c.reach_onset_speed:
+        return float(s.t[lo])
+    peak = int(np.nanargmax(v))
+    slow = np.flatnonzero(~(v[: peak + 1] >= c.reach_onset_speed))  # NaN counts as slow
+    if slow.size == 0:
+        return float(s.t[lo])  # already moving when the data start
+    i_c = lo + int(slow[-1]) + 1
+    rest = np.flatnonzero(~(s.giver_speed[lo:i_c] >= c.rest_speed))
+    i_r = lo + int(rest[-1]) if rest.size else lo
+    x = float(np.linalg.norm(s.giver[i_c] - s.giver[i_r]))
+    speed = float(s.giver_speed[i_c])
+    back = 3.0 * x / speed if math.isfinite(x) and speed > 0 else 0.0
+    return max(float(s.t[i_c]) - min(back, c.max_refine), float(s.t[lo]))
+
+
+def _rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
+    """End of the giver's first motion after grid index ``lo`` (not after index ``hi``)."""
+    hi = min(hi, lo + int(c.max_retreat * c.offline_rate), s.t.shape[0] - 1)
+    v = s.giver_speed[lo : hi + 1]
+    fast = np.flatnonzero(v >= c.reach_onset_speed)
+    if hi <= lo or fast.size == 0:
+        return float(s.t[hi])
+    slow = np.flatnonzero(~(v[fast[0] :] >= c.reach_onset_speed))
+    if slow.size == 0:
+        return float(s.t[hi])  # still moving when the data (or the window) end
+    i_c = lo + int(fast[0] + slow[0]) - 1
+    rest = np.flatnonzero(~(s.giver_speed[i_c : hi + 1] >= c.rest_speed))
+    i_r = i_c + int(rest[0]) if rest.size else hi
+    x = float(np.linalg.norm(s.giver[i_r] - s.giver[i_c]))
+    speed = float(s.giver_speed[i_c])
+    fwd = 3.0 * x / speed if math.isfinite(x) and speed > 0 else 0.0
+    return min(float(s.t[i_c]) + min(fwd, c.max_refine), float(s.t[hi]))
+
+
+def segment(trajectory: Trajectory, config: PhaseConfig | None = None) -> list[Segment]:
+    """Split a recording into contiguous reach, transfer and retreat segments per handover.
+
+    The trajectory is sorted by time first (duplicates dropped, see :meth:`Trajectory.cleaned`).
+    Returns segments in time order; within a handover they are contiguous (reach end = transfer
+    start, transfer end = retreat start), and handovers never overlap. A recording without a
+    transfer yields no segments.
+    """
+    c = config if config is not None else PhaseConfig()
+    traj, _, _ = trajectory.cleaned()
+    if len(traj) < 3:
+        return []
+    s = compute_signals(traj, c)
+    transfers = _find_transfers(s, c)
+    out: list[Segment] = []
+    t_idx = s.t
+    prev_end_idx = 0
+    for k, tr in enumerate(transfers):
+        i_start = int(np.searchsorted(t_idx, tr.t_start))
+        i_end = min(int(np.searchsorted(t_idx, tr.t_end)), len(t_idx) - 1)
+        reach_start = _onset_before(s, c, prev_end_idx, max(i_start - 1, prev_end_idx))
+        if out:
+            reach_start = max(reach_start, out[-1].end)
+        nxt = transfers[k + 1].start if k + 1 < len(transfers) else len(t_idx) - 1
+        retreat_end = _rest_after(s, c, i_end, max(nxt, i_end))
+        retreat_end = max(retreat_end, tr.t_end)
+        out.append(Segment(Phase.REACH, min(reach_start, tr.t_start), tr.t_start, k))
+        out.append(Segment(Phase.TRANSFER, tr.t_start, tr.t_end, k))
+        out.append(Segment(Phase.RETREAT, tr.t_end, retreat_end, k))
+        prev_end_idx = int(np.searchsorted(t_idx, retreat_end))
+    # The next reach may begin before the retreat looked finished: clip the retreat.
+    for i in range(2, len(out) - 1, 3):
+        nxt_reach = out[i + 1]
+        if out[i].end > nxt_reach.start:
+            fixed = max(nxt_reach.start, out[i].start)
+            out[i] = Segment(Phase.RETREAT, out[i].start, fixed, out[i].handover)
+            if nxt_reach.start < fixed:
+                out[i + 1] = Segment(Phase.REACH, fixed, nxt_reach.end, nxt_reach.handover)
+    return out

@@ -1,0 +1,253 @@
+"""Synthetic human-to-robot handovers with known phase times, for tests and benchmarks.
+
+A giver reaches from rest to a handover location with a minimum-jerk profile (slightly curved),
+holds the object while a robot gripper (moving from home to the handover pose, also
+minimum-jerk) grasps it, releases it, and retracts to rest; the gripper carries the object to a
+drop-off pose and returns home. Durations are drawn around the seed's human-human means
+(section 6.2 annotations: reach ~0.8-1.0 s, transfer ~0.6 s (0.25-1.75), retreat ~1.1 s), scaled
+for slow or fast givers; heights follow a standing or sitting giver. The recording gets motion
+capture noise, sway at rest, short dropouts, irregular sampling from 8 to 240 Hz, and the robot's
+gripper state and load share (seed section 4.3).
+
+Ground truth per handover (:class:`HandoverTruth`): reach starts at the giver's motion onset;
+transfer starts when both hands touch the object (the later of the two arrivals) and ends at the
+giver's release; the retreat ends when the giver's hand is back at rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+
+from gazebot.phases.segment import Segment
+from gazebot.phases.trajectory import Trajectory
+from gazebot.types import Phase
+
+Posture = Literal["standing", "sitting"]
+
+
+def min_jerk(s: np.ndarray) -> np.ndarray:
+    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (clipped to 0..1)."""
+    s = np.clip(s, 0.0, 1.0)
+    return s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
+
+
+def _bump(s: np.ndarray) -> np.ndarray:
+    """Smooth 0 -> 1 -> 0 bump (zero velocity and acceleration at both ends)."""
+    s = np.clip(s, 0.0, 1.0)
+    return 64.0 * s**3 * (1.0 - s) ** 3
+
+
+@dataclass
+class _Path:
+    """A point that rests, then makes minimum-jerk moves (each optionally curved)."""
+
+    start: np.ndarray
+    moves: list[tuple[float, float, np.ndarray, np.ndarray]] = field(default_factory=list)
+
+    @property
+    def end(self) -> np.ndarray:
+        return self.moves[-1][2] if self.moves else self.start
+
+    def move(self, t0: float, duration: float, to: np.ndarray, bump: np.ndarray | None = None):
+        bump = np.zeros(3) if bump is None else bump
+        self.moves.append((t0, duration, np.asarray(to, float), bump))
+
+    def at(self, t: np.ndarray) -> np.ndarray:
+        out = np.repeat(self.start[None, :], t.shape[0], axis=0)
+        prev = self.start
+        for t0, dur, to, bump in self.moves:
+            s = (t - t0) / dur
+            out += min_jerk(s)[:, None] * (to - prev) + _bump(s)[:, None] * bump
+            prev = to
+        return out
+
+
+@dataclass(frozen=True)
+class HandoverTruth:
+    """Known phase times of one synthetic handover (s)."""
+
+    reach_start: float
+    transfer_start: float
+    transfer_end: float
+    retreat_end: float
+
+    def segments(self, handover: int = 0) -> list[Segment]:
+        return [
+            Segment(Phase.REACH, self.reach_start, self.transfer_start, handover),
+            Segment(Phase.TRANSFER, self.transfer_start, self.transfer_end, handover),
+            Segment(Phase.RETREAT, self.transfer_end, self.retreat_end, handover),
+        ]
+
+
+@dataclass(frozen=True)
+class SyntheticOptions:
+    """How a synthetic recording is made.
+
+    Attributes:
+        rate: Mean sampling rate (Hz), 8..240.
+        irregular: Relative jitter of the sampling intervals (0 = regular, 0.3 = +-30 %).
+        noise: Motion-capture noise of the human points (m, standard deviation).
+        gripper_noise: Noise of the gripper position (m).
+        dropouts_per_s: Rate of short dropouts of a human point (each 20-200 ms).
+        posture: ``standing`` or ``sitting`` giver; ``None`` draws one.
+        speed: Giver speed factor (>1 fast, <1 slow); durations scale with ``1 / speed``.
+        handovers: Number of consecutive handovers in the recording.
+        robot_evidence: Whether the recording has the gripper state and load share.
+    """
+
+    rate: float = 100.0
+    irregular: float = 0.0
+    noise: float = 0.001
+    gripper_noise: float = 0.0003
+    dropouts_per_s: float = 0.0
+    posture: Posture | None = None
+    speed: float = 1.0
+    handovers: int = 1
+    robot_evidence: bool = False
+
+    def __post_init__(self) -> None:
+        if not 1.0 <= self.rate <= 2000.0:
+            raise ValueError(f"rate must be 1..2000 Hz, got {self.rate}")
+        if not 0.0 <= self.irregular < 0.9:
+            raise ValueError(f"irregular must be 0..0.9, got {self.irregular}")
+        if self.handovers < 1 or self.speed <= 0:
+            raise ValueError("handovers must be >= 1 and speed > 0")
+
+
+@dataclass
+class SyntheticHandover:
+    """A generated recording and its ground truth."""
+
+    trajectory: Trajectory
+    truth: list[HandoverTruth]
+    options: SyntheticOptions
+    seed: int
+
+    def truth_segments(self) -> list[Segment]:
+        return [s for i, h in enumerate(self.truth) for s in h.segments(i)]
+
+
+def _sample_times(rng: np.random.Generator, t_end: float, opts: SyntheticOptions) -> np.ndarray:
+    dt = 1.0 / opts.rate
+    n = int(t_end / dt) + 2
+    steps = dt * (1.0 + rng.uniform(-opts.irregular, opts.irregular, n))
+    t = np.concatenate([[0.0], np.cumsum(steps)])
+    return t[t <= t_end]
+
+
+def generate(seed: int = 0, options: SyntheticOptions | None = None) -> SyntheticHandover:
+    """Generate one recording (reproducible for a seed)."""
+    opts = options or SyntheticOptions()
+    rng = np.random.default_rng(seed)
+    posture: Posture = opts.posture or ("standing" if rng.random() < 0.5 else "sitting")
+    u = rng.uniform
+    giver = np.array([u(0.95, 1.3), u(-0.15, 0.15), 0.0])
+    if posture == "standing":
+        face = giver + [0.0, 0.0, u(0.55, 0.75)]
+        rest = giver + [u(-0.2, -0.1), u(-0.25, -0.15), u(-0.1, 0.0)]
+        hand_z = (0.05, 0.3)
+    else:
+        face = giver + [0.05, 0.0, u(0.25, 0.4)]
+        rest = giver + [u(-0.3, -0.2), u(-0.2, -0.1), u(-0.25, -0.15)]
+        hand_z = (-0.1, 0.12)
+    home = np.array([u(0.3, 0.4), u(-0.35, -0.25), u(0.2, 0.3)])
+    dropoff = np.array([u(0.25, 0.35), u(-0.55, -0.45), u(0.15, 0.25)])
+
+    hand = _Path(rest.copy())
+    grip = _Path(home.copy())
+    lean = _Path(np.zeros(3))
+    grip_events: list[tuple[float, float, float]] = []  # (t_close, t_release, t_open)
+    truth: list[HandoverTruth] = []
+    t = u(0.4, 1.2)
+    for _ in range(opts.handovers):
+        onset = t
+        reach = float(np.clip(u(0.7, 1.25) / opts.speed, 0.4, 2.5))
+        target = np.array([giver[0] - u(0.3, 0.5), giver[1] + u(-0.12, 0.12), u(*hand_z)])
+        hand.move(onset, reach, target, bump=np.array([0.0, u(-0.04, 0.04), u(0.0, 0.05)]))
+        lean.move(onset, reach, np.array([-u(0.0, 0.05), 0.0, 0.0]))
+        # The robot reacts to the giver and aims at the handover pose with a small error;
+        # its fingers meet the object half a size in front of the hand.
+        lag = u(0.05, 0.4)
+        g_dur = u(0.8, 1.5)
+        offset = np.array([-u(0.04, 0.15), u(-0.01, 0.01), u(-0.01, 0.01)])
+        grip.move(onset + lag, g_dur, target + offset)
+        contact = max(onset + reach, onset + lag + g_dur)
+        t_close = contact + u(0.05, 0.25)
+        hold = float(np.clip(u(0.3, 1.2) / opts.speed, 0.25, 1.75))
+        release = max(contact + hold, t_close + 0.1)
+        # Both hold the object: a small common pull toward the robot.
+        pull = np.array([-u(0.0, 0.03), 0.0, u(-0.01, 0.01)])
+        pull_t0 = contact + 0.05
+        if release - pull_t0 > 0.1:
+            hand.move(pull_t0, release - pull_t0, target + pull)
+            grip.move(pull_t0, release - pull_t0, target + offset + pull)
+        back = rest + np.array([u(-0.03, 0.03), u(-0.03, 0.03), u(-0.02, 0.02)])
+        retreat = float(np.clip(u(0.7, 1.5) / opts.speed, 0.5, 2.5))
+        giver_out = release + u(0.0, 0.05)
+        hand.move(giver_out, retreat, back, bump=np.array([0.0, 0.0, u(0.0, 0.04)]))
+        lean.move(giver_out, retreat, np.zeros(3))
+        robot_out = release + u(0.15, 0.4)
+        carry = u(1.0, 1.5)
+        grip.move(robot_out, carry, dropoff)
+        t_open = robot_out + carry + 0.2
+        grip.move(t_open + 0.1, u(0.9, 1.2), home)
+        grip_events.append((t_close, release, t_open))
+        truth.append(HandoverTruth(onset, contact, release, giver_out + retreat))
+        rest = back
+        # Next handover: after the hand rests and the robot is home again.
+        t = max(giver_out + retreat, t_open + 1.3) + u(0.3, 1.0)
+    t_end = t + u(0.0, 0.5)
+
+    ts = _sample_times(rng, t_end, opts)
+    n = ts.shape[0]
+    sway = 0.004 * np.sin(2 * np.pi * u(0.2, 0.4) * ts + u(0, 6))[:, None] * np.array([1, 0.5, 0.3])
+    gh = hand.at(ts) + sway + rng.normal(0.0, opts.noise, (n, 3))
+    rh = grip.at(ts) + rng.normal(0.0, opts.gripper_noise, (n, 3))
+    gf = face + lean.at(ts) + 0.5 * sway + rng.normal(0.0, opts.noise, (n, 3))
+    if opts.dropouts_per_s > 0:
+        for arr in (gh, gf, rh):
+            k = rng.poisson(opts.dropouts_per_s * t_end * (0.3 if arr is rh else 1.0))
+            for t0 in rng.uniform(0, t_end, k):
+                arr[(ts >= t0) & (ts < t0 + u(0.02, 0.2))] = np.nan
+
+    closed = np.full(n, np.nan)
+    load = np.full(n, np.nan)
+    if opts.robot_evidence:
+        closed[:] = 0.0
+        load[:] = 0.0
+        for t_close, release, t_open in grip_events:
+            closed[(ts >= t_close) & (ts < t_open)] = 1.0
+            hold = (ts >= t_close) & (ts < release)
+            load[hold] = 0.15 + 0.7 * (ts[hold] - t_close) / (release - t_close)
+            after = (ts >= release) & (ts < t_open)
+            load[after] = np.minimum(1.0, 0.85 + 3.0 * (ts[after] - release))
+    traj = Trajectory(ts, gh, rh, gf, closed, load)
+    return SyntheticHandover(traj, truth, replace(opts, posture=posture), seed)
+
+
+def synthetic_set(n: int = 40, seed: int = 0, **overrides: object) -> list[SyntheticHandover]:
+    """A varied set of recordings: rates 8-240 Hz, regular and irregular sampling, noise 0.5-3
+    mm, dropouts, both postures, slow and fast givers, single and double handovers.
+
+    ``overrides`` fix any :class:`SyntheticOptions` field for the whole set.
+    """
+    rng = np.random.default_rng(seed)
+    rates = (8.0, 15.0, 30.0, 60.0, 100.0, 120.0, 240.0)
+    out = []
+    for i in range(n):
+        opts = SyntheticOptions(
+            rate=float(rates[i % len(rates)]),
+            irregular=float(rng.choice([0.0, 0.0, 0.2, 0.4])),
+            noise=float(rng.uniform(0.0005, 0.003)),
+            dropouts_per_s=float(rng.choice([0.0, 0.0, 0.3, 1.0])),
+            posture="standing" if i % 2 == 0 else "sitting",
+            speed=float(rng.choice([0.7, 1.0, 1.0, 1.4])),
+            handovers=2 if i % 5 == 4 else 1,
+        )
+        if overrides:
+            opts = replace(opts, **overrides)  # type: ignore[arg-type]
+        out.append(generate(int(rng.integers(2**31)), opts))
+    return out

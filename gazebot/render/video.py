@@ -1,0 +1,191 @@
+"""The one handover loop shared by ``gazebot demo``, ``gazebot render video`` and the study's
+renders: the simulation runs the handover, the gaze engine drives head and eyes every control tick,
+and an observer camera records an H.264 MP4 (yuv420p) off-screen.
+
+Deterministic for a seed: the giver's timing, the engine's random choices and the blinks all derive
+from it, and physics and software rendering are deterministic.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from gazebot.render.timeline import TickRecord
+from gazebot.types import Event
+
+CONTROL_HZ = 120.0  # tracking rate of the seed's motion capture setup
+MAX_DURATION_S = 30.0  # a handover that has not finished by then is cut (and reported)
+
+
+@dataclass
+class HandoverRecording:
+    """Result of :func:`record_handover`."""
+
+    ticks: list[TickRecord]
+    video: Path | None
+    frames: int
+    fps: float
+    width: int
+    height: int
+    completed: bool  # the handover finished before MAX_DURATION_S
+    robot_events: list[Event] = field(default_factory=list)
+
+
+def _check_size(width: int, height: int, fps: float) -> None:
+    for name, v in (("width", width), ("height", height)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < 16 or v % 2:
+            raise ValueError(f"video {name} must be an even number of pixels >= 16, got {v!r}")
+    if not (math.isfinite(fps) and 1.0 <= fps <= CONTROL_HZ):
+        raise ValueError(f"fps must be between 1 and {CONTROL_HZ:g}, got {fps}")
+
+
+def _open_writer(path: Path, width: int, height: int, fps: float):
+    import imageio_ffmpeg
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    writer = imageio_ffmpeg.write_frames(
+        str(path),
+        (width, height),
+        fps=fps,
+        codec="libx264",
+        pix_fmt_in="rgb24",
+        pix_fmt_out="yuv420p",
+        macro_block_size=2,
+        quality=None,
+        # One encoder thread keeps the bit stream identical run to run and leaves the other core
+        # to physics and rendering.
+        output_params=["-preset", "veryfast", "-crf", "20", "-threads", "1"],
+        ffmpeg_log_level="error",
+    )
+    writer.send(None)
+    return writer
+
+
+def _direction_change(prev: np.ndarray | None, cur: np.ndarray) -> float:
+    if prev is None or not (np.all(np.isfinite(prev)) and np.all(np.isfinite(cur))):
+        return 0.0
+    a, b = np.linalg.norm(prev), np.linalg.norm(cur)
+    if a < 1e-9 or b < 1e-9:
+        return 0.0
+    return float(np.arccos(np.clip(prev.dot(cur) / (a * b), -1.0, 1.0)))
+
+
+def record_handover(
+    robot: str | Path = "sawyer",
+    behavior: str | Path = "face-hand-face",
+    scene: str | Path = "default",
+    out_path: str | Path | None = None,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+    fps: float = 30.0,
+    progress: bool = True,
+) -> HandoverRecording:
+    """Run one handover with the gaze engine in the loop; record the video when ``out_path``.
+
+    Returns the per-tick timeline, the frame count and the robot's events.
+    """
+    from gazebot.sim.gl_check import ensure_gl_backend
+
+    ensure_gl_backend()
+    from tqdm import tqdm
+
+    from gazebot.engine import GazeEngine
+    from gazebot.render.blink import BlinkModel
+    from gazebot.sim.simulation import HandoverSimulation
+
+    _check_size(width, height, fps)
+    sim = HandoverSimulation(robot=robot, scene=scene, seed=seed)
+    engine = GazeEngine.from_config(robot=robot, behavior=behavior, seed=seed)
+    blinks = BlinkModel(seed)
+    dt = 1.0 / CONTROL_HZ
+    gaze_site = sim.data.site(sim.robot.gaze_site)
+    tail = sim.config.tail_s
+    writer = _open_writer(Path(out_path), width, height, fps) if out_path is not None else None
+    ticks: list[TickRecord] = []
+    events: list[Event] = []
+    frames, done_at, prev_dir = 0, None, None
+    bar = tqdm(
+        total=None,
+        unit="frame",
+        desc=f"{Path(str(robot)).stem} {Path(str(behavior)).stem}",
+        disable=not progress,
+        leave=False,
+    )
+    try:
+        while True:
+            frame = sim.tracking()
+            for event in sim.robot_events():
+                events.append(event)
+                engine.notify(event)
+            cmd = engine.step(frame)
+            sim.apply_head(cmd.head)
+            direction = np.asarray(cmd.target_point, float) - gaze_site.xpos
+            blink = blinks.update(sim.t, _direction_change(prev_dir, direction))
+            prev_dir = direction
+            distance = float(np.linalg.norm(direction))
+            # The eyes converge on the target (EYES' vergence) when its distance is known.
+            sim.apply_eyes(
+                cmd.eye_yaw, cmd.eye_pitch, blink, distance if math.isfinite(distance) else None
+            )
+            state = sim.joint_state()
+            ticks.append(
+                TickRecord(
+                    t=sim.t,
+                    phase=cmd.phase.value,
+                    target=cmd.target,
+                    head=dict(cmd.head),
+                    eye_yaw=cmd.eye_yaw,
+                    eye_pitch=cmd.eye_pitch,
+                    target_point=np.asarray(cmd.target_point, float).copy(),
+                    hand=sim.giver.hand.copy(),
+                    face=sim.scene.giver.face_point.copy(),
+                    head_measured={j: state[j] for j in cmd.head if j in state},
+                    events=tuple(e.kind.value for e in cmd.events),
+                )
+            )
+            # Frame k shows the first tick at or after k / fps.
+            if writer is not None and sim.t >= frames / fps - 1e-9:
+                writer.send(np.ascontiguousarray(sim.render(width=width, height=height)))
+                frames += 1
+                bar.update(1)
+            if done_at is None and sim.done:
+                done_at = sim.t
+            if (done_at is not None and sim.t >= done_at + tail) or sim.t >= MAX_DURATION_S:
+                break
+            sim.step(dt)
+    finally:
+        bar.close()
+        if writer is not None:
+            writer.close()
+        sim.close()
+    return HandoverRecording(
+        ticks=ticks,
+        video=Path(out_path) if out_path is not None else None,
+        frames=frames,
+        fps=fps,
+        width=width,
+        height=height,
+        completed=done_at is not None,
+        robot_events=events,
+    )
+
+
+def render_handover_video(
+    robot: str | Path,
+    behavior: str | Path,
+    scene: str | Path,
+    out_path: str | Path,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+    fps: float = 30.0,
+    progress: bool = True,
+) -> Path:
+    """Render one full handover to ``out_path`` (H.264 MP4, yuv420p) and return the path."""
+    record_handover(robot, behavior, scene, out_path, seed, width, height, fps, progress)
+    return Path(out_path)

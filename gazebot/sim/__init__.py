@@ -1,0 +1,27 @@
+"""Simulated human-to-robot handovers in MuJoCo: scene composition, the simulated giver, the robot's
+handover controller and off-screen rendering.
+
+Import :class:`HandoverSimulation` from here; everything heavy (MuJoCo) loads on first use.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from gazebot.sim.scene_config import SceneConfig, load_scene, scene_names
+    from gazebot.sim.simulation import HandoverSimulation
+
+__all__ = ["HandoverSimulation", "SceneConfig", "load_scene", "scene_names"]
+
+
+def __getattr__(name: str):
+    if name == "HandoverSimulation":
+        from gazebot.sim.simulation import HandoverSimulation
+
+        return HandoverSimulation
+    if name in ("SceneConfig", "load_scene", "scene_names"):
+        from gazebot.sim import scene_config
+
+        return getattr(scene_config, name)
+    raise AttributeError(f"module 'gazebot.sim' has no attribute {name!r}")

@@ -1,0 +1,151 @@
+"""Scene configuration (``configs/scenes/*.yaml``): the giver's posture and timing, the object, the
+robot's handover controller and the tracking noise. Durations are seconds; angles at this YAML
+surface are degrees (``*_deg``)."""
+
+from __future__ import annotations
+
+from enum import Enum
+from pathlib import Path
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from gazebot.config import configs_dir, load_model
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class Posture(str, Enum):
+    STANDING = "standing"
+    SITTING = "sitting"
+
+
+class ObjectKind(str, Enum):
+    SMALL_BOX = "small_box"
+    LARGE_BOX = "large_box"
+    PLASTIC_BOTTLE = "plastic_bottle"
+    GLASS_BOTTLE = "glass_bottle"
+
+
+class DurationModel(_Strict):
+    """A duration drawn from a normal distribution clipped to ``[min_s, max_s]``."""
+
+    mean_s: float = Field(gt=0)
+    sd_s: float = Field(ge=0)
+    min_s: float = Field(gt=0)
+    max_s: float = Field(gt=0)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> DurationModel:
+        if not self.min_s <= self.mean_s <= self.max_s:
+            raise ValueError("min_s <= mean_s <= max_s")
+        return self
+
+    def sample(self, rng: np.random.Generator) -> float:
+        return float(np.clip(rng.normal(self.mean_s, self.sd_s), self.min_s, self.max_s))
+
+
+# Phase durations of the 288 annotated human-human handovers (seed section 6.2, 8 fps):
+# reach 0.99 +- 0.24 s, transfer 0.59 +- 0.22 s, retreat 1.05 +- 0.26 s (mean +- sd).
+def _reach() -> DurationModel:
+    return DurationModel(mean_s=0.99, sd_s=0.24, min_s=0.6, max_s=2.0)
+
+
+def _transfer() -> DurationModel:
+    return DurationModel(mean_s=0.59, sd_s=0.22, min_s=0.25, max_s=1.75)
+
+
+def _retreat() -> DurationModel:
+    return DurationModel(mean_s=1.05, sd_s=0.26, min_s=0.5, max_s=2.1)
+
+
+class GiverConfig(_Strict):
+    """The simulated giver: where it stands and how long each of its motions takes."""
+
+    height_m: float = Field(default=1.75, ge=1.4, le=2.1)
+    standoff_m: float = Field(
+        default=0.42, ge=0.2, le=0.6, description="shoulder ahead of the handover location (+x)"
+    )
+    start_delay_s: float = Field(default=1.0, ge=0.0, description="idle time before the reach")
+    start_jitter_s: float = Field(default=0.2, ge=0.0, description="uniform +- jitter of the start")
+    reach: DurationModel = Field(default_factory=_reach)
+    transfer: DurationModel = Field(default_factory=_transfer)
+    retreat: DurationModel = Field(default_factory=_retreat)
+
+
+class ControllerConfig(_Strict):
+    """The robot's handover controller (seed 6.3.2/6.4.3): reach a predefined handover pose once
+    the giver starts, grasp when the object is close, retreat home after the giver lets go."""
+
+    reach_min_duration_s: float = Field(default=1.6, gt=0)
+    retreat_min_duration_s: float = Field(default=1.6, gt=0)
+    max_joint_speed_deg: float = Field(default=120.0, gt=0, description="peak joint speed, deg/s")
+    start_trigger_m: float = Field(default=0.04, gt=0, description="giver hand travel that starts")
+    grasp_distance_m: float = Field(default=0.05, gt=0, description="object-gripper distance")
+    gripper_close_s: float = Field(default=0.35, gt=0)
+    release_trigger_m: float = Field(default=0.04, gt=0, description="hand-object gap = let go")
+
+
+class TrackingNoiseConfig(_Strict):
+    """Motion-capture realism: isotropic Gaussian noise and random dropped samples."""
+
+    noise_m: float = Field(default=0.0, ge=0.0, le=0.1)
+    dropout_rate: float = Field(default=0.0, ge=0.0, lt=1.0)
+
+
+class CameraConfig(_Strict):
+    """Observer camera; ``None`` fields are derived from the robot and the giver."""
+
+    pos_m: tuple[float, float, float] | None = None
+    look_at_m: tuple[float, float, float] | None = None
+    fovy_deg: float = Field(default=33.0, gt=5, lt=150)
+
+
+class SceneConfig(_Strict):
+    """One handover setup (seed Table 6.3 conditions: object size, fragility, posture)."""
+
+    name: str = "default"
+    description: str = ""
+    posture: Posture = Posture.STANDING
+    object: ObjectKind = ObjectKind.SMALL_BOX
+    table: bool | None = Field(default=None, description="None: a table when sitting")
+    giver: GiverConfig = Field(default_factory=GiverConfig)
+    controller: ControllerConfig = Field(default_factory=ControllerConfig)
+    tracking: TrackingNoiseConfig = Field(default_factory=TrackingNoiseConfig)
+    camera: CameraConfig = Field(default_factory=CameraConfig)
+    tail_s: float = Field(default=1.2, ge=0.0, description="video time kept after the handover")
+
+    @property
+    def has_table(self) -> bool:
+        return self.posture is Posture.SITTING if self.table is None else self.table
+
+
+def scenes_dir() -> Path:
+    return configs_dir() / "scenes"
+
+
+def scene_names() -> list[str]:
+    """Names of the shipped scenes (``configs/scenes/<name>.yaml``)."""
+    return sorted(p.stem for p in scenes_dir().glob("*.yaml"))
+
+
+def load_scene(scene: str | Path | SceneConfig = "default") -> SceneConfig:
+    """Load a scene by name (``configs/scenes/<name>.yaml``) or YAML path.
+
+    Raises:
+        FileNotFoundError: unknown name or missing file (the message lists the known scenes).
+        ConfigError: the YAML does not validate.
+    """
+    if isinstance(scene, SceneConfig):
+        return scene
+    path = Path(scene)
+    if path.suffix not in (".yaml", ".yml"):
+        path = scenes_dir() / f"{scene}.yaml"
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"unknown scene {str(scene)!r}: no file {path} "
+            f"(known scenes: {', '.join(scene_names())})"
+        )
+    return load_model(SceneConfig, path)

@@ -1,0 +1,320 @@
+"""``HandoverSimulation``: a human-to-robot handover in MuJoCo (seed sections 6.3.2 and 6.4.3).
+
+A simulated giver reaches toward the robot with the object; the robot's handover controller reaches
+a predefined handover pose once the giver starts, grasps when the object is close and retreats home
+after the giver lets go. The gaze engine (or a bus node) reads :meth:`tracking` and
+:meth:`robot_events` and drives the head (:meth:`apply_head`) and the eyes on the head display
+(:meth:`apply_eyes` / :meth:`set_display`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from gazebot.sim.controller import ControllerState, HandoverController, Sensed
+from gazebot.sim.display import DisplayTexture
+from gazebot.sim.giver import GiverPlan, GiverState, SimulatedGiver
+from gazebot.sim.offscreen import OffscreenRenderer
+from gazebot.sim.robot import SimRobot, load_sim_robot
+from gazebot.sim.scene import OBSERVER, Scene, build_scene
+from gazebot.sim.scene_config import SceneConfig, TrackingNoiseConfig, load_scene
+from gazebot.sim.tracking import TrackingNoise
+from gazebot.types import Event, TrackingFrame
+
+
+def nearest_equivalent(q: np.ndarray, goal: np.ndarray, ranges: np.ndarray) -> np.ndarray:
+    """``q`` with each joint shifted by whole turns (staying within its range) to be as close as
+    possible to ``goal``: the same arm configuration, but no needless full-turn moves on joints
+    that turn more than 360 deg (e.g. the Jaco-2's)."""
+    out = np.asarray(q, float).copy()
+    for i, (lo, hi) in enumerate(ranges):
+        if hi - lo < 2 * np.pi:
+            continue
+        shifted = out[i] + 2 * np.pi * np.arange(-2, 3)
+        ok = shifted[(shifted >= lo) & (shifted <= hi)]
+        if ok.size:
+            out[i] = ok[np.argmin(np.abs(ok - goal[i]))]
+    return out
+
+
+class HandoverSimulation:
+    """One simulated handover.
+
+    Args:
+        robot: Robot name (``sawyer``, ``jaco2``), robot YAML path or a :class:`SimRobot`.
+        scene: Scene name (``configs/scenes/<name>.yaml``), YAML path or a :class:`SceneConfig`.
+        seed: Seeds the giver's timing and the tracking noise (same seed, same handover).
+        tracking_noise: Overrides the scene's tracking noise (``None``: the scene's).
+    """
+
+    def __init__(
+        self,
+        robot: str | Path | SimRobot = "sawyer",
+        scene: str | Path | SceneConfig = "default",
+        seed: int = 0,
+        tracking_noise: TrackingNoiseConfig | None = None,
+    ) -> None:
+        self.robot = robot if isinstance(robot, SimRobot) else load_sim_robot(robot)
+        self.config = load_scene(scene)
+        self.seed = int(seed)
+        self.scene: Scene = build_scene(self.robot, self.config)
+        self.model = self.scene.model
+        self.data = mujoco.MjData(self.model)
+        self.layout = self.scene.layout
+
+        m = self.model
+        self._arm_qpos = np.array([m.joint(j).qposadr[0] for j in self.robot.arm_joints])
+        self._arm_act = np.array([self._actuator(j) for j in self.robot.arm_joints])
+        self._head_act = {j: self._actuator(j) for j in self.robot.head_joints}
+        self._head_qpos = {j: int(m.joint(j).qposadr[0]) for j in self.robot.head_joints}
+        self._gripper_act = self._actuator(self.robot.gripper_actuator)
+        self._gripper_site = int(m.site(self.robot.gripper_site).id)
+        self._joint_names = [
+            m.joint(i).name
+            for i in range(m.njnt)
+            if int(m.jnt_type[i])
+            in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+        ]
+
+        arm_ranges = np.array([m.jnt_range[m.joint(j).id] for j in self.robot.arm_joints])
+        self.home = nearest_equivalent(self.robot.home, self.robot.handover, arm_ranges)
+        self.data.qpos[self._arm_qpos] = self.home
+        self.data.ctrl[self._arm_act] = self.home
+        for j, a in self._head_act.items():
+            self.data.ctrl[a] = self._clip_ctrl(a, self.data.qpos[self._head_qpos[j]])
+        self.data.ctrl[self._gripper_act] = 0.0
+
+        rng = np.random.default_rng([self.seed, 0])
+        plan = GiverPlan.draw(self.config.giver, rng)
+        self.giver = SimulatedGiver(self.layout.rest_hand, self.layout.offer_hand, plan)
+        self.controller = HandoverController(self.home, self.robot.handover, self.config.controller)
+        self._noise = TrackingNoise(
+            tracking_noise or self.config.tracking, np.random.default_rng([self.seed, 1])
+        )
+        self.display = DisplayTexture(m)
+        self._eyes: tuple[float, float, float, float | None] | None = None
+        self._eyes_drawn: tuple | None = None
+        self._eye_renderer = None
+        self._renderers: dict[tuple[int, int], OffscreenRenderer] = {}
+        self._events: list[Event] = []
+        self._object_rel: tuple[np.ndarray, np.ndarray] | None = None  # object in gripper frame
+        self._arm_external = False
+        self._t = 0.0
+        self._place_kinematic()
+        mujoco.mj_forward(m, self.data)
+
+    # ----------------------------------------------------------------------------- helpers
+    def _actuator(self, name: str) -> int:
+        act = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+        if act < 0:
+            raise ValueError(f"robot {self.robot.name!r} has no position actuator named {name!r}")
+        return act
+
+    def _clip_ctrl(self, act: int, value: float) -> float:
+        lo, hi = self.model.actuator_ctrlrange[act]
+        if self.model.actuator_ctrllimited[act]:
+            return float(np.clip(value, lo, hi))
+        jnt = self.model.actuator_trnid[act, 0]
+        if self.model.jnt_limited[jnt]:
+            return float(np.clip(value, *self.model.jnt_range[jnt]))
+        return float(value)
+
+    def _gripper_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        pos = self.data.site_xpos[self._gripper_site].copy()
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, self.data.site_xmat[self._gripper_site])
+        return pos, quat
+
+    def _place_kinematic(self) -> None:
+        """Pose the giver's arm and the object for the current state."""
+        hand = self.giver.hand
+        self.scene.giver.pose_arm(self.data, hand)
+        mocap = self.scene.object_mocap
+        if self.giver.holds_object or not self.controller.grasped:
+            self.data.mocap_pos[mocap] = hand + self.layout.object_offset
+            self.data.mocap_quat[mocap] = [1.0, 0.0, 0.0, 0.0]
+            return
+        g_pos, g_quat = self._gripper_pose()
+        if self._object_rel is None:
+            # The giver just let go: from now on the object moves with the gripper.
+            inv = np.zeros(4)
+            mujoco.mju_negQuat(inv, g_quat)
+            rel_pos = np.zeros(3)
+            mujoco.mju_rotVecQuat(rel_pos, self.data.mocap_pos[mocap] - g_pos, inv)
+            rel_quat = np.zeros(4)
+            mujoco.mju_mulQuat(rel_quat, inv, self.data.mocap_quat[mocap].copy())
+            self._object_rel = (rel_pos, rel_quat)
+        rel_pos, rel_quat = self._object_rel
+        world = np.zeros(3)
+        mujoco.mju_rotVecQuat(world, rel_pos, g_quat)
+        self.data.mocap_pos[mocap] = g_pos + world
+        quat = np.zeros(4)
+        mujoco.mju_mulQuat(quat, g_quat, rel_quat)
+        self.data.mocap_quat[mocap] = quat
+
+    # ----------------------------------------------------------------------------- state
+    @property
+    def t(self) -> float:
+        """Simulation time (s) since the start."""
+        return self._t
+
+    @property
+    def done(self) -> bool:
+        """True once the robot is back home with the object and the giver has retreated."""
+        return self.controller.state is ControllerState.DONE and self.giver.state is GiverState.DONE
+
+    @property
+    def head_joints(self) -> tuple[str, ...]:
+        return self.robot.head_joints
+
+    def step(self, dt: float) -> None:
+        """Advance the giver, the handover controller and the physics by ``dt`` seconds."""
+        if not (math.isfinite(dt) and dt > 0.0):
+            raise ValueError(f"step dt must be a positive number of seconds, got {dt}")
+        t = self._t + dt
+        self.giver.update(t, self.controller.grasped)
+        obj = self.data.mocap_pos[self.scene.object_mocap]
+        gripper = self.data.site_xpos[self._gripper_site]
+        sensed = Sensed(
+            giver_hand=self.giver.hand.copy(),
+            object_gap=float(np.linalg.norm(obj - gripper)),
+            hand_object_gap=float(
+                np.linalg.norm(self.giver.hand + self.layout.object_offset - obj)
+            ),
+        )
+        cmd = self.controller.update(t, self.data.qpos[self._arm_qpos], sensed)
+        self._events.extend(self.controller.pop_events())
+        if not self._arm_external:
+            for a, q in zip(self._arm_act, cmd.arm, strict=True):
+                self.data.ctrl[a] = self._clip_ctrl(a, q)
+        self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, cmd.gripper)
+        n = max(1, round((t - self.data.time) / self.model.opt.timestep))
+        mujoco.mj_step(self.model, self.data, nstep=n)
+        self._t = t
+        mujoco.mj_kinematics(self.model, self.data)
+        self._place_kinematic()
+        mujoco.mj_kinematics(self.model, self.data)
+
+    def tracking(self) -> TrackingFrame:
+        """What a motion-capture system would report now (robot base frame, m)."""
+        noise = self._noise.apply
+        grasped = self.controller.grasped
+        if not grasped:
+            share = 0.0
+        elif self.giver.holds_object:
+            share = 0.5
+        else:
+            share = 1.0
+        return TrackingFrame.make(
+            self._t,
+            giver_hand=noise(self.giver.hand),
+            receiver_hand=noise(self.data.site_xpos[self._gripper_site]),
+            giver_face=noise(self.scene.giver.face_point),
+            gripper_closed=grasped,
+            load_share=share,
+        )
+
+    def joint_state(self) -> dict[str, float]:
+        """Every hinge/slide joint's position (rad or m) by name."""
+        return {
+            name: float(self.data.qpos[self.model.joint(name).qposadr[0]])
+            for name in self._joint_names
+        }
+
+    def robot_events(self) -> list[Event]:
+        """Robot controller events since the last call, oldest first."""
+        out, self._events = self._events, []
+        return out
+
+    # ----------------------------------------------------------------------------- commands
+    def apply_head(self, joints: Mapping[str, float]) -> None:
+        """Set head joint goals (rad); values are clipped to the joint limits.
+
+        Raises:
+            ValueError: an unknown head joint or a non-finite value.
+        """
+        for name, value in joints.items():
+            if name not in self._head_act:
+                raise ValueError(
+                    f"unknown head joint {name!r} (head joints: {list(self._head_act)})"
+                )
+            if not math.isfinite(value):
+                raise ValueError(f"head joint {name!r} goal must be finite, got {value}")
+        for name, value in joints.items():
+            act = self._head_act[name]
+            self.data.ctrl[act] = self._clip_ctrl(act, float(value))
+
+    def apply_arm(self, joints: Mapping[str, float]) -> None:
+        """Take the arm over from the handover controller and set arm joint goals (rad, clipped).
+        The controller keeps running (events, gripper) but no longer moves the arm."""
+        arm = dict(zip(self.robot.arm_joints, self._arm_act, strict=True))
+        for name, value in joints.items():
+            if name not in arm:
+                raise ValueError(f"unknown arm joint {name!r} (arm joints: {list(arm)})")
+            if not math.isfinite(value):
+                raise ValueError(f"arm joint {name!r} goal must be finite, got {value}")
+        self._arm_external = True
+        for name, value in joints.items():
+            self.data.ctrl[arm[name]] = self._clip_ctrl(arm[name], float(value))
+
+    def apply_eyes(
+        self, yaw: float, pitch: float, blink: float = 0.0, distance: float | None = None
+    ) -> None:
+        """Show eyes looking at (``yaw``, ``pitch``) rad (+yaw = robot's left, +pitch = down) with
+        lids ``blink`` (0 open .. 1 closed) on the head display, drawn by the robot's eye renderer
+        (``gazebot.render.EyeRenderer``). Drawn lazily, at the next :meth:`render`."""
+        values = (yaw, pitch, blink) + ((distance,) if distance is not None else ())
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"eye yaw/pitch/blink/distance must be finite, got {values}")
+        self._eyes = (float(yaw), float(pitch), float(np.clip(blink, 0.0, 1.0)), distance)
+
+    def set_display(self, image: np.ndarray) -> None:
+        """Show ``image`` ((H, W, 3) uint8 RGB) on the head display (replaces the eyes)."""
+        self.display.write(image)
+        self._eyes = None
+        self._eyes_drawn = None
+
+    def _draw_eyes(self) -> None:
+        if self._eyes is None or self._eyes == self._eyes_drawn:
+            return
+        if self._eye_renderer is None:
+            from gazebot.render import EyeRenderer
+
+            # Draw at the texture's size: no resize per frame.
+            self._eye_renderer = EyeRenderer.for_robot(
+                self.robot.name, width=self.display.width, height=self.display.height
+            )
+        yaw, pitch, blink, distance = self._eyes
+        self.display.write(self._eye_renderer.render(yaw, pitch, blink=blink, distance=distance))
+        self._eyes_drawn = self._eyes
+
+    # ----------------------------------------------------------------------------- rendering
+    def render(self, camera: str = OBSERVER, width: int = 640, height: int = 480) -> np.ndarray:
+        """An RGB frame ((height, width, 3) uint8) from ``camera`` (default: the observer)."""
+        self._draw_eyes()
+        key = (int(width), int(height))
+        renderer = self._renderers.get(key)
+        if renderer is None:
+            renderer = self._renderers[key] = OffscreenRenderer(self.model, *key)
+        if renderer.texture_version.get(self.display.id) != self.display.version:
+            renderer.make_current()
+            self.display.upload(renderer.context)
+            renderer.texture_version[self.display.id] = self.display.version
+        return renderer.render(self.data, camera)
+
+    def close(self) -> None:
+        """Free the GL contexts (also done when the object is garbage collected)."""
+        for renderer in self._renderers.values():
+            renderer.close()
+        self._renderers.clear()
+
+    def __enter__(self) -> HandoverSimulation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

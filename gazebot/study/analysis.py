@@ -1,0 +1,365 @@
+"""Preference analysis of a pairwise video study (seed sections 6.3.2 and 6.4.4).
+
+Responses CSV (one row per participant and session; extra columns such as ``comments`` or
+``video`` are ignored; the questionnaire sheet written by ``gazebot study render`` has this
+layout with the answers left blank)::
+
+    participant,session,condition,level,first,second,q1,q2,q3,q4,q5
+    1,1,object-size,small-box,hand,face-hand-face,2,2,2,1,2
+
+``first``/``second``: the behaviors shown as Handover 1 / Handover 2; ``q1``..``q5``: 1 if the
+participant chose the 1st handover, 2 if the 2nd. ``condition``/``level`` may be empty for a study
+with a single scenario (the seed's section 6.3 studies).
+
+Per level and measure, participant k's preference for behavior i over j is the share of i-wins
+over the measure's questions and both ordered comparisons (i first, j first); the win matrix sums
+it over participants, which is the seed's "averaging both ordered comparisons" (Tables 6.1/6.2:
+cell (i, j) + cell (j, i) = number of participants).
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from gazebot.study.bradley_terry import BradleyTerryFit, fit_bradley_terry
+from gazebot.study.plan import DEFAULT_BEHAVIORS
+from gazebot.study.questionnaire import MEASURES, QUESTIONS
+from gazebot.study.stats import (
+    BiasTest,
+    ChiSquare,
+    ProportionTest,
+    likelihood_ratio_chi2,
+    matched_equivalence,
+    matched_proportion_difference,
+    position_bias_test,
+)
+
+RESPONSE_COLUMNS = ("participant", "session", "condition", "level", "first", "second") + tuple(
+    QUESTIONS
+)
+
+
+@dataclass(frozen=True)
+class Response:
+    """One answered session: ``answers[q]`` is 1 (first handover chosen) or 2 (second)."""
+
+    participant: str
+    session: int
+    condition: str
+    level: str
+    first: str
+    second: str
+    answers: dict[str, int]
+
+
+def read_responses(path: str | Path) -> list[Response]:
+    """Read a responses CSV (format in the module doc); a missing column, an answer other than 1
+    or 2, or a session comparing a behavior with itself raises ``ValueError`` naming file, line
+    and column."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"responses file not found: {path}")
+    out = []
+    with path.open(newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        missing = [c for c in RESPONSE_COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise ValueError(
+                f"{path}: missing column(s) {missing}; expected {list(RESPONSE_COLUMNS)}"
+            )
+        for line, row in enumerate(reader, start=2):
+            row = {k: (v or "").strip() for k, v in row.items() if k is not None}
+            for col in ("participant", "session", "first", "second"):
+                if not row[col]:
+                    raise ValueError(f"{path}: line {line}: column '{col}' is empty")
+            try:
+                session = int(row["session"])
+            except ValueError:
+                raise ValueError(
+                    f"{path}: line {line}: column 'session' expected an integer, "
+                    f"got {row['session']!r}"
+                ) from None
+            if row["first"] == row["second"]:
+                raise ValueError(f"{path}: line {line}: first and second are the same behavior")
+            answers = {}
+            for q in QUESTIONS:
+                raw = row[q]
+                if raw not in ("1", "2"):
+                    raise ValueError(
+                        f"{path}: line {line}: column '{q}' expected 1 (1st handover) or "
+                        f"2 (2nd handover), got {raw!r}"
+                    )
+                answers[q] = int(raw)
+            out.append(
+                Response(
+                    participant=row["participant"],
+                    session=session,
+                    condition=row["condition"],
+                    level=row["level"],
+                    first=row["first"],
+                    second=row["second"],
+                    answers=answers,
+                )
+            )
+    if not out:
+        raise ValueError(f"{path}: no responses")
+    return out
+
+
+def behaviors_of(responses: list[Response]) -> list[str]:
+    """The behaviors compared, the seed's defaults first (in their order), then the others."""
+    seen = {r.first for r in responses} | {r.second for r in responses}
+    known = [b for b in DEFAULT_BEHAVIORS if b in seen]
+    return known + sorted(seen - set(known))
+
+
+def preferences(
+    responses: list[Response], behaviors: list[str], questions: tuple[str, ...]
+) -> dict[str, np.ndarray]:
+    """Per participant a ``g x g`` matrix: entry (i, j) = share of i-wins over ``questions`` and
+    all of the participant's comparisons of i with j (NaN where the pair was never compared)."""
+    index = {b: i for i, b in enumerate(behaviors)}
+    g = len(behaviors)
+    sums: dict[str, np.ndarray] = {}
+    counts: dict[str, np.ndarray] = {}
+    for r in responses:
+        s = sums.setdefault(r.participant, np.zeros((g, g)))
+        c = counts.setdefault(r.participant, np.zeros((g, g)))
+        i, j = index[r.first], index[r.second]
+        first_share = float(np.mean([r.answers[q] == 1 for q in questions]))
+        s[i, j] += first_share
+        s[j, i] += 1.0 - first_share
+        c[i, j] += 1
+        c[j, i] += 1
+    out = {}
+    for k, s in sums.items():
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[k] = np.where(counts[k] > 0, s / np.maximum(counts[k], 1), np.nan)
+    return out
+
+
+def win_matrix(
+    responses: list[Response], behaviors: list[str], questions: tuple[str, ...]
+) -> np.ndarray:
+    """The seed's averaged win matrix: cell (i, j) = sum over participants of their preference
+    for i over j (see :func:`preferences`)."""
+    prefs = preferences(responses, behaviors, questions)
+    g = len(behaviors)
+    w = np.zeros((g, g))
+    for m in prefs.values():
+        w += np.nan_to_num(m, nan=0.0)
+    np.fill_diagonal(w, 0.0)
+    return w
+
+
+@dataclass(frozen=True)
+class MeasureResult:
+    """Bradley-Terry analysis of one measure in one level."""
+
+    measure: str
+    participants: int
+    wins: np.ndarray
+    fit: BradleyTerryFit
+    chi2: ChiSquare
+
+
+@dataclass(frozen=True)
+class LevelComparison:
+    """Between-level tests (eqs 6.3-6.4 and equivalence) for one pair of behaviors and measure;
+    the proportions are of participants preferring ``behavior_i`` over ``behavior_j``."""
+
+    measure: str
+    behavior_i: str
+    behavior_j: str
+    level_a: str
+    level_b: str
+    proportion_a: float
+    proportion_b: float
+    difference: ProportionTest
+    equivalence: ProportionTest
+
+
+@dataclass
+class StudyAnalysis:
+    """Everything ``gazebot study analyze`` reports."""
+
+    behaviors: list[str]
+    levels: list[str]
+    per_level: dict[str, dict[str, MeasureResult]] = field(default_factory=dict)
+    bias: dict[str, BiasTest] = field(default_factory=dict)
+    comparisons: list[LevelComparison] = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        """A JSON-ready dict."""
+        return {
+            "behaviors": self.behaviors,
+            "levels": self.levels,
+            "per_level": {
+                level: {
+                    m: {
+                        "participants": r.participants,
+                        "wins": r.wins.round(6).tolist(),
+                        "a": r.fit.wins.round(6).tolist(),
+                        "p": r.fit.p.round(6).tolist(),
+                        "chi2": round(r.chi2.chi2, 6),
+                        "df": r.chi2.df,
+                        "p_value": r.chi2.p_value,
+                    }
+                    for m, r in measures.items()
+                }
+                for level, measures in self.per_level.items()
+            },
+            "bias": {
+                m: {"W": b.statistic, "S": b.s, "n": b.n, "p_value": b.p_value}
+                for m, b in self.bias.items()
+            },
+            "level_comparisons": [
+                {
+                    "measure": c.measure,
+                    "pair": [c.behavior_i, c.behavior_j],
+                    "levels": [c.level_a, c.level_b],
+                    "proportions": [c.proportion_a, c.proportion_b],
+                    "difference": c.difference.difference,
+                    "z": c.difference.z,
+                    "p_value": c.difference.p_value,
+                    "equivalence_margin": c.equivalence.margin,
+                    "equivalence_p_value": c.equivalence.p_value,
+                }
+                for c in self.comparisons
+            ],
+        }
+
+
+def position_differences(
+    responses: list[Response], questions: tuple[str, ...], unit: str = "participant"
+) -> np.ndarray:
+    """Share of "1st" answers minus share of "2nd" answers over ``questions``, one value per
+    participant (``unit="participant"``: independent observations) or per answered session
+    (``unit="session"``: what the seed's S statistics imply, about 300 values for 24
+    participants; repeated measures of one participant are then treated as independent)."""
+    if unit not in ("participant", "session"):
+        raise ValueError(f"bias unit must be 'participant' or 'session', got {unit!r}")
+    groups: dict[object, list[int]] = {}
+    for r in responses:
+        key = r.participant if unit == "participant" else (r.participant, r.session, r.level)
+        groups.setdefault(key, []).extend(r.answers[q] for q in questions)
+    return np.array(
+        [np.mean([a == 1 for a in v]) - np.mean([a == 2 for a in v]) for v in groups.values()]
+    )
+
+
+def analyze(
+    responses: list[Response],
+    margin: float = 0.1,
+    behaviors: list[str] | None = None,
+    bias_unit: str = "participant",
+) -> StudyAnalysis:
+    """Bradley-Terry P_i with the likelihood-ratio chi-square (= eqs 6.1-6.2 for a complete
+    design) per level and measure, the first/second bias test per measure (see
+    :func:`position_differences` for ``bias_unit``), and for a study with two levels the matched
+    proportion difference and equivalence tests (margin ``margin``) per pair of behaviors.
+    ``behaviors`` fixes the order of the conditions (default: :func:`behaviors_of`)."""
+    found = behaviors_of(responses)
+    if behaviors is None:
+        behaviors = found
+    elif sorted(behaviors) != sorted(found):
+        raise ValueError(f"responses compare behaviors {found}, not {list(behaviors)}")
+    behaviors = list(behaviors)
+    levels = list(dict.fromkeys(r.level for r in responses))
+    result = StudyAnalysis(behaviors=behaviors, levels=levels)
+    for level in levels:
+        rows = [r for r in responses if r.level == level]
+        result.per_level[level] = {}
+        for measure, questions in MEASURES.items():
+            w = win_matrix(rows, behaviors, questions)
+            fit = fit_bradley_terry(w, behaviors)
+            result.per_level[level][measure] = MeasureResult(
+                measure=measure,
+                participants=len({r.participant for r in rows}),
+                wins=w,
+                fit=fit,
+                chi2=likelihood_ratio_chi2(w, fit.p),
+            )
+    for measure, questions in MEASURES.items():
+        diffs = position_differences(responses, questions, bias_unit)
+        result.bias[measure] = position_bias_test(diffs)
+    if len(levels) == 2:
+        result.comparisons = _compare_levels(responses, behaviors, levels, margin)
+    return result
+
+
+def _compare_levels(
+    responses: list[Response], behaviors: list[str], levels: list[str], margin: float
+) -> list[LevelComparison]:
+    level_a, level_b = levels
+    out = []
+    for measure, questions in MEASURES.items():
+        pa = preferences([r for r in responses if r.level == level_a], behaviors, questions)
+        pb = preferences([r for r in responses if r.level == level_b], behaviors, questions)
+        both = [k for k in pa if k in pb]
+        for i, j in itertools.combinations(range(len(behaviors)), 2):
+            xa = np.array([pa[k][i, j] for k in both])
+            xb = np.array([pb[k][i, j] for k in both])
+            keep = np.isfinite(xa) & np.isfinite(xb)
+            xa, xb = xa[keep], xb[keep]
+            if xa.size == 0:
+                continue
+            out.append(
+                LevelComparison(
+                    measure=measure,
+                    behavior_i=behaviors[i],
+                    behavior_j=behaviors[j],
+                    level_a=level_a,
+                    level_b=level_b,
+                    proportion_a=float(xa.mean()),
+                    proportion_b=float(xb.mean()),
+                    difference=matched_proportion_difference(xa, xb),
+                    equivalence=matched_equivalence(xa, xb, margin),
+                )
+            )
+    return out
+
+
+def read_win_matrix(path: str | Path) -> tuple[list[str], np.ndarray]:
+    """Read a win-count matrix CSV: header row and first column hold the condition names (same
+    order), cell (i, j) = participants preferring i over j (fractions allowed; the diagonal may
+    be empty)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"win matrix file not found: {path}")
+    with path.open(newline="", encoding="utf-8") as fh:
+        rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
+    if len(rows) < 3:
+        raise ValueError(f"{path}: expected a header row and at least 2 condition rows")
+    header = [c.strip() for c in rows[0][1:]]
+    names = [r[0].strip() for r in rows[1:]]
+    if header != names:
+        raise ValueError(
+            f"{path}: header conditions {header} differ from first-column conditions {names}"
+        )
+    g = len(names)
+    w = np.zeros((g, g))
+    for i, r in enumerate(rows[1:]):
+        cells = [c.strip() for c in r[1:]]
+        if len(cells) != g:
+            raise ValueError(f"{path}: line {i + 2}: expected {g} values, got {len(cells)}")
+        for j, c in enumerate(cells):
+            if i == j and c in ("", "-"):
+                continue
+            try:
+                w[i, j] = float(c)
+            except ValueError:
+                raise ValueError(
+                    f"{path}: line {i + 2}, column '{names[j]}': expected a number, got {c!r}"
+                ) from None
+            if i == j and w[i, j] != 0:
+                raise ValueError(
+                    f"{path}: line {i + 2}: diagonal cell ({names[i]}, {names[i]}) must be empty "
+                    f"or 0, got {c!r}"
+                )
+    return names, w

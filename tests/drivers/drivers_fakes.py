@@ -1,0 +1,102 @@
+"""Fakes and bus helpers for the driver tests: a tiny engine with GazeEngine's interface (so the
+transport is tested on its own) and free loopback ports."""
+
+from __future__ import annotations
+
+import math
+import socket
+import time
+from collections.abc import Callable
+from types import SimpleNamespace
+
+import numpy as np
+
+from gazebot.types import Event, EventKind, GazeCommand, Phase, TrackingFrame, is_valid_point
+
+PAN_LIMIT = 1.3
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 nobody listens on right now."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_until(pred: Callable[[], object], timeout: float = 3.0, poll: float = 0.005) -> bool:
+    """Poll ``pred`` until it is truthy or ``timeout`` s passed; returns its last truthiness."""
+    end = time.monotonic() + timeout
+    while True:
+        if pred():
+            return True
+        if time.monotonic() >= end:
+            return False
+        time.sleep(poll)
+
+
+class FakeGaze:
+    """Pan-only head pointing straight at the target (no dynamics)."""
+
+    def __init__(self) -> None:
+        self.head = {"head_pan": 0.0}
+        self.targets: list[tuple[float, np.ndarray]] = []
+
+    def update(self, t: float, point: np.ndarray) -> SimpleNamespace:
+        self.targets.append((t, np.asarray(point, float)))
+        if is_valid_point(point):
+            pan = float(np.clip(math.atan2(point[1], point[0]), -PAN_LIMIT, PAN_LIMIT))
+            self.head = {"head_pan": pan}
+        return SimpleNamespace(head=dict(self.head), eye_yaw=0.0, eye_pitch=0.0, residual=0.0)
+
+
+class FakeEngine:
+    """Looks at the face; ``reach_started`` when the giver's hand comes closer than 0.7 m."""
+
+    def __init__(self) -> None:
+        self.robot = SimpleNamespace(
+            name="fake", head_joints=["head_pan"], points={"face": np.array([1.0, 0.0, 1.5])}
+        )
+        self.gaze = FakeGaze()
+        self.behavior = SimpleNamespace(state="start")
+        self.phase = Phase.IDLE
+        self.notified: list[Event] = []
+        self.resynced: list[Event] = []
+        self.reset_heads: list[dict | None] = []
+        self.frames: list[TrackingFrame] = []
+        self._face = self.robot.points["face"]
+
+    def step(self, frame: TrackingFrame) -> GazeCommand:
+        self.frames.append(frame)
+        events = []
+        if (
+            self.phase == Phase.IDLE
+            and is_valid_point(frame.giver_hand)
+            and frame.giver_hand[0] < 0.7
+        ):
+            self.phase = Phase.REACH
+            self.behavior.state = "reach"
+            events.append(Event(EventKind.REACH_STARTED, frame.t, frame.t))
+        if is_valid_point(frame.giver_face):
+            self._face = frame.giver_face
+        st = self.gaze.update(frame.t, self._face)
+        return GazeCommand(
+            t=frame.t, phase=self.phase, target="face", target_point=self._face, head=st.head,
+            eye_yaw=0.0, eye_pitch=0.0, events=tuple(events),
+        )
+
+    def notify(self, event: Event) -> None:
+        self.notified.append(event)
+
+    def resync(self, events: list[Event]) -> None:
+        self.resynced.extend(events)
+        for e in events:
+            if e.kind == EventKind.REACH_STARTED:
+                self.phase = Phase.REACH
+            elif e.kind == EventKind.TRANSFER_STARTED:
+                self.phase = Phase.TRANSFER
+
+    def reset(self, head: dict | None = None) -> None:
+        self.reset_heads.append(head)
+        self.phase = Phase.IDLE
+        if head:
+            self.gaze.head = dict(head)

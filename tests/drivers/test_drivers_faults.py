@@ -1,0 +1,261 @@
+"""Transport and faults with real Zenoh sessions on loopback and a fake engine.
+
+Each test has its own robot id and port; the robot side listens, the engine connects.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+from drivers_fakes import FakeEngine, wait_until
+
+from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig, current_handover
+from gazebot.drivers.payloads import EventMsg, HeadCommandMsg, StatusMsg
+from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
+from gazebot.types import Event, EventKind, TrackingFrame
+
+pytestmark = pytest.mark.zenoh
+
+FAST = EngineNodeConfig(hold_timeout=0.05, face_timeout=0.15, heartbeat_period=0.05,
+                        resync_timeout=0.3)
+
+
+class Recorder:
+    """Collects decoded messages of one key from a plain subscriber."""
+
+    def __init__(self, session, key, model):
+        self.msgs: list = []
+        self._sub = session.declare_subscriber(
+            key, lambda s: self.msgs.append(model.decode(s.payload.to_bytes())))
+
+    def where(self, **kw):
+        return [m for m in self.msgs if all(getattr(m, k) == v for k, v in kw.items())]
+
+
+def robot_side(bus, peer_timeout=2.0) -> ZenohRobotEndpoint:
+    ep = ZenohRobotEndpoint(bus.listener(), bus.config().keys, "sim", peer_timeout=peer_timeout)
+    bus.closers.append(ep.close)
+    return ep
+
+
+def engine_side(bus, engine=None, config=FAST, peer_timeout=2.0):
+    drv = ZenohRobotDriver(bus.connector(), bus.config().keys, "engine", peer_timeout=peer_timeout)
+    node = EngineNode(engine or FakeEngine(), drv, config)
+    stop = threading.Event()
+    th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
+
+    def close():  # stop the loop before closing its driver
+        stop.set()
+        if th.is_alive():
+            th.join(timeout=5)
+        drv.close()
+
+    bus.closers.append(close)
+    return node, drv, stop, th
+
+
+def connected(ep, drv) -> bool:
+    return ep.peers().get("engine") and drv.peers().get("sim")
+
+
+def frame(t, hand_x=1.0, face=(1.0, 0.3, 1.5)):
+    return TrackingFrame.make(t, giver_hand=[hand_x, 0.0, 1.0], giver_face=face)
+
+
+def test_tracking_in_head_command_out_over_the_bus(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    events = Recorder(ep.session, ep.keys.events, EventMsg)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(5)
+    sent = [ep.publish_tracking(frame(i / 120, hand_x=1.0 - i * 0.02)) for i in range(20)]
+    assert wait_until(lambda: (m := ep.head.peek()) is not None and m.answers == sent[-1].seq)
+    cmd = ep.head.peek()
+    assert cmd.head["head_pan"] == pytest.approx(np.arctan2(0.3, 1.0))
+    assert cmd.mode == "behavior" and cmd.v == 1
+    assert wait_until(lambda: ep.eyes.peek() is not None)
+    # the fake engine's phase event is published once, with the engine as source
+    assert wait_until(lambda: events.where(kind="reach_started"))
+    [reach] = events.where(kind="reach_started")
+    assert reach.source == "engine" and reach.category == "phase"
+
+
+def test_robot_events_reach_the_engine(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(5)
+    reach = Event(EventKind.ROBOT_REACH_STARTED, 0.5, 0.5, {"planned_duration": 1.2})
+    ep.publish_robot_event(reach)
+    ep.publish_tracking(frame(0.6))
+    assert wait_until(lambda: node.engine.notified)
+    assert node.engine.notified == [reach]
+
+
+def test_malformed_payloads_are_counted_dropped_and_never_crash(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    status = Recorder(ep.session, ep.keys.status, StatusMsg)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(5)
+    garbage = [b"", b"\x00\xff", b"{", b"[]", b'{"v":1}', b'{"v":9,"seq":0,"t":0,"stamp":0}',
+               b'{"v":1,"seq":0,"t":NaN,"stamp":0}']
+    for raw in garbage:
+        for key in (ep.keys.tracking, ep.keys.joint_states, ep.keys.events, ep.keys.status):
+            ep.session.put(key, raw)
+        ep.session.put(ep.keys.head_command, raw)  # the robot side drops these
+    ep.publish_tracking(frame(1.0))
+    assert wait_until(lambda: (m := ep.head.peek()) is not None and m.t == 1.0)
+    n = len(garbage)
+    assert wait_until(lambda: drv.dropped().get(ep.keys.tracking) == n)
+    assert drv.dropped() == {k: n for k in (ep.keys.tracking, ep.keys.joint_states,
+                                            ep.keys.events, ep.keys.status)}
+    assert ep.dropped()[ep.keys.head_command] == n
+    # the engine's heartbeat reports the counts and the loop is still alive
+    assert wait_until(lambda: any(s.node == "engine" and s.dropped.get(ep.keys.tracking) == n
+                                  for s in status.msgs))
+    assert th.is_alive() and node.frames_processed == 1
+
+
+def test_tracking_stop_holds_gaze_then_looks_at_last_face_and_resumes(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    events = Recorder(ep.session, ep.keys.events, EventMsg)
+    heads = Recorder(ep.session, ep.keys.head_command, HeadCommandMsg)
+    status = Recorder(ep.session, ep.keys.status, StatusMsg)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(5)
+    last_face = (1.2, -0.4, 1.6)
+    ep.publish_tracking(frame(0.0))
+    ep.publish_tracking(frame(1 / 120, face=last_face))
+    ep.publish_tracking(frame(2 / 120, face=None))  # face dropped out before tracking stopped
+    # hold first: stale event, no new head command
+    assert wait_until(lambda: events.where(kind="tracking_stale"))
+    n_before = len(heads.msgs)
+    assert all(m.mode == "behavior" for m in heads.msgs)
+    # then the timeout: event with the last face, commands looking at it
+    assert wait_until(lambda: events.where(kind="tracking_timeout"))
+    [timeout] = events.where(kind="tracking_timeout")
+    assert timeout.info["face"] == pytest.approx(list(last_face))
+    assert wait_until(lambda: heads.where(mode="last_face"))
+    fallback = heads.where(mode="last_face")[0]
+    assert fallback.answers is None and fallback.target == "face"
+    assert fallback.head["head_pan"] == pytest.approx(np.arctan2(-0.4, 1.2))
+    assert len(heads.msgs) > n_before
+    assert wait_until(lambda: any(s.node == "engine" and s.tracking == "lost"
+                                  and s.state == "degraded" for s in status.msgs))
+    # tracking returns: resumed, behavior commands again
+    ep.publish_tracking(frame(3.0))
+    assert wait_until(lambda: events.where(kind="tracking_resumed"))
+    assert wait_until(lambda: heads.msgs[-1].mode == "behavior" and heads.msgs[-1].t == 3.0)
+    assert node.tracking == "ok"
+
+
+def test_restarted_engine_resyncs_from_event_history_and_joint_state(bus):
+    ep = robot_side(bus)
+    node1, drv1, stop1, th1 = engine_side(bus)
+    assert wait_until(lambda: connected(ep, drv1))
+    th1.start()
+    ep.publish_robot_event(Event(EventKind.ROBOT_REACH_STARTED, 0.1, 0.1, {"planned_duration": 1}))
+    for i in range(10):
+        ep.publish_tracking(frame(0.2 + i / 120, hand_x=0.9 - 0.05 * i))
+    assert wait_until(lambda: any(m.kind == "reach_started" for m in ep.history()))
+    stop1.set()
+    th1.join(timeout=5)
+    drv1.close()
+    assert wait_until(lambda: not ep.peers().get("engine"))
+    # the robot keeps publishing its joint state; a fresh engine joins mid-handover
+    ep.publish_joint_state(1.0, {"head_pan": 0.4, "right_j0": 0.1})
+    engine2 = FakeEngine()
+    node2, drv2, _, th2 = engine_side(bus, engine=engine2)
+    assert wait_until(lambda: connected(ep, drv2))
+    ep.publish_joint_state(1.0, {"head_pan": 0.4, "right_j0": 0.1})
+    replayed = node2.start()
+    assert [e.kind for e in engine2.resynced] == [
+        EventKind.ROBOT_REACH_STARTED, EventKind.REACH_STARTED]
+    assert replayed == 2 and engine2.phase.value == "reach"
+    assert engine2.reset_heads == [{"head_pan": 0.4}]
+    # the replayed robot event is not notified a second time
+    node2.tick()
+    assert engine2.notified == []
+
+
+def test_history_replays_only_the_current_handover():
+    ev = [Event(k, t, t) for k, t in [
+        (EventKind.REACH_STARTED, 1), (EventKind.HANDOVER_DONE, 5), (EventKind.REACH_STARTED, 8),
+        (EventKind.ROBOT_REACH_STARTED, 7.5)]]
+    assert [e.t for e in current_handover(ev)] == [7.5, 8]
+    assert [e.kind for e in current_handover(ev[:2])] == [EventKind.HANDOVER_DONE]
+    assert current_handover([]) == []
+
+
+def test_robot_gone_engine_keeps_running_and_reports_peer_lost(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    events = Recorder(drv.session, drv.keys.events, EventMsg)
+    status = Recorder(drv.session, drv.keys.status, StatusMsg)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(5)
+    ep.publish_tracking(frame(0.0))
+    assert wait_until(lambda: node.frames_processed == 1)
+    ep.close()
+    ep.session.close()  # the simulator process is gone
+    assert wait_until(lambda: events.where(kind="peer_lost"))
+    assert events.where(kind="peer_lost")[0].info == {"peer": "sim"}
+    assert wait_until(lambda: any(s.peers == {"sim": False} and s.state == "degraded"
+                                  for s in status.msgs))
+    n = len(status.msgs)
+    assert wait_until(lambda: len(status.msgs) > n + 2)  # still beating
+    assert th.is_alive()
+
+
+def test_robot_whose_heartbeat_stops_counts_as_lost(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus, peer_timeout=0.2)
+    events = Recorder(drv.session, drv.keys.events, EventMsg)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(5)
+    ep.heartbeat()
+    assert wait_until(lambda: drv.peers() == {"sim": True})
+    # the simulator hangs: its session (and token) stays, its heartbeats stop
+    assert wait_until(lambda: events.where(kind="peer_lost"))
+    ep.heartbeat()
+    assert wait_until(lambda: events.where(kind="peer_restored"))
+
+
+class CountingRenderer:
+    def __init__(self):
+        self.calls = 0
+
+    def render(self, yaw, pitch, blink=0.0):
+        self.calls += 1
+        return np.full((24, 40, 3), 200, np.uint8)
+
+
+def test_eye_frames_are_rendered_only_while_someone_subscribes(bus):
+    ep = robot_side(bus)  # draws its own eyes: does not ask for frames
+    drv = ZenohRobotDriver(bus.connector(), bus.config().keys, "engine")
+    bus.closers.append(drv.close)
+    renderer = CountingRenderer()
+    node = EngineNode(FakeEngine(), drv, FAST, eye_renderer=renderer)
+    assert wait_until(lambda: connected(ep, drv))
+    for i in range(5):
+        node.on_tracking(ep.publish_tracking(frame(i / 120)))
+    assert renderer.calls == 0 and node.commands_sent == 5
+    # a display that wants frames joins
+    viewer = ZenohRobotEndpoint(bus.connector(), bus.config().keys, "display", eye_frames=True)
+    bus.closers.append(viewer.close)
+    assert wait_until(drv.wants_eye_frames)
+    node.on_tracking(ep.publish_tracking(frame(1.0)))
+    assert renderer.calls == 1
+    assert wait_until(lambda: viewer.eye_frame.peek() is not None)
+    assert viewer.eye_frame.peek().image().shape == (24, 40, 3)

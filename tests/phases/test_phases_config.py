@@ -1,0 +1,84 @@
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from gazebot.config import ConfigError
+from gazebot.phases import PhaseConfig, default_phase_config_path, load_phase_config
+
+
+def test_defaults_are_the_seed_transfer_rule():
+    c = PhaseConfig()
+    assert c.transfer_distance_margin == pytest.approx(0.20)
+    assert c.transfer_speed_max == pytest.approx(0.15)
+
+
+def test_seed_text_states_the_default_thresholds(seed_text):
+    text = " ".join(seed_text.split())
+    m = re.search(r"within (\d+)\s?cm of the minimum distance.*?less than (\d+)\s?cm/s", text)
+    assert m, "seed section 7.2.5 rule not found"
+    c = PhaseConfig()
+    assert int(m.group(1)) / 100 == pytest.approx(c.transfer_distance_margin)
+    assert int(m.group(2)) / 100 == pytest.approx(c.transfer_speed_max)
+
+
+def test_shipped_yaml_equals_the_defaults():
+    assert default_phase_config_path().is_file()
+    assert load_phase_config(None) == PhaseConfig()
+
+
+def test_yaml_override_is_loaded(tmp_path):
+    f = tmp_path / "p.yaml"
+    f.write_text("transfer_speed_max: 0.1\ntransfer_exit_speed: 0.12\n")
+    c = load_phase_config(f)
+    assert c.transfer_speed_max == 0.1 and c.transfer_exit_speed == 0.12
+    assert c.transfer_distance_margin == 0.20  # untouched fields keep the defaults
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ("transfer_speed_max: fast\n", "transfer_speed_max"),
+        ("transfer_speed_max: -0.1\n", "transfer_speed_max"),
+        ("transfer_speeed_max: 0.1\n", "transfer_speeed_max"),
+        ("transfer_speed_max: 0.3\n", "<root>"),  # above the exit speed: no hysteresis
+        ("load_share_robot: 1.5\n", "load_share_robot"),
+        ("settle_speed: 0.2\n", "<root>"),
+    ],
+)
+def test_bad_yaml_names_the_field(tmp_path, text, field):
+    f = tmp_path / "bad.yaml"
+    f.write_text(text)
+    with pytest.raises(ConfigError) as exc:
+        load_phase_config(f)
+    assert exc.value.field == field
+    assert str(f) in str(exc.value)
+
+
+def test_missing_file_is_a_config_error(tmp_path):
+    with pytest.raises(ConfigError):
+        load_phase_config(tmp_path / "nope.yaml")
+
+
+def test_typical_durations_match_the_human_annotations(annotations_dir):
+    """The typical phase durations are the giver's means in the published annotations
+    (288 handovers at 8 fps; seed section 6.2)."""
+    openpyxl = pytest.importorskip("openpyxl")
+    counts: dict[str, list[float]] = {"Reach": [], "Transfer": [], "Retreat": []}
+    files = sorted(annotations_dir.glob("*/*.xlsx"))
+    assert len(files) == 288
+    for f in files:
+        sheet = openpyxl.load_workbook(f, read_only=True).active
+        labels = []
+        for row in list(sheet.iter_rows(values_only=True))[1:]:
+            if row[0] is None:
+                break  # rows end at the first empty frame number
+            labels.append(str(row[2]).strip() if row[2] is not None else "")
+        for k, v in counts.items():
+            v.append(labels.count(k) / 8.0)
+    c = PhaseConfig()
+    mean = {k: sum(v) / len(v) for k, v in counts.items()}
+    assert mean["Reach"] == pytest.approx(c.reach_duration, abs=0.05)
+    assert mean["Transfer"] == pytest.approx(c.transfer_duration, abs=0.02)
+    assert mean["Retreat"] == pytest.approx(c.retreat_duration, abs=0.02)

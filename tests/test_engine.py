@@ -1,0 +1,165 @@
+"""The engine end to end without a simulator: tracking frames in, head and eye commands out."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gazebot import Event, EventKind, GazeEngine, Phase, TrackingFrame
+
+
+def _min_jerk(s: np.ndarray) -> np.ndarray:
+    s = np.clip(s, 0.0, 1.0)
+    return 10 * s**3 - 15 * s**4 + 6 * s**5
+
+
+def handover_frames(rate: float = 120.0, seed: int = 0) -> list[TrackingFrame]:
+    """A scripted human-to-robot handover: the giver reaches (1.0-2.0 s), both hold the object
+    (2.0-2.6 s), the giver retreats (2.6-3.6 s); the gripper reaches a little later and stays."""
+    rng = np.random.default_rng(seed)
+    face = np.array([1.15, 0.0, 1.6])
+    hand_rest = np.array([1.0, -0.35, 0.85])
+    meet = np.array([0.7, -0.2, 1.0])
+    grip_home = np.array([0.35, 0.0, 0.9])
+    grip_meet = meet + np.array([-0.03, 0.0, 0.0])
+    frames = []
+    for t in np.arange(0.0, 5.0, 1.0 / rate):
+        if t < 2.6:
+            hand = hand_rest + (meet - hand_rest) * _min_jerk((t - 1.0) / 1.0)
+        else:
+            hand = meet + (hand_rest - meet) * _min_jerk((t - 2.6) / 1.0)
+        grip = grip_home + (grip_meet - grip_home) * _min_jerk((t - 1.2) / 0.9)
+        noise = rng.normal(0.0, 0.002, size=(2, 3))
+        frames.append(
+            TrackingFrame.make(t, giver_hand=hand + noise[0], receiver_hand=grip + noise[1],
+                               giver_face=face)
+        )
+    return frames
+
+
+@pytest.fixture(scope="module")
+def engine() -> GazeEngine:
+    return GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
+
+
+def run(engine: GazeEngine, frames: list[TrackingFrame]):
+    engine.reset()
+    return [engine.step(f) for f in frames]
+
+
+def _runs(values: list[str]) -> list[str]:
+    out: list[str] = []
+    for v in values:
+        if not out or out[-1] != v:
+            out.append(v)
+    return out
+
+
+def test_phases_run_in_order_reach_transfer_retreat(engine):
+    commands = run(engine, handover_frames())
+    phases = [c.phase for c in commands if c.phase in (Phase.REACH, Phase.TRANSFER, Phase.RETREAT)]
+    assert _runs([p.value for p in phases]) == ["reach", "transfer", "retreat"]
+
+
+def test_face_hand_face_targets_face_then_hand_then_face(engine):
+    commands = run(engine, handover_frames())
+    assert _runs([c.target for c in commands]) == ["face", "hand", "face"]
+
+
+def test_every_command_is_finite_and_within_head_limits(engine):
+    commands = run(engine, handover_frames())
+    lower, upper = engine.robot.lower, engine.robot.upper
+    for c in commands:
+        assert c.is_finite()
+        q = np.array([c.head[j] for j in engine.robot.head_joints])
+        assert np.all(q >= lower - 1e-9) and np.all(q <= upper + 1e-9)
+
+
+def test_head_turns_toward_the_hand_when_the_target_changes(engine):
+    commands = run(engine, handover_frames())
+    first_hand = next(i for i, c in enumerate(commands) if c.target == "hand")
+    settled = commands[min(first_hand + 120, len(commands) - 1)]  # 1 s later
+    before = commands[first_hand - 1]
+    # Sawyer's head pans; the hand is to the robot's right of the face (y < 0) and lower.
+    pan_before, pan_after = before.head["head_pan"], settled.head["head_pan"]
+    assert pan_after < pan_before - math.radians(5)
+    # The head turned most of the way: the eyes only cover the rest.
+    assert abs(settled.eye_yaw) < abs(pan_after - pan_before)
+    assert settled.eye_pitch > before.eye_pitch  # looks down toward the hand
+    assert settled.residual < math.radians(1.0)
+
+
+def test_missing_tracking_never_produces_a_non_finite_command(engine):
+    frames = handover_frames()
+    holey = [
+        TrackingFrame.make(f.t) if 150 <= i < 200 else f  # 0.4 s with no tracking at all
+        for i, f in enumerate(frames)
+    ]
+    for c in run(engine, holey):
+        assert c.is_finite()
+        assert np.all(np.isfinite(c.target_point))
+
+
+def test_out_of_order_frames_do_not_move_time_backwards(engine):
+    frames = handover_frames()
+    shuffled = frames[:300] + [frames[100], frames[50]] + frames[300:]
+    commands = run(engine, shuffled)
+    ts = [c.t for c in commands]
+    assert all(b >= a for a, b in zip(ts, ts[1:]))
+    assert all(c.is_finite() for c in commands)
+
+
+def test_resync_after_restart_resumes_the_handover_phase(engine):
+    frames = handover_frames()
+    commands = run(engine, frames[:260])  # into the transfer (t ~ 2.17 s)
+    assert commands[-1].phase == Phase.TRANSFER
+    published = [e for c in commands for e in c.events]
+    fresh = GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
+    fresh.resync(published)
+    cmd = fresh.step(frames[260])
+    assert cmd.phase == Phase.TRANSFER
+    assert cmd.target == "hand"
+
+
+def test_robot_events_reach_the_behavior(engine):
+    long_fh = GazeEngine.from_config(robot="sawyer", behavior="long-face-hand")
+    frames = handover_frames()
+    commands = []
+    for f in frames:
+        if abs(f.t - 1.2) < 1e-9:
+            long_fh.notify(Event(EventKind.ROBOT_REACH_STARTED, f.t, f.t, {"planned_duration": 0.9}))
+        if abs(f.t - 2.1) < 1e-9:
+            long_fh.notify(Event(EventKind.ROBOT_REACH_ENDED, f.t, f.t))
+        commands.append(long_fh.step(f))
+    first_hand = next(c.t for c in commands if c.target == "hand")
+    assert 2.1 - 1e-6 <= first_hand < 2.2
+
+
+def test_behavior_naming_a_point_the_robot_lacks_is_rejected_with_file_and_field(tmp_path):
+    from gazebot.config import ConfigError
+
+    path = tmp_path / "look-at-lamp.yaml"
+    path.write_text(
+        "segments:\n"
+        "  - {phase: reach, at: 0.0, target: face}\n"
+        "  - {phase: transfer, at: 0.0, target: lamp}\n"
+    )
+    with pytest.raises(ConfigError) as err:
+        GazeEngine.from_config(robot="sawyer", behavior=path)
+    assert "targets" in str(err.value) and "lamp" in str(err.value)
+
+
+def test_example_user_behavior_runs_and_looks_at_the_dropoff_point():
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "look-at-dropoff.yaml"
+    eng = GazeEngine.from_config(robot="sawyer", behavior=example)
+    frames = handover_frames()
+    targets = []
+    for f in frames:
+        if abs(f.t - 2.7) < 1e-9:
+            eng.notify(Event(EventKind.ROBOT_RETREAT_STARTED, f.t, f.t, {"planned_duration": 1.0}))
+        targets.append(eng.step(f).target)
+    assert _runs(targets)[:3] == ["face", "hand", "dropoff"]
