@@ -1,1 +1,2 @@
-"""gazebot's benchmarks: each ``bench_*.py`` module times real work against a peer in the same run."""
+"""gazebot's benchmarks: each ``bench_*.py`` module times real work against a peer in the
+same run."""

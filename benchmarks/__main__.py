@@ -12,12 +12,14 @@ from benchmarks.common import print_results
 
 
 def main(argv: list[str]) -> int:
-    names = sorted(m.name for m in pkgutil.iter_modules(benchmarks.__path__) if m.name.startswith("bench_"))
+    names = sorted(
+        m.name for m in pkgutil.iter_modules(benchmarks.__path__) if m.name.startswith("bench_")
+    )
     if argv:
         names = [n for n in names if any(a in n for a in argv)]
     for name in names:
         module = importlib.import_module(f"benchmarks.{name}")
-        print(f"\n## {name[len('bench_'):]}")
+        print(f"\n## {name[len('bench_') :]}")
         print_results(module.run())
     return 0
 

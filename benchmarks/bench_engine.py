@@ -10,7 +10,7 @@ import numpy as np
 
 from benchmarks.common import Result, median_time
 from gazebot import GazeEngine
-from tests.test_engine import handover_frames
+from gazebot.phases.synthetic import SyntheticOptions, generate
 
 
 def _hand_written_peer(frames):
@@ -30,7 +30,8 @@ def _hand_written_peer(frames):
 
 
 def run() -> list[Result]:
-    frames = handover_frames(rate=120.0)
+    recording = generate(seed=3, options=SyntheticOptions(rate=120.0, posture="standing"))
+    frames = recording.trajectory.frames()
     results = []
     for robot in ("sawyer", "jaco2"):
         engine = GazeEngine.from_config(robot=robot, behavior="face-hand-face")
@@ -47,7 +48,12 @@ def run() -> list[Result]:
         ours = median_time(step, repeat=7, number=n) * 1e6
         peer = median_time(_hand_written_peer(frames), repeat=7, number=n) * 1e6
         results.append(
-            Result(f"engine.step, {robot}, face-hand-face, 120 Hz handover", ours, peer, "us/step",
-                   "hand-written distance rule + atan2")
+            Result(
+                f"engine.step, {robot}, face-hand-face, 120 Hz handover",
+                ours,
+                peer,
+                "us/step",
+                "hand-written distance rule + atan2",
+            )
         )
     return results

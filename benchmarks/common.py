@@ -32,7 +32,9 @@ class Result:
         return self.ours / self.peer if self.higher_is_better else self.peer / self.ours
 
 
-def median_time(fn: Callable[[], object], repeat: int = 7, number: int = 1, warmup: int = 1) -> float:
+def median_time(
+    fn: Callable[[], object], repeat: int = 7, number: int = 1, warmup: int = 1
+) -> float:
     """Median wall time of ``number`` calls of ``fn`` over ``repeat`` runs, per call (s)."""
     for _ in range(warmup):
         fn()

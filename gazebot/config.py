@@ -1,4 +1,4 @@
-"""Loading YAML configuration into pydantic models with errors that name file, field and expectation.
+"""Loading YAML configuration into pydantic models, with errors naming file, field and expectation.
 
 Every package validates its own YAML through :func:`load_model`; nothing reads YAML by hand.
 """

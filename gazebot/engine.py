@@ -26,7 +26,6 @@ from gazebot.types import (
     is_valid_point,
 )
 
-
 # Targets the engine fills from tracking each tick; all others come from the robot config.
 _TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
 
@@ -121,8 +120,11 @@ class GazeEngine:
         points.update(face=face, hand=hand, object=hand, receiver_hand=receiver)
         return points
 
-    def step(self, frame: TrackingFrame) -> GazeCommand:
+    def step(self, frame: TrackingFrame, arm: Mapping[str, float] | None = None) -> GazeCommand:
         """Advance one tick with ``frame`` and return the command for the head and the eyes.
+
+        ``arm`` is the robot's measured arm joint positions (rad) by name; pass it when the arm
+        carries the head (Sawyer's head sits on ``right_j0``) so the head goals compensate.
 
         Out-of-order frames are handed to the phase detector (which ignores them) and answered
         with the previous command's goals, so the output never jumps back in time.
@@ -146,7 +148,7 @@ class GazeEngine:
             points=self._points(frame),
         )
         target = self.behavior.target(ctx)
-        state = self.gaze.update(t, target.point)
+        state = self.gaze.update(t, target.point, arm=arm)
         return GazeCommand(
             t=t,
             phase=ctx.phase,
@@ -157,6 +159,32 @@ class GazeEngine:
             eye_pitch=state.eye_pitch,
             residual=state.residual,
             events=tuple(events),
+        )
+
+    def look_at(
+        self,
+        t: float,
+        point: np.ndarray,
+        target: str = "face",
+        arm: Mapping[str, float] | None = None,
+    ) -> GazeCommand:
+        """Point the head and eyes at a fixed ``point`` (base frame, m), bypassing the behavior.
+
+        A fallback for a robot stack, e.g. the last face position while tracking is lost; the
+        gaze shift timing and limits still apply. The phase is left as it is.
+        """
+        t = max(t, self._last_t) if math.isfinite(t) else self._last_t
+        self._last_t = t
+        state = self.gaze.update(t, point, arm=arm)
+        return GazeCommand(
+            t=t,
+            phase=self.detector.phase,
+            target=target,
+            target_point=np.asarray(point, float),
+            head=state.head,
+            eye_yaw=state.eye_yaw,
+            eye_pitch=state.eye_pitch,
+            residual=state.residual,
         )
 
     def resync(self, events: list[Event]) -> None:

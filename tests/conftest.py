@@ -21,7 +21,8 @@ SHARED_DATA = Path(os.environ.get("GAZEBOT_SHARED_DATA", REPO.parent / "shared" 
 
 @pytest.fixture(scope="session")
 def annotations_dir() -> Path:
-    """The human-human gaze annotations (288 handovers), or a skip saying where they were looked for."""
+    """The human-human gaze annotations (288 handovers), or a skip saying where they were
+    looked for."""
     path = SHARED_DATA / "handover-gaze-annotations"
     if not path.is_dir():
         pytest.skip(

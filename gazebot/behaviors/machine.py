@@ -29,13 +29,13 @@ Rules for imperfect event streams (``handle`` never raises):
   last known face position (the policy's target) until ``tracking_restored``; phases keep
   advancing meanwhile, so on restore the gaze resumes where the behavior now is.
 
-"Halfway" (and any fraction of a phase) needs the phase's end online. The estimate, in order of
-preference: ``ctx.expected_phase_end`` (the phase detector's prediction, e.g. the giver's time to
-contact, because the seed times the shift on the human's reach), an ``expected_end`` in the phase
-event's info, the robot's own motion end (``robot_reach_started``/``robot_retreat_started`` time +
-``planned_duration``) for reach/retreat, and finally ``phase_durations_s`` of the spec (the human
-mean phase lengths). The estimate is re-read every tick; a segment that has started stays started,
-so a revised estimate never moves the gaze back.
+"Halfway" (and any fraction of a phase) needs the phase's end online. A reach ends when both
+hands have arrived and a retreat when both are back, so the estimate is the latest of those known:
+``ctx.expected_phase_end`` (the phase detector's prediction from the giver's and the gripper's
+motion), an ``expected_end`` in the phase event's info, and the robot's own motion end
+(``robot_reach_started``/``robot_retreat_started`` time + ``planned_duration``); with none known,
+``phase_durations_s`` of the spec (the human mean phase lengths). The estimate is re-read every
+tick; a segment that has started stays started, so a revised estimate never moves the gaze back.
 
 Points: the returned point is ``ctx.points[kind]`` (the hand moves: it is read every call). When
 that point is missing (NaN or an unknown named point) the last finite position of that kind is
@@ -343,18 +343,26 @@ class BehaviorMachine:
 
     # ----------------------------------------------------------------- gaze timing
     def _expected_end(self, ctx_end: float) -> float:
+        # A reach ends when both hands have arrived and a retreat when both are back, so the
+        # latest of the estimates at hand wins (the giver's predicted arrival, the robot's plan).
         start = self._phase_start
-        if _finite(ctx_end) and ctx_end > start:
-            return float(ctx_end)
-        if _finite(self._phase_expected_end) and self._phase_expected_end > start:
-            return self._phase_expected_end
+        candidates = [
+            end
+            for end in (ctx_end, self._phase_expected_end, self._robot_motion_end())
+            if _finite(end) and end > start
+        ]
+        if candidates:
+            return float(max(candidates))
+        return start + self.spec.phase_durations_s.of(self._phase)
+
+    def _robot_motion_end(self) -> float:
+        """End of the robot's own reach/retreat (start + planned duration), NaN if unknown."""
         motion = _ROBOT_MOTION.get(self._phase)
         ev = self._robot.get(motion) if motion is not None else None
-        if ev is not None and ev.t >= self._handover_t0:
-            planned = ev.info.get("planned_duration")
-            if _finite(planned) and planned > 0 and ev.t + planned > start:
-                return ev.t + float(planned)
-        return start + self.spec.phase_durations_s.of(self._phase)
+        if ev is None or ev.t < self._handover_t0:
+            return math.nan
+        planned = ev.info.get("planned_duration")
+        return ev.t + float(planned) if _finite(planned) and planned > 0 else math.nan
 
     def _anchor_time(self, at: AtEvent) -> float:
         """When the ``after`` event of the current handover happened (NaN if it did not yet)."""

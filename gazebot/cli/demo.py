@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -34,23 +35,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run_demo(args: argparse.Namespace) -> int:
     from gazebot.render.timeline import phase_spans, plot_timeline, write_timeline_csv
-    from gazebot.render.video import record_handover
+    from gazebot.sim.gl_check import OffscreenRenderingError
 
     out: Path = args.out
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    rec = record_handover(
-        robot=args.robot,
-        behavior=args.behavior,
-        scene=args.scene,
-        out_path=out / "handover.mp4",
-        seed=args.seed,
-        width=args.width,
-        height=args.height,
-        progress=not args.no_progress,
-    )
+    try:
+        rec = _record(args, out)
+    except OffscreenRenderingError as exc:
+        print(f"gazebot: error: {exc}", file=sys.stderr)
+        return 2
     csv_path = write_timeline_csv(rec.ticks, out / "timeline.csv")
     title = f"{Path(str(args.robot)).stem} - {Path(str(args.behavior)).stem} - {args.scene}"
     png_path = plot_timeline(rec.ticks, out / "timeline.png", title=title)
@@ -83,3 +79,18 @@ def run_demo(args: argparse.Namespace) -> int:
         print("gazebot: warning: the handover did not finish in time; the video is cut")
         return 1
     return 0
+
+
+def _record(args: argparse.Namespace, out: Path):
+    from gazebot.render.video import record_handover
+
+    return record_handover(
+        robot=args.robot,
+        behavior=args.behavior,
+        scene=args.scene,
+        out_path=out / "handover.mp4",
+        seed=args.seed,
+        width=args.width,
+        height=args.height,
+        progress=not args.no_progress,
+    )

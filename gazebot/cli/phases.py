@@ -24,7 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "through the causal detector the engine runs."
         ),
     )
-    p.add_argument("file", help="trajectory CSV")
+    p.add_argument("file", metavar="FILE.csv", help="trajectory CSV")
     p.add_argument("--online", action="store_true", help="replay through the online detector")
     p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     p.add_argument(

@@ -4,6 +4,7 @@ side, eyes on the head display) to an H.264 MP4, deterministic for a seed."""
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 
@@ -25,19 +26,24 @@ def register(kinds: argparse._SubParsersAction) -> None:
 
 def run_render_video(args: argparse.Namespace) -> int:
     from gazebot.render.video import render_handover_video
+    from gazebot.sim.gl_check import OffscreenRenderingError
 
     if args.out.suffix.lower() != ".mp4":
         raise ValueError(f"--out must name an .mp4 file, got {args.out}")
-    path = render_handover_video(
-        args.robot,
-        args.behavior,
-        args.scene,
-        args.out,
-        seed=args.seed,
-        width=args.width,
-        height=args.height,
-        fps=args.fps,
-        progress=not args.no_progress,
-    )
+    try:
+        path = render_handover_video(
+            args.robot,
+            args.behavior,
+            args.scene,
+            args.out,
+            seed=args.seed,
+            width=args.width,
+            height=args.height,
+            fps=args.fps,
+            progress=not args.no_progress,
+        )
+    except OffscreenRenderingError as exc:
+        print(f"gazebot: error: {exc}", file=sys.stderr)
+        return 2
     print(f"wrote {path}")
     return 0

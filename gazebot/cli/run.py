@@ -61,12 +61,16 @@ def build_engine_node(
     phases: str | None = None,
     config: Any = None,
     eye_frames: bool = True,
+    engine: Any = None,
 ) -> Any:
-    """A :class:`~gazebot.drivers.engine_node.EngineNode` running ``GazeEngine.from_config``."""
+    """A :class:`~gazebot.drivers.engine_node.EngineNode` running ``engine`` (default:
+    ``GazeEngine.from_config(robot, behavior, phases, seed=seed)``), with blinks and lazily
+    rendered eye frames."""
     from gazebot.drivers.engine_node import EngineNode
     from gazebot.engine import GazeEngine
 
-    engine = GazeEngine.from_config(robot=robot, behavior=behavior, phases=phases, seed=seed)
+    if engine is None:
+        engine = GazeEngine.from_config(robot=robot, behavior=behavior, phases=phases, seed=seed)
     try:
         from gazebot.render import BlinkModel
 
@@ -87,11 +91,15 @@ def handle(args: argparse.Namespace) -> int:
     node_cfg = EngineNodeConfig(
         hold_timeout=args.hold_timeout, face_timeout=args.face_timeout, resync=not args.no_resync
     )
+    from gazebot.engine import GazeEngine
+
+    # Build the engine before joining the bus: samples arriving meanwhile would only go stale.
+    engine = GazeEngine.from_config(args.robot, args.behavior, args.phases, seed=args.seed)
     driver = ZenohRobotDriver.open(cfg, "engine")
     try:
         node = build_engine_node(args.robot, args.behavior, driver, seed=args.seed,
-                                 phases=args.phases, config=node_cfg,
-                                 eye_frames=not args.no_eye_frames)
+                                 config=node_cfg, eye_frames=not args.no_eye_frames,
+                                 engine=engine)
         print(
             f"gazebot run: {args.behavior} on {node.engine.robot.name} at gazebot/{cfg.robot_id}/ "
             f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})",

@@ -12,6 +12,8 @@ Faults (each pinned by ``tests/drivers``):
   (``GazeEngine.resync``), then reports ``engine_resynced``.
 * robot gone: the loop keeps running; ``peer_lost``/``peer_restored`` events and the status'
   ``peers`` and ``state: degraded`` report it.
+* robot clock restart (a sample older than the last by ``clock_reset``): event
+  ``tracking_clock_reset``, then the same resynchronisation as at start.
 * malformed payloads: dropped by the driver, counted in the status' ``dropped``.
 """
 
@@ -50,10 +52,10 @@ class EngineLike(Protocol):
     """What the node needs of :class:`gazebot.engine.GazeEngine`."""
 
     robot: Any  # .name, .head_joints, .points
-    gaze: Any  # .update(t, point) -> state with .head, .eye_yaw, .eye_pitch, .residual
     behavior: Any  # .state
 
-    def step(self, frame: Any) -> GazeCommand: ...
+    def step(self, frame: Any, arm: Any = None) -> GazeCommand: ...
+    def look_at(self, t: float, point: Any, target: str = "face") -> GazeCommand: ...
     def notify(self, event: Event) -> None: ...
     def resync(self, events: list[Event]) -> None: ...
     def reset(self, head: Any = None) -> None: ...
@@ -71,6 +73,8 @@ class EngineNodeConfig:
         resync: Catch up with a handover under way at start (events + joint state).
         resync_timeout: How long to wait at start for the joint state and the event history.
         eye_frame_rate: Maximum rate of rendered eye frames (only while someone subscribes).
+        clock_reset: A sample this much older than the previous one (s) means the robot's
+            clock restarted: the engine is reset and resynchronised.
     """
 
     hold_timeout: float = 0.25
@@ -80,10 +84,11 @@ class EngineNodeConfig:
     resync: bool = True
     resync_timeout: float = 1.0
     eye_frame_rate: float = 30.0
+    clock_reset: float = 0.5
 
     def __post_init__(self) -> None:
         for name in ("hold_timeout", "face_timeout", "fallback_rate", "heartbeat_period",
-                     "resync_timeout", "eye_frame_rate"):
+                     "resync_timeout", "eye_frame_rate", "clock_reset"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(
@@ -272,6 +277,13 @@ class EngineNode:
     def on_tracking(self, msg: TrackingMsg) -> None:
         """Step the engine with one sample and send the command."""
         now = self.clock()
+        if msg.t < self._last_t - self.config.clock_reset:
+            # The robot's clock went back (e.g. the simulator restarted): the engine would
+            # ignore every sample as out of order, so start over from the robot's state.
+            self.emit("tracking_clock_reset", t=msg.t, previous_t=self._last_t)
+            self._last_t = math.nan
+            self._last_face = None
+            self.resync()
         if self.tracking in ("hold", "lost"):
             self.emit("tracking_resumed", t=msg.t, silence=now - self._last_frame_wall)
         self.tracking = "ok"
@@ -280,7 +292,9 @@ class EngineNode:
         frame = msg.to_frame()
         if is_valid_point(frame.giver_face):
             self._last_face = frame.giver_face
-        cmd = self.engine.step(frame)
+        # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
+        joints = self.driver.joint_state()
+        cmd = self.engine.step(frame, arm=joints.position if joints is not None else None)
         self.frames_processed += 1
         for event in cmd.events:
             if category_of(event.kind.value) == "phase":
@@ -322,17 +336,7 @@ class EngineNode:
     def _look_at_last_face(self) -> None:
         face = self._face()
         t = self._now_t()
-        state = self.engine.gaze.update(t, face)
-        cmd = GazeCommand(
-            t=t,
-            phase=getattr(self.engine, "phase", "idle"),
-            target="face",
-            target_point=face,
-            head=dict(state.head),
-            eye_yaw=float(state.eye_yaw),
-            eye_pitch=float(state.eye_pitch),
-            residual=float(getattr(state, "residual", 0.0)),
-        )
+        cmd = self.engine.look_at(t, face, target="face")
         self._send(cmd, answers=None, mode="last_face")
 
     def _send(self, cmd: GazeCommand, answers: int | None, mode: str) -> None:

@@ -153,8 +153,8 @@ class TrackingMsg(Msg):
 
 
 class JointStateMsg(Msg):
-    """``gazebot/<id>/joint_states``: measured joint positions by joint name (rad; the
-    ``gripper`` actuator 0 = open .. 1 = closed)."""
+    """``gazebot/<id>/joint_states``: measured joint positions by joint name (rad for revolute,
+    m for prismatic joints; head, arm and gripper joints as the robot names them)."""
 
     seq: Seq
     t: float

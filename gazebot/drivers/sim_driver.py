@@ -36,10 +36,7 @@ def apply_arm_command(sim: Any, msg: ArmCommandMsg) -> None:
     """
     robot = sim.robot
     if msg.resume:
-        release = getattr(sim, "release_arm", None)
-        if release is None:
-            raise ValueError("this simulation cannot hand the arm back to its controller")
-        release()
+        sim.release_arm()
         return
     if msg.pose is not None:
         goal = dict(zip(robot.arm_joints, (float(q) for q in getattr(robot, msg.pose)),

@@ -113,7 +113,7 @@ class ZenohRobotEndpoint(ZenohNode):
         return msg
 
     def publish_joint_state(self, t: float, position: Mapping[str, float]) -> JointStateMsg:
-        """Publish the measured joint positions (rad; ``gripper`` 0..1)."""
+        """Publish the measured joint positions (rad or m, by joint name)."""
         msg = JointStateMsg(
             seq=self._joint_seq,
             t=float(t),

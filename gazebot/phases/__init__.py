@@ -1,8 +1,16 @@
 """Handover phase detection: reach, transfer and retreat from tracked hands.
 
-Offline :func:`segment` splits a whole recording; online :class:`PhaseDetector` sees one
-:class:`~gazebot.types.TrackingFrame` at a time (what the engine runs). Both use the seed's
-transfer rule (dissertation section 7.2.5) with thresholds from :class:`PhaseConfig`.
+Both detectors use the seed's transfer rule (dissertation section 7.2.5: hands within 20 cm of
+their minimum distance, relative speed under 15 cm/s) with every threshold in
+:class:`PhaseConfig` (``configs/phases.yaml``).
+
+- Offline, :func:`segment` splits a whole :class:`Trajectory` (see :func:`load_trajectory_csv`)
+  into contiguous :class:`Segment` s per handover.
+- Online, :class:`PhaseDetector` sees one :class:`~gazebot.types.TrackingFrame` at a time (what
+  the engine runs): ``update(frame) -> Event | None`` with ``.phase``, ``.phase_start``,
+  ``.expected_phase_end`` and ``.resync(event)``; :func:`run_online` replays a recording.
+- :mod:`gazebot.phases.synthetic` generates handovers with known phase times for tests and
+  benchmarks.
 """
 
 from gazebot.phases.config import PhaseConfig, default_phase_config_path, load_phase_config

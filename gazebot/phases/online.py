@@ -21,9 +21,10 @@ minimum-jerk profile of human motions:
   not a transfer). The candidate dies when the speed exceeds ``transfer_exit_speed``
   (hysteresis). The event is back-dated to the estimated stop of the approach: the two
   threshold crossings of the parabolic speed tail, extrapolated by ``stop_extrapolation``.
-  Robot evidence (seed section 4.3) short-cuts it: a rising edge of "gripper closed" or of a
+  Robot evidence (seed section 4.3) replaces it: a rising edge of "gripper closed" or of a
   load share above ``load_share_shared`` starts the transfer at once (and reports the reach if
-  it was missed).
+  it was missed). Once the frames carry that evidence, hand motion alone no longer starts a
+  transfer: hands resting close together while the robot has not grasped are a giver waiting.
 - **retreat**: the hands' relative position leaves the held pose by ``release_distance`` at a
   relative speed above ``release_speed``; back-dated like a reach onset. A load share above
   ``load_share_robot`` (the robot alone holds the object: the giver released) starts it at once.
@@ -196,15 +197,18 @@ class PhaseDetector:
         self._last_t = -math.inf
         self._t0 = math.nan  # first accepted time
         self._prev_evidence = False
+        # Set once a frame carries the robot's gripper state or load share: from then on the
+        # robot's own sensing, not hand motion, says when both hold the object.
+        self._robot_reports = False
         self._source = "motion"
         self._lag = 1.0 / (math.pi * c.filter_bandwidth)  # velocity lag behind an acceleration
         self._tail_ratio = math.sqrt(c.transfer_speed_max / c.settle_speed) - 1.0
-        self._rest_tau = 0.1
+        self._rest_tau = 0.1  # s, smoothing of the velocity that decides "at rest"
         self._prev_rs = self._prev_t = math.nan
         # Receiver hand's own motion: rest anchor, onset, speed peak (for the reach's end).
         self._r_rx = self._r_ry = self._r_rz = math.nan
         self._r_on = self._r_tpeak = math.nan
-        self._r_vpeak = self._r_speed = 0.0  # s, smoothing of the speed that decides "at rest"
+        self._r_vpeak = self._r_speed = 0.0
         self._reset_phase_state()
         # Rest anchor of the giver's hand (where the last slow sample was).
         self._rest_t = -math.inf
@@ -254,6 +258,7 @@ class PhaseDetector:
         if between and phase in (Phase.REACH, Phase.TRANSFER):
             self.handover += 1
         self._enter(phase, event.t)
+        self._moved_unknown = phase is Phase.RETREAT
         self._queue.clear()
 
     # ----------------------------------------------------------------- internals
@@ -267,6 +272,9 @@ class PhaseDetector:
         # Transfer: held relative pose (giver -> receiver); retreat: giver hand at the release.
         self._anc_x = self._anc_y = self._anc_z = math.nan
         self._settled = False
+        # A retreat adopted by resync started before this detector saw the hand: how far it
+        # moved since the release is unknown, so rest alone ends it.
+        self._moved_unknown = False
         self._v_peak = 0.0
         self._t_peak = math.nan
         self._slow_since = math.nan
@@ -369,6 +377,8 @@ class PhaseDetector:
         load = frame.load_share
         load_ok = load is not None and math.isfinite(load)
         evidence = grip or (load_ok and load > c.load_share_shared)
+        if frame.gripper_closed is not None or load_ok:
+            self._robot_reports = True
         shared = evidence and not self._prev_evidence
         self._prev_evidence = evidence
         self._source = "gripper" if grip else "load_share"
@@ -527,9 +537,19 @@ class PhaseDetector:
         near = d <= self._d_min + c.transfer_distance_margin
         closed = d <= self._ref_d - c.reach_confirm_distance
         if shared:
-            t0 = self._cand_t0 if self._cand_t0 == self._cand_t0 else t
-            self._start(Phase.TRANSFER, EventKind.TRANSFER_STARTED, t0, t, self._source)
+            # The gripper closing (or the load being shared) is the transfer's start, exactly.
+            self._start(Phase.TRANSFER, EventKind.TRANSFER_STARTED, t, t, self._source)
             return
+        if self._robot_reports:
+            # Hands at rest near each other are not yet a transfer while the robot says it has
+            # not grasped (a giver waiting for a slow gripper); only the reach abort applies.
+            self._cand_t0 = math.nan
+        elif self._cand_t0 != self._cand_t0:
+            if near and closed and rel_speed < c.transfer_speed_max and d <= c.contact_distance_max:
+                self._cand_seen = self._crossing(t, rel_speed, c.transfer_speed_max)
+                self._cand_t0 = self._cand_seen
+                self._cand_d0 = d
+                self._settled = False
         if self._cand_t0 == self._cand_t0:
             if rel_speed > c.transfer_exit_speed or not near:
                 self._cand_t0 = math.nan
@@ -554,11 +574,6 @@ class PhaseDetector:
                         t0 -= self._lag
                     self._start(Phase.TRANSFER, EventKind.TRANSFER_STARTED, t0, t, "motion")
                     return
-        elif near and closed and rel_speed < c.transfer_speed_max and d <= c.contact_distance_max:
-            self._cand_seen = self._crossing(t, rel_speed, c.transfer_speed_max)
-            self._cand_t0 = self._cand_seen
-            self._cand_d0 = d
-            self._settled = False
         # Aborted reach: the giver takes the hand back before any transfer.
         if (
             d > self._d_min + c.transfer_distance_margin
@@ -571,11 +586,15 @@ class PhaseDetector:
         self, t: float, qx: float, qy: float, qz: float, rel_speed: float, released: bool
     ) -> None:
         c = self.config
-        if self._n_ref < 1:
+        first = self._n_ref < 1
+        if first:
             self._n_ref = 1
             self._anc_x, self._anc_y, self._anc_z = qx, qy, qz
         if released:
             self._start(Phase.RETREAT, EventKind.RETREAT_STARTED, t, t, "load_share")
+            # Released before the first sample this detector saw of the transfer (a restart):
+            # the hand may be well on its way back, so rest alone ends the retreat.
+            self._moved_unknown = first
             return
         # Separation from the held relative pose, not only the distance: a release often moves
         # the hand sideways or down first.
@@ -624,7 +643,7 @@ class PhaseDetector:
         at_rest = (
             self._slow_since == self._slow_since
             and t - self._slow_since >= c.rest_hold
-            and moved >= c.min_approach
+            and (moved >= c.min_approach or self._moved_unknown)
         )
         if at_rest:
             t_rest = self._slow_since - self._rest_tau

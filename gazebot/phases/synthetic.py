@@ -73,6 +73,7 @@ class HandoverTruth:
     transfer_start: float
     transfer_end: float
     retreat_end: float
+    grasp: float = float("nan")  # the gripper closes (robot evidence), after the contact
 
     def segments(self, handover: int = 0) -> list[Segment]:
         return [
@@ -195,7 +196,7 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
         t_open = robot_out + carry + 0.2
         grip.move(t_open + 0.1, u(0.9, 1.2), home)
         grip_events.append((t_close, release, t_open))
-        truth.append(HandoverTruth(onset, contact, release, giver_out + retreat))
+        truth.append(HandoverTruth(onset, contact, release, giver_out + retreat, t_close))
         rest = back
         # Next handover: after the hand rests and the robot is home again.
         t = max(giver_out + retreat, t_open + 1.3) + u(0.3, 1.0)

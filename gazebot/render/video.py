@@ -74,6 +74,22 @@ def _direction_change(prev: np.ndarray | None, cur: np.ndarray) -> float:
     return float(np.arccos(np.clip(prev.dot(cur) / (a * b), -1.0, 1.0)))
 
 
+def expected_duration(sim) -> float:
+    """Rough length (s) of the handover ``sim`` will run, for the progress bar: the giver's start,
+    the slower of the two reaches, the grasp, the transfer, the slower retreat and the tail."""
+    plan, ctl, cfg = sim.giver.plan, sim.controller, sim.config.controller
+    robot_reach = ctl.planned_duration(ctl.home, ctl.handover, cfg.reach_min_duration_s)
+    robot_back = ctl.planned_duration(ctl.handover, ctl.home, cfg.retreat_min_duration_s)
+    reach = max(plan.reach_s, 0.25 * plan.reach_s + robot_reach) + cfg.gripper_close_s
+    return (
+        plan.start_t
+        + reach
+        + plan.transfer_s
+        + max(plan.retreat_s, 0.25 * plan.retreat_s + robot_back)
+        + sim.config.tail_s
+    )
+
+
 def record_handover(
     robot: str | Path = "sawyer",
     behavior: str | Path = "face-hand-face",
@@ -110,7 +126,7 @@ def record_handover(
     events: list[Event] = []
     frames, done_at, prev_dir = 0, None, None
     bar = tqdm(
-        total=None,
+        total=int(expected_duration(sim) * fps) + 1 if writer is not None else None,
         unit="frame",
         desc=f"{Path(str(robot)).stem} {Path(str(behavior)).stem}",
         disable=not progress,
@@ -122,7 +138,8 @@ def record_handover(
             for event in sim.robot_events():
                 events.append(event)
                 engine.notify(event)
-            cmd = engine.step(frame)
+            # The measured arm pose: on Sawyer the head rides on right_j0.
+            cmd = engine.step(frame, arm=sim.joint_state())
             sim.apply_head(cmd.head)
             direction = np.asarray(cmd.target_point, float) - gaze_site.xpos
             blink = blinks.update(sim.t, _direction_change(prev_dir, direction))
@@ -159,6 +176,9 @@ def record_handover(
                 break
             sim.step(dt)
     finally:
+        if bar.total is not None and bar.n != bar.total:
+            bar.total = bar.n  # the estimate was off: end the bar where the video ended
+            bar.refresh()
         bar.close()
         if writer is not None:
             writer.close()

@@ -17,6 +17,10 @@ __all__ = ["HandoverSimulation", "SceneConfig", "load_scene", "scene_names"]
 
 def __getattr__(name: str):
     if name == "HandoverSimulation":
+        from gazebot.sim.gl_check import ensure_gl_backend
+
+        # Pick an off-screen GL back end before MuJoCo loads (EGL unless MUJOCO_GL says).
+        ensure_gl_backend(probe_first=False)
         from gazebot.sim.simulation import HandoverSimulation
 
         return HandoverSimulation

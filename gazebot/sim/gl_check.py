@@ -41,26 +41,43 @@ def probe(backend: str, timeout: float = 60.0) -> tuple[bool, str]:
     return proc.returncode == 0, lines[-1] if lines else ""
 
 
-def ensure_gl_backend() -> str:
-    """Use ``MUJOCO_GL`` if set, else the first working of EGL and OSMesa (sets the variables).
+class OffscreenRenderingError(RuntimeError):
+    """MuJoCo could not render off-screen; the message says what to install or set."""
+
+
+def ensure_gl_backend(probe_first: bool = True) -> str:
+    """Choose MuJoCo's GL back end for this process before MuJoCo is imported.
+
+    Uses ``MUJOCO_GL`` if set. Otherwise, with ``probe_first``, the first working of EGL and OSMesa
+    (a child process renders a tiny scene, ~1 s); without it, EGL. Sets ``MUJOCO_GL`` (and
+    ``PYOPENGL_PLATFORM``) for this process and returns the choice.
 
     Raises:
-        RuntimeError: neither back end works; the message names the packages to install.
+        OffscreenRenderingError: probing found no working back end (the message names the
+            packages to install).
     """
     chosen = os.environ.get("MUJOCO_GL")
     if chosen:
         return chosen
     if "mujoco" in sys.modules:  # too late to choose: MuJoCo picked its back end on import
         return "default"
+    if not sys.platform.startswith("linux"):  # macOS/Windows: MuJoCo's own default works
+        return "default"
     errors = {}
-    for backend in BACKENDS:
-        ok, err = probe(backend)
+    for backend in BACKENDS if probe_first else BACKENDS[:1]:
+        ok, err = probe(backend) if probe_first else (True, "")
         if ok:
             os.environ["MUJOCO_GL"] = backend
             os.environ.setdefault("PYOPENGL_PLATFORM", backend)
             return backend
         errors[backend] = err
-    raise RuntimeError(_help(errors))
+    raise OffscreenRenderingError(_help(errors))
+
+
+def explain_failure(exc: BaseException) -> OffscreenRenderingError:
+    """Turn a GL error from MuJoCo into an error that says what to do."""
+    backend = os.environ.get("MUJOCO_GL", "<unset>")
+    return OffscreenRenderingError(_help({backend: f"{type(exc).__name__}: {exc}"}))
 
 
 def _help(errors: dict[str, str]) -> str:
@@ -69,7 +86,8 @@ def _help(errors: dict[str, str]) -> str:
     lines.append("Install one of these system packages and retry, e.g. on Debian/Ubuntu:")
     lines.append("  sudo apt-get install libegl1        # EGL (preferred; GPU or Mesa)")
     lines.append("  sudo apt-get install libosmesa6     # OSMesa (software fallback)")
-    lines.append("then run with MUJOCO_GL=egl or MUJOCO_GL=osmesa.")
+    lines.append("then run with MUJOCO_GL=egl or MUJOCO_GL=osmesa")
+    lines.append("(check with: python -m gazebot.sim.gl_check).")
     return "\n".join(lines)
 
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from gazebot.sim.gl_check import explain_failure
+
 
 class OffscreenRenderer:
     """Renders RGB frames of ``model`` off-screen at ``width`` x ``height``.
@@ -23,9 +25,13 @@ class OffscreenRenderer:
             )
         self.model = model
         self.width, self.height = int(width), int(height)
-        self._gl = mujoco.GLContext(buf_w, buf_h)
-        self._gl.make_current()
-        self.context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
+        self._gl = None
+        try:
+            self._gl = mujoco.GLContext(buf_w, buf_h)
+            self._gl.make_current()
+            self.context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
+        except Exception as exc:  # GL errors come as FatalError, RuntimeError, AttributeError...
+            raise explain_failure(exc) from exc
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self.context)
         self.scene = mujoco.MjvScene(model, maxgeom=max_geom)
         self.option = mujoco.MjvOption()
@@ -61,8 +67,16 @@ class OffscreenRenderer:
         return cam_id
 
     def close(self) -> None:
+        """Free the GL resources with this renderer's own context current: GL object ids are per
+        context, so freeing them under another renderer's context would delete that one's."""
         if self._gl is not None:
             self._gl.make_current()
             self.context.free()
             self._gl.free()
             self._gl = None
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - interpreter shutdown may have torn GL down already
+            pass

@@ -159,7 +159,11 @@ def _add_table(spec: mujoco.MjSpec, x0: float, x1: float, y: float, top: float) 
             )
 
 
-def _layout(cfg: SceneConfig, robot: SimRobot, obj: HandoverObject, dims: GiverDims):
+def _layout(
+    cfg: SceneConfig, robot: SimRobot, obj: HandoverObject, dims: GiverDims
+) -> tuple[SceneLayout, np.ndarray]:
+    """Where the giver stands and holds the object, from the robot's handover pose; also
+    returns the robot's gaze site at that pose."""
     handover, gaze = _robot_fk(robot, robot.handover)
     # The giver's hand is behind the object (on the giver's side, +x) at its center height.
     object_offset = np.array([-(obj.half_extent_x + 0.035), 0.0, 0.0])
@@ -172,7 +176,7 @@ def _layout(cfg: SceneConfig, robot: SimRobot, obj: HandoverObject, dims: GiverD
     shoulder = np.array([offer[0] + standoff, offer[1], shoulder_z])
     table_top = None
     if cfg.has_table:
-        table_top = float(min(0.72, offer[2] - obj.half_height - 0.12))
+        table_top = float(min(0.75, offer[2] - obj.half_height - 0.12))
         rest = shoulder + np.array([-0.27, -0.06, 0.0])
         rest[2] = table_top + obj.half_height + 0.005
     else:
@@ -188,7 +192,9 @@ def _layout(cfg: SceneConfig, robot: SimRobot, obj: HandoverObject, dims: GiverD
     return layout, gaze
 
 
-def _camera(cfg: SceneConfig, layout: SceneLayout, gaze: np.ndarray, face: np.ndarray):
+def _camera(
+    cfg: SceneConfig, layout: SceneLayout, gaze: np.ndarray, face: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The default observer view: from the front right (the side the head turns to when it looks
     at the giver), far enough to see the whole scene, looking at the middle of head, handover
     location and giver. A head standing beside the arm (Jaco-2) is watched from higher up, so
@@ -198,7 +204,7 @@ def _camera(cfg: SceneConfig, layout: SceneLayout, gaze: np.ndarray, face: np.nd
     if look is None:
         look = (gaze + layout.handover_location + face) / 3.0
         look[2] -= 0.0 if beside else 0.05
-    offset = np.array([1.1, -2.1, 0.9]) if beside else np.array([0.9, -2.2, 0.2])
+    offset = np.array([1.1, -2.1, 0.9]) if beside else np.array([0.7, -2.25, 0.2])
     pos = np.array(cfg.camera.pos_m) if cfg.camera.pos_m else look + offset
     return pos, look
 

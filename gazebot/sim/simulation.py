@@ -81,6 +81,7 @@ class HandoverSimulation:
             in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
         ]
 
+        self._arm_lo, self._arm_hi = np.array([self._ctrl_limits(a) for a in self._arm_act]).T
         arm_ranges = np.array([m.jnt_range[m.joint(j).id] for j in self.robot.arm_joints])
         self.home = nearest_equivalent(self.robot.home, self.robot.handover, arm_ranges)
         self.data.qpos[self._arm_qpos] = self.home
@@ -115,14 +116,20 @@ class HandoverSimulation:
             raise ValueError(f"robot {self.robot.name!r} has no position actuator named {name!r}")
         return act
 
+    def _ctrl_limits(self, act: int) -> tuple[float, float]:
+        """The actuator's control range, else its joint's range, else unbounded."""
+        m = self.model
+        if m.actuator_ctrllimited[act]:
+            lo, hi = m.actuator_ctrlrange[act]
+        elif m.jnt_limited[m.actuator_trnid[act, 0]]:
+            lo, hi = m.jnt_range[m.actuator_trnid[act, 0]]
+        else:
+            lo, hi = -np.inf, np.inf
+        return float(lo), float(hi)
+
     def _clip_ctrl(self, act: int, value: float) -> float:
-        lo, hi = self.model.actuator_ctrlrange[act]
-        if self.model.actuator_ctrllimited[act]:
-            return float(np.clip(value, lo, hi))
-        jnt = self.model.actuator_trnid[act, 0]
-        if self.model.jnt_limited[jnt]:
-            return float(np.clip(value, *self.model.jnt_range[jnt]))
-        return float(value)
+        lo, hi = self._ctrl_limits(act)
+        return min(max(float(value), lo), hi)
 
     def _gripper_pose(self) -> tuple[np.ndarray, np.ndarray]:
         pos = self.data.site_xpos[self._gripper_site].copy()
@@ -190,8 +197,7 @@ class HandoverSimulation:
         cmd = self.controller.update(t, self.data.qpos[self._arm_qpos], sensed)
         self._events.extend(self.controller.pop_events())
         if not self._arm_external:
-            for a, q in zip(self._arm_act, cmd.arm, strict=True):
-                self.data.ctrl[a] = self._clip_ctrl(a, q)
+            self.data.ctrl[self._arm_act] = np.clip(cmd.arm, self._arm_lo, self._arm_hi)
         self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, cmd.gripper)
         n = max(1, round((t - self.data.time) / self.model.opt.timestep))
         mujoco.mj_step(self.model, self.data, nstep=n)
@@ -261,6 +267,10 @@ class HandoverSimulation:
         self._arm_external = True
         for name, value in joints.items():
             self.data.ctrl[arm[name]] = self._clip_ctrl(arm[name], float(value))
+
+    def release_arm(self) -> None:
+        """Hand the arm back to the handover controller after :meth:`apply_arm`."""
+        self._arm_external = False
 
     def apply_eyes(
         self, yaw: float, pitch: float, blink: float = 0.0, distance: float | None = None

@@ -115,10 +115,20 @@ def test_face_hand_face_halfway_falls_back_to_the_robot_planned_duration():
     assert kind(m, 2.0, R, 1.0) == "hand"
 
 
-def test_face_hand_face_prefers_the_detector_prediction_over_the_robot_plan():
+def test_face_hand_face_halfway_waits_for_the_later_of_giver_and_robot_arrival():
+    # The reach ends when both hands have arrived: the giver at 1.6 s, the robot at 4.0 s.
     m = machine("face-hand-face")
     m.handle(ev("reach_started", 1.0))
     m.handle(ev("robot_reach_started", 1.0, planned_duration=3.0))
+    assert kind(m, 2.49, R, 1.0, 1.6) == "face"
+    assert kind(m, 2.5, R, 1.0, 1.6) == "hand"  # halfway of the 1.0-4.0 s reach
+
+
+def test_face_hand_face_uses_the_detector_prediction_when_the_robot_arrives_first():
+    m = machine("face-hand-face")
+    m.handle(ev("reach_started", 1.0))
+    m.handle(ev("robot_reach_started", 1.0, planned_duration=0.4))
+    assert kind(m, 1.29, R, 1.0, 1.6) == "face"
     assert kind(m, 1.3, R, 1.0, 1.6) == "hand"  # halfway of the predicted 1.0-1.6 s reach
 
 

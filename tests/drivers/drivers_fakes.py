@@ -65,7 +65,7 @@ class FakeEngine:
         self.frames: list[TrackingFrame] = []
         self._face = self.robot.points["face"]
 
-    def step(self, frame: TrackingFrame) -> GazeCommand:
+    def step(self, frame: TrackingFrame, arm: dict | None = None) -> GazeCommand:
         self.frames.append(frame)
         events = []
         if (
@@ -82,6 +82,13 @@ class FakeEngine:
         return GazeCommand(
             t=frame.t, phase=self.phase, target="face", target_point=self._face, head=st.head,
             eye_yaw=0.0, eye_pitch=0.0, events=tuple(events),
+        )
+
+    def look_at(self, t: float, point: np.ndarray, target: str = "face") -> GazeCommand:
+        st = self.gaze.update(t, point)
+        return GazeCommand(
+            t=t, phase=self.phase, target=target, target_point=np.asarray(point, float),
+            head=st.head, eye_yaw=0.0, eye_pitch=0.0,
         )
 
     def notify(self, event: Event) -> None:

@@ -43,7 +43,8 @@ def start_sim_node(bus, sim):
 
     def close():
         stop.set()
-        th.join(timeout=10)
+        if th.is_alive():
+            th.join(timeout=10)
         ep.close()
 
     bus.closers.append(close)
@@ -122,13 +123,14 @@ def test_engine_restarted_mid_handover_resumes_the_phase_over_the_bus(bus, sim):
     assert second.ready.wait(5)
     assert wait_until(lambda: len([m for m in events.msgs if m.kind == "engine_resynced"]) == 2)
     resync = [m for m in events.msgs if m.kind == "engine_resynced"][-1]
-    assert resync.info["events"] >= 2
+    assert resync.info["events"] >= 2 and resync.info["head_from_joint_state"] is True
     assert resync.info["phase"] in ("transfer", "retreat")
     assert wait_until(lambda: sim.done, timeout=12 / SPEED + 5)
     # the second engine carried on from the transfer: no second reach, the rest in order
     kinds = events.kinds("engine")
     assert kinds.count("reach_started") == 1
-    assert kinds[-1] == "handover_done" and "retreat_started" in kinds
+    trace = [(m.source, m.kind, round(m.t, 2), round(m.detected_at, 2)) for m in events.msgs]
+    assert kinds[-1] == "handover_done" and "retreat_started" in kinds, trace
     assert second.frames_processed > 0
 
 

@@ -259,3 +259,28 @@ def test_eye_frames_are_rendered_only_while_someone_subscribes(bus):
     assert renderer.calls == 1
     assert wait_until(lambda: viewer.eye_frame.peek() is not None)
     assert viewer.eye_frame.peek().image().shape == (24, 40, 3)
+
+
+def test_listening_on_a_taken_endpoint_is_a_clear_error(bus):
+    from gazebot.drivers.session import BusConfig, open_session
+
+    bus.listener()
+    with pytest.raises(ValueError, match="could not open a Zenoh session.*" + bus.endpoint):
+        open_session(BusConfig(bus.robot_id, listen=(bus.endpoint,)))
+
+
+def test_robot_clock_going_back_resets_and_resyncs_the_engine(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    events = Recorder(ep.session, ep.keys.events, EventMsg)
+    assert wait_until(lambda: connected(ep, drv))
+    ep.publish_joint_state(0.0, {"head_pan": 0.2})
+    th.start()
+    assert node.ready.wait(5)
+    ep.publish_tracking(frame(5.0, hand_x=0.5))
+    assert wait_until(lambda: node.engine.phase.value == "reach")
+    ep.publish_joint_state(0.0, {"head_pan": -0.3})
+    ep.publish_tracking(frame(0.0))  # the simulator restarted
+    assert wait_until(lambda: events.where(kind="tracking_clock_reset"))
+    assert wait_until(lambda: node.engine.frames and node.engine.frames[-1].t == 0.0)
+    assert node.engine.reset_heads == [{"head_pan": 0.2}, {"head_pan": -0.3}]

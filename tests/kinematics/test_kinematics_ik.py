@@ -186,4 +186,3 @@ def test_any_target_gives_finite_within_limit_joints(x, y, z, robot_name):
     assert np.all(sol.q >= robot.lower) and np.all(sol.q <= robot.upper)
     if sol.valid:
         assert math.isfinite(sol.total_residual) and math.isfinite(sol.eye_yaw)
-

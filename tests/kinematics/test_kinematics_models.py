@@ -228,3 +228,23 @@ def test_unknown_robot_and_malformed_yaml_give_clear_errors(tmp_path: Path):
     with pytest.raises(ConfigError, match="mjcf"):
         RobotModel.load(missing)
     assert resolve_mjcf(config, path).name == "sawyer.xml"
+
+
+def test_joint_space_move_from_home_to_handover_is_short_and_collision_free(robot):
+    """The simulation moves the arm between the two YAML poses in joint space."""
+    home = np.array([robot.arm_home[j] for j in robot.arm_joints])
+    handover = np.array([robot.arm_handover[j] for j in robot.arm_joints])
+    assert np.all(np.abs(handover - home) < math.pi), "no joint swings half a turn"
+    mj = mujoco.MjModel.from_xml_path(str(robot.mjcf_path))
+    mj.geom_contype[:] = 1  # let every robot geom collide with every other for this check
+    mj.geom_conaffinity[:] = 1
+    data = mujoco.MjData(mj)
+    adr = [mj.joint(j).qposadr[0] for j in robot.arm_joints]
+    for s in np.linspace(0.0, 1.0, 41):
+        data.qpos[:] = 0.0
+        data.qpos[adr] = home + (handover - home) * s
+        mujoco.mj_forward(mj, data)
+        touching = {
+            (mj.geom(c.geom1).name, mj.geom(c.geom2).name) for c in data.contact[: data.ncon]
+        }
+        assert not touching, f"at {s:.2f} of the move: {touching}"

@@ -71,3 +71,17 @@ def test_render_rejects_an_oversized_frame_and_an_unknown_camera(sim):
         sim.render(width=5000, height=100)
     with pytest.raises(ValueError, match="unknown camera"):
         sim.render(camera="nope", width=W, height=H)
+
+
+def test_dropping_one_renderer_leaves_another_intact():
+    import gc
+
+    from gazebot.sim.offscreen import OffscreenRenderer
+
+    a = HandoverSimulation("sawyer", "default", seed=0)
+    first = OffscreenRenderer(a.model, 64, 48)
+    reference = first.render(a.data, "observer")
+    second = OffscreenRenderer(a.model, 64, 48)
+    del first  # GL ids are per context: freeing must not touch the second renderer's
+    gc.collect()
+    np.testing.assert_array_equal(second.render(a.data, "observer"), reference)

@@ -152,3 +152,17 @@ def test_nearest_equivalent_only_shifts_joints_that_turn_more_than_once():
     ranges = np.array([[-2 * np.pi, 2 * np.pi], [-3.0, 3.0]])
     q = nearest_equivalent(np.array([np.radians(282.8), 2.9]), np.array([0.6, -2.9]), ranges)
     np.testing.assert_allclose(q, [np.radians(282.8 - 360), 2.9])
+
+
+def test_arm_commands_take_the_arm_over_from_the_controller():
+    sim = HandoverSimulation("sawyer", "default", seed=0)
+    goal = dict(zip(sim.robot.arm_joints, sim.home, strict=True))
+    goal["right_j0"] = sim.home[0] + 0.3
+    sim.apply_arm(goal)
+    for _ in range(int(3.5 * 120)):  # past the robot's reach start
+        sim.step(1 / 120)
+    assert sim.controller.state is not ControllerState.WAITING  # the controller still runs...
+    # ...but the arm holds the commanded pose.
+    assert sim.joint_state()["right_j0"] == pytest.approx(goal["right_j0"], abs=0.02)
+    with pytest.raises(ValueError, match="unknown arm joint"):
+        sim.apply_arm({"head_pan": 0.0})
