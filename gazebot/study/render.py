@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import multiprocessing
 import os
 import shutil
 from collections.abc import Callable
@@ -100,7 +101,10 @@ def _run_jobs(jobs: list[tuple[Callable, tuple]], workers: int, progress: bool, 
                 if bar:
                     bar.update()
             return
-        with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
+        # Spawned, not forked: a forked child inherits the parent's GL (EGL/OSMesa) state and
+        # can deadlock creating its own context.
+        spawn = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=spawn) as pool:
             futures: list[Future] = [pool.submit(fn, *args) for fn, args in jobs]
             for fut in futures:
                 fut.result()
