@@ -23,7 +23,7 @@ check-gl: $(STAMP)
 demo: $(STAMP) check-gl
 	$(PY) -m gazebot demo --out out/demo
 
-test: $(TEST_STAMP)
+test: $(TEST_STAMP) check-gl
 	$(PY) -m pytest
 
 bench: $(TEST_STAMP)

@@ -4,8 +4,11 @@
   ``face-hand-face``, against a hand-written if/else implementation of the same timing;
 - annotation loading: ``load_annotations`` (validating, reporting oddities) on the first 64 real
   files against a raw openpyxl read of the same cells (read-only, stop at the first empty frame);
-- replay: one behavior over all annotated handovers, reusing one machine (``reset``) against
-  building a machine per handover.
+- replay: ``gazebot.annotations.replay`` of ``hand-face`` over all annotated receivers (events,
+  contexts and the behavior machine frame by frame) against an independent plain-NumPy
+  vectorised scoring of the same behavior (hand in reach and transfer, face from 0.375 s after
+  each retreat start; ``Own Hand`` as hand, ``Other`` ignored); both must give the same matched
+  and compared frame counts in every phase.
 
 The annotation timings need the reference data (``GAZEBOT_SHARED_DATA`` or ``../shared/data``);
 without it they are left out.
@@ -154,7 +157,6 @@ def _annotation_results() -> list[Result]:
         return []
     from gazebot.annotations import load_annotations, replay
     from gazebot.annotations.loader import annotation_files, load_handover
-    from gazebot.annotations.replay import replay_handover
 
     files = annotation_files(_ANNOTATIONS)[:64]
 
@@ -176,26 +178,69 @@ def _annotation_results() -> list[Result]:
     annotations = load_annotations(_ANNOTATIONS)
     spec = load_behavior("hand-face")
     frames = sum(h.n_frames for h in annotations.handovers)
+    delay_s = spec.parameters["retreat_face"].delay
 
-    def fresh() -> list:
-        return [
-            replay_handover(h, spec, "receiver", seed=k)
-            for k, h in enumerate(annotations.handovers)
-        ]
+    def ours() -> dict[str, tuple[int, int]]:
+        r = replay(annotations, spec, "receiver")
+        return {
+            p: (
+                sum(h.by_phase[p][0] for h in r.handovers),
+                sum(h.by_phase[p][1] for h in r.handovers),
+            )
+            for p in ("reach", "transfer", "retreat")
+        }
 
-    t_reuse = median_time(lambda: replay(annotations, spec, "receiver"), repeat=3)
-    t_fresh = median_time(fresh, repeat=3)
+    def peer() -> dict[str, tuple[int, int]]:
+        return numpy_replay_hand_face(annotations.handovers, "receiver", delay_s)
+
+    if ours() != peer():
+        raise AssertionError(f"replay peers disagree: ours {ours()} vs NumPy {peer()}")
+    matched, compared = (sum(v[k] for v in ours().values()) for k in (0, 1))
+    t_ours = median_time(ours, repeat=3)
+    t_peer = median_time(peer, repeat=3)
     results.append(
         Result(
             f"replay hand-face over {len(annotations)} handovers",
-            t_reuse * 1e6 / frames,
-            t_fresh * 1e6 / frames,
+            t_ours * 1e6 / frames,
+            t_peer * 1e6 / frames,
             "us/frame",
-            "new machine per handover",
-            note=f"{frames} frames",
+            "plain NumPy vectorised scoring",
+            note=f"{frames} frames; same match share {matched / compared:.4f} "
+            f"({matched}/{compared}) from both",
         )
     )
     return results
+
+
+def numpy_replay_hand_face(
+    handovers, role: str, delay_s: float, fps: float = 8.0
+) -> dict[str, tuple[int, int]]:
+    """The peer: hand-face replay scoring written directly in NumPy over all frames at once.
+
+    Robot gaze: hand in reach and transfer; in a retreat, hand until ``delay_s`` after the start
+    of that retreat run, then face. Person's gaze: ``face``; ``hand`` and ``own_hand`` as hand;
+    anything else ignored. Returns ``{phase: (matched, compared)}``.
+    """
+    phases = np.concatenate([np.asarray(h.phase(role)) for h in handovers])
+    gaze = np.concatenate([np.asarray(h.gaze(role)) for h in handovers])
+    first = np.zeros(phases.size, dtype=bool)
+    first[np.cumsum([0] + [len(h.phase(role)) for h in handovers[:-1]])] = True
+    idx = np.arange(phases.size)
+    retreat = phases == "retreat"
+    run_start = retreat & ~(np.roll(retreat, 1) & ~first)
+    since_s = (idx - np.maximum.accumulate(np.where(run_start, idx, 0))) / fps
+    robot_face = retreat & (since_s >= delay_s)
+    human_face = gaze == "face"
+    human_hand = (gaze == "hand") | (gaze == "own_hand")
+    compared = human_face | human_hand
+    matched = compared & np.where(robot_face, human_face, human_hand)
+    return {
+        p: (
+            int(np.count_nonzero(matched & (phases == p))),
+            int(np.count_nonzero(compared & (phases == p))),
+        )
+        for p in ("reach", "transfer", "retreat")
+    }
 
 
 def run() -> list[Result]:

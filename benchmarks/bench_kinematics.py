@@ -122,7 +122,7 @@ def run() -> list[Result]:
                 p_track,
                 "us",
                 peer_name,
-                note="IK + min-jerk neck/eye plans + limits",
+                note="IK (tracking: usually one Gauss-Newton step) + min-jerk plans + limits",
             ),
         ]
     return results

@@ -47,6 +47,13 @@ def read_yaml(path: str | Path) -> Any:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ConfigError(path, "<file>", "a readable YAML file", str(exc)) from exc
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            path,
+            "<file>",
+            "UTF-8 text",
+            f"byte 0x{exc.object[exc.start]:02x} at offset {exc.start}",
+        ) from exc
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError as exc:
@@ -63,12 +70,21 @@ def validate(model: type[M], data: Any, source: str | Path = "<config>") -> M:
     except ValidationError as exc:
         err = exc.errors()[0]
         field = ".".join(str(p) for p in err["loc"]) or "<root>"
-        expected = err["msg"]
-        if expected.startswith("Input should be "):
-            expected = expected[len("Input should be ") :]
-        elif expected.startswith("Value error, "):
-            expected = expected[len("Value error, ") :]
-        raise ConfigError(source, field, expected, err.get("input")) from exc
+        kind = err["type"]
+        got = err.get("input")
+        if kind == "extra_forbidden":
+            allowed = ", ".join(sorted(model.model_fields)) if len(err["loc"]) == 1 else None
+            expected = f"no such field{f' (known fields: {allowed})' if allowed else ''}"
+        elif kind == "missing":
+            expected, got = "a value (the field is required)", None
+        else:
+            expected = err["msg"]
+            for prefix in ("Input should be ", "Value error, "):
+                if expected.startswith(prefix):
+                    expected = expected[len(prefix) :]
+        if isinstance(got, dict) and len(repr(got)) > 200:
+            got = f"a mapping with keys {sorted(map(str, got))}"
+        raise ConfigError(source, field, expected, got) from exc
 
 
 def load_model(model: type[M], path: str | Path) -> M:

@@ -15,7 +15,7 @@ import numpy as np
 
 from gazebot.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
 from gazebot.config import ConfigError
-from gazebot.kinematics import GazeController, GazeShiftConfig, RobotModel
+from gazebot.kinematics import GazeController, GazeShiftConfig, RobotConfig, RobotModel
 from gazebot.phases import PhaseConfig, PhaseDetector, load_phase_config
 from gazebot.types import (
     Event,
@@ -84,7 +84,7 @@ class GazeEngine:
     @classmethod
     def from_config(
         cls,
-        robot: str | Path = "sawyer",
+        robot: str | Path | RobotConfig = "sawyer",
         behavior: str | Path = "face-hand-face",
         phases: str | Path | PhaseConfig | None = None,
         shifts: GazeShiftConfig | None = None,
@@ -93,7 +93,7 @@ class GazeEngine:
         """Build an engine from names or YAML paths.
 
         Args:
-            robot: Robot name (``sawyer``, ``jaco2``) or a robot YAML file.
+            robot: Robot name (``sawyer``, ``jaco2``), a robot YAML file or a loaded config.
             behavior: Behavior name (see ``gazebot behaviors list``) or a behavior YAML file.
             phases: Phase config YAML file or object; ``None`` for ``configs/phases.yaml``.
         """
@@ -129,17 +129,17 @@ class GazeEngine:
         Out-of-order frames are handed to the phase detector (which ignores them) and answered
         with the previous command's goals, so the output never jumps back in time.
         """
-        events: list[Event] = []
-        phase_event = self.detector.update(frame)
-        if phase_event is not None:
-            events.append(phase_event)
+        # Every event this sample reveals (a gripper closing can reveal a reach and a transfer).
+        events = self.detector.update_all(frame)
         events.extend(self._pending)
         self._pending.clear()
         for event in events:
             self.behavior.handle(event)
 
-        t = max(frame.t, self._last_t) if math.isfinite(frame.t) else self._last_t
-        self._last_t = t
+        if math.isfinite(frame.t):
+            t = self._last_t = max(frame.t, self._last_t)
+        else:  # a frame without a usable time: answer at the last known time
+            t = self._last_t if math.isfinite(self._last_t) else 0.0
         ctx = GazeContext(
             t=t,
             phase=self.detector.phase,
@@ -173,8 +173,10 @@ class GazeEngine:
         A fallback for a robot stack, e.g. the last face position while tracking is lost; the
         gaze shift timing and limits still apply. The phase is left as it is.
         """
-        t = max(t, self._last_t) if math.isfinite(t) else self._last_t
-        self._last_t = t
+        if math.isfinite(t):
+            t = self._last_t = max(t, self._last_t)
+        else:
+            t = self._last_t if math.isfinite(self._last_t) else 0.0
         state = self.gaze.update(t, point, arm=arm)
         return GazeCommand(
             t=t,

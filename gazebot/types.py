@@ -29,7 +29,15 @@ def as_point(value: Any) -> np.ndarray:
 
 def is_valid_point(p: np.ndarray | None) -> bool:
     """True when ``p`` is a finite 3D point."""
-    return p is not None and bool(np.all(np.isfinite(p)))
+    if type(p) is np.ndarray and p.shape == (3,) and p.dtype.kind == "f":
+        # Scalar checks: this runs several times per engine tick, where numpy's per-call
+        # overhead would cost microseconds.
+        x, y, z = p.tolist()
+        return math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
+    if p is None:
+        return False
+    arr = np.asarray(p, dtype=float)
+    return arr.shape == (3,) and bool(np.all(np.isfinite(arr)))
 
 
 class Phase(str, Enum):

@@ -176,3 +176,33 @@ def test_sawyer_head_pan_compensates_the_arm_joint_that_carries_the_head():
     b = [turned.step(f, arm={"right_j0": 0.4}) for f in frames][-1]
     assert a.residual < math.radians(0.5) and b.residual < math.radians(0.5)
     assert b.head["head_pan"] == pytest.approx(a.head["head_pan"] - 0.4, abs=math.radians(0.5))
+
+
+def test_frame_without_a_usable_time_is_answered_at_the_last_known_time(engine):
+    engine.reset()
+    first = engine.step(TrackingFrame.make(float("nan"), giver_face=[1.1, 0.0, 1.6]))
+    assert first.t == 0.0 and first.is_finite()
+    engine.step(TrackingFrame.make(0.5, giver_face=[1.1, 0.0, 1.6]))
+    later = engine.step(TrackingFrame.make(float("nan"), giver_face=[1.1, 0.0, 1.6]))
+    assert later.t == 0.5 and later.is_finite()
+
+
+def test_a_sample_revealing_several_phase_events_delivers_them_all_at_once():
+    # No reach was seen (tracking starts with the hands together), then the gripper closes:
+    # that one sample reveals both the reach and the transfer.
+    eng = GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
+    kinds = []
+    for t in np.arange(0.0, 1.0, 1 / 120):
+        frame = TrackingFrame.make(
+            t,
+            giver_hand=[0.7, 0.0, 1.0],
+            receiver_hand=[0.66, 0.0, 1.0],
+            giver_face=[1.1, 0.0, 1.6],
+            gripper_closed=t >= 0.5,
+            load_share=0.5 if t >= 0.5 else 0.0,
+        )
+        cmd = eng.step(frame)
+        kinds += [(round(t, 3), e.kind.value) for e in cmd.events]
+    assert [k for _, k in kinds] == ["reach_started", "transfer_started"]
+    assert kinds[0][0] == kinds[1][0]
+    assert cmd.phase == Phase.TRANSFER and cmd.target == "hand"

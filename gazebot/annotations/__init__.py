@@ -6,8 +6,10 @@
   reach-phase (6.3.1) and three-phase (6.4.2) gaze patterns.
 - :mod:`~gazebot.annotations.summary`: pattern shares beside the seed's published ones.
 - :mod:`~gazebot.annotations.replay`: run behaviors along the annotated phases and score them.
+- :mod:`~gazebot.annotations.fit`: fit the data-driven ``human-<role>`` behavior.
 """
 
+from gazebot.annotations.fit import fit_human_model
 from gazebot.annotations.loader import (
     AnnotatedHandover,
     AnnotationSet,
@@ -36,6 +38,7 @@ __all__ = [
     "ReplayResult",
     "Summary",
     "classify_reach",
+    "fit_human_model",
     "classify_three_phase",
     "load_annotations",
     "load_handover",

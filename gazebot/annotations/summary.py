@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import statistics
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -43,6 +43,9 @@ class Summary:
         phase_frames: ``{role: {phase: mean length in frames}}`` over handovers having the phase.
         issues: Oddities found while loading.
         rule: How ``Own Hand`` and ``Other`` frames counted.
+        own_hand_sensitivity: ``{"hand"|"other": {role: {pattern: percent}}}``: the reach shares
+            with ``Own Hand`` counted as hand and as ``Other`` counts (``rule.other``), so a
+            reader sees how much that counting choice moves the numbers (empty if not computed).
     """
 
     n_handovers: int
@@ -52,6 +55,7 @@ class Summary:
     phase_frames: dict[str, dict[str, float]]
     issues: tuple[LoadIssue, ...]
     rule: GazeRule
+    own_hand_sensitivity: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
         """``{"n_handovers", "reach": {role: {pattern: percent}}, "three_phase": {...}}``."""
@@ -74,6 +78,7 @@ class Summary:
             "Reach-phase patterns (seed 6.3.1, fig. 6.1), % of handovers:",
         ]
         lines += _table(self.reach, self.counts["reach"], SEED_REACH, REACH_PATTERNS)
+        lines += self._sensitivity_lines()
         lines += ["", "Three-phase patterns (seed 6.4.2, fig. 6.5), % of handovers:"]
         lines += _table(
             self.three_phase, self.counts["three_phase"], SEED_THREE_PHASE, THREE_PHASE_PATTERNS
@@ -89,6 +94,35 @@ class Summary:
         if len(self.issues) > 20:
             lines.append(f"  ... {len(self.issues) - 20} more")
         return "\n".join(lines)
+
+    def _sensitivity_lines(self) -> list[str]:
+        sens = self.own_hand_sensitivity
+        if set(sens) != {"hand", "other"}:
+            return []
+        lines = [
+            "",
+            f"Sensitivity of the reach shares to Own Hand (as hand vs as Other, i.e. "
+            f"{self.rule.other}), % of handovers:",
+            f"  {'role':<9} {'pattern':<16} {'hand':>6} {'other':>6} {'change':>7} {'seed':>6}",
+        ]
+        for role in ROLES:
+            for pattern in REACH_PATTERNS:
+                a, b = sens["hand"][role][pattern], sens["other"][role][pattern]
+                lines.append(
+                    f"  {role:<9} {pattern:<16} {a:>6.1f} {b:>6.1f} {b - a:>+7.1f} "
+                    f"{SEED_REACH[role].get(pattern, '-'):>6}"
+                )
+        return lines
+
+
+def check_png_path(path: str | Path) -> Path:
+    """``path`` as a Path if it names a ``.png`` file (not a folder); else ``ValueError``."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"plot path {path} is a directory; give a file name ending in .png")
+    if path.suffix.lower() != ".png":
+        raise ValueError(f"plot path {path} must end in .png (a PNG image is written)")
+    return path
 
 
 def _table(
@@ -113,7 +147,9 @@ def _percent(counter: Counter, patterns: tuple[str, ...], n: int) -> dict[str, f
 
 
 def summarize(annotations: AnnotationSet, rule: GazeRule = DEFAULT_RULE) -> Summary:
-    """Classify every handover's giver and receiver gaze and measure the phases."""
+    """Classify every handover's giver and receiver gaze and measure the phases; also the reach
+    shares with ``Own Hand`` counted as hand and as ``rule.other`` (see
+    :attr:`Summary.own_hand_sensitivity`)."""
     n = len(annotations.handovers)
     reach: dict[str, dict[str, float]] = {}
     three: dict[str, dict[str, float]] = {}
@@ -127,7 +163,21 @@ def summarize(annotations: AnnotationSet, rule: GazeRule = DEFAULT_RULE) -> Summ
         counts["reach"][role] = {p: rc.get(p, 0) for p in REACH_PATTERNS}
         counts["three_phase"][role] = {p: tc.get(p, 0) for p in THREE_PHASE_PATTERNS}
         frames[role] = mean_phase_frames(annotations, role)
-    return Summary(n, reach, three, counts, frames, annotations.issues, rule)
+    sensitivity = {
+        label: {
+            role: _percent(
+                Counter(reach_pattern(h, role, alt) for h in annotations.handovers),
+                REACH_PATTERNS,
+                n,
+            )
+            for role in ROLES
+        }
+        for label, alt in (
+            ("hand", replace(rule, own_hand="hand")),
+            ("other", replace(rule, own_hand=rule.other)),
+        )
+    }
+    return Summary(n, reach, three, counts, frames, annotations.issues, rule, sensitivity)
 
 
 def mean_phase_frames(annotations: AnnotationSet, role: str) -> dict[str, float]:
@@ -150,13 +200,14 @@ def phase_count(annotations: AnnotationSet, role: str) -> Counter:
 
 
 def plot_summary(summary: Summary, path: str | Path) -> Path:
-    """Bar charts of ours against the seed's shares (numbers only where the seed gives one)."""
+    """Bar charts of ours against the seed's shares (numbers only where the seed gives one), as a
+    PNG at ``path`` (must end in ``.png``; ``ValueError`` otherwise)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    path = Path(path)
+    path = check_png_path(path)
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), constrained_layout=True)
     for row, (title, ours, seed, patterns) in enumerate(
         (

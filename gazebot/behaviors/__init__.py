@@ -6,7 +6,8 @@
   online (phase events in, gaze target out).
 - :mod:`~gazebot.behaviors.registry`: :func:`load_behavior` and :func:`list_behaviors` (built-ins in
   ``configs/behaviors/`` plus user folders).
-- :mod:`~gazebot.behaviors.human`: the data-driven ``human-receiver`` timing model.
+- :mod:`~gazebot.behaviors.human`: the data-driven ``human-receiver`` timing model (read from
+  YAML; fitted by :mod:`gazebot.annotations.fit`, so this package never imports annotations).
 """
 
 from gazebot.behaviors.machine import BehaviorMachine

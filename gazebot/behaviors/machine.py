@@ -29,12 +29,14 @@ Rules for imperfect event streams (``handle`` never raises):
   last known face position (the policy's target) until ``tracking_restored``; phases keep
   advancing meanwhile, so on restore the gaze resumes where the behavior now is.
 
-"Halfway" (and any fraction of a phase) needs the phase's end online. A reach ends when both
-hands have arrived and a retreat when both are back, so the estimate is the latest of those known:
+"Halfway" (and any fraction of a phase) needs the phase's end online. The estimates:
 ``ctx.expected_phase_end`` (the phase detector's prediction from the giver's and the gripper's
 motion), an ``expected_end`` in the phase event's info, and the robot's own motion end
 (``robot_reach_started``/``robot_retreat_started`` time + ``planned_duration``); with none known,
-``phase_durations_s`` of the spec (the human mean phase lengths). The estimate is re-read every
+``phase_durations_s`` of the spec (the human mean phase lengths). A reach ends when both hands
+have arrived, so the latest estimate wins; a retreat ends when the giver's hand is back at rest
+(the detector's ``handover_done``, usually before the robot is home), so the first known
+estimate in the order above wins. The estimate is re-read every
 tick; a segment that has started stays started, so a revised estimate never moves the gaze back.
 
 Points: the returned point is ``ctx.points[kind]`` (the hand moves: it is read every call). When
@@ -343,17 +345,17 @@ class BehaviorMachine:
 
     # ----------------------------------------------------------------- gaze timing
     def _expected_end(self, ctx_end: float) -> float:
-        # A reach ends when both hands have arrived and a retreat when both are back, so the
-        # latest of the estimates at hand wins (the giver's predicted arrival, the robot's plan).
         start = self._phase_start
-        candidates = [
-            end
-            for end in (ctx_end, self._phase_expected_end, self._robot_motion_end())
-            if _finite(end) and end > start
-        ]
-        if candidates:
-            return float(max(candidates))
-        return start + self.spec.phase_durations_s.of(self._phase)
+        estimates = (ctx_end, self._phase_expected_end, self._robot_motion_end())
+        known = [end for end in estimates if _finite(end) and end > start]
+        if not known:
+            return start + self.spec.phase_durations_s.of(self._phase)
+        if self._phase is Phase.REACH:
+            # A reach ends when both hands have arrived: the later arrival wins.
+            return float(max(known))
+        # A retreat ends when the giver's hand is back at rest (the detector's handover_done),
+        # often well before the robot is home: its prediction comes first.
+        return float(known[0])
 
     def _robot_motion_end(self) -> float:
         """End of the robot's own reach/retreat (start + planned duration), NaN if unknown."""

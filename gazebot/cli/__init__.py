@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from gazebot.config import ConfigError
@@ -43,7 +44,14 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         result = args.func(args)
-    except (ConfigError, ValueError, FileNotFoundError) as exc:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # The reader went away (e.g. `| head`): not an error of ours. Point stdout at devnull so
+        # the interpreter's final flush does not complain again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except (ConfigError, ValueError, OSError) as exc:
+        # OSError covers missing files, directories where a file was expected, permissions.
         print(f"gazebot: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -47,7 +47,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _summarize(args: argparse.Namespace) -> int:
     from gazebot.annotations import load_annotations, plot_summary, summarize
+    from gazebot.annotations.summary import check_png_path
 
+    if args.plot:
+        check_png_path(args.plot)  # before the slow load: a folder or .jpg is a usage error
     summary = summarize(load_annotations(args.dir))
     if args.plot:
         plot_summary(summary, args.plot)
@@ -92,7 +95,7 @@ def _fit(args: argparse.Namespace) -> int:
     import yaml
 
     from gazebot.annotations import load_annotations, summarize
-    from gazebot.behaviors.human import (
+    from gazebot.annotations.fit import (
         fit_human_model,
         human_behavior_document,
         retreat_face_delay_s,

@@ -82,7 +82,7 @@ def run_demo(args: argparse.Namespace) -> int:
 
 
 def _record(args: argparse.Namespace, out: Path):
-    from gazebot.render.video import record_handover
+    from gazebot.sim.record import record_handover
 
     return record_handover(
         robot=args.robot,

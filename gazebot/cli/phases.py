@@ -41,7 +41,14 @@ def handle(args: argparse.Namespace) -> int:
     from gazebot.phases import load_phase_config, load_trajectory_csv, run_online, segment
 
     config = load_phase_config(args.config)
-    traj = load_trajectory_csv(args.file)
+    try:
+        traj = load_trajectory_csv(args.file)
+    except UnicodeDecodeError as exc:
+        # The bare codec message names neither the file nor what to do about it.
+        raise ValueError(
+            f"{args.file}: not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset "
+            f"{exc.start}); save the CSV as UTF-8"
+        ) from None
     _, reordered, dropped = traj.cleaned()
     if reordered or dropped:
         print(

@@ -25,8 +25,8 @@ def register(kinds: argparse._SubParsersAction) -> None:
 
 
 def run_render_video(args: argparse.Namespace) -> int:
-    from gazebot.render.video import render_handover_video
     from gazebot.sim.gl_check import OffscreenRenderingError
+    from gazebot.sim.record import render_handover_video
 
     if args.out.suffix.lower() != ".mp4":
         raise ValueError(f"--out must name an .mp4 file, got {args.out}")

@@ -29,6 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="s without tracking before holding the gaze (default 0.25)")
     p.add_argument("--face-timeout", type=positive, default=1.0,
                    help="s without tracking before looking at the last face (default 1.0)")
+    p.add_argument("--no-robot-warning", type=positive, default=3.0, metavar="S",
+                   help="warn on stderr if no robot data arrived after S seconds (default 3)")
     p.add_argument("--no-resync", action="store_true",
                    help="do not catch up with a handover under way at start")
     p.add_argument("--no-eye-frames", action="store_true",
@@ -45,12 +47,14 @@ class LazyEyeRenderer:
         self.robot = robot
         self._renderer: Any = None
 
-    def render(self, yaw: float, pitch: float, blink: float = 0.0) -> Any:
+    def render(
+        self, yaw: float, pitch: float, blink: float = 0.0, distance: float | None = None
+    ) -> Any:
         if self._renderer is None:
             from gazebot.render import EyeRenderer
 
             self._renderer = EyeRenderer.for_robot(self.robot)
-        return self._renderer.render(yaw, pitch, blink=blink)
+        return self._renderer.render(yaw, pitch, blink=blink, distance=distance)
 
 
 def build_engine_node(
@@ -62,10 +66,11 @@ def build_engine_node(
     config: Any = None,
     eye_frames: bool = True,
     engine: Any = None,
+    warn: Any = None,
 ) -> Any:
     """A :class:`~gazebot.drivers.engine_node.EngineNode` running ``engine`` (default:
     ``GazeEngine.from_config(robot, behavior, phases, seed=seed)``), with blinks and lazily
-    rendered eye frames."""
+    rendered eye frames; ``warn(text)`` receives operator warnings (no robot seen)."""
     from gazebot.drivers.engine_node import EngineNode
     from gazebot.engine import GazeEngine
 
@@ -78,7 +83,7 @@ def build_engine_node(
     except ImportError:  # eyes package absent: the eyes never blink
         blink = None
     renderer = LazyEyeRenderer(engine.robot.name) if eye_frames else None
-    return EngineNode(engine, driver, config, blink=blink, eye_renderer=renderer)
+    return EngineNode(engine, driver, config, blink=blink, eye_renderer=renderer, warn=warn)
 
 
 def handle(args: argparse.Namespace) -> int:
@@ -89,7 +94,10 @@ def handle(args: argparse.Namespace) -> int:
         raise ValueError("--face-timeout must be >= --hold-timeout")
     cfg = bus_config(args, listens_by_default=False)
     node_cfg = EngineNodeConfig(
-        hold_timeout=args.hold_timeout, face_timeout=args.face_timeout, resync=not args.no_resync
+        hold_timeout=args.hold_timeout,
+        face_timeout=args.face_timeout,
+        resync=not args.no_resync,
+        no_robot_warning=args.no_robot_warning,
     )
     from gazebot.engine import GazeEngine
 
@@ -97,12 +105,17 @@ def handle(args: argparse.Namespace) -> int:
     engine = GazeEngine.from_config(args.robot, args.behavior, args.phases, seed=args.seed)
     driver = ZenohRobotDriver.open(cfg, "engine")
     try:
+        endpoints = f"listen {list(cfg.listen)}, connect {list(cfg.connect)}"
+
+        def warn(text: str) -> None:
+            print(f"gazebot run: warning: {text} ({endpoints})", file=sys.stderr, flush=True)
+
         node = build_engine_node(args.robot, args.behavior, driver, seed=args.seed,
                                  config=node_cfg, eye_frames=not args.no_eye_frames,
-                                 engine=engine)
+                                 engine=engine, warn=warn)
         print(
             f"gazebot run: {args.behavior} on {node.engine.robot.name} at gazebot/{cfg.robot_id}/ "
-            f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})",
+            f"({endpoints})",
             file=sys.stderr,
         )
         try:
@@ -115,6 +128,8 @@ def handle(args: argparse.Namespace) -> int:
             "phase": node.phase,
             "tracking": node.tracking,
             "peers": driver.peers(),
+            "robot_seen": node.robot_seen,
+            "warnings": node.warnings,
             "dropped": driver.dropped(),
             "tracking_skipped": driver.tracking_skipped,
         }

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from pathlib import Path
+
+from gazebot.study.conditions import CONDITION_LEVELS, DEFAULT_BEHAVIORS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -15,10 +18,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = study.add_parser("plan", help="write a counterbalanced session plan (CSV)")
     p.add_argument(
         "--behaviors",
-        default="hand-face,face-hand-face,hand",
+        default=",".join(DEFAULT_BEHAVIORS),
         help="comma-separated behavior names (default: the seed's three)",
     )
-    p.add_argument("--condition", required=True, choices=["object-size", "fragility", "posture"])
+    p.add_argument(
+        "--condition",
+        required=True,
+        choices=list(CONDITION_LEVELS),
+        help="; ".join(f"{c}: {a} / {b}" for c, (a, b) in CONDITION_LEVELS.items()),
+    )
     p.add_argument(
         "--participants",
         type=int,
@@ -35,7 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="LEVEL=SCENE",
         help="render a level in another scene (default: the shipped scene of the level)",
     )
-    p.add_argument("--out", required=True, type=Path)
+    p.add_argument("--out", required=True, type=Path, help="plan CSV file to write")
     p.add_argument("--json", action="store_true", help="print the balance summary as JSON")
     p.set_defaults(func=_plan)
 
@@ -70,7 +78,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="PNG like the seed's Figure 6.3 (one file per level if several)",
     )
-    a.add_argument("--margin", type=float, default=0.1, help="equivalence margin (proportion)")
+    a.add_argument(
+        "--margin", type=float, default=0.1, help="equivalence margin (proportion in (0, 1))"
+    )
     a.add_argument(
         "--behaviors", default=None, help="comma-separated order of the behaviors in the output"
     )
@@ -94,10 +104,35 @@ def register(sub: argparse._SubParsersAction) -> None:
     f.set_defaults(func=_fit_wins)
 
 
+def _finite(value: float, option: str, low: float = 0.0, high: float = math.inf) -> float:
+    """``value`` if finite and in (low, high); ``ValueError`` naming ``option`` otherwise."""
+    if not (math.isfinite(value) and low < value < high):
+        bound = f"in ({low:g}, {high:g})" if math.isfinite(high) else f"> {low:g}"
+        raise ValueError(f"{option} must be a finite number {bound}, got {value}")
+    return value
+
+
+def _check_behaviors(names: list[str]) -> None:
+    """Every name must be an available behavior (see ``gazebot behaviors list``)."""
+    from gazebot.behaviors import list_behaviors, load_behavior
+
+    for name in names:
+        try:
+            load_behavior(name)
+        except FileNotFoundError:
+            available = ", ".join(i.name for i in list_behaviors())
+            raise ValueError(
+                f"--behaviors: unknown behavior {name!r}; available: {available}"
+            ) from None
+
+
 def _plan(args: argparse.Namespace) -> int:
+    from gazebot.study.csvio import check_output_file
     from gazebot.study.plan import check_balance, make_plan, write_plan
 
+    check_output_file(args.out, "plan")
     behaviors = [b.strip() for b in args.behaviors.split(",") if b.strip()]
+    _check_behaviors(behaviors)
     scenes = {}
     for item in args.scene:
         level, sep, scene = item.partition("=")
@@ -174,6 +209,11 @@ def _render(args: argparse.Namespace) -> int:
 def _analyze(args: argparse.Namespace) -> int:
     from gazebot.study.analysis import analyze, read_responses
 
+    _finite(args.margin, "--margin", 0.0, 1.0)
+    if args.plot is not None:
+        from gazebot.study.csvio import check_output_file
+
+        check_output_file(args.plot, "plot", ".png")
     order = [b.strip() for b in args.behaviors.split(",")] if args.behaviors else None
     result = analyze(
         read_responses(args.responses),
@@ -187,7 +227,8 @@ def _analyze(args: argparse.Namespace) -> int:
         for level, measures in result.per_level.items():
             out = args.plot
             if len(result.per_level) > 1:
-                out = args.plot.with_name(f"{args.plot.stem}-{level or 'all'}{args.plot.suffix}")
+                tag = (level or "all").replace(":", "-")
+                out = args.plot.with_name(f"{args.plot.stem}-{tag}{args.plot.suffix}")
             plot_preferences(measures, out, title=level)
     if args.json:
         print(json.dumps(result.to_json()))
@@ -204,9 +245,10 @@ def _analyze(args: argparse.Namespace) -> int:
         print(f"first/second bias {m}: S={b.s:.1f} p={b.p_value:.2f}")
     for c in result.comparisons:
         print(
-            f"{c.measure} {c.behavior_i} vs {c.behavior_j}: {c.level_a} {c.proportion_a:.2f} "
-            f"vs {c.level_b} {c.proportion_b:.2f}, z={c.difference.z:.2f} "
-            f"p={c.difference.p_value:.2f}, equivalence p={c.equivalence.p_value:.2f}"
+            f"{c.measure} {c.behavior_i} vs {c.behavior_j} ({c.design}, n={c.n_a}/{c.n_b}): "
+            f"{c.sample_a} {c.proportion_a:.2f} vs {c.sample_b} {c.proportion_b:.2f}, "
+            f"z={c.difference.z:.2f} p={c.difference.p_value:.2f}, "
+            f"equivalence p={c.equivalence.p_value:.2f}"
         )
     return 0
 
@@ -218,8 +260,8 @@ def _fit_wins(args: argparse.Namespace) -> int:
     from gazebot.study.bradley_terry import fit_bradley_terry
     from gazebot.study.stats import bradley_terry_chi2
 
+    n = _finite(args.participants, "--participants")
     names, w = read_win_matrix(args.wins)
-    n = args.participants
     totals = w + w.T
     iu = np.triu_indices(len(names), k=1)
     bad = [

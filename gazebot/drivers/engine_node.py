@@ -12,6 +12,10 @@ Faults (each pinned by ``tests/drivers``):
   (``GazeEngine.resync``), then reports ``engine_resynced``.
 * robot gone: the loop keeps running; ``peer_lost``/``peer_restored`` events and the status'
   ``peers`` and ``state: degraded`` report it.
+* robot never seen (e.g. a wrong ``--connect``): after ``no_robot_warning`` s without any
+  tracking sample or joint state, event ``no_robot`` (``info.after``, ``info.peers``), the
+  ``warn`` callback (``gazebot run`` prints it on stderr), status ``state: degraded`` with
+  ``info.robot_seen: false`` until the robot shows up.
 * robot clock restart (a sample older than the last by ``clock_reset``): event
   ``tracking_clock_reset``, then the same resynchronisation as at start.
 * malformed payloads: dropped by the driver, counted in the status' ``dropped``.
@@ -75,6 +79,8 @@ class EngineNodeConfig:
         eye_frame_rate: Maximum rate of rendered eye frames (only while someone subscribes).
         clock_reset: A sample this much older than the previous one (s) means the robot's
             clock restarted: the engine is reset and resynchronised.
+        no_robot_warning: Warn once when no tracking sample or joint state arrived this long
+            (s) after the start.
     """
 
     hold_timeout: float = 0.25
@@ -85,10 +91,11 @@ class EngineNodeConfig:
     resync_timeout: float = 1.0
     eye_frame_rate: float = 30.0
     clock_reset: float = 0.5
+    no_robot_warning: float = 3.0
 
     def __post_init__(self) -> None:
         for name in ("hold_timeout", "face_timeout", "fallback_rate", "heartbeat_period",
-                     "resync_timeout", "eye_frame_rate", "clock_reset"):
+                     "resync_timeout", "eye_frame_rate", "clock_reset", "no_robot_warning"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(
@@ -117,8 +124,9 @@ class EngineNode:
         driver: The robot (``ZenohRobotDriver`` over the bus, ``SimRobotDriver`` in process).
         config: Timeouts and rates.
         blink: Optional blink model with ``update(t, gaze_shift_rad) -> 0..1``.
-        eye_renderer: Optional renderer with ``render(yaw, pitch, blink) -> (H, W, 3) uint8``,
-            used only while the robot wants eye frames.
+        eye_renderer: Optional renderer with ``render(yaw, pitch, blink=, distance=) -> (H, W, 3)
+            uint8``, used only while the robot wants eye frames.
+        warn: Called with a one-line message for conditions an operator must see (no robot).
         clock: Monotonic clock (s).
     """
 
@@ -130,6 +138,7 @@ class EngineNode:
         *,
         blink: Any = None,
         eye_renderer: Any = None,
+        warn: Callable[[str], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.engine = engine
@@ -137,12 +146,16 @@ class EngineNode:
         self.config = config or EngineNodeConfig()
         self.blink = blink
         self.eye_renderer = eye_renderer
+        self.warn = warn
         self.clock = clock
+        self.robot_seen = False
+        self.warnings: list[str] = []
         self.tracking: TrackingState = "waiting"
         self.commands_sent = 0
         self.frames_processed = 0
         self.unsafe_commands = 0
         self._started = clock()
+        self._run_started = self._started
         self._seq = {"head": 0, "eyes": 0, "frame": 0, "event": 0, "status": 0}
         self._last_frame_wall = math.nan
         self._last_t = math.nan
@@ -196,6 +209,7 @@ class EngineNode:
     def start(self) -> int:
         """Announce the node and, if configured, resynchronise with a handover under way.
         Returns the number of events replayed."""
+        self._run_started = self.clock()  # the no-robot delay counts from here
         self.emit("node_started", category="node", robot=getattr(self.engine.robot, "name", ""))
         replayed = self.resync() if self.config.resync else 0
         self.ready.set()
@@ -271,6 +285,7 @@ class EngineNode:
         else:
             self.on_silence()
         self._check_peers()
+        self._check_robot_seen()
         if self.clock() - self._last_beat >= self.config.heartbeat_period:
             self._heartbeat()
 
@@ -356,9 +371,10 @@ class EngineNode:
         blink = 0.0
         if self.blink is not None:
             blink = float(np.clip(self.blink.update(cmd.t, shift), 0.0, 1.0))
+        distance = self._target_distance(cmd)
         self.driver.send_eyes(
             EyeStateMsg(seq=self._next("eyes"), t=cmd.t, stamp=stamp, yaw=cmd.eye_yaw,
-                        pitch=cmd.eye_pitch, blink=blink)
+                        pitch=cmd.eye_pitch, blink=blink, distance=distance)
         )
         now = self.clock()
         if (
@@ -367,10 +383,52 @@ class EngineNode:
             and self.driver.wants_eye_frames()
         ):
             self._last_eye_frame = now
-            img = self.eye_renderer.render(cmd.eye_yaw, cmd.eye_pitch, blink=blink)
+            img = self.eye_renderer.render(
+                cmd.eye_yaw, cmd.eye_pitch, blink=blink, distance=distance
+            )
             frame = EyeFrameMsg.from_image(img, self._next("frame"), cmd.t, stamp)
             self.driver.send_eye_frame(frame)
         self.commands_sent += 1
+
+    def _target_distance(self, cmd: GazeCommand) -> float | None:
+        """Distance (m) from the ``gaze`` site at the commanded head pose to the target point,
+        for the eyes' vergence; ``None`` when unknown (no valid target point, or a robot model
+        without ``gaze_pose``, like the test fakes)."""
+        robot = self.engine.robot
+        gaze_pose = getattr(robot, "gaze_pose", None)
+        if gaze_pose is None or not is_valid_point(cmd.target_point):
+            return None
+        try:
+            origin = gaze_pose(robot.head_vector(cmd.head)).position
+        except (KeyError, ValueError) as exc:
+            log.debug("no gaze pose for the eye distance: %s", exc)
+            return None
+        d = float(np.linalg.norm(np.asarray(cmd.target_point, float) - origin))
+        # A target at the display itself has no defined vergence: treat it as unknown.
+        return d if math.isfinite(d) and d > 1e-3 else None
+
+    def _check_robot_seen(self) -> None:
+        """Warn once if no tracking sample or joint state arrived ``no_robot_warning`` s after
+        the start: otherwise a wrong endpoint would look like a quiet robot."""
+        if self.robot_seen:
+            return
+        if self.frames_processed or self.driver.joint_state() is not None:
+            self.robot_seen = True
+            return
+        after = self.clock() - self._run_started
+        if after < self.config.no_robot_warning or self.warnings:
+            return
+        peers = self.driver.peers()
+        text = (
+            f"no robot seen after {after:.1f} s: no tracking or joint state received "
+            f"(peers: {peers or 'none'}); is the robot running and the bus endpoint right?"
+        )
+        self.warnings.append(text)
+        self.emit("no_robot", after=after, peers=peers)
+        if self.warn is not None:
+            self.warn(text)
+        else:
+            log.warning("%s", text)
 
     def _check_peers(self) -> None:
         peers = self.driver.peers()
@@ -385,7 +443,8 @@ class EngineNode:
     def _heartbeat(self, stopping: bool = False) -> StatusMsg:
         self._last_beat = self.clock()
         peers = self.driver.peers()
-        degraded = not all(peers.values()) or self.tracking in ("hold", "lost")
+        no_robot = bool(self.warnings) and not self.robot_seen
+        degraded = not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
         msg = StatusMsg(
             node=self.driver.node,
             seq=self._next("status"),
@@ -402,6 +461,8 @@ class EngineNode:
                 "unsafe_commands": self.unsafe_commands,
                 "behavior": self._behavior_state,
                 "target": self._target,
+                "robot_seen": self.robot_seen,
+                "warnings": list(self.warnings),
             },
         )
         self.driver.publish_status(msg)

@@ -209,7 +209,12 @@ class HeadCommandMsg(Msg):
 
 class EyeStateMsg(Msg):
     """``gazebot/<id>/eyes``: eye direction on the display (rad; ``yaw`` + = robot's left,
-    ``pitch`` + = down) and eyelid closure ``blink`` (0 open .. 1 closed)."""
+    ``pitch`` + = down), eyelid closure ``blink`` (0 open .. 1 closed) and ``distance`` (m, > 0)
+    from the display (the head's ``gaze`` site) to the gaze target, for the eyes' vergence.
+
+    ``distance`` is optional within ``v: 1``: ``null`` or absent means unknown (parallel eyes),
+    and it is left out of the JSON when unknown, so such messages read as before.
+    """
 
     seq: Seq
     t: float
@@ -217,6 +222,10 @@ class EyeStateMsg(Msg):
     yaw: float
     pitch: float
     blink: Unit = 0.0
+    distance: Annotated[float, Field(gt=0.0)] | None = None
+
+    def encode(self) -> bytes:
+        return self.model_dump_json(exclude_none=True).encode()
 
 
 class EyeFrameMsg(Msg):

@@ -103,7 +103,7 @@ class SimRobotDriver(RobotDriver):
             self._reject("head", exc)
 
     def send_eyes(self, msg: EyeStateMsg) -> None:
-        self.sim.apply_eyes(msg.yaw, msg.pitch, msg.blink)
+        self.sim.apply_eyes(msg.yaw, msg.pitch, msg.blink, distance=msg.distance)
 
     def send_eye_frame(self, msg: EyeFrameMsg) -> None:
         self.sim.set_display(msg.image())

@@ -104,7 +104,7 @@ class SimNode:
                 self._reject("eye_frame", exc)
         if (eyes := ep.eyes.take()) is not None:
             try:
-                sim.apply_eyes(eyes.yaw, eyes.pitch, eyes.blink)
+                sim.apply_eyes(eyes.yaw, eyes.pitch, eyes.blink, distance=eyes.distance)
                 self.applied["eyes"] += 1
             except ValueError as exc:
                 self._reject("eyes", exc)

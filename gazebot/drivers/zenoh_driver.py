@@ -6,7 +6,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ClassVar
 
 from gazebot.drivers.base import RobotDriver
 from gazebot.drivers.keys import KeyLayout
@@ -18,7 +18,6 @@ from gazebot.drivers.payloads import (
     JointStateMsg,
     TrackingMsg,
 )
-from gazebot.drivers.session import BusConfig, open_session
 from gazebot.drivers.zenoh_node import ZenohNode
 
 if TYPE_CHECKING:
@@ -39,6 +38,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
             ``tracking_skipped``): 12 = 0.1 s at 120 Hz, the most the engine may lag.
     """
 
+    default_node: ClassVar[str] = "engine"
+
     def __init__(
         self,
         session: zenoh.Session,
@@ -50,8 +51,9 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         tracking_backlog: int = 12,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        super().__init__(session, keys, node, peer_timeout=peer_timeout, clock=clock)
-        self._owns_session = owns_session
+        super().__init__(
+            session, keys, node, owns_session=owns_session, peer_timeout=peer_timeout, clock=clock
+        )
         self._cond = threading.Condition(threading.Lock())
         self._queue: deque[TrackingMsg] = deque()
         self.tracking_backlog = tracking_backlog
@@ -65,16 +67,6 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self.subscribe(keys.tracking, TrackingMsg, self._on_tracking)
         self.subscribe(keys.joint_states, JointStateMsg, self._on_joints)
         self.announce()
-
-    @classmethod
-    def open(cls, config: BusConfig, node: str = "engine", **kwargs) -> ZenohRobotDriver:
-        """Open a session for ``config`` and a driver that closes it."""
-        session = open_session(config)
-        try:
-            return cls(session, config.keys, node, owns_session=True, **kwargs)
-        except Exception:
-            session.close()
-            raise
 
     def _on_tracking(self, msg: TrackingMsg) -> None:
         with self._cond:
@@ -119,6 +111,4 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
             return
         super().close()
         with self._cond:
-            self._cond.notify_all()
-        if self._owns_session:
-            self.session.close()
+            self._cond.notify_all()  # wake a wait_tracking() in progress

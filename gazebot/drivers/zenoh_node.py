@@ -12,7 +12,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, TypeVar
 
 from gazebot.drivers.keys import KeyLayout, check_chunk
 from gazebot.drivers.payloads import (
@@ -26,7 +26,10 @@ from gazebot.drivers.payloads import (
 if TYPE_CHECKING:
     import zenoh
 
+    from gazebot.drivers.session import BusConfig
+
 log = logging.getLogger("gazebot.drivers")
+_Node = TypeVar("_Node", bound="ZenohNode")
 
 
 class DropCounter:
@@ -65,15 +68,20 @@ class ZenohNode:
     """A named node on the bus of one robot.
 
     Args:
-        session: An open Zenoh session (not closed by the node: it may be shared).
+        session: An open Zenoh session (closed by :meth:`close` only if ``owns_session``: it may
+            be shared).
         keys: The robot's key layout.
         node: This node's name (``engine``, ``sim``, ...): its liveliness token, the ``source``
             of its events and the ``node`` of its heartbeats.
+        owns_session: Close ``session`` in :meth:`close` (set by :meth:`open`).
         history_len: Events kept for the history queryable and the inbox.
         peer_timeout: A peer whose heartbeats stop for this long (s) counts as lost even if its
             session (and token) lingers.
         clock: Monotonic clock (s).
     """
+
+    #: The node name :meth:`open` uses when none is given.
+    default_node: ClassVar[str] = "node"
 
     def __init__(
         self,
@@ -81,6 +89,7 @@ class ZenohNode:
         keys: KeyLayout,
         node: str,
         *,
+        owns_session: bool = False,
         history_len: int = 1000,
         peer_timeout: float = 2.0,
         clock: Callable[[], float] = time.monotonic,
@@ -88,6 +97,7 @@ class ZenohNode:
         self.session = session
         self.keys = keys
         self.node = check_chunk(node, "node name")
+        self._owns_session = owns_session
         self.peer_timeout = float(peer_timeout)
         self.clock = clock
         self.drops = DropCounter()
@@ -111,6 +121,20 @@ class ZenohNode:
         self._declare(liveliness.declare_subscriber(keys.alive_all, self._on_alive, history=True))
         self._declare(session.declare_queryable(keys.events_history(self.node), self._on_query))
         self._token: Any = None
+
+    @classmethod
+    def open(cls: type[_Node], config: BusConfig, node: str | None = None, **kwargs: Any) -> _Node:
+        """Open a session for ``config`` and a node named ``node`` (default
+        :attr:`default_node`) that closes the session with itself; ``kwargs`` go to the
+        constructor. The session is closed again if the node cannot be built."""
+        from gazebot.drivers.session import open_session
+
+        session = open_session(config)
+        try:
+            return cls(session, config.keys, node or cls.default_node, owns_session=True, **kwargs)
+        except Exception:
+            session.close()
+            raise
 
     def announce(self) -> None:
         """Declare the node's liveliness token: call last in a subclass' ``__init__``, so a
@@ -292,7 +316,8 @@ class ZenohNode:
         return self._closed
 
     def close(self) -> None:
-        """Undeclare everything this node declared (the token last-first), idempotent."""
+        """Undeclare everything this node declared (the token last-first), then close the
+        session if the node owns it; idempotent."""
         if self._closed:
             return
         self._closed = True
@@ -302,3 +327,5 @@ class ZenohNode:
             except Exception:  # the session may already be closed
                 pass
         self._entities.clear()
+        if self._owns_session:
+            self.session.close()

@@ -6,7 +6,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Generic, TypeVar
+from typing import TYPE_CHECKING, ClassVar, Generic, TypeVar
 
 from gazebot.drivers.keys import KeyLayout
 from gazebot.drivers.payloads import (
@@ -19,7 +19,6 @@ from gazebot.drivers.payloads import (
     Msg,
     TrackingMsg,
 )
-from gazebot.drivers.session import BusConfig, open_session
 from gazebot.drivers.zenoh_node import ZenohNode
 from gazebot.types import Event, TrackingFrame
 
@@ -67,6 +66,8 @@ class ZenohRobotEndpoint(ZenohNode):
             someone subscribes, so a robot that draws its eyes from the eye state leaves this off.
     """
 
+    default_node: ClassVar[str] = "sim"
+
     def __init__(
         self,
         session: zenoh.Session,
@@ -78,8 +79,9 @@ class ZenohRobotEndpoint(ZenohNode):
         peer_timeout: float = 2.0,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        super().__init__(session, keys, node, peer_timeout=peer_timeout, clock=clock)
-        self._owns_session = owns_session
+        super().__init__(
+            session, keys, node, owns_session=owns_session, peer_timeout=peer_timeout, clock=clock
+        )
         self._tracking_seq = 0
         self._joint_seq = 0
         self.head: Latest[HeadCommandMsg] = Latest()
@@ -94,16 +96,6 @@ class ZenohRobotEndpoint(ZenohNode):
             self.subscribe(keys.eyes_frame, EyeFrameMsg, self.eye_frame.put)
         self.subscribe(keys.arm_command, ArmCommandMsg, self.arm.put)
         self.announce()
-
-    @classmethod
-    def open(cls, config: BusConfig, node: str = "sim", **kwargs) -> ZenohRobotEndpoint:
-        """Open a session for ``config`` and an endpoint that closes it."""
-        session = open_session(config)
-        try:
-            return cls(session, config.keys, node, owns_session=True, **kwargs)
-        except Exception:
-            session.close()
-            raise
 
     def publish_tracking(self, frame: TrackingFrame) -> TrackingMsg:
         """Publish one tracking sample (numbered) and return it."""
@@ -129,10 +121,3 @@ class ZenohRobotEndpoint(ZenohNode):
         msg = EventMsg.from_event(event, self.node, self.next_event_seq(), time.time())
         self.publish_event(msg)
         return msg
-
-    def close(self) -> None:
-        if self.closed:
-            return
-        super().close()
-        if self._owns_session:
-            self.session.close()

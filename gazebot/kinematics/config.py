@@ -21,7 +21,7 @@ REQUIRED_POINTS = ("face", "handover_location", "rest")
 class DisplayConfig(BaseModel):
     """The head screen."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     width_px: int = Field(gt=0)
     height_px: int = Field(gt=0)
@@ -34,7 +34,7 @@ class EyeConfig(BaseModel):
     Yaw is about the gaze frame's +z (positive = robot's left), pitch about +y (positive = down).
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     yaw_range_deg: tuple[float, float]
     pitch_range_deg: tuple[float, float]
@@ -55,7 +55,7 @@ Point = tuple[float, float, float]
 class RobotConfig(BaseModel):
     """A robot for gazebot: its MJCF, head and arm joints, poses, eyes and default points."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     name: str = Field(min_length=1)
     mjcf: str = Field(min_length=1)

@@ -1,6 +1,10 @@
 """``GazeController``: timed neck and eye commands that keep the robot's gaze on a target.
 
-Each :meth:`GazeController.update` solves the look-at IK for the target (warm-started), then:
+Each :meth:`GazeController.update` solves the look-at IK for the target, warm-started from the
+last solution (whose gaze frame and Jacobian are reused). While the target moves without a gaze
+shift, the solve stops at the looser ``IKConfig.tracking_tolerance`` (usually after one
+Gauss-Newton step: the per-tick cost of following a hand or face); once it stops moving, the
+goal is refined to the full tolerance. Then:
 
 * a target direction change above ``saccade_threshold_deg`` starts a **gaze shift**: the neck
   re-plans a minimum-jerk move to the new goal with ``neck_duration_s`` and the eyes saccade
@@ -25,13 +29,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gazebot.kinematics.eyes import angle_between
-from gazebot.kinematics.look_at import IKConfig, solve_ik
+from gazebot.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.kinematics.robot import RobotModel
 from gazebot.kinematics.shifts import (
+    MINJERK_PEAK,
     GazeShiftConfig,
     MinJerkTrajectory,
     min_jerk,
-    min_jerk_duration,
 )
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
@@ -85,6 +89,13 @@ class GazeController:
         self.robot = robot
         self.shifts = shifts if shifts is not None else robot.config.shifts
         self.ik = ik or IKConfig(max_iterations=25)
+        # The per-tick state is kept in plain floats: with 1-4 joints numpy's per-call overhead
+        # would cost more than the arithmetic (this runs at the tracking rate).
+        self._names = tuple(robot.head_joints)
+        self._lower = robot.lower.tolist()
+        self._upper = robot.upper.tolist()
+        self._vlim = robot.velocity_limits.tolist()
+        self._limits = tuple(zip(self._vlim, self._lower, self._upper, strict=True))
         self.reset()
 
     # --- state --------------------------------------------------------------------------------
@@ -94,24 +105,30 @@ class GazeController:
         Raises:
             ValueError: unknown joint names or non-finite values.
         """
-        q = self.robot.head_vector(head)
-        n = self.robot.n_head
-        self._q = q
-        self._vel = np.zeros(n)
-        self._goal = q.copy()
+        q = self.robot.head_vector(head).tolist()
+        n = len(q)
+        # Head vectors are lists that are replaced, never changed in place.
+        self._q: list[float] = q
+        self._vel: list[float] = [0.0] * n
+        self._goal: list[float] = list(q)
         self._traj: MinJerkTrajectory | None = None
-        self._eyes = np.zeros(2)
-        self._saccade: tuple[float, float, np.ndarray] | None = None
+        self._eyes: tuple[float, float] = (0.0, 0.0)
+        self._saccade: tuple[float, float, tuple[float, float]] | None = None
         self._clock = 0.0
         self._t: float | None = None
-        self._target: np.ndarray | None = None
+        self._target: tuple[float, float, float] | None = None
         self._goal_final = False
         self._residual = 0.0
+        # Gaze frame at the head command: (head vector, arm revision, frame rows).
+        self._frame: tuple[list[float], int, list[list[float]]] | None = None
+        # The last IK solution (its q is ``_goal``) and the arm revision it was solved for: its
+        # gaze frame and Jacobian seed the next warm start.
+        self._solution: tuple[RawSolution, int] | None = None
 
     @property
     def head(self) -> dict[str, float]:
         """Current head command by joint."""
-        return self.robot.head_dict(self._q)
+        return dict(zip(self._names, self._q, strict=True))
 
     def set_arm(self, joints: Mapping[str, float]) -> None:
         """Tell the model where the arm is (matters when the arm carries the head, as on Sawyer).
@@ -144,52 +161,67 @@ class GazeController:
         target = self._parse(target_point)
         valid = target is not None
         shift = 0.0
-        unchanged = (
-            self._target is not None
-            and np.array_equal(target, self._target)
-            and not arm_moved
-            and self._goal_final
-        )
+        unchanged = target == self._target and not arm_moved and self._goal_final
         if valid and not unchanged:
             # Plans start where the last command left off (previous tick) and are evaluated now.
             shift = self._retarget(target, self._clock - dt)
 
-        q_prev = self._q
         if self._traj is not None and dt > 0.0:
-            pos = self._traj.position(self._clock)
-            step = self.robot.velocity_limits * dt
-            q = self.robot.clamp(np.clip(pos, q_prev - step, q_prev + step))
-            if np.all(np.isfinite(q)):
-                self._vel = (q - q_prev) / dt
+            pos = self._traj.sample(self._clock)[0]
+            q_prev = self._q
+            q = []
+            vel = []
+            finite = True
+            for p, a, (v, lo, hi) in zip(pos, q_prev, self._limits, strict=True):
+                # Rate limit, then joint limits (comparisons, not min/max calls: this is the hot
+                # path; a NaN stays NaN and is caught below).
+                step = v * dt
+                x = p
+                if x < a - step:
+                    x = a - step
+                if x > a + step:
+                    x = a + step
+                if x < lo:
+                    x = lo
+                if x > hi:
+                    x = hi
+                finite = finite and math.isfinite(x)
+                q.append(x)
+                vel.append((x - a) / dt)
+            if finite:
+                self._vel = vel
                 self._q = q
         elif dt > 0.0:
-            self._vel = np.zeros_like(self._vel)
+            self._vel = [0.0] * len(self._q)
 
         eyes_saturated = False
         if self._target is not None:
-            pose = self.robot.gaze_pose(self._q)
-            v = pose.to_local(self._target)
-            if float(np.linalg.norm(v)) >= self.ik.min_distance:
-                yaw, pitch, eyes_saturated = self.robot.eyes.look(v)
-                goal = np.array([yaw, pitch])
+            v = self._to_local(self._target)
+            if math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) >= self.ik.min_distance:
+                eyes = self.robot.eyes
+                yaw, pitch, eyes_saturated = eyes.look(v)
                 if self._saccade is not None:
-                    t0, dur, start = self._saccade
+                    t0, dur, (y0, p0) = self._saccade
                     s = min_jerk((self._clock - t0) / dur)
-                    goal = start + s * (goal - start)
+                    yaw, pitch = y0 + s * (yaw - y0), p0 + s * (pitch - p0)
                     if s >= 1.0:
                         self._saccade = None
                 limit = self.robot.eye_velocity_limit * dt
-                eyes = np.clip(goal, self._eyes - limit, self._eyes + limit)
-                self._eyes = np.array(self.robot.eyes.clip(float(eyes[0]), float(eyes[1]))[:2])
-                self._residual = self.robot.eyes.residual(self._eyes[0], self._eyes[1], v)
+                e0, e1 = self._eyes
+                yaw = min(max(yaw, e0 - limit), e0 + limit)
+                pitch = min(max(pitch, e1 - limit), e1 + limit)
+                yaw, pitch, _ = eyes.clip(yaw, pitch)
+                self._eyes = (yaw, pitch)
+                self._residual = eyes.residual(yaw, pitch, v)
+        names = self._names
         return HeadEyeState(
-            head=self.robot.head_dict(self._q),
+            head=dict(zip(names, self._q, strict=True)),
             eye_yaw=float(self._eyes[0]),
             eye_pitch=float(self._eyes[1]),
             residual=float(self._residual),
             t=float(self._t if self._t is not None else 0.0),
-            head_goal=self.robot.head_dict(self._goal),
-            head_velocity=self.robot.head_dict(self._vel),
+            head_goal=dict(zip(names, self._goal, strict=True)),
+            head_velocity=dict(zip(names, self._vel, strict=True)),
             shift_amplitude=shift,
             target_valid=valid,
             eyes_saturated=eyes_saturated,
@@ -211,68 +243,125 @@ class GazeController:
         return dt
 
     @staticmethod
-    def _parse(target_point: np.ndarray | None) -> np.ndarray | None:
+    def _parse(target_point: np.ndarray | None) -> tuple[float, float, float] | None:
         if target_point is None:
             return None
-        p = np.asarray(target_point, dtype=float).reshape(-1)
+        p = target_point
+        if type(p) is not np.ndarray or p.dtype != np.float64:
+            p = np.asarray(target_point, dtype=float)
         if p.shape != (3,):
-            raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
-        return p if bool(np.all(np.isfinite(p))) else None
+            p = p.reshape(-1)
+            if p.shape != (3,):
+                raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
+        x, y, z = p.tolist()
+        return (x, y, z) if math.isfinite(x) and math.isfinite(y) and math.isfinite(z) else None
 
-    def _retarget(self, target: np.ndarray, t_start: float) -> float:
+    def _gaze_frame(self) -> list[list[float]]:
+        """Gaze frame rows at the head command (cached: the eyes of one tick and the re-plan of
+        the next both need it)."""
+        revision = self.robot.arm_revision
+        cached = self._frame
+        if cached is not None and cached[1] == revision and cached[0] == self._q:
+            return cached[2]
+        frame = self.robot.gaze_frame_lists(self._q)
+        self._frame = (self._q, revision, frame)
+        return frame
+
+    def _to_local(self, point: tuple[float, float, float]) -> tuple[float, float, float]:
+        """``point`` (base frame) in the gaze frame at the head command."""
+        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = self._gaze_frame()
+        dx, dy, dz = point[0] - px, point[1] - py, point[2] - pz
+        return (
+            r00 * dx + r10 * dy + r20 * dz,
+            r01 * dx + r11 * dy + r21 * dz,
+            r02 * dx + r12 * dy + r22 * dz,
+        )
+
+    def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
-        sol = solve_ik(self.robot, target, q0=self._goal, config=self.ik)
-        if not sol.valid:
-            return 0.0
         cfg = self.shifts
-        pose = self.robot.gaze_pose(self._q)
+        frame = self._gaze_frame()
+        origin = (frame[0][3], frame[1][3], frame[2][3])
+        to_new = (target[0] - origin[0], target[1] - origin[1], target[2] - origin[2])
         if self._target is None:
-            amplitude = angle_between(target - pose.position, pose.line_of_sight)
+            amplitude = angle_between(to_new, (frame[0][0], frame[1][0], frame[2][0]))
             new_shift = True
         else:
-            amplitude = angle_between(target - pose.position, self._target - pose.position)
+            old = self._target
+            to_old = (old[0] - origin[0], old[1] - origin[1], old[2] - origin[2])
+            amplitude = angle_between(to_new, to_old)
             new_shift = amplitude > cfg.saccade_threshold
+
+        robot = self.robot
+        revision = robot.arm_revision
+        # A target that moved without a gaze shift is followed at the tracking tolerance; a new
+        # or unchanged one (e.g. after the arm moved, or to finish a tracked goal) in full.
+        tracking = not new_shift and target != self._target
+        last = self._solution
+        if last is not None and last[1] == revision and last[0].q is self._goal:
+            warm_frame, warm_rows = last[0].frame, last[0].rows  # the warm start's kinematics
+        else:
+            warm_frame = warm_rows = None
+        sol = solve_ik_raw(
+            robot,
+            target,
+            self._goal,
+            self.ik,
+            warm_frame,
+            warm_rows,
+            jacobian=True,
+            tracking=tracking,
+        )
+        if not sol.valid:
+            return 0.0  # at the gaze origin: no direction to look
+        self._solution = (sol, revision)
         self._target = target
         goal = sol.q
-        # A solve stopped by the iteration cap is refined on the next tick even if nothing moved.
+        # A solve stopped by the iteration cap or at the tracking tolerance is refined on the
+        # next tick even if nothing moved.
         self._goal_final = sol.converged
 
         # Neck: continue from the current command, its velocity and the plan's acceleration.
-        if self._traj is not None:
-            _, _, acc = self._traj.evaluate(t_start)
-        else:
-            acc = np.zeros_like(self._q)
+        traj = self._traj
+        q = self._q
+        acc = traj.sample(t_start)[2] if traj is not None else (0.0,) * len(q)
         vel = self._vel
-        delta = goal - self._q
+        margin = cfg.velocity_margin
+        # One pass over the joints: the shortest rest-to-rest minimum-jerk duration within
+        # margin * the velocity limits, and the largest move, goal change and speed.
+        need = move = goal_change = speed = 0.0
+        for g, a, old_g, v, vlim in zip(goal, q, self._goal, vel, self._vlim, strict=True):
+            d = abs(g - a)
+            if d > move:
+                move = d
+            d = MINJERK_PEAK * d / (vlim * margin)
+            if d > need:
+                need = d
+            d = abs(g - old_g)
+            if d > goal_change:
+                goal_change = d
+            d = abs(v)
+            if d > speed:
+                speed = d
         if new_shift:
-            duration = min_jerk_duration(
-                delta, cfg.neck_duration_s, self.robot.velocity_limits, cfg.velocity_margin
-            )
+            duration = max(cfg.neck_duration_s, need)
         else:
-            remaining = self._traj.end_time - t_start if self._traj is not None else 0.0
-            duration = max(
-                remaining,
-                cfg.tracking_duration_s,
-                min_jerk_duration(delta, 0.0, self.robot.velocity_limits, cfg.velocity_margin),
-            )
-        if (
-            new_shift
-            or float(np.max(np.abs(goal - self._goal))) > _REPLAN_EPS
-            or self._traj is None
-        ):
-            if float(np.max(np.abs(delta))) > _REPLAN_EPS or float(np.max(np.abs(vel))) > 0.0:
-                self._traj = MinJerkTrajectory(t_start, duration, self._q, goal, vel, acc)
+            remaining = traj.end_time - t_start if traj is not None else 0.0
+            duration = max(remaining, cfg.tracking_duration_s, need)
+        if new_shift or goal_change > _REPLAN_EPS or traj is None:
+            if move > _REPLAN_EPS or speed > 0.0:
+                self._traj = MinJerkTrajectory(t_start, duration, q, goal, vel, acc)
         self._goal = goal
 
         # Eyes: a saccade from where they are now toward the target (re-aimed every tick).
         if new_shift:
-            v = pose.to_local(target)
-            yaw, pitch, _ = self.robot.eyes.look(v)
-            amp = float(np.hypot(yaw - self._eyes[0], pitch - self._eyes[1]))
-            dur = min_jerk_duration(
-                amp, cfg.eye_duration_s, self.robot.eye_velocity_limit, cfg.velocity_margin
+            yaw, pitch, _ = self.robot.eyes.look(self._to_local(target))
+            amp = math.hypot(yaw - self._eyes[0], pitch - self._eyes[1])
+            dur = max(
+                cfg.eye_duration_s,
+                MINJERK_PEAK * amp / (self.robot.eye_velocity_limit * margin),
             )
-            self._saccade = (t_start, dur, self._eyes.copy())
+            self._saccade = (t_start, dur, self._eyes)
             return float(amplitude)
         return 0.0

@@ -8,12 +8,13 @@ for ``(yaw, pitch)`` is ``Rz(yaw) Ry(pitch) x = (cos p cos y, cos p sin y, -sin 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 
-def eye_angles(v: np.ndarray) -> tuple[float, float]:
+def eye_angles(v: np.ndarray | Sequence[float]) -> tuple[float, float]:
     """Yaw and pitch (rad) that point the eyes along ``v`` (gaze frame, any length > 0)."""
     x, y, z = float(v[0]), float(v[1]), float(v[2])
     return math.atan2(y, x), math.atan2(-z, math.hypot(x, y))
@@ -25,7 +26,7 @@ def eye_direction(yaw: float, pitch: float) -> np.ndarray:
     return np.array([cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch)])
 
 
-def angle_between(a: np.ndarray, b: np.ndarray) -> float:
+def angle_between(a: np.ndarray | Sequence[float], b: np.ndarray | Sequence[float]) -> float:
     """Angle (rad) between two non-zero 3-vectors, accurate for small and large angles."""
     ax, ay, az = float(a[0]), float(a[1]), float(a[2])
     bx, by, bz = float(b[0]), float(b[1]), float(b[2])
@@ -47,10 +48,12 @@ class DisplayEyes:
         p = min(max(pitch, self.pitch_range[0]), self.pitch_range[1])
         return y, p, (y != yaw or p != pitch)
 
-    def look(self, v: np.ndarray) -> tuple[float, float, bool]:
+    def look(self, v: np.ndarray | Sequence[float]) -> tuple[float, float, bool]:
         """Eye angles looking along ``v`` (gaze frame), clipped to the range, and the clip flag."""
         return self.clip(*eye_angles(v))
 
-    def residual(self, yaw: float, pitch: float, v: np.ndarray) -> float:
+    def residual(self, yaw: float, pitch: float, v: np.ndarray | Sequence[float]) -> float:
         """Angle (rad) between the eyes' line of sight and ``v`` (gaze frame)."""
-        return angle_between(eye_direction(yaw, pitch), v)
+        # eye_direction() as a tuple: this runs every controller tick.
+        cp = math.cos(pitch)
+        return angle_between((cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch)), v)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -34,6 +35,9 @@ class IKConfig:
         min_distance: Targets closer than this to the gaze origin (m) have no direction.
         min_step: A step smaller than this (rad) means the head cannot do better.
         posture_off: Reducible pointing error (rad) below which the posture pull stops.
+        tracking_tolerance: Looser stop (rad) for a target that moved slightly since the last
+            solve (see :func:`solve_ik_raw`): the gaze controller uses it while following a
+            moving target, where one Gauss-Newton step from the last solution usually meets it.
     """
 
     damping: float = 1e-4
@@ -44,6 +48,7 @@ class IKConfig:
     min_distance: float = 1e-3
     min_step: float = 1e-9
     posture_off: float = 1e-3
+    tracking_tolerance: float = 1e-4
 
 
 @dataclass(frozen=True)
@@ -120,7 +125,8 @@ def pointing_error(
 def _pointing_error(
     R: list[list[float]], p: list[float], rows: list[list[float]], target
 ) -> tuple[float, float, list[float], list[float]]:
-    """Core of :func:`pointing_error` on plain lists (rotation rows, origin, Jacobian rows)."""
+    """Core of :func:`pointing_error` on plain lists (rotation rows, extra columns ignored;
+    origin; Jacobian rows)."""
     # Scalar arithmetic on purpose: for 3-vectors and n <= 4 columns it is several times faster
     # than numpy's per-call overhead, and this runs in every IK iteration.
     px, py, pz = p
@@ -129,11 +135,15 @@ def _pointing_error(
     ux, uy, uz = tx / dist, ty / dist, tz / dist
     xx, xy, xz = R[0][0], R[1][0], R[2][0]
     wn = math.hypot(xx, xy)  # |up x x|
-    if wn > 1e-6:
+    horizontal = wn > 1e-6
+    if horizontal:
         b1x, b1y, b1z = -xy / wn, xx / wn, 0.0
+        roll = xz / wn
     else:  # looking straight up or down: fall back on the display's left axis
         b1x, b1y, b1z = R[0][1], R[1][1], R[2][1]
+        roll = 0.0
     b2x, b2y, b2z = xy * b1z - xz * b1y, xz * b1x - xx * b1z, xx * b1y - xy * b1x
+    # The target direction in the tangent frame F = (x, b1, b2).
     a = ux * xx + uy * xy + uz * xz
     b = ux * b1x + uy * b1y + uz * b1z
     c = ux * b2x + uy * b2y + uz * b2z
@@ -145,23 +155,20 @@ def _pointing_error(
     for j in range(len(rows[0])):
         vx, vy, vz = rows[0][j], rows[1][j], rows[2][j]
         wx, wy, wz = rows[3][j], rows[4][j], rows[5][j]
-        # line of sight: dx = w x x ; target direction: du = -(v - u (u.v)) / dist
-        dxx, dxy, dxz = wy * xz - wz * xy, wz * xx - wx * xz, wx * xy - wy * xx
-        uv = ux * vx + uy * vy + uz * vz
-        dux, duy, duz = (ux * uv - vx) / dist, (uy * uv - vy) / dist, (uz * uv - vz) / dist
-        if wn > 1e-6:  # b1 = (up x x) / |up x x|
-            dwx, dwy = -dxy, dxx
-            bdw = b1x * dwx + b1y * dwy
-            db1x, db1y, db1z = (dwx - b1x * bdw) / wn, (dwy - b1y * bdw) / wn, -b1z * bdw / wn
-        else:  # b1 turns with the head
-            db1x, db1y, db1z = wy * b1z - wz * b1y, wz * b1x - wx * b1z, wx * b1y - wy * b1x
-        # b2 = x x b1 -> db2 = dx x b1 + x x db1
-        db2x = (dxy * b1z - dxz * b1y) + (xy * db1z - xz * db1y)
-        db2y = (dxz * b1x - dxx * b1z) + (xz * db1x - xx * db1z)
-        db2z = (dxx * b1y - dxy * b1x) + (xx * db1y - xy * db1x)
-        da = xx * dux + xy * duy + xz * duz + ux * dxx + uy * dxy + uz * dxz
-        db = b1x * dux + b1y * duy + b1z * duz + ux * db1x + uy * db1y + uz * db1z
-        dc = b2x * dux + b2y * duy + b2z * duz + ux * db2x + uy * db2y + uz * db2z
+        # Origin velocity v and angular velocity w in F. F turns with w about b1 and b2 (that
+        # moves the line of sight); about x it turns so that b1 stays horizontal (o0 = o2 xz /
+        # |up x x|), or with the head when b1 is the display's axis.
+        v0 = vx * xx + vy * xy + vz * xz
+        v1 = vx * b1x + vy * b1y + vz * b1z
+        v2 = vx * b2x + vy * b2y + vz * b2z
+        o1 = wx * b1x + wy * b1y + wz * b1z
+        o2 = wx * b2x + wy * b2y + wz * b2z
+        o0 = o2 * roll if horizontal else wx * xx + wy * xy + wz * xz
+        # d(u in F) = F^T du - o x (u in F), with du = (u (u.v) - v) / dist
+        uv = a * v0 + b * v1 + c * v2
+        da = (a * uv - v0) / dist - (o1 * c - o2 * b)
+        db = (b * uv - v1) / dist - (o2 * a - o0 * c)
+        dc = (c * uv - v2) / dist - (o0 * b - o1 * a)
         d_rho = (a * da + b * db) / rho
         d_az.append((a * db - b * da) / rho2)
         d_el.append((rho * dc - c * d_rho) / n2)
@@ -179,6 +186,231 @@ def _invalid(robot: RobotModel, q: np.ndarray, message: str) -> LookAtSolution:
         total_residual=nan,
         valid=False,
         message=message,
+    )
+
+
+class RawSolution(NamedTuple):
+    """Result of :func:`solve_ik_raw` in plain floats (rad).
+
+    Attributes:
+        q: Head joint goals (``robot.head_joints`` order).
+        valid: ``False`` when the target reached the gaze origin (then ``q`` is where the solver
+            stopped and the other fields are NaN / 0).
+        local: The target in the gaze frame at ``q``.
+        residual: Pointing error of the head alone.
+        iterations: Solver iterations used.
+        converged: On target, or no joint can turn closer (``False``: the iteration cap).
+        stalled: No joint can turn closer.
+        reached: Within the tolerance.
+        frame: Gaze frame rows at ``q`` (see :meth:`RobotModel.gaze_frame_lists`).
+        rows: Gaze Jacobian rows at ``q`` if the solver computed them, else ``None``.
+    """
+
+    q: list[float]
+    valid: bool
+    local: tuple[float, float, float]
+    residual: float
+    iterations: int
+    converged: bool
+    stalled: bool
+    reached: bool
+    frame: list[list[float]] | None = None
+    rows: list[list[float]] | None = None
+
+
+def solve_ik_raw(
+    robot: RobotModel,
+    target: tuple[float, float, float],
+    qs: list[float],
+    cfg: IKConfig,
+    frame: list[list[float]] | None = None,
+    rows: list[list[float]] | None = None,
+    jacobian: bool = False,
+    tracking: bool = False,
+) -> RawSolution:
+    """The look-at iterations of :func:`solve_ik` on plain floats, for hot paths (the gaze
+    controller calls this every tick).
+
+    Args:
+        robot: The robot model.
+        target: Finite 3D point (base frame).
+        qs: Warm start: finite head vector within limits.
+        cfg: Solver settings.
+        frame, rows: The gaze frame (and Jacobian rows) at ``qs`` when known, e.g. from the
+            :class:`RawSolution` that produced ``qs`` (the same arm pose): saves recomputing them.
+        jacobian: Also return the Jacobian rows at the solution (to warm-start the next solve).
+        tracking: After the first step, stop as soon as the head points within
+            ``cfg.tracking_tolerance`` of the target, or its joints can reduce the error by no
+            more than that; such a solution reports ``converged`` only if it also meets
+            ``cfg.tolerance``. (The first step is always taken, so the goal follows every
+            move of the target, as with a full solve.)
+    """
+    lower, upper, rest = robot.head_bounds
+    lower_eps = [v + _LIMIT_EPS for v in lower]
+    upper_eps = [v - _LIMIT_EPS for v in upper]
+    n = len(qs)
+    lam = cfg.damping
+    tol = cfg.tolerance
+    cos_tol = math.cos(tol)
+    loose = cfg.tracking_tolerance if tracking else 0.0
+    cos_loose = math.cos(loose) if tracking else 2.0
+    gain = cfg.posture_gain
+    posture_off = cfg.posture_off
+    tx, ty, tz = target
+    qs = list(qs)
+    iterations = 0
+    converged = False
+    stalled = False
+    nudged = False
+    stepped = False  # the looser tracking stop applies only after a step
+    # Only the pose is needed to test convergence; the Jacobian is computed for the steps (a
+    # warm start on a slowly moving target converges in one step: one Jacobian, two poses).
+    # ``current``: robot.data holds the kinematics of ``qs`` (else the Jacobian recomputes them).
+    current = frame is None
+    if frame is None:
+        frame = robot.gaze_frame_lists(qs)
+        rows = None
+    # Plain-Python floats on purpose: with n <= 4 joints numpy's per-call overhead would dominate.
+    for iterations in range(1, cfg.max_iterations + 1):  # noqa: B007 (reported afterwards)
+        (r00, _, _, px), (r10, _, _, py), (r20, _, _, pz) = frame
+        dx, dy, dz = tx - px, ty - py, tz - pz
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if dist < cfg.min_distance:
+            nan = math.nan
+            return RawSolution(qs, False, (nan, nan, nan), nan, iterations, False, False, False)
+        cos = (r00 * dx + r10 * dy + r20 * dz) / dist
+        if cos >= cos_tol:
+            converged = True
+            break
+        if stepped and cos >= cos_loose:
+            break
+        if rows is None:
+            rows = robot.gaze_jacobian_rows(None if current else qs)
+        e0, e1, r0, r1 = _pointing_error(frame, (px, py, pz), rows, target)
+        if not nudged and e0 * e0 + e1 * e1 > 2.0:
+            g2 = sum((a * e0 + b * e1) ** 2 for a, b in zip(r0, r1, strict=True))
+            if g2 < 1e-20:
+                # Looking straight away from the target (a saddle of the error): nudge the first
+                # joint that can move so the gradient picks a side.
+                for j in range(n):
+                    if upper[j] - lower[j] > 1e-6:
+                        qs[j] = qs[j] + 0.1 if qs[j] + 0.1 <= upper[j] else qs[j] - 0.1
+                        nudged = True
+                        break
+                if nudged:
+                    frame, rows, current = robot.gaze_frame_lists(qs), None, True
+                    continue
+        # The active set below only matters when some joint is at a limit.
+        at_limit = False
+        for q, lo, hi in zip(qs, lower_eps, upper_eps, strict=True):
+            if q <= lo or q >= hi:
+                at_limit = True
+                break
+        free = range(n)
+        dq = [0.0] * n
+        reducible = 0.0
+        for _ in range(n):
+            a11 = a12 = a22 = 0.0
+            for j in free:
+                v, w = r0[j], r1[j]
+                a11 += v * v
+                a12 += v * w
+                a22 += w * w
+            a11 += lam
+            a22 += lam
+            det = a11 * a22 - a12 * a12
+            i11, i12, i22 = a22 / det, -a12 / det, a11 / det
+            # damped pseudo-inverse columns (pinv = Jf^T (Jf Jf^T + lam I)^-1)
+            p0 = [0.0] * n
+            p1 = [0.0] * n
+            dq = [0.0] * n
+            j0 = j1 = 0.0
+            for j in free:
+                v, w = r0[j], r1[j]
+                a, b = v * i11 + w * i12, v * i12 + w * i22
+                p0[j] = a
+                p1[j] = b
+                s_ = -(a * e0 + b * e1)
+                dq[j] = s_
+                j0 += v * s_
+                j1 += w * s_
+            reducible = math.hypot(j0, j1)
+            # The posture pull only shapes the big first steps; near the best pointing it would
+            # keep trading redundant joints and slow the final convergence.
+            if reducible > posture_off and gain > 0.0:
+                y = [0.0] * n
+                y0 = y1 = 0.0
+                for j in free:
+                    yj = gain * (rest[j] - qs[j])
+                    y[j] = yj
+                    y0 += r0[j] * yj
+                    y1 += r1[j] * yj
+                # null-space projection: y - pinv (Jf y)
+                for j in free:
+                    dq[j] = dq[j] + y[j] - (p0[j] * y0 + p1[j] * y1)
+            if not at_limit:
+                break
+            blocked = [
+                j
+                for j in free
+                if (qs[j] <= lower[j] + _LIMIT_EPS and dq[j] < 0.0)
+                or (qs[j] >= upper[j] - _LIMIT_EPS and dq[j] > 0.0)
+            ]
+            if not blocked:
+                break
+            free = [j for j in free if j not in blocked]
+            if not free:
+                dq = [0.0] * n
+                reducible = 0.0
+                break
+        if reducible <= tol:
+            stalled = True  # the joints can no longer turn the gaze closer: the eyes take the rest
+            break
+        if stepped and reducible <= loose:
+            break
+        biggest = max(map(abs, dq))
+        scale = cfg.max_step / biggest if biggest > cfg.max_step else 1.0
+        q_new = []
+        moved = 0.0
+        for a, b, lo, hi in zip(qs, dq, lower, upper, strict=True):
+            x = a + scale * b
+            if x < lo:
+                x = lo
+            if x > hi:
+                x = hi
+            q_new.append(x)
+            d = abs(x - a)
+            if d > moved:
+                moved = d
+        if moved < cfg.min_step:
+            stalled = True
+            break
+        qs = q_new
+        stepped = True
+        frame, rows, current = robot.gaze_frame_lists(qs), None, True
+
+    (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = frame
+    dx, dy, dz = tx - px, ty - py, tz - pz
+    local = (
+        r00 * dx + r10 * dy + r20 * dz,
+        r01 * dx + r11 * dy + r21 * dz,
+        r02 * dx + r12 * dy + r22 * dz,
+    )
+    residual = angle_between((1.0, 0.0, 0.0), local)
+    reached = residual <= tol
+    if jacobian and rows is None:
+        rows = robot.gaze_jacobian_rows(None if current else qs)
+    return RawSolution(
+        qs,
+        True,
+        local,
+        residual,
+        iterations,
+        converged or stalled or reached,
+        stalled,
+        reached,
+        frame,
+        rows,
     )
 
 
@@ -218,111 +450,16 @@ def solve_ik(
     if not np.all(np.isfinite(t)):
         return _invalid(robot, q, "target is not finite: holding the previous head pose")
 
-    lower, upper = robot.lower.tolist(), robot.upper.tolist()
-    rest = robot.rest.tolist()
-    n = robot.n_head
-    lam = cfg.damping
-    tol = cfg.tolerance
-    tx, ty, tz = (float(v) for v in t)
-    qs = q.tolist()
-    iterations = 0
-    converged = False
-    stalled = False
-    nudged = False
-    # Plain-Python floats on purpose: with n <= 4 joints numpy's per-call overhead would dominate.
-    for iterations in range(1, cfg.max_iterations + 1):  # noqa: B007 (reported afterwards)
-        R, p, rows = robot.gaze_jacobian_lists(qs)
-        dx, dy, dz = tx - p[0], ty - p[1], tz - p[2]
-        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
-        if dist < cfg.min_distance:
-            return _invalid(
-                robot, np.array(qs), "target is at the gaze origin: no direction to look"
-            )
-        cos = (R[0][0] * dx + R[1][0] * dy + R[2][0] * dz) / dist
-        if cos >= math.cos(tol):
-            converged = True
-            break
-        e0, e1, r0, r1 = _pointing_error(R, p, rows, t)
-        g2 = sum((a * e0 + b * e1) ** 2 for a, b in zip(r0, r1, strict=True))
-        if not nudged and g2 < 1e-20 and e0 * e0 + e1 * e1 > 2.0:
-            # Looking straight away from the target (a saddle of the error): nudge the first
-            # joint that can move so the gradient picks a side.
-            for j in range(n):
-                if upper[j] - lower[j] > 1e-6:
-                    qs[j] = qs[j] + 0.1 if qs[j] + 0.1 <= upper[j] else qs[j] - 0.1
-                    nudged = True
-                    break
-            if nudged:
-                continue
-        free = list(range(n))
-        dq = [0.0] * n
-        reducible = 0.0
-        for _ in range(n):
-            f0 = [r0[j] for j in free]
-            f1 = [r1[j] for j in free]
-            a11 = sum(v * v for v in f0) + lam
-            a12 = sum(v * w for v, w in zip(f0, f1, strict=True))
-            a22 = sum(w * w for w in f1) + lam
-            det = a11 * a22 - a12 * a12
-            i11, i12, i22 = a22 / det, -a12 / det, a11 / det
-            # damped pseudo-inverse columns (pinv = Jf^T (Jf Jf^T + lam I)^-1)
-            p0 = [v * i11 + w * i12 for v, w in zip(f0, f1, strict=True)]
-            p1 = [v * i12 + w * i22 for v, w in zip(f0, f1, strict=True)]
-            step = [-(a * e0 + b * e1) for a, b in zip(p0, p1, strict=True)]
-            j0 = sum(v * s_ for v, s_ in zip(f0, step, strict=True))
-            j1 = sum(w * s_ for w, s_ in zip(f1, step, strict=True))
-            reducible = math.hypot(j0, j1)
-            # The posture pull only shapes the big first steps; near the best pointing it would
-            # keep trading redundant joints and slow the final convergence.
-            if reducible > cfg.posture_off and cfg.posture_gain > 0.0:
-                y = [cfg.posture_gain * (rest[j] - qs[j]) for j in free]
-                y0 = sum(v * w for v, w in zip(f0, y, strict=True))
-                y1 = sum(v * w for v, w in zip(f1, y, strict=True))
-                # null-space projection: y - pinv (Jf y)
-                step = [
-                    s_ + yy - (a * y0 + b * y1)
-                    for s_, yy, a, b in zip(step, y, p0, p1, strict=True)
-                ]
-            dq = [0.0] * n
-            for j, s_ in zip(free, step, strict=True):
-                dq[j] = s_
-            blocked = [
-                j
-                for j in free
-                if (qs[j] <= lower[j] + _LIMIT_EPS and dq[j] < 0.0)
-                or (qs[j] >= upper[j] - _LIMIT_EPS and dq[j] > 0.0)
-            ]
-            if not blocked:
-                break
-            free = [j for j in free if j not in blocked]
-            if not free:
-                dq = [0.0] * n
-                reducible = 0.0
-                break
-        if reducible <= tol:
-            stalled = True  # the joints can no longer turn the gaze closer: the eyes take the rest
-            break
-        biggest = max(abs(v) for v in dq)
-        scale = cfg.max_step / biggest if biggest > cfg.max_step else 1.0
-        q_new = [
-            min(max(a + scale * b, lo), hi)
-            for a, b, lo, hi in zip(qs, dq, lower, upper, strict=True)
-        ]
-        if max(abs(a - b) for a, b in zip(q_new, qs, strict=True)) < cfg.min_step:
-            stalled = True
-            break
-        qs = q_new
-
-    q = np.array(qs)
-    lower, upper = robot.lower, robot.upper
-    pose = robot.gaze_pose(q)
-    v = pose.to_local(t)
-    residual = angle_between(np.array([1.0, 0.0, 0.0]), v)
-    reached = residual <= cfg.tolerance
-    converged = converged or stalled or reached
+    out = solve_ik_raw(robot, tuple(t.tolist()), q.tolist(), cfg)
+    if not out.valid:
+        message = "target is at the gaze origin: no direction to look"
+        return _invalid(robot, np.array(out.q), message)
+    q = np.array(out.q)
+    residual, reached, stalled, converged = out.residual, out.reached, out.stalled, out.converged
+    v = out.local
     yaw, pitch, saturated = robot.eyes.look(v)
     total = robot.eyes.residual(yaw, pitch, v)
-    at_limit = (q <= lower + 1e-7) | (q >= upper - 1e-7)
+    at_limit = (q <= robot.lower + 1e-7) | (q >= robot.upper - 1e-7)
     limited = tuple(nm for nm, a in zip(robot.head_joints, at_limit, strict=True) if a)
     clamped = (not reached) and bool(limited)
     message = ""
@@ -341,7 +478,7 @@ def solve_ik(
         eye_pitch=pitch,
         residual=residual,
         total_residual=total,
-        iterations=iterations,
+        iterations=out.iterations,
         converged=converged,
         clamped=clamped,
         eyes_saturated=saturated,

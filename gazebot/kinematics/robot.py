@@ -9,7 +9,7 @@ locked. Carrying arm joints are passive: the look-at solver never moves them, bu
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,6 +53,7 @@ class RobotModel:
         lower, upper: Head joint position limits (rad), from the MJCF.
         velocity_limits: Head joint velocity limits (rad/s), from the YAML.
         rest: Head rest posture (rad).
+        head_bounds: ``(lower, upper, rest)`` as lists of floats (read-only arrays above).
         eye_yaw_range, eye_pitch_range: Eye ranges (rad) as ``(min, max)``.
         eye_velocity_limit: Eye speed limit (rad/s).
         eyes: The display eyes (range and speed) as a :class:`DisplayEyes`.
@@ -102,6 +103,10 @@ class RobotModel:
         )
         rest = np.radians([config.head_rest_deg.get(n, 0.0) for n in self.head_joints])
         self.rest = np.clip(rest, self.lower, self.upper)
+        # Read-only, so the plain-float copies the hot paths use cannot go stale.
+        for arr in (self.lower, self.upper, self.rest):
+            arr.flags.writeable = False
+        self.head_bounds = (self.lower.tolist(), self.upper.tolist(), self.rest.tolist())
         self.eye_yaw_range = tuple(math.radians(v) for v in config.eyes.yaw_range_deg)
         self.eye_pitch_range = tuple(math.radians(v) for v in config.eyes.pitch_range_deg)
         self.eye_velocity_limit = math.radians(config.eyes.velocity_limit_deg_s)
@@ -112,6 +117,14 @@ class RobotModel:
         for name, i in zip(self.passive_joints, self.passive_idx, strict=True):
             self._q[i] = self.arm_home.get(name, 0.0)
         self._q[self.head_idx] = self.rest
+        # Hot-path helpers: a scratch configuration (its head entries are overwritten by every
+        # list-based kinematics call), a basic slice for the head when its indices are
+        # contiguous (cheaper than fancy indexing), and a counter of arm moves for pose caches.
+        self._q_work = self._q.copy()
+        first = int(self.head_idx[0]) if len(self.head_idx) else 0
+        contiguous = self.head_idx.tolist() == list(range(first, first + len(self.head_idx)))
+        self._head_sel = slice(first, first + len(self.head_idx)) if contiguous else self.head_idx
+        self._arm_revision = 0
 
     @classmethod
     def load(cls, name_or_yaml: str | Path | RobotConfig = "sawyer") -> RobotModel:
@@ -184,8 +197,17 @@ class RobotModel:
             value = joints.get(name)
             if value is not None and math.isfinite(value) and float(value) != self._q[i]:
                 self._q[i] = float(value)
+                self._q_work[i] = float(value)
                 moved = True
+        if moved:
+            self._arm_revision += 1
         return moved
+
+    @property
+    def arm_revision(self) -> int:
+        """Counts the :meth:`set_arm` calls that moved the head's carrying joints (a cache key
+        for gaze poses)."""
+        return self._arm_revision
 
     def configuration(self, q_head: np.ndarray) -> np.ndarray:
         """The Pinocchio configuration of :attr:`model` for head vector ``q_head``."""
@@ -200,17 +222,41 @@ class RobotModel:
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
         return GazePose(M.translation.copy(), M.rotation.copy())
 
+    def gaze_frame_lists(self, q_head: Sequence[float]) -> list[list[float]]:
+        """Gaze frame pose for head vector ``q_head`` as plain lists: three rows ``[R_i0, R_i1,
+        R_i2, p_i]`` (rotation columns = x, y, z; origin ``p``).
+
+        The hot paths (look-at solver, gaze controller) use lists: with 3-vectors and <= 4 joints,
+        numpy's per-call overhead would dominate. Also leaves :attr:`data` at this configuration
+        for :meth:`gaze_jacobian_rows`.
+        """
+        q = self._q_work
+        q[self._head_sel] = q_head
+        pin.forwardKinematics(self.model, self.data, q)
+        M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
+        return M.homogeneous[:3].tolist()
+
+    def gaze_jacobian_rows(self, q_head: Sequence[float] | None = None) -> list[list[float]]:
+        """The 6 rows (linear, angular; LOCAL_WORLD_ALIGNED) of the gaze frame Jacobian over the
+        head joints at ``q_head``; ``None``: at the configuration of the last
+        :meth:`gaze_frame_lists` call (reuses its forward kinematics)."""
+        if q_head is None:
+            pin.computeJointJacobians(self.model, self.data)
+        else:
+            q = self._q_work
+            q[self._head_sel] = q_head
+            pin.computeJointJacobians(self.model, self.data, q)
+        J = pin.getFrameJacobian(self.model, self.data, self.gaze_frame_id, pin.LOCAL_WORLD_ALIGNED)
+        return J[:, self._head_sel].tolist()
+
     def gaze_jacobian_lists(
-        self, q_head: list[float]
+        self, q_head: Sequence[float]
     ) -> tuple[list[list[float]], list[float], list[list[float]]]:
         """:meth:`gaze_jacobian` as plain lists (rotation rows, origin, 6 Jacobian rows over the
-        head joints): the look-at solver's hot path avoids numpy per-call overhead."""
-        q = self._q.copy()
-        q[self.head_idx] = q_head
-        pin.computeJointJacobians(self.model, self.data, q)
-        M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
-        J = pin.getFrameJacobian(self.model, self.data, self.gaze_frame_id, pin.LOCAL_WORLD_ALIGNED)
-        return M.rotation.tolist(), M.translation.tolist(), J[:, self.head_idx].tolist()
+        head joints)."""
+        frame = self.gaze_frame_lists(q_head)
+        rows = self.gaze_jacobian_rows()
+        return [r[:3] for r in frame], [r[3] for r in frame], rows
 
     def gaze_jacobian(self, q_head: np.ndarray) -> tuple[GazePose, np.ndarray]:
         """Gaze pose and its frame Jacobian (6 x n_head) in LOCAL_WORLD_ALIGNED: linear velocity

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -89,6 +90,19 @@ class Trajectory(ABC):
         return self.evaluate(t)[0]
 
 
+# Position, velocity and acceleration of every joint as plain floats.
+Sample = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]
+
+
+def _floats(x: np.ndarray | Sequence[float]) -> list[float]:
+    """A flat list of Python floats."""
+    if isinstance(x, np.ndarray):
+        return x.astype(float, copy=False).reshape(-1).tolist()
+    if type(x) is list or type(x) is tuple:
+        return list(map(float, x))
+    return np.asarray(x, dtype=float).reshape(-1).tolist()
+
+
 class MinJerkTrajectory(Trajectory):
     """Quintic from ``(p0, v0, a0)`` at ``t0`` to ``(p1, 0, 0)`` at ``t0 + duration``.
 
@@ -101,44 +115,74 @@ class MinJerkTrajectory(Trajectory):
         self,
         t0: float,
         duration: float,
-        p0: np.ndarray,
-        p1: np.ndarray,
-        v0: np.ndarray | None = None,
-        a0: np.ndarray | None = None,
+        p0: np.ndarray | Sequence[float],
+        p1: np.ndarray | Sequence[float],
+        v0: np.ndarray | Sequence[float] | None = None,
+        a0: np.ndarray | Sequence[float] | None = None,
     ) -> None:
         if not duration > 0.0:
             raise ValueError(f"duration must be positive, got {duration}")
-        p0 = np.asarray(p0, dtype=float)
-        p1 = np.asarray(p1, dtype=float)
-        v0 = np.zeros_like(p0) if v0 is None else np.asarray(v0, dtype=float)
-        a0 = np.zeros_like(p0) if a0 is None else np.asarray(a0, dtype=float)
+        # Plain floats on purpose: the gaze controller re-plans every tick for 1-4 joints, where
+        # numpy's per-call overhead would cost more than the arithmetic.
+        start = _floats(p0)
+        goal = _floats(p1)
+        n = len(start)
+        vel = [0.0] * n if v0 is None else _floats(v0)
+        acc = [0.0] * n if a0 is None else _floats(a0)
+        if not len(goal) == len(vel) == len(acc) == n:
+            raise ValueError("p0, p1, v0 and a0 must have the same length")
         T = float(duration)
-        d = p1 - p0
+        k3, k4, k5 = 0.5 / T**3, 0.5 / T**4, 0.5 / T**5
         self.t0 = float(t0)
         self.duration = T
-        self.goal = p1.copy()
-        self._c = np.array(
-            [
-                p0,
-                v0,
-                0.5 * a0,
-                (20.0 * d - 12.0 * v0 * T - 3.0 * a0 * T * T) / (2.0 * T**3),
-                (-30.0 * d + 16.0 * v0 * T + 3.0 * a0 * T * T) / (2.0 * T**4),
-                (12.0 * d - 6.0 * v0 * T - a0 * T * T) / (2.0 * T**5),
-            ]
-        )
+        self._goal = tuple(goal)
+        coeffs = []
+        for p, g, v, a in zip(start, goal, vel, acc, strict=True):
+            d, vt, at2 = g - p, v * T, a * T * T
+            coeffs.append(
+                (
+                    p,
+                    v,
+                    0.5 * a,
+                    (20.0 * d - 12.0 * vt - 3.0 * at2) * k3,
+                    (-30.0 * d + 16.0 * vt + 3.0 * at2) * k4,
+                    (12.0 * d - 6.0 * vt - at2) * k5,
+                )
+            )
+        self._coeffs = coeffs
+        self._last: tuple[float, Sample] | None = None
+
+    @property
+    def goal(self) -> np.ndarray:
+        """The end position."""
+        return np.array(self._goal)
 
     @property
     def end_time(self) -> float:
         return self.t0 + self.duration
 
-    def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def sample(self, t: float) -> Sample:
+        """:meth:`evaluate` as tuples of floats (position, velocity, acceleration)."""
+        last = self._last
+        if last is not None and last[0] == t:
+            # The controller evaluates each plan at the same time twice (the command now, then
+            # the re-plan's start state on the next tick).
+            return last[1]
         s = min(max(t - self.t0, 0.0), self.duration)
-        c = self._c
-        pos = c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * (c[4] + s * c[5]))))
-        vel = c[1] + s * (2 * c[2] + s * (3 * c[3] + s * (4 * c[4] + s * 5 * c[5])))
-        acc = 2 * c[2] + s * (6 * c[3] + s * (12 * c[4] + s * 20 * c[5]))
         if s >= self.duration:
             # Exactly at rest on the goal afterwards (no round-off creep).
-            return self.goal.copy(), np.zeros_like(pos), np.zeros_like(pos)
-        return pos, vel, acc
+            zeros = (0.0,) * len(self._goal)
+            out: Sample = (self._goal, zeros, zeros)
+        else:
+            pos, vel, acc = [], [], []
+            for c0, c1, c2, c3, c4, c5 in self._coeffs:
+                pos.append(c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5)))))
+                vel.append(c1 + s * (2 * c2 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5))))
+                acc.append(2 * c2 + s * (6 * c3 + s * (12 * c4 + s * 20 * c5)))
+            out = (tuple(pos), tuple(vel), tuple(acc))
+        self._last = (t, out)
+        return out
+
+    def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        pos, vel, acc = self.sample(t)
+        return np.array(pos), np.array(vel), np.array(acc)

@@ -32,12 +32,27 @@ class PhaseConfig(BaseModel):
         approach_ratio: A reach brings the hands together: their closing speed must be at least
             this fraction of the giver hand's speed.
         reach_confirm_distance: An online reach is confirmed once the hands closed by this (m).
+        early_fraction: Online, a reach (or release) whose start looks like a minimum-jerk
+            start (aimed at the receiver, or away from the held pose, and still accelerating) is
+            confirmed already at this fraction of ``reach_onset_speed`` and
+            ``reach_confirm_distance`` (``release_speed`` and ``release_distance``).
+        early_speed_margin: Online, an early reach also needs the hand's speed *now* (the
+            filter lags: 3 x / a for a minimum-jerk start at x from rest and age a) above this
+            many times ``reach_onset_speed``: fidgets of 1-2 cm at rest peak near 0.12 m/s.
+        noise_speed_factor: Online, those early speed thresholds are at least this many times
+            the RMS speed noise the filter shows while the giver's hand rests (measured live).
+        noise_distance_factor: ... and the early distance thresholds at least this many times
+            the RMS fluctuation of the hands' distance at rest.
+        noise_tau: Time constant of that live noise measurement (s).
         min_approach: Offline, a handover is a dip of the hands' distance at least this deep;
             online, the giver's hand must move this far before its retreat can end (m).
         contact_distance_max: Hands (tracked points) farther apart than this never share an
             object, whatever their speed (m).
         rest_speed: The giver's hand is at rest below this speed (m/s).
         rest_hold: Online, the hand must stay at rest this long to end the retreat (s).
+        done_fraction: Online, the retreat ends once the giver's decelerating hand has fallen
+            below this fraction of its peak speed (the mirrored bell-shaped profile says it is
+            almost at rest), without waiting for ``rest_hold``.
         retreat_far_distance: The retreat also ends once the giver's hand is this far from
             where the transfer happened (m).
         min_transfer: Shortest transfer kept (s); also the online confirmation time.
@@ -66,7 +81,7 @@ class PhaseConfig(BaseModel):
         max_retreat: Longest retreat before ``handover_done`` is forced (s).
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     transfer_distance_margin: float = Field(0.20, gt=0)
     transfer_speed_max: float = Field(0.15, gt=0)
@@ -76,10 +91,16 @@ class PhaseConfig(BaseModel):
     reach_onset_speed: float = Field(0.15, gt=0)
     approach_ratio: float = Field(0.3, ge=-1, le=1)
     reach_confirm_distance: float = Field(0.015, gt=0)
+    early_fraction: float = Field(0.5, gt=0, le=1)
+    early_speed_margin: float = Field(1.67, ge=1)
+    noise_speed_factor: float = Field(2.5, ge=0)
+    noise_distance_factor: float = Field(5.0, ge=0)
+    noise_tau: float = Field(1.0, gt=0)
     min_approach: float = Field(0.10, gt=0)
     contact_distance_max: float = Field(0.35, gt=0)
     rest_speed: float = Field(0.05, gt=0)
     rest_hold: float = Field(0.15, ge=0)
+    done_fraction: float = Field(0.15, ge=0, lt=1)
     retreat_far_distance: float = Field(0.60, gt=0)
     min_transfer: float = Field(0.08, ge=0)
     settle_speed: float = Field(0.05, gt=0)

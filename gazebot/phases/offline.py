@@ -22,8 +22,10 @@ relative speed is below ``transfer_speed_max`` (15 cm/s). Steps:
    tracking gap of the receiver, the giver's own motion onset dates it. A refinement that would
    shrink a transfer below ``min_transfer`` is dropped for the rule's own run.
 5. The reach starts at the giver's motion onset before the transfer (speed above
-   ``reach_onset_speed``, back-dated the same way); the retreat ends when the giver's hand is
-   back at rest (the mirror image), when the next reach starts, or when the data end.
+   ``reach_onset_speed``, back-dated the same way from the last rest sample *seen*: an onset
+   hidden in a tracking gap is dated across the gap, not at its end); the retreat ends when the
+   giver's hand is back at rest (the mirror image), when the next reach starts, or when the
+   data end.
 
 The robot's gripper/load-share columns are not used offline: at low sampling rates their first
 sample after the release is later than the back-dated kinematic estimate (the online detector
@@ -319,12 +321,17 @@ def _onset_before(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
     if slow.size == 0:
         return float(s.t[lo])  # already moving when the data start
     i_c = lo + int(slow[-1]) + 1
-    rest = np.flatnonzero(~(s.giver_speed[lo:i_c] >= c.rest_speed))
+    # The last *seen* rest: when the onset hides in a tracking gap, the displacement across
+    # the gap still dates it (not before that rest sample).
+    rest = np.flatnonzero(s.giver_speed[lo:i_c] < c.rest_speed)
     i_r = lo + int(rest[-1]) if rest.size else lo
     x = float(np.linalg.norm(s.giver[i_c] - s.giver[i_r]))
     speed = float(s.giver_speed[i_c])
     back = 3.0 * x / speed if math.isfinite(x) and speed > 0 else 0.0
-    return max(float(s.t[i_c]) - min(back, c.max_refine), float(s.t[lo]))
+    floor = float(s.t[lo])
+    if i_c - i_r > 1 and not np.isfinite(s.giver_speed[i_r + 1 : i_c]).all():
+        floor = max(floor, float(s.t[i_r]))
+    return max(float(s.t[i_c]) - min(back, c.max_refine), floor)
 
 
 def _rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:

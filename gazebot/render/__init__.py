@@ -4,7 +4,9 @@
 image; ``BlinkModel(seed).update(t, gaze_shift_rad)`` returns the blink (0 open .. 1 closed);
 ``encode_frame`` / ``EyeState`` carry frames or the eye state to a real head screen.
 
-The video renderer (``gazebot.render.video``) pulls in MuJoCo, so it is not imported here.
+``gazebot.render.video`` (the H.264 MP4 writer) and ``gazebot.render.timeline`` (the timeline CSV
+and plot) are imported on their own; the handover recording loop that drives the simulation is
+``gazebot.sim.record`` (render draws things, it does not run them).
 """
 
 from __future__ import annotations

@@ -45,7 +45,7 @@ Color = Annotated[RGB, BeforeValidator(_parse_color)]
 
 
 class _Part(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class FaceStyle(_Part):

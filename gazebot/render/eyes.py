@@ -29,12 +29,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
 
 from gazebot.render.eye_style import EyeStyle, load_eye_style
 from gazebot.render.eyes_display import robot_display
+
+if TYPE_CHECKING:
+    from gazebot.kinematics.config import RobotConfig
 
 _SHIFT = 4  # fixed-point bits for OpenCV drawing: positions at 1/16 px
 _ONE = 1 << _SHIFT
@@ -227,15 +231,16 @@ class EyeRenderer:
     @classmethod
     def for_robot(
         cls,
-        name: str | Path = "sawyer",
+        robot: str | Path | RobotConfig = "sawyer",
         *,
         width: int | None = None,
         height: int | None = None,
         style: EyeStyle | str | Path | None = None,
     ) -> EyeRenderer:
-        """The renderer for robot ``name``'s head screen (size, style and eye range from its YAML,
-        else the built-in table: sawyer 1024x600, jaco2 800x480). Keyword arguments override."""
-        info = robot_display(name)
+        """The renderer for a robot's head screen; ``robot`` is a name (``"sawyer"``), a robot
+        YAML path or a parsed :class:`~gazebot.kinematics.config.RobotConfig`. Size, style and
+        eye range come from its config; keyword arguments override."""
+        info = robot_display(robot)
         return cls(
             width if width is not None else info.width,
             height if height is not None else info.height,

@@ -1,211 +1,139 @@
-"""The one handover loop shared by ``gazebot demo``, ``gazebot render video`` and the study's
-renders: the simulation runs the handover, the gaze engine drives head and eyes every control tick,
-and an observer camera records an H.264 MP4 (yuv420p) off-screen.
+"""H.264 MP4 writing shared by every video gazebot makes (the simulated handovers, the study's
+pair videos and its synthetic stand-in clips): one encoder setting, and atomic files.
 
-Deterministic for a seed: the giver's timing, the engine's random choices and the blinks all derive
-from it, and physics and software rendering are deterministic.
+:func:`open_h264_writer` encodes RGB frames with libx264 to yuv420p through imageio-ffmpeg into a
+temporary file beside the target and renames it over the target only when the writer closes
+without an error, so a failed or interrupted run never leaves a truncated, undecodable MP4.
+
+The handover recording loop (``record_handover``, ``render_handover_video``) lives in
+:mod:`gazebot.sim.record`: render draws things, sim runs the handover, and data flows one way
+(sim imports render, never the reverse).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+import os
 from pathlib import Path
+from types import TracebackType
+from typing import Any
 
 import numpy as np
 
-from gazebot.render.timeline import TickRecord
-from gazebot.types import Event
-
-CONTROL_HZ = 120.0  # tracking rate of the seed's motion capture setup
-MAX_DURATION_S = 30.0  # a handover that has not finished by then is cut (and reported)
+# One encoder thread keeps the bit stream identical run to run (same seed, same bytes) and leaves
+# the other core to physics and rendering; CRF 20 at "veryfast" is visually clean at 640x480.
+H264_OUTPUT_PARAMS = ("-preset", "veryfast", "-crf", "20", "-threads", "1")
 
 
-@dataclass
-class HandoverRecording:
-    """Result of :func:`record_handover`."""
+class H264Writer:
+    """An open H.264 MP4 being written; use :func:`open_h264_writer` to make one.
 
-    ticks: list[TickRecord]
-    video: Path | None
-    frames: int
-    fps: float
-    width: int
-    height: int
-    completed: bool  # the handover finished before MAX_DURATION_S
-    robot_events: list[Event] = field(default_factory=list)
-
-
-def _check_size(width: int, height: int, fps: float) -> None:
-    for name, v in (("width", width), ("height", height)):
-        if isinstance(v, bool) or not isinstance(v, int) or v < 16 or v % 2:
-            raise ValueError(f"video {name} must be an even number of pixels >= 16, got {v!r}")
-    if not (math.isfinite(fps) and 1.0 <= fps <= CONTROL_HZ):
-        raise ValueError(f"fps must be between 1 and {CONTROL_HZ:g}, got {fps}")
-
-
-def _open_writer(path: Path, width: int, height: int, fps: float):
-    import imageio_ffmpeg
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    writer = imageio_ffmpeg.write_frames(
-        str(path),
-        (width, height),
-        fps=fps,
-        codec="libx264",
-        pix_fmt_in="rgb24",
-        pix_fmt_out="yuv420p",
-        macro_block_size=2,
-        quality=None,
-        # One encoder thread keeps the bit stream identical run to run and leaves the other core
-        # to physics and rendering.
-        output_params=["-preset", "veryfast", "-crf", "20", "-threads", "1"],
-        ffmpeg_log_level="error",
-    )
-    writer.send(None)
-    return writer
-
-
-def _direction_change(prev: np.ndarray | None, cur: np.ndarray) -> float:
-    if prev is None or not (np.all(np.isfinite(prev)) and np.all(np.isfinite(cur))):
-        return 0.0
-    a, b = np.linalg.norm(prev), np.linalg.norm(cur)
-    if a < 1e-9 or b < 1e-9:
-        return 0.0
-    return float(np.arccos(np.clip(prev.dot(cur) / (a * b), -1.0, 1.0)))
-
-
-def expected_duration(sim) -> float:
-    """Rough length (s) of the handover ``sim`` will run, for the progress bar: the giver's start,
-    the slower of the two reaches, the grasp, the transfer, the slower retreat and the tail."""
-    plan, ctl, cfg = sim.giver.plan, sim.controller, sim.config.controller
-    robot_reach = ctl.planned_duration(ctl.home, ctl.handover, cfg.reach_min_duration_s)
-    robot_back = ctl.planned_duration(ctl.handover, ctl.home, cfg.retreat_min_duration_s)
-    reach = max(plan.reach_s, 0.25 * plan.reach_s + robot_reach) + cfg.gripper_close_s
-    return (
-        plan.start_t
-        + reach
-        + plan.transfer_s
-        + max(plan.retreat_s, 0.25 * plan.retreat_s + robot_back)
-        + sim.config.tail_s
-    )
-
-
-def record_handover(
-    robot: str | Path = "sawyer",
-    behavior: str | Path = "face-hand-face",
-    scene: str | Path = "default",
-    out_path: str | Path | None = None,
-    seed: int = 0,
-    width: int = 640,
-    height: int = 480,
-    fps: float = 30.0,
-    progress: bool = True,
-) -> HandoverRecording:
-    """Run one handover with the gaze engine in the loop; record the video when ``out_path``.
-
-    Returns the per-tick timeline, the frame count and the robot's events.
+    Frames go to a temporary file; :meth:`close` finishes the stream and renames it to
+    :attr:`path`; :meth:`abort` (or leaving the ``with`` block by an exception) deletes it.
     """
-    from gazebot.sim.gl_check import ensure_gl_backend
 
-    ensure_gl_backend()
-    from tqdm import tqdm
+    def __init__(self, path: Path, fps: float, size: tuple[int, int]) -> None:
+        import imageio_ffmpeg
 
-    from gazebot.engine import GazeEngine
-    from gazebot.render.blink import BlinkModel
-    from gazebot.sim.simulation import HandoverSimulation
+        self.path = path
+        self.fps = fps
+        self.size = size  # (width, height) px
+        self.frames = 0
+        path.parent.mkdir(parents=True, exist_ok=True)
+        # Same folder (so the rename is atomic), hidden, and still ending in .mp4 for the muxer.
+        self.tmp_path = path.with_name(f".{path.stem}.part{os.getpid()}-{id(self):x}.mp4")
+        self._gen: Any = imageio_ffmpeg.write_frames(
+            str(self.tmp_path),
+            size,
+            fps=fps,
+            codec="libx264",
+            pix_fmt_in="rgb24",
+            pix_fmt_out="yuv420p",
+            macro_block_size=2,
+            quality=None,
+            output_params=list(H264_OUTPUT_PARAMS),
+            ffmpeg_log_level="error",
+        )
+        self._gen.send(None)
+        self._open = True
 
-    _check_size(width, height, fps)
-    sim = HandoverSimulation(robot=robot, scene=scene, seed=seed)
-    engine = GazeEngine.from_config(robot=robot, behavior=behavior, seed=seed)
-    blinks = BlinkModel(seed)
-    dt = 1.0 / CONTROL_HZ
-    gaze_site = sim.data.site(sim.robot.gaze_site)
-    tail = sim.config.tail_s
-    writer = _open_writer(Path(out_path), width, height, fps) if out_path is not None else None
-    ticks: list[TickRecord] = []
-    events: list[Event] = []
-    frames, done_at, prev_dir = 0, None, None
-    bar = tqdm(
-        total=int(expected_duration(sim) * fps) + 1 if writer is not None else None,
-        unit="frame",
-        desc=f"{Path(str(robot)).stem} {Path(str(behavior)).stem}",
-        disable=not progress,
-        leave=False,
-    )
-    try:
-        while True:
-            frame = sim.tracking()
-            for event in sim.robot_events():
-                events.append(event)
-                engine.notify(event)
-            # The measured arm pose: on Sawyer the head rides on right_j0.
-            cmd = engine.step(frame, arm=sim.joint_state())
-            sim.apply_head(cmd.head)
-            direction = np.asarray(cmd.target_point, float) - gaze_site.xpos
-            blink = blinks.update(sim.t, _direction_change(prev_dir, direction))
-            prev_dir = direction
-            distance = float(np.linalg.norm(direction))
-            # The eyes converge on the target (EYES' vergence) when its distance is known.
-            sim.apply_eyes(
-                cmd.eye_yaw, cmd.eye_pitch, blink, distance if math.isfinite(distance) else None
+    def append(self, frame: np.ndarray) -> None:
+        """Add one (height, width, 3) uint8 RGB frame.
+
+        Raises:
+            ValueError: wrong shape or dtype (the encoder would silently misread the bytes).
+        """
+        width, height = self.size
+        if frame.shape != (height, width, 3) or frame.dtype != np.uint8:
+            raise ValueError(
+                f"video frame must be ({height}, {width}, 3) uint8 RGB, "
+                f"got {frame.shape} {frame.dtype}"
             )
-            state = sim.joint_state()
-            ticks.append(
-                TickRecord(
-                    t=sim.t,
-                    phase=cmd.phase.value,
-                    target=cmd.target,
-                    head=dict(cmd.head),
-                    eye_yaw=cmd.eye_yaw,
-                    eye_pitch=cmd.eye_pitch,
-                    target_point=np.asarray(cmd.target_point, float).copy(),
-                    hand=sim.giver.hand.copy(),
-                    face=sim.scene.giver.face_point.copy(),
-                    head_measured={j: state[j] for j in cmd.head if j in state},
-                    events=tuple(e.kind.value for e in cmd.events),
-                )
-            )
-            # Frame k shows the first tick at or after k / fps.
-            if writer is not None and sim.t >= frames / fps - 1e-9:
-                writer.send(np.ascontiguousarray(sim.render(width=width, height=height)))
-                frames += 1
-                bar.update(1)
-            if done_at is None and sim.done:
-                done_at = sim.t
-            if (done_at is not None and sim.t >= done_at + tail) or sim.t >= MAX_DURATION_S:
-                break
-            sim.step(dt)
-    finally:
-        if bar.total is not None and bar.n != bar.total:
-            bar.total = bar.n  # the estimate was off: end the bar where the video ended
-            bar.refresh()
-        bar.close()
-        if writer is not None:
-            writer.close()
-        sim.close()
-    return HandoverRecording(
-        ticks=ticks,
-        video=Path(out_path) if out_path is not None else None,
-        frames=frames,
-        fps=fps,
-        width=width,
-        height=height,
-        completed=done_at is not None,
-        robot_events=events,
-    )
+        if not self._open:
+            raise ValueError(f"the video writer for {self.path} is closed")
+        self._gen.send(np.ascontiguousarray(frame))
+        self.frames += 1
+
+    def close(self) -> Path:
+        """Finish the MP4 and move it to :attr:`path`; returns the path.
+
+        Raises:
+            ValueError: no frame was written (an empty MP4 is not a video).
+        """
+        if not self._open:
+            return self.path
+        if self.frames == 0:
+            self.abort()
+            raise ValueError(f"no frames were written to {self.path}")
+        self._open = False
+        try:
+            self._gen.close()
+            os.replace(self.tmp_path, self.path)
+        finally:
+            self.tmp_path.unlink(missing_ok=True)
+        return self.path
+
+    def abort(self) -> None:
+        """Stop encoding and delete the partial file (the target is left untouched)."""
+        if self._open:
+            self._open = False
+            try:
+                self._gen.close()
+            except Exception:  # noqa: BLE001 - already failing; the partial file goes anyway
+                pass
+        self.tmp_path.unlink(missing_ok=True)
+
+    def __enter__(self) -> H264Writer:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
 
 
-def render_handover_video(
-    robot: str | Path,
-    behavior: str | Path,
-    scene: str | Path,
-    out_path: str | Path,
-    seed: int = 0,
-    width: int = 640,
-    height: int = 480,
-    fps: float = 30.0,
-    progress: bool = True,
-) -> Path:
-    """Render one full handover to ``out_path`` (H.264 MP4, yuv420p) and return the path."""
-    record_handover(robot, behavior, scene, out_path, seed, width, height, fps, progress)
-    return Path(out_path)
+def open_h264_writer(path: str | Path, fps: float, size: tuple[int, int]) -> H264Writer:
+    """Open an H.264 (libx264, yuv420p) MP4 writer for ``size`` = (width, height) px frames.
+
+    Use it as a context manager: the file appears at ``path`` only if the block ends without an
+    error. Deterministic: the same frames give the same bytes.
+
+    Raises:
+        ValueError: odd or tiny size (yuv420p needs even sides), or a non-positive frame rate.
+    """
+    width, height = size
+    for name, v in (("width", width), ("height", height)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 16 or v % 2:
+            raise ValueError(f"video {name} must be an even number of pixels >= 16, got {v!r}")
+    if not (isinstance(fps, (int, float)) and math.isfinite(fps) and fps > 0):
+        raise ValueError(f"video fps must be a positive number, got {fps!r}")
+    return H264Writer(Path(path), float(fps), (int(width), int(height)))
+
+
+__all__ = ["H264_OUTPUT_PARAMS", "H264Writer", "open_h264_writer"]

@@ -1,23 +1,26 @@
 """What the simulation needs to know about a robot: its MJCF, which joints are head and arm, and the
-arm's home and predefined handover poses. Read from the robot YAML (``configs/robots/<name>.yaml``,
-written by the kinematics package) so the simulation and the gaze engine share one description."""
+arm's home and predefined handover poses.
+
+The robot YAML (``configs/robots/<name>.yaml``) has one parser, the kinematics package's pydantic
+:class:`~gazebot.kinematics.config.RobotConfig`; this module only converts the parsed config to
+what the simulation uses (radians, joint order, the resolved MJCF path), so the simulation, the
+gaze engine and the eye renderer all read the same description.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from gazebot.config import ConfigError, configs_dir, read_yaml
-
-ASSETS = Path(__file__).resolve().parents[1] / "assets" / "robots"
+from gazebot.config import ConfigError
+from gazebot.kinematics.config import RobotConfig, load_robot_config, resolve_mjcf
 
 
 @dataclass(frozen=True)
 class SimRobot:
-    """A robot as the simulation uses it (angles in rad)."""
+    """A robot as the simulation uses it (angles in rad), with the config it came from."""
 
     name: str
     mjcf: Path
@@ -25,76 +28,59 @@ class SimRobot:
     arm_joints: tuple[str, ...]
     home: np.ndarray  # arm joints at home
     handover: np.ndarray  # arm joints at the predefined handover pose
+    config: RobotConfig
+    source: Path | None = None  # the robot YAML, None for a config built in code
     gripper_actuator: str = "gripper"
     gripper_site: str = "gripper"
     gaze_site: str = "gaze"
 
+    @property
+    def spec(self) -> str | Path | RobotConfig:
+        """What to hand to other loaders (gaze engine, eye renderer) for the same robot: the
+        YAML path when there is one (a relative ``mjcf`` resolves beside it), else the config."""
+        return self.source if self.source is not None else self.config
 
-def _pose(data: dict[str, Any], key: str, joints: tuple[str, ...], source: Path) -> np.ndarray:
-    """A pose given in degrees as a mapping joint -> deg or a list in ``arm_joints`` order."""
-    raw = data.get(key)
-    if isinstance(raw, dict):
-        missing = [j for j in joints if j not in raw]
-        if missing:
-            raise ConfigError(source, key, f"a value for every arm joint (missing {missing})")
-        values = [raw[j] for j in joints]
-    elif isinstance(raw, list) and len(raw) == len(joints):
-        values = raw
-    else:
-        raise ConfigError(source, key, f"{len(joints)} arm joint angles in degrees", raw)
-    try:
-        out = np.deg2rad(np.asarray(values, dtype=float))
-    except (TypeError, ValueError) as exc:
-        raise ConfigError(source, key, "numbers (degrees)", raw) from exc
+
+def _pose_rad(config: RobotConfig, key: str, source: Path | str) -> np.ndarray:
+    """``arm_home_deg`` / ``arm_handover_deg`` (validated: exactly the arm joints) in rad, in
+    ``arm_joints`` order."""
+    pose = getattr(config, key)
+    out = np.deg2rad(np.array([pose[j] for j in config.arm_joints], dtype=float))
     if not np.all(np.isfinite(out)):
-        raise ConfigError(source, key, "finite numbers (degrees)", raw)
+        raise ConfigError(source, key, "finite joint angles (degrees)", pose)
     return out
 
 
-def load_sim_robot(robot: str | Path) -> SimRobot:
-    """Load ``configs/robots/<robot>.yaml`` (or a YAML path) as a :class:`SimRobot`.
+def sim_robot_from_config(config: RobotConfig, source: Path | None = None) -> SimRobot:
+    """The simulation's view of a parsed robot config (``source``: its YAML, for a relative MJCF).
+
+    Raises:
+        ConfigError: the MJCF file does not exist or a pose is not finite.
+    """
+    where: Path | str = source if source is not None else f"<robot config {config.name!r}>"
+    return SimRobot(
+        name=config.name,
+        mjcf=resolve_mjcf(config, source),
+        head_joints=tuple(config.head_joints),
+        arm_joints=tuple(config.arm_joints),
+        home=_pose_rad(config, "arm_home_deg", where),
+        handover=_pose_rad(config, "arm_handover_deg", where),
+        config=config,
+        source=source,
+        gripper_actuator=config.gripper_actuator,
+        gripper_site=config.gripper_site,
+        gaze_site=config.gaze_site,
+    )
+
+
+def load_sim_robot(robot: str | Path | RobotConfig) -> SimRobot:
+    """A robot by name (``configs/robots/<robot>.yaml``), YAML path or parsed :class:`RobotConfig`.
 
     Raises:
         FileNotFoundError: no such robot.
-        ConfigError: a field the simulation needs is missing or malformed.
+        ConfigError: the YAML is malformed (names file, field and expectation).
     """
-    path = Path(robot)
-    if path.suffix not in (".yaml", ".yml"):
-        path = configs_dir() / "robots" / f"{robot}.yaml"
-    if not path.is_file():
-        known = sorted(p.stem for p in (configs_dir() / "robots").glob("*.yaml"))
-        raise FileNotFoundError(f"unknown robot {str(robot)!r}: no file {path} (known: {known})")
-    data = read_yaml(path)
-    if not isinstance(data, dict):
-        raise ConfigError(path, "<root>", "a mapping")
-    mjcf_raw = data.get("mjcf")
-    if not isinstance(mjcf_raw, str):
-        raise ConfigError(path, "mjcf", "the robot's MJCF file name", mjcf_raw)
-    mjcf = Path(mjcf_raw)
-    if not mjcf.is_absolute():
-        candidates = [path.parent / mjcf, ASSETS / mjcf, ASSETS / mjcf.name]
-        mjcf = next((c for c in candidates if c.is_file()), candidates[-1])
-    if not mjcf.is_file():
-        raise ConfigError(path, "mjcf", f"an existing MJCF file (looked for {mjcf})", mjcf_raw)
-    joints: dict[str, tuple[str, ...]] = {}
-    for key in ("head_joints", "arm_joints"):
-        raw = data.get(key)
-        if not (isinstance(raw, list) and raw and all(isinstance(j, str) for j in raw)):
-            raise ConfigError(path, key, "a non-empty list of joint names", raw)
-        joints[key] = tuple(raw)
-    arm = joints["arm_joints"]
-    names = {}
-    for key in ("gripper_actuator", "gripper_site", "gaze_site"):
-        raw = data.get(key, key.split("_")[0])
-        if not isinstance(raw, str) or not raw:
-            raise ConfigError(path, key, "a name in the MJCF", raw)
-        names[key] = raw
-    return SimRobot(
-        name=str(data.get("name", path.stem)),
-        mjcf=mjcf,
-        head_joints=joints["head_joints"],
-        arm_joints=arm,
-        home=_pose(data, "arm_home_deg", arm, path),
-        handover=_pose(data, "arm_handover_deg", arm, path),
-        **names,
-    )
+    if isinstance(robot, RobotConfig):
+        return sim_robot_from_config(robot)
+    config, path = load_robot_config(robot)
+    return sim_robot_from_config(config, path)

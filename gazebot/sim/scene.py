@@ -195,16 +195,19 @@ def _layout(
 def _camera(
     cfg: SceneConfig, layout: SceneLayout, gaze: np.ndarray, face: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The default observer view: from the front right (the side the head turns to when it looks
-    at the giver), far enough to see the whole scene, looking at the middle of head, handover
-    location and giver. A head standing beside the arm (Jaco-2) is watched from higher up, so
-    the arm does not hide the display."""
-    beside = abs(gaze[1]) > 0.15
+    """The default observer view, looking at the middle of head, handover location and giver.
+
+    A head on the arm (Sawyer) is watched from the front right, the side the head turns to when
+    it looks at the giver. A head standing beside the arm (Jaco-2) is watched from the head's own
+    side and well in front of it: the arm, and the object it carries home, then stay behind the
+    display, and the display still faces the camera when the head turns to the handover location.
+    """
+    side = float(np.sign(gaze[1])) if abs(gaze[1]) > 0.15 else 0.0
     look = np.array(cfg.camera.look_at_m) if cfg.camera.look_at_m else None
     if look is None:
         look = (gaze + layout.handover_location + face) / 3.0
-        look[2] -= 0.0 if beside else 0.05
-    offset = np.array([1.1, -2.1, 0.9]) if beside else np.array([0.7, -2.25, 0.2])
+        look[2] -= 0.0 if side else 0.05
+    offset = np.array([1.7, side * 1.2, 0.7]) if side else np.array([0.7, -2.25, 0.2])
     pos = np.array(cfg.camera.pos_m) if cfg.camera.pos_m else look + offset
     return pos, look
 

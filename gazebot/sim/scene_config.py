@@ -14,7 +14,7 @@ from gazebot.config import configs_dir, load_model
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
 class Posture(str, Enum):

@@ -16,6 +16,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from gazebot.kinematics.config import RobotConfig
 from gazebot.sim.controller import ControllerState, HandoverController, Sensed
 from gazebot.sim.display import DisplayTexture
 from gazebot.sim.giver import GiverPlan, GiverState, SimulatedGiver
@@ -46,7 +47,8 @@ class HandoverSimulation:
     """One simulated handover.
 
     Args:
-        robot: Robot name (``sawyer``, ``jaco2``), robot YAML path or a :class:`SimRobot`.
+        robot: Robot name (``sawyer``, ``jaco2``), robot YAML path, parsed
+            :class:`~gazebot.kinematics.config.RobotConfig` or a :class:`SimRobot`.
         scene: Scene name (``configs/scenes/<name>.yaml``), YAML path or a :class:`SceneConfig`.
         seed: Seeds the giver's timing and the tracking noise (same seed, same handover).
         tracking_noise: Overrides the scene's tracking noise (``None``: the scene's).
@@ -54,7 +56,7 @@ class HandoverSimulation:
 
     def __init__(
         self,
-        robot: str | Path | SimRobot = "sawyer",
+        robot: str | Path | RobotConfig | SimRobot = "sawyer",
         scene: str | Path | SceneConfig = "default",
         seed: int = 0,
         tracking_noise: TrackingNoiseConfig | None = None,
@@ -283,6 +285,12 @@ class HandoverSimulation:
             raise ValueError(f"eye yaw/pitch/blink/distance must be finite, got {values}")
         self._eyes = (float(yaw), float(pitch), float(np.clip(blink, 0.0, 1.0)), distance)
 
+    @property
+    def eyes(self) -> tuple[float, float, float, float | None] | None:
+        """The last :meth:`apply_eyes` command (yaw rad, pitch rad, blink, vergence distance m or
+        None), or None while the display shows an image from :meth:`set_display` or nothing."""
+        return self._eyes
+
     def set_display(self, image: np.ndarray) -> None:
         """Show ``image`` ((H, W, 3) uint8 RGB) on the head display (replaces the eyes)."""
         self.display.write(image)
@@ -295,9 +303,10 @@ class HandoverSimulation:
         if self._eye_renderer is None:
             from gazebot.render import EyeRenderer
 
-            # Draw at the texture's size: no resize per frame.
+            # The robot's own config (not a lookup by name: a custom robot YAML has no entry
+            # anywhere else); drawn at the texture's size, so no resize per frame.
             self._eye_renderer = EyeRenderer.for_robot(
-                self.robot.name, width=self.display.width, height=self.display.height
+                self.robot.config, width=self.display.width, height=self.display.height
             )
         yaw, pitch, blink, distance = self._eyes
         self.display.write(self._eye_renderer.render(yaw, pitch, blink=blink, distance=distance))

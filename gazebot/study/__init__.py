@@ -1,64 +1,55 @@
 """Video-study toolkit (seed chapter 6): counterbalanced plans, rendering of the study videos,
-and the Bradley-Terry preference analysis with the seed's significance tests."""
+and the Bradley-Terry preference analysis with the seed's significance tests.
 
-from gazebot.study.analysis import (
-    RESPONSE_COLUMNS,
-    Response,
-    StudyAnalysis,
-    analyze,
-    read_responses,
-    read_win_matrix,
-    win_matrix,
-)
-from gazebot.study.bradley_terry import BradleyTerryFit, fit_bradley_terry
-from gazebot.study.plan import (
-    CONDITION_LEVELS,
-    DEFAULT_BEHAVIORS,
-    Session,
-    check_balance,
-    make_plan,
-    ordered_pairings,
-    read_plan,
-    williams_square,
-    write_plan,
-)
-from gazebot.study.questionnaire import MEASURES, QUESTIONS
-from gazebot.study.stats import (
-    bradley_terry_chi2,
-    likelihood_ratio_chi2,
-    matched_equivalence,
-    matched_proportion_difference,
-    position_bias_test,
-    unmatched_equivalence,
-    unmatched_proportion_difference,
-)
+The names below are imported on first use (PEP 562), so that ``gazebot --help`` can read the
+study's conditions (:mod:`gazebot.study.conditions`) without loading SciPy.
+"""
 
-__all__ = [
-    "CONDITION_LEVELS",
-    "DEFAULT_BEHAVIORS",
-    "MEASURES",
-    "QUESTIONS",
-    "RESPONSE_COLUMNS",
-    "BradleyTerryFit",
-    "Response",
-    "Session",
-    "StudyAnalysis",
-    "analyze",
-    "bradley_terry_chi2",
-    "check_balance",
-    "fit_bradley_terry",
-    "likelihood_ratio_chi2",
-    "make_plan",
-    "matched_equivalence",
-    "matched_proportion_difference",
-    "ordered_pairings",
-    "position_bias_test",
-    "read_plan",
-    "read_responses",
-    "read_win_matrix",
-    "unmatched_equivalence",
-    "unmatched_proportion_difference",
-    "williams_square",
-    "win_matrix",
-    "write_plan",
-]
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_EXPORTS: dict[str, str] = {
+    "CONDITION_LEVELS": "conditions",
+    "DEFAULT_BEHAVIORS": "conditions",
+    "MEASURES": "questionnaire",
+    "QUESTIONS": "questionnaire",
+    "RESPONSE_COLUMNS": "analysis",
+    "BradleyTerryFit": "bradley_terry",
+    "Response": "analysis",
+    "Session": "plan",
+    "StudyAnalysis": "analysis",
+    "analyze": "analysis",
+    "bradley_terry_chi2": "stats",
+    "check_balance": "plan",
+    "fit_bradley_terry": "bradley_terry",
+    "likelihood_ratio_chi2": "stats",
+    "make_plan": "plan",
+    "matched_equivalence": "stats",
+    "matched_proportion_difference": "stats",
+    "ordered_pairings": "plan",
+    "position_bias_test": "stats",
+    "read_plan": "plan",
+    "read_responses": "analysis",
+    "read_win_matrix": "analysis",
+    "unmatched_equivalence": "stats",
+    "unmatched_proportion_difference": "stats",
+    "williams_square": "plan",
+    "win_matrix": "analysis",
+    "write_plan": "plan",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'gazebot.study' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"gazebot.study.{_EXPORTS[name]}"), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_EXPORTS])

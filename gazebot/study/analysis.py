@@ -9,7 +9,26 @@ layout with the answers left blank)::
 
 ``first``/``second``: the behaviors shown as Handover 1 / Handover 2; ``q1``..``q5``: 1 if the
 participant chose the 1st handover, 2 if the 2nd. ``condition``/``level`` may be empty for a study
-with a single scenario (the seed's section 6.3 studies).
+with a single scenario (the seed's section 6.3 studies). An optional ``group`` column names
+independent groups of participants (e.g. ``video`` and ``in-person``, the seed's two studies of
+section 6.4 that both number their participants from 1): a participant is identified by
+(group, participant), and each group and level is analysed on its own.
+
+Between-sample tests (seed section 6.4.4-6.4.5), per measure and pair of behaviors:
+
+- two levels of one condition answered by the **same** participants (the seed's within-subject
+  levels, hypotheses H2-H4): the matched tests, eqs 6.3-6.4 and the McNemar-type equivalence
+  test, on the participants who answered both levels;
+- two levels of one condition answered by **disjoint** participants (a between-subject
+  condition), and one level answered by two ``group`` s (the seed's video vs in-person
+  comparison, H5): the unmatched tests, eqs 6.5-6.6 and the two-proportion equivalence test, with
+  X = the summed preferences (the win-matrix cell, like the seed's Tables B.1-B.6) and n = the
+  participants who compared the pair;
+- levels of **different** conditions are not compared: the seed states no hypothesis about them,
+  and e.g. "small box" vs "sitting" would confound two factors.
+
+Two levels with only some participants in common are compared with the matched tests on the
+common participants (the others cannot be paired).
 
 Per level and measure, participant k's preference for behavior i over j is the share of i-wins
 over the measure's questions and both ordered comparisons (i first, j first); the win matrix sums
@@ -21,12 +40,14 @@ from __future__ import annotations
 
 import csv
 import itertools
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from gazebot.study.bradley_terry import BradleyTerryFit, fit_bradley_terry
+from gazebot.study.csvio import open_text
 from gazebot.study.plan import DEFAULT_BEHAVIORS
 from gazebot.study.questionnaire import MEASURES, QUESTIONS
 from gazebot.study.stats import (
@@ -37,16 +58,21 @@ from gazebot.study.stats import (
     matched_equivalence,
     matched_proportion_difference,
     position_bias_test,
+    unmatched_equivalence,
+    unmatched_proportion_difference,
 )
 
 RESPONSE_COLUMNS = ("participant", "session", "condition", "level", "first", "second") + tuple(
     QUESTIONS
 )
+#: Optional column: independent participant groups (e.g. ``video`` / ``in-person``).
+GROUP_COLUMN = "group"
 
 
 @dataclass(frozen=True)
 class Response:
-    """One answered session: ``answers[q]`` is 1 (first handover chosen) or 2 (second)."""
+    """One answered session: ``answers[q]`` is 1 (first handover chosen) or 2 (second);
+    ``group``: the independent participant group ("" for a single group)."""
 
     participant: str
     session: int
@@ -55,6 +81,17 @@ class Response:
     first: str
     second: str
     answers: dict[str, int]
+    group: str = ""
+
+    @property
+    def who(self) -> tuple[str, str]:
+        """The participant's identity: (group, participant)."""
+        return (self.group, self.participant)
+
+    @property
+    def sample(self) -> str:
+        """The analysed sample: the level, prefixed by the group if any (``group:level``)."""
+        return f"{self.group}:{self.level}" if self.group else self.level
 
 
 def read_responses(path: str | Path) -> list[Response]:
@@ -65,7 +102,7 @@ def read_responses(path: str | Path) -> list[Response]:
     if not path.is_file():
         raise FileNotFoundError(f"responses file not found: {path}")
     out = []
-    with path.open(newline="", encoding="utf-8") as fh:
+    with open_text(path) as fh:
         reader = csv.DictReader(fh)
         missing = [c for c in RESPONSE_COLUMNS if c not in (reader.fieldnames or [])]
         if missing:
@@ -104,6 +141,7 @@ def read_responses(path: str | Path) -> list[Response]:
                     first=row["first"],
                     second=row["second"],
                     answers=answers,
+                    group=row.get(GROUP_COLUMN, ""),
                 )
             )
     if not out:
@@ -120,16 +158,17 @@ def behaviors_of(responses: list[Response]) -> list[str]:
 
 def preferences(
     responses: list[Response], behaviors: list[str], questions: tuple[str, ...]
-) -> dict[str, np.ndarray]:
-    """Per participant a ``g x g`` matrix: entry (i, j) = share of i-wins over ``questions`` and
-    all of the participant's comparisons of i with j (NaN where the pair was never compared)."""
+) -> dict[tuple[str, str], np.ndarray]:
+    """Per participant (key :attr:`Response.who`) a ``g x g`` matrix: entry (i, j) = share of
+    i-wins over ``questions`` and all of the participant's comparisons of i with j (NaN where the
+    pair was never compared)."""
     index = {b: i for i, b in enumerate(behaviors)}
     g = len(behaviors)
-    sums: dict[str, np.ndarray] = {}
-    counts: dict[str, np.ndarray] = {}
+    sums: dict[tuple[str, str], np.ndarray] = {}
+    counts: dict[tuple[str, str], np.ndarray] = {}
     for r in responses:
-        s = sums.setdefault(r.participant, np.zeros((g, g)))
-        c = counts.setdefault(r.participant, np.zeros((g, g)))
+        s = sums.setdefault(r.who, np.zeros((g, g)))
+        c = counts.setdefault(r.who, np.zeros((g, g)))
         i, j = index[r.first], index[r.second]
         first_share = float(np.mean([r.answers[q] == 1 for q in questions]))
         s[i, j] += first_share
@@ -170,8 +209,14 @@ class MeasureResult:
 
 @dataclass(frozen=True)
 class LevelComparison:
-    """Between-level tests (eqs 6.3-6.4 and equivalence) for one pair of behaviors and measure;
-    the proportions are of participants preferring ``behavior_i`` over ``behavior_j``."""
+    """Between-sample tests for one pair of behaviors and measure; the proportions are of
+    participants preferring ``behavior_i`` over ``behavior_j`` in sample a and sample b.
+
+    ``design``: ``"matched"`` (same participants in both samples: eqs 6.3-6.4 and the
+    McNemar-type equivalence test) or ``"unmatched"`` (independent participants: eqs 6.5-6.6 and
+    the two-proportion equivalence test); ``group_a``/``group_b``: the participant groups ("" for
+    a single group); ``n_a``/``n_b``: participants in each test.
+    """
 
     measure: str
     behavior_i: str
@@ -182,6 +227,19 @@ class LevelComparison:
     proportion_b: float
     difference: ProportionTest
     equivalence: ProportionTest
+    design: str = "matched"
+    group_a: str = ""
+    group_b: str = ""
+    n_a: int = 0
+    n_b: int = 0
+
+    @property
+    def sample_a(self) -> str:
+        return f"{self.group_a}:{self.level_a}" if self.group_a else self.level_a
+
+    @property
+    def sample_b(self) -> str:
+        return f"{self.group_b}:{self.level_b}" if self.group_b else self.level_b
 
 
 @dataclass
@@ -222,7 +280,10 @@ class StudyAnalysis:
                 {
                     "measure": c.measure,
                     "pair": [c.behavior_i, c.behavior_j],
+                    "design": c.design,
                     "levels": [c.level_a, c.level_b],
+                    "groups": [c.group_a, c.group_b],
+                    "n": [c.n_a, c.n_b],
                     "proportions": [c.proportion_a, c.proportion_b],
                     "difference": c.difference.difference,
                     "z": c.difference.z,
@@ -246,7 +307,7 @@ def position_differences(
         raise ValueError(f"bias unit must be 'participant' or 'session', got {unit!r}")
     groups: dict[object, list[int]] = {}
     for r in responses:
-        key = r.participant if unit == "participant" else (r.participant, r.session, r.level)
+        key = r.who if unit == "participant" else (r.who, r.session, r.level)
         groups.setdefault(key, []).extend(r.answers[q] for q in questions)
     return np.array(
         [np.mean([a == 1 for a in v]) - np.mean([a == 2 for a in v]) for v in groups.values()]
@@ -260,27 +321,30 @@ def analyze(
     bias_unit: str = "participant",
 ) -> StudyAnalysis:
     """Bradley-Terry P_i with the likelihood-ratio chi-square (= eqs 6.1-6.2 for a complete
-    design) per level and measure, the first/second bias test per measure (see
-    :func:`position_differences` for ``bias_unit``), and for a study with two levels the matched
-    proportion difference and equivalence tests (margin ``margin``) per pair of behaviors.
-    ``behaviors`` fixes the order of the conditions (default: :func:`behaviors_of`)."""
+    design) per sample (level, or ``group:level``) and measure, the first/second bias test per
+    measure (see :func:`position_differences` for ``bias_unit``), and the between-sample
+    difference and equivalence tests (margin ``margin``) per pair of behaviors: matched or
+    unmatched as the module doc explains. ``behaviors`` fixes the order of the conditions
+    (default: :func:`behaviors_of`)."""
+    if not (isinstance(margin, int | float) and math.isfinite(margin) and 0 < margin < 1):
+        raise ValueError(f"equivalence margin must be a finite proportion in (0, 1), got {margin}")
     found = behaviors_of(responses)
     if behaviors is None:
         behaviors = found
     elif sorted(behaviors) != sorted(found):
         raise ValueError(f"responses compare behaviors {found}, not {list(behaviors)}")
     behaviors = list(behaviors)
-    levels = list(dict.fromkeys(r.level for r in responses))
-    result = StudyAnalysis(behaviors=behaviors, levels=levels)
-    for level in levels:
-        rows = [r for r in responses if r.level == level]
-        result.per_level[level] = {}
+    samples = list(dict.fromkeys(r.sample for r in responses))
+    result = StudyAnalysis(behaviors=behaviors, levels=samples)
+    for sample in samples:
+        rows = [r for r in responses if r.sample == sample]
+        result.per_level[sample] = {}
         for measure, questions in MEASURES.items():
             w = win_matrix(rows, behaviors, questions)
             fit = fit_bradley_terry(w, behaviors)
-            result.per_level[level][measure] = MeasureResult(
+            result.per_level[sample][measure] = MeasureResult(
                 measure=measure,
-                participants=len({r.participant for r in rows}),
+                participants=len({r.who for r in rows}),
                 wins=w,
                 fit=fit,
                 chi2=likelihood_ratio_chi2(w, fit.p),
@@ -288,38 +352,76 @@ def analyze(
     for measure, questions in MEASURES.items():
         diffs = position_differences(responses, questions, bias_unit)
         result.bias[measure] = position_bias_test(diffs)
-    if len(levels) == 2:
-        result.comparisons = _compare_levels(responses, behaviors, levels, margin)
+    for a, b in comparable_samples(responses):
+        result.comparisons += _compare(a, b, behaviors, margin)
     return result
 
 
-def _compare_levels(
-    responses: list[Response], behaviors: list[str], levels: list[str], margin: float
+def comparable_samples(
+    responses: list[Response],
+) -> list[tuple[list[Response], list[Response]]]:
+    """The pairs of samples the module doc says to compare, in order of appearance: two levels
+    of one condition within a group, then one level across two groups."""
+    by_sample: dict[tuple[str, str, str], list[Response]] = {}
+    for r in responses:
+        by_sample.setdefault((r.group, r.condition, r.level), []).append(r)
+    keys = list(by_sample)
+    pairs = []
+    for ka, kb in itertools.combinations(keys, 2):
+        same_group_levels = ka[0] == kb[0] and ka[1] == kb[1] and ka[2] != kb[2]
+        same_level_groups = ka[0] != kb[0] and ka[1:] == kb[1:]
+        if same_group_levels or same_level_groups:
+            pairs.append((by_sample[ka], by_sample[kb]))
+    pairs.sort(key=lambda ab: ab[0][0].group != ab[1][0].group)  # stable: levels first
+    return pairs
+
+
+def _compare(
+    rows_a: list[Response], rows_b: list[Response], behaviors: list[str], margin: float
 ) -> list[LevelComparison]:
-    level_a, level_b = levels
+    """Matched tests if the samples share participants (on the shared ones), else unmatched."""
+    ra, rb = rows_a[0], rows_b[0]
     out = []
     for measure, questions in MEASURES.items():
-        pa = preferences([r for r in responses if r.level == level_a], behaviors, questions)
-        pb = preferences([r for r in responses if r.level == level_b], behaviors, questions)
+        pa = preferences(rows_a, behaviors, questions)
+        pb = preferences(rows_b, behaviors, questions)
         both = [k for k in pa if k in pb]
         for i, j in itertools.combinations(range(len(behaviors)), 2):
-            xa = np.array([pa[k][i, j] for k in both])
-            xb = np.array([pb[k][i, j] for k in both])
-            keep = np.isfinite(xa) & np.isfinite(xb)
-            xa, xb = xa[keep], xb[keep]
-            if xa.size == 0:
-                continue
+            if both:
+                xa = np.array([pa[k][i, j] for k in both])
+                xb = np.array([pb[k][i, j] for k in both])
+                keep = np.isfinite(xa) & np.isfinite(xb)
+                xa, xb = xa[keep], xb[keep]
+                if xa.size == 0:
+                    continue
+                design = "matched"
+                difference = matched_proportion_difference(xa, xb)
+                equivalence = matched_equivalence(xa, xb, margin)
+            else:
+                xa = np.array([v[i, j] for v in pa.values() if np.isfinite(v[i, j])])
+                xb = np.array([v[i, j] for v in pb.values() if np.isfinite(v[i, j])])
+                if xa.size == 0 or xb.size == 0:
+                    continue
+                design = "unmatched"
+                counts = (float(xa.sum()), xa.size, float(xb.sum()), xb.size)
+                difference = unmatched_proportion_difference(*counts)
+                equivalence = unmatched_equivalence(*counts, margin=margin)
             out.append(
                 LevelComparison(
                     measure=measure,
                     behavior_i=behaviors[i],
                     behavior_j=behaviors[j],
-                    level_a=level_a,
-                    level_b=level_b,
+                    level_a=ra.level,
+                    level_b=rb.level,
                     proportion_a=float(xa.mean()),
                     proportion_b=float(xb.mean()),
-                    difference=matched_proportion_difference(xa, xb),
-                    equivalence=matched_equivalence(xa, xb, margin),
+                    difference=difference,
+                    equivalence=equivalence,
+                    design=design,
+                    group_a=ra.group,
+                    group_b=rb.group,
+                    n_a=int(xa.size),
+                    n_b=int(xb.size),
                 )
             )
     return out
@@ -332,7 +434,7 @@ def read_win_matrix(path: str | Path) -> tuple[list[str], np.ndarray]:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"win matrix file not found: {path}")
-    with path.open(newline="", encoding="utf-8") as fh:
+    with open_text(path) as fh:
         rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
     if len(rows) < 3:
         raise ValueError(f"{path}: expected a header row and at least 2 condition rows")
@@ -354,9 +456,11 @@ def read_win_matrix(path: str | Path) -> tuple[list[str], np.ndarray]:
             try:
                 w[i, j] = float(c)
             except ValueError:
+                w[i, j] = math.nan
+            if not math.isfinite(w[i, j]):
                 raise ValueError(
                     f"{path}: line {i + 2}, column '{names[j]}': expected a number, got {c!r}"
-                ) from None
+                )
             if i == j and w[i, j] != 0:
                 raise ValueError(
                     f"{path}: line {i + 2}: diagonal cell ({names[i]}, {names[i]}) must be empty "

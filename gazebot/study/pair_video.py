@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -26,32 +25,21 @@ def make_pair_video(
     first: Path, second: Path, out_path: Path, width: int, height: int, fps: int, card_s: float
 ) -> Path:
     """Title card + first video + title card + second video, re-encoded as one H.264 MP4 (frames
-    of another size are resized); written under a temporary name, then renamed."""
+    of another size are resized); the file appears only once it is complete."""
     import cv2
     import imageio.v2 as imageio
 
-    tmp = out_path.with_name(out_path.stem + f".part{os.getpid()}.mp4")
+    from gazebot.render.video import open_h264_writer
+
     n_card = max(1, round(card_s * fps))
-    try:
-        with imageio.get_writer(
-            tmp,
-            fps=fps,
-            codec="libx264",
-            pixelformat="yuv420p",
-            macro_block_size=2,
-            ffmpeg_log_level="error",
-            format="FFMPEG",
-        ) as writer:
-            for label, src in (("Handover 1", first), ("Handover 2", second)):
-                card = title_card(label, width, height)
-                for _ in range(n_card):
-                    writer.append_data(card)
-                with imageio.get_reader(src, format="FFMPEG") as reader:
-                    for frame in reader:
-                        if frame.shape[:2] != (height, width):
-                            frame = cv2.resize(frame, (width, height))
-                        writer.append_data(frame[..., :3])
-        os.replace(tmp, out_path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    with open_h264_writer(out_path, fps, (width, height)) as writer:
+        for label, src in (("Handover 1", first), ("Handover 2", second)):
+            card = title_card(label, width, height)
+            for _ in range(n_card):
+                writer.append(card)
+            with imageio.get_reader(src, format="FFMPEG") as reader:
+                for frame in reader:
+                    if frame.shape[:2] != (height, width):
+                        frame = cv2.resize(frame, (width, height))
+                    writer.append(frame[..., :3])
     return out_path

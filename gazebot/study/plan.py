@@ -29,23 +29,23 @@ from pathlib import Path
 
 import numpy as np
 
-DEFAULT_BEHAVIORS = ("hand-face", "face-hand-face", "hand")
+from gazebot.study.conditions import CONDITION_LEVELS, DEFAULT_BEHAVIORS, DEFAULT_SCENES
+from gazebot.study.csvio import check_output_file, open_text
 
-# Table 6.3: the two levels (a, b) of each condition.
-CONDITION_LEVELS: dict[str, tuple[str, str]] = {
-    "object-size": ("small-box", "large-box"),
-    "fragility": ("plastic-bottle", "glass-bottle"),
-    "posture": ("sitting", "standing"),
-}
-# The shipped scene (configs/scenes/<name>.yaml) that shows each level.
-DEFAULT_SCENES: dict[str, str] = {
-    "small-box": "small-object",
-    "large-box": "large-object",
-    "plastic-bottle": "non-fragile",
-    "glass-bottle": "fragile",
-    "sitting": "sitting",
-    "standing": "standing",
-}
+__all__ = [
+    "CONDITION_LEVELS",
+    "DEFAULT_BEHAVIORS",
+    "DEFAULT_SCENES",
+    "PLAN_COLUMNS",
+    "BalanceReport",
+    "Session",
+    "check_balance",
+    "make_plan",
+    "ordered_pairings",
+    "read_plan",
+    "williams_square",
+    "write_plan",
+]
 
 
 @dataclass(frozen=True)
@@ -201,8 +201,9 @@ def check_balance(plan: list[Session]) -> BalanceReport:
 
 
 def write_plan(plan: list[Session], path: str | Path) -> Path:
-    """Write the plan as CSV with the columns :data:`PLAN_COLUMNS`."""
-    path = Path(path)
+    """Write the plan as CSV with the columns :data:`PLAN_COLUMNS`; ``ValueError`` if ``path`` is
+    a folder (see :func:`~gazebot.study.csvio.check_output_file`)."""
+    path = check_output_file(path, "plan")
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=PLAN_COLUMNS)
@@ -218,7 +219,7 @@ def read_plan(path: str | Path) -> list[Session]:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"plan file not found: {path}")
-    with path.open(newline="", encoding="utf-8") as fh:
+    with open_text(path) as fh:
         reader = csv.DictReader(fh)
         missing = [c for c in PLAN_COLUMNS if c not in (reader.fieldnames or [])]
         if missing:

@@ -52,7 +52,7 @@ class RenderReport:
 def default_renderer() -> RenderFn:
     """The SIM package's MuJoCo renderer (imported lazily: it pulls in MuJoCo)."""
     try:
-        from gazebot.render.video import render_handover_video
+        from gazebot.sim.record import render_handover_video
     except ImportError as exc:
         raise ValueError(
             f"the MuJoCo handover renderer is not available ({exc}); "

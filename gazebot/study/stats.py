@@ -45,8 +45,8 @@ def bradley_terry_chi2(wins_per_condition: np.ndarray, p: np.ndarray, n: float) 
     g = a.size
     if p.shape != a.shape or g < 2:
         raise ValueError("a_i and P_i must be vectors of the same length >= 2")
-    if n <= 0:
-        raise ValueError(f"number of participants must be positive, got {n}")
+    if not (math.isfinite(n) and n > 0):
+        raise ValueError(f"number of participants must be a finite positive number, got {n}")
     if np.any(p <= 0):
         raise ValueError("all P_i must be positive for the chi-square of eq. 6.2")
     iu, ju = np.triu_indices(g, k=1)
@@ -130,8 +130,8 @@ def _z_test(diff: float, se: float) -> ProportionTest:
 
 
 def _tost(diff: float, se: float, margin: float) -> ProportionTest:
-    if margin <= 0:
-        raise ValueError(f"equivalence margin must be positive, got {margin}")
+    if not (math.isfinite(margin) and margin > 0):
+        raise ValueError(f"equivalence margin must be a finite positive number, got {margin}")
     if se <= 0:
         inside = abs(diff) < margin
         return ProportionTest(diff, 0.0, 0.0, 0.0 if inside else 1.0, margin)
@@ -171,9 +171,9 @@ def matched_equivalence(x_a: np.ndarray, x_b: np.ndarray, margin: float = 0.1) -
 
 
 def _check_count(x: float, n: int, name: str) -> None:
-    if n <= 0:
+    if not n > 0:
         raise ValueError(f"{name}: group size must be positive, got {n}")
-    if not 0 <= x <= n:
+    if not (math.isfinite(x) and 0 <= x <= n):
         raise ValueError(f"{name}: count {x} outside [0, {n}]")
 
 

@@ -1,4 +1,4 @@
-"""A fast stand-in for ``gazebot.render.video.render_handover_video``: a short H.264 clip of flat
+"""A fast stand-in for ``gazebot.sim.record.render_handover_video``: a short H.264 clip of flat
 frames labelled with robot, behavior and scene.
 
 Same signature as the real renderer, so ``gazebot study render --renderer synthetic`` can dry-run
@@ -28,12 +28,11 @@ def render_synthetic_video(
 ) -> Path:
     """Write a ``duration``-second clip (deterministic for its arguments) and return its path."""
     import cv2
-    import imageio.v2 as imageio
+
+    from gazebot.render.video import open_h264_writer
 
     if width % 2 or height % 2 or width < 16 or height < 16:
         raise ValueError(f"width and height must be even and >= 16, got {width}x{height}")
-    out_path = Path(out_path)
-    out_path.parent.mkdir(parents=True, exist_ok=True)
     digest = hashlib.sha256(f"{robot}|{behavior}|{scene}|{seed}".encode()).digest()
     color = np.frombuffer(digest[:3], dtype=np.uint8)
     frames = max(1, round(duration * fps))
@@ -42,19 +41,11 @@ def render_synthetic_video(
     label = f"{robot} {behavior} {scene} s{seed}"
     scale = max(width / 900.0, 0.25)
     cv2.putText(base, label, (4, height // 2), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 1)
-    with imageio.get_writer(
-        out_path,
-        fps=fps,
-        codec="libx264",
-        pixelformat="yuv420p",
-        macro_block_size=2,
-        ffmpeg_log_level="error",
-        format="FFMPEG",
-    ) as writer:
+    with open_h264_writer(out_path, fps, (width, height)) as writer:
         for k in range(frames):
             frame = base.copy()
             # A moving square so consecutive frames differ, like a real handover clip.
             x = int((width - 8) * k / max(frames - 1, 1))
             frame[height - 12 : height - 4, x : x + 8] = 255
-            writer.append_data(frame)
-    return out_path
+            writer.append(frame)
+    return Path(out_path)

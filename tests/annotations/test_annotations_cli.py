@@ -54,3 +54,33 @@ def test_fit_human_writes_a_loadable_behavior(synthetic_dir, tmp_path, capsys):
     spec = load_behavior(out)
     assert spec.human.patterns[0].name == "FH-H-HF" and spec.human.patterns[0].count == 4
     assert "hand_face_delay_s" in capsys.readouterr().out
+
+
+def test_summarize_plot_must_be_a_png_file_not_a_folder(synthetic_dir, tmp_path):
+    import pytest
+
+    with pytest.raises(ValueError, match="is a directory"):
+        run(["annotations", "summarize", str(synthetic_dir), "--plot", str(tmp_path)])
+    with pytest.raises(ValueError, match=r"must end in \.png"):
+        run(["annotations", "summarize", str(synthetic_dir), "--plot", str(tmp_path / "a.jpg")])
+    assert not (tmp_path.parent / f"{tmp_path.name}.png").exists()
+    assert not (tmp_path / "a.jpg").exists()
+
+
+def test_summarize_prints_reach_shares_with_own_hand_as_hand_and_as_other(tmp_path, capsys):
+    from annotation_helpers import OWN, PHASES, RECEIVER, F, H, handover_rows, write_xlsx
+
+    # Reach of the receiver: face, Own Hand, then hand. As hand: Short Face-Hand (hand from
+    # frame 1 of 6); as Other (ignored): the face lasts until frame 4 of 6 -> Long Face-Hand.
+    receiver = RECEIVER[:2] + [F, OWN, OWN, OWN, H, H] + RECEIVER[8:]
+    root = tmp_path / "ann"
+    write_xlsx(
+        root / "volunteer_1_volunteer_2" / "volunteer_1_volunteer_2 1.xlsx",
+        handover_rows(receiver=receiver, phases=PHASES),
+    )
+    assert run(["annotations", "summarize", str(root)]) == 0
+    out = capsys.readouterr().out
+    assert "Sensitivity of the reach shares to Own Hand" in out
+    rows = {tuple(line.split()[:3]): line.split()[3:] for line in out.splitlines() if line}
+    assert rows[("receiver", "Short", "Face-Hand")][:3] == ["100.0", "0.0", "-100.0"]
+    assert rows[("receiver", "Long", "Face-Hand")][:3] == ["0.0", "100.0", "+100.0"]

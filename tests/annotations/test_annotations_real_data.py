@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from gazebot.annotations import load_annotations, replay, summarize
+from gazebot.annotations.fit import fit_human_model
 from gazebot.behaviors import load_behavior
-from gazebot.behaviors.human import fit_human_model
 
 
 @pytest.fixture(scope="module")

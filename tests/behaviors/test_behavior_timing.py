@@ -291,3 +291,14 @@ def test_human_receiver_shift_times_follow_the_fitted_distributions():
     for shift in model.shifts:
         got = fractions[(shift.phase, shift.to_target)]
         assert abs(np.mean(got) - shift.fraction.mean) < 0.03, shift
+
+
+def test_face_hand_face_retreat_halfway_follows_the_giver_not_the_slower_robot():
+    # The giver is back at rest at 3.5 s (detector's prediction); the robot needs until 5.0 s.
+    m = machine("face-hand-face")
+    m.handle(ev("reach_started", 1.0))
+    m.handle(ev("transfer_started", 2.0))
+    m.handle(ev("retreat_started", 2.5))
+    m.handle(ev("robot_retreat_started", 2.6, planned_duration=2.4))
+    assert kind(m, 2.99, E, 2.5, 3.5) == "hand"
+    assert kind(m, 3.0, E, 2.5, 3.5) == "face"  # halfway of the giver's 2.5-3.5 s retreat

@@ -15,7 +15,7 @@ import pytest
 from drivers_fakes import wait_until
 
 from gazebot.drivers.engine_node import EngineNode
-from gazebot.drivers.payloads import EventMsg, HeadCommandMsg
+from gazebot.drivers.payloads import EventMsg, EyeStateMsg, HeadCommandMsg
 from gazebot.drivers.sim_node import SimNode, SimNodeConfig
 from gazebot.drivers.zenoh_driver import ZenohRobotDriver
 from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
@@ -88,6 +88,7 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     sim_node, ep, sim_thread, _ = start_sim_node(bus, sim)
     events = Log(ep.session, ep.keys.events, EventMsg)
     heads = Log(ep.session, ep.keys.head_command, HeadCommandMsg)
+    eyes = Log(ep.session, ep.keys.eyes, EyeStateMsg)
     engine_node, drv, *_ = start_engine_node(bus)
     assert wait_until(lambda: ep.peers().get("engine") and drv.peers().get("sim"), timeout=5)
     assert engine_node.ready.wait(5)
@@ -107,6 +108,10 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     assert abs(pan_end - pan0) > 0.05
     assert pan_end == pytest.approx(heads.msgs[-1].head["head_pan"], abs=0.05)
     assert np.isfinite([m.head["head_pan"] for m in heads.msgs]).all()
+    # the eyes' vergence distance crossed the bus: the giver is 0.3-2 m from the display
+    distances = [m.distance for m in eyes.msgs]
+    assert distances and all(d is not None and 0.2 < d < 2.5 for d in distances)
+    assert sim_node.applied["eyes"] > 0 and sim._eyes[3] == pytest.approx(distances[-1], abs=0.5)
     assert drv.dropped() == {} and ep.dropped() == {}
 
 
@@ -180,6 +185,7 @@ def test_run_cli_drives_a_simulator_on_the_bus(bus, sim, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["frames"] > 0 and summary["commands"] > 0
     assert summary["peers"] == {"sim": True} and summary["dropped"] == {}
+    assert summary["robot_seen"] is True and summary["warnings"] == []
     assert sim_node.applied["head"] > 0
 
 

@@ -236,7 +236,7 @@ class CountingRenderer:
     def __init__(self):
         self.calls = 0
 
-    def render(self, yaw, pitch, blink=0.0):
+    def render(self, yaw, pitch, blink=0.0, distance=None):
         self.calls += 1
         return np.full((24, 40, 3), 200, np.uint8)
 

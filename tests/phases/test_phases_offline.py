@@ -54,6 +54,10 @@ def test_reach_start_and_retreat_end_near_truth(varied_set, offline_results):
     reach = _errors(varied_set, offline_results, "start", "reach_start", Phase.REACH)
     retreat = _errors(varied_set, offline_results, "end", "retreat_end", Phase.RETREAT)
     assert np.median(reach) <= 0.05 and np.percentile(reach, 80) <= 0.1
+    # Measured reach start: p90 92 ms, max 123 ms, 94 % within 100 ms (an onset hidden in a
+    # tracking gap is dated across the gap from the last seen rest).
+    assert np.percentile(reach, 90) <= 0.095 and reach.max() <= 0.13
+    assert np.mean(reach <= 0.1) >= 0.93
     assert np.median(retreat) <= 0.05 and np.percentile(retreat, 90) <= 0.1
 
 
@@ -124,3 +128,14 @@ def test_thresholds_come_from_the_config():
 def test_too_short_recordings_give_nothing():
     assert segment(Trajectory(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))) == []
     assert segment(Trajectory(np.array([0.0, 0.1]), np.zeros((2, 3)), np.ones((2, 3)))) == []
+
+
+def test_reach_onset_hidden_in_a_tracking_gap_is_dated_across_it():
+    case = generate(4, SyntheticOptions(rate=60))
+    h = case.truth[0]
+    tr = case.trajectory
+    gap = (tr.t > h.reach_start - 0.1) & (tr.t < h.reach_start + 0.25)
+    tr.giver_hand[gap] = np.nan
+    reach = [s for s in segment(tr) if s.phase is Phase.REACH]
+    assert len(reach) == 1
+    assert abs(reach[0].start - h.reach_start) <= 0.15

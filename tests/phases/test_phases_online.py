@@ -65,10 +65,10 @@ def test_events_are_never_detected_before_they_happen(online_results):
 @pytest.mark.parametrize("kind", [EventKind.TRANSFER_STARTED, EventKind.RETREAT_STARTED])
 def test_transfer_events_are_accurate_from_motion_alone(varied_set, online_results, kind):
     err, lat = _errors(varied_set, online_results, kind)
-    # Measured: transfer start |err| median 25 / p90 100 / max 236 ms; release 43 / 121 / 237.
-    assert np.median(err) <= 0.05
-    assert np.percentile(err, 90) <= 0.14
-    assert err.max() <= 0.27
+    # Measured: transfer start |err| median 25 / p90 100 / max 236 ms; release 35 / 111 / 199.
+    assert np.median(err) <= 0.04
+    assert np.percentile(err, 90) <= 0.12
+    assert err.max() <= 0.24
 
 
 def test_transfer_start_is_detected_within_250ms(varied_set, online_results):
@@ -78,12 +78,13 @@ def test_transfer_start_is_detected_within_250ms(varied_set, online_results):
 
 
 def test_reach_and_release_latency_from_motion_alone(varied_set, online_results):
-    # A minimum-jerk motion needs time to show: ~1.5 cm of travel is required before a reach
-    # or a release is believed. Measured medians: reach 207 ms, release 250 ms.
+    # A minimum-jerk motion needs time to show: 0.75-1.5 cm of travel (more under heavy noise)
+    # before a reach or a release is believed. Measured medians: reach 192 ms, release 224 ms
+    # (test_phases_online_latency.py pins the rest).
     _, reach = _errors(varied_set, online_results, EventKind.REACH_STARTED)
     _, release = _errors(varied_set, online_results, EventKind.RETREAT_STARTED)
-    assert np.median(reach) <= 0.25 and np.percentile(reach, 90) <= 0.4
-    assert np.median(release) <= 0.3 and np.percentile(release, 90) <= 0.45
+    assert np.median(reach) <= 0.2 and np.percentile(reach, 90) <= 0.32
+    assert np.median(release) <= 0.23 and np.percentile(release, 90) <= 0.33
 
 
 def test_robot_evidence_brings_all_transfer_events_within_250ms():

@@ -8,6 +8,7 @@ import math
 
 import cv2
 import pytest
+import yaml
 
 from gazebot.cli import render_eyes
 from gazebot.config import ConfigError
@@ -93,42 +94,49 @@ def test_known_robots_have_their_screens():
     assert (robot_display("jaco2").width, robot_display("jaco2").height) == (800, 480)
 
 
-@pytest.mark.parametrize(
-    "text",
-    [
-        "name: bot\ndisplay:\n  width_px: 320\n  height_px: 200\n  eye_style: cartoon\n"
-        "eyes:\n  yaw_range_deg: [-20, 20]\n  pitch_range_deg: 15\n",
-        "name: bot\ndisplay_resolution: [320, 200]\neye_style: cartoon\n"
-        "eye_yaw_range_deg: 20\neye_pitch_range_deg: [-15, 10]\n",
-        "name: bot\nscreen:\n  resolution_px: [320, 200]\neyes:\n  style: cartoon\n"
-        "eye_limits_deg:\n  yaw: [-20, 20]\n  pitch: [-15, 15]\n",
-    ],
-)
-def test_robot_yaml_layouts_are_read_tolerantly(tmp_path, text):
-    path = tmp_path / "bot.yaml"
-    path.write_text(text)
-    info = robot_display(path)
-    assert (info.width, info.height, info.style) == (320, 200, "cartoon")
-    assert info.yaw_range == pytest.approx(math.radians(20))
-    assert info.pitch_range == pytest.approx(math.radians(15))
-    r = EyeRenderer.for_robot(path)
-    assert r.shape == (200, 320, 3) and r.style.name == "cartoon"
+def _custom_robot_yaml(tmp_path, **display):
+    """configs/robots/sawyer.yaml renamed to a robot gazebot has never heard of."""
+    from gazebot.config import configs_dir
+
+    data = yaml.safe_load((configs_dir() / "robots" / "sawyer.yaml").read_text())
+    data["name"] = "myrobot"
+    data["display"].update(display)
+    path = tmp_path / "myrobot.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path, data
 
 
-def test_robot_yaml_without_display_falls_back_to_the_builtin_table(tmp_path):
-    path = tmp_path / "sawyer.yaml"
-    path.write_text("name: sawyer\nhead_joints: [head_pan]\n")
+def test_custom_robot_yaml_path_gives_its_own_display(tmp_path):
+    path, _ = _custom_robot_yaml(tmp_path, width_px=320, height_px=200)
     info = robot_display(path)
-    assert (info.width, info.height, info.style) == (1024, 600, "sawyer")
+    assert (info.robot, info.width, info.height, info.style) == ("myrobot", 320, 200, "sawyer")
+    assert info.yaw_range == pytest.approx(math.radians(40))
+    assert info.pitch_range == pytest.approx(math.radians(45))
+    assert EyeRenderer.for_robot(path).shape == (200, 320, 3)
+
+
+def test_for_robot_takes_a_parsed_robot_config(tmp_path):
+    from gazebot.kinematics.config import load_robot_config
+
+    path, _ = _custom_robot_yaml(tmp_path, width_px=320, height_px=200)
+    config, _ = load_robot_config(path)
+    r = EyeRenderer.for_robot(config)
+    assert r.shape == (200, 320, 3) and r.style.name == "sawyer"
+    assert r.yaw_range == pytest.approx(math.radians(40))
+
+
+def test_eye_range_is_the_larger_side_of_an_asymmetric_yaml_range(tmp_path):
+    path, data = _custom_robot_yaml(tmp_path)
+    data["eyes"]["yaw_range_deg"] = [-20.0, 30.0]
+    path.write_text(yaml.safe_dump(data))
+    assert robot_display(path).yaw_range == pytest.approx(math.radians(30))
 
 
 def test_robot_yaml_with_bad_display_values_raises_config_error(tmp_path):
-    path = tmp_path / "bot.yaml"
-    path.write_text("name: bot\ndisplay:\n  width_px: -3\n  height_px: 200\n")
-    with pytest.raises(ConfigError, match="display_width_px"):
-        robot_display(path)
-    path.write_text("name: bot\ndisplay:\n  width_px: 30\n  height_px: 20\neye_yaw_range_deg: 95\n")
-    with pytest.raises(ConfigError, match="eye_yaw_range_deg"):
+    path, _ = _custom_robot_yaml(tmp_path, width_px=-3)
+    with pytest.raises(ConfigError, match=r"display\.width_px"):
         robot_display(path)
     with pytest.raises(FileNotFoundError):
         robot_display(tmp_path / "missing.yaml")
+    with pytest.raises(FileNotFoundError, match="unknown robot 'r2d2'"):
+        robot_display("r2d2")

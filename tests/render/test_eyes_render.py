@@ -188,7 +188,7 @@ def test_bad_construction_raises_value_error(args, kwargs):
 def test_unknown_style_and_robot_raise_clear_errors():
     with pytest.raises(FileNotFoundError, match="shipped: .*sawyer"):
         EyeRenderer(512, 300, "no-such-style")
-    with pytest.raises(ValueError, match="unknown robot 'r2d2'"):
+    with pytest.raises(FileNotFoundError, match="unknown robot 'r2d2'"):
         EyeRenderer.for_robot("r2d2")
 
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from gazebot.cli import demo
-from gazebot.render.video import record_handover, render_handover_video
+from gazebot.sim.record import record_handover, render_handover_video
 from gazebot.sim.robot import load_sim_robot
 
 pytestmark = pytest.mark.slow

@@ -56,11 +56,65 @@ def test_level_comparisons_use_matched_participant_preferences(two_level_csv):
     assert 0 <= c.equivalence.p_value <= 1
 
 
-def test_bias_test_runs_per_measure_with_one_value_per_participant(two_level_csv):
-    result = analyze(read_responses(two_level_csv), behaviors=BEHAVIORS)
-    assert set(result.bias) == {"likability", "anthropomorphism", "timing-communication"}
-    for b in result.bias.values():
-        assert b.n <= 24 and 0 <= b.p_value <= 1
+def _with_first_share(rows: list[dict], share_first: float | None, seed: int) -> list[dict]:
+    """The rows with every answer redrawn: 1 (first handover) with probability ``share_first``,
+    whatever the behaviors, i.e. a known position bias. ``None``: no bias by construction, the
+    participants 13-24 give the mirror answers (1 <-> 2) of participants 1-12 to random ones."""
+    rng = np.random.default_rng(seed)
+    qs = ("q1", "q2", "q3", "q4", "q5")
+    drawn = {}
+    out = []
+    for r in rows:
+        r = dict(r)
+        k = (r["participant"], r["level"], r["first"], r["second"])
+        mirror = (r["participant"] - 12, r["level"], r["first"], r["second"])
+        for q in qs:
+            if share_first is None and mirror in drawn:
+                r[q] = 3 - drawn[mirror][q]
+            else:
+                r[q] = 1 if rng.random() < (share_first or 0.5) else 2
+        drawn[k] = r
+        out.append(r)
+    return out
+
+
+def _participant_differences(rows: list[dict], questions: tuple[str, ...]) -> np.ndarray:
+    """Independent of gazebot: per participant share of 1s minus share of 2s."""
+    answers: dict[int, list[int]] = {}
+    for r in rows:
+        answers.setdefault(int(r["participant"]), []).extend(int(r[q]) for q in questions)
+    return np.array([np.mean(np.equal(a, 1)) - np.mean(np.equal(a, 2)) for a in answers.values()])
+
+
+@pytest.mark.parametrize(
+    ("share_first", "biased"), [(0.75, True), (None, False)], ids=["strong-bias", "no-bias"]
+)
+def test_bias_test_equals_scipy_wilcoxon_and_detects_a_first_position_bias(
+    tmp_path, share_first, biased
+):
+    from scipy import stats as sps
+
+    base = responses_from_tables({"small-box": TABLE_6_1, "large-box": TABLE_6_2})
+    rows = _with_first_share(base, share_first, seed=7)
+    result = analyze(read_responses(write_responses(rows, tmp_path / "r.csv")), behaviors=BEHAVIORS)
+    for measure, questions in (
+        ("likability", ("q1", "q2")),
+        ("anthropomorphism", ("q3", "q4")),
+        ("timing-communication", ("q5",)),
+    ):
+        d = _participant_differences(rows, questions)
+        d = d[d != 0]
+        ref = sps.wilcoxon(d, zero_method="wilcox", alternative="two-sided")
+        w_plus = sps.wilcoxon(d, zero_method="wilcox", alternative="greater").statistic
+        b = result.bias[measure]
+        assert b.n == d.size
+        assert b.p_value == pytest.approx(ref.pvalue, rel=1e-12)
+        assert b.statistic == pytest.approx(w_plus)
+        assert b.s == pytest.approx(w_plus - d.size * (d.size + 1) / 4)
+        if biased:
+            assert b.p_value < 1e-4 and b.s > 0  # 24 participants, 3 in 4 answers "1st"
+        else:
+            assert b.s == 0 and b.p_value == pytest.approx(1.0)  # exactly symmetric differences
 
 
 def test_json_report_is_serialisable(two_level_csv):
@@ -121,3 +175,64 @@ def test_bias_differences_per_participant_or_per_session(two_level_csv):
     assert set(np.unique(per_session)) <= {-1.0, 1.0}
     with pytest.raises(ValueError, match="bias unit"):
         position_differences(responses, ("q5",), unit="question")
+
+
+def _rows(level: str, table: dict, offset: int = 0, group: str | None = None, condition=None):
+    rows = responses_from_tables({level: table})
+    for r in rows:
+        r["participant"] += offset
+        if condition:
+            r["condition"] = condition
+        if group is not None:
+            r["group"] = group
+    return rows
+
+
+def _pick(comparisons, measure="likability", pair=("face", "hand")):
+    return [c for c in comparisons if c.measure == measure and (c.behavior_i, c.behavior_j) == pair]
+
+
+def test_one_level_in_two_groups_uses_the_unmatched_tests_of_equations_6_5_and_6_6(tmp_path):
+    from gazebot.study.stats import unmatched_equivalence, unmatched_proportion_difference
+
+    # Like the seed's video vs in-person comparison (H5): both groups number participants 1..24.
+    rows = _rows("small-box", TABLE_6_1, group="in-person")
+    rows += _rows("small-box", TABLE_6_2, group="video")
+    result = analyze(read_responses(write_responses(rows, tmp_path / "r.csv")), behaviors=BEHAVIORS)
+    assert result.levels == ["in-person:small-box", "video:small-box"]
+    assert result.per_level["video:small-box"]["likability"].participants == 24
+    assert len(result.comparisons) == 3 * 6
+    assert {c.design for c in result.comparisons} == {"unmatched"}
+    (c,) = _pick(result.comparisons)
+    assert (c.group_a, c.group_b, c.n_a, c.n_b) == ("in-person", "video", 24, 24)
+    # X = the win-matrix cell (Tables B.1-B.6), n = 24 per group.
+    ref = unmatched_proportion_difference(6.75, 24, 15.0, 24)
+    assert c.difference.z == pytest.approx(ref.z) and c.difference.p_value < 0.05
+    assert c.equivalence.p_value == pytest.approx(unmatched_equivalence(6.75, 24, 15.0, 24).p_value)
+    doc = result.to_json()["level_comparisons"][0]
+    assert doc["design"] == "unmatched" and doc["groups"] == ["in-person", "video"]
+
+
+def test_two_levels_seen_by_disjoint_participants_are_compared_unmatched(tmp_path):
+    rows = _rows("small-box", TABLE_6_1) + _rows("large-box", TABLE_6_2, offset=24)
+    result = analyze(read_responses(write_responses(rows, tmp_path / "r.csv")), behaviors=BEHAVIORS)
+    (c,) = _pick(result.comparisons)
+    assert c.design == "unmatched" and (c.n_a, c.n_b) == (24, 24)
+    assert (c.level_a, c.level_b) == ("small-box", "large-box")
+    assert c.proportion_a == pytest.approx(6.75 / 24) and c.proportion_b == pytest.approx(15 / 24)
+
+
+def test_same_participants_in_two_levels_stay_matched(two_level_csv):
+    result = analyze(read_responses(two_level_csv), behaviors=BEHAVIORS)
+    assert {c.design for c in result.comparisons} == {"matched"}
+    assert {(c.n_a, c.n_b) for c in result.comparisons} == {(24, 24)}
+
+
+def test_levels_of_different_conditions_are_not_compared(tmp_path):
+    rows = _rows("small-box", TABLE_6_1, condition="object-size")
+    rows += _rows("large-box", TABLE_6_2, condition="object-size")
+    rows += _rows("sitting", TABLE_6_2, offset=24, condition="posture")
+    rows += _rows("standing", TABLE_6_1, offset=24, condition="posture")
+    result = analyze(read_responses(write_responses(rows, tmp_path / "r.csv")), behaviors=BEHAVIORS)
+    pairs = {(c.level_a, c.level_b, c.design) for c in result.comparisons}
+    assert pairs == {("small-box", "large-box", "matched"), ("sitting", "standing", "matched")}

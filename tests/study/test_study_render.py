@@ -153,7 +153,7 @@ def test_invalid_resolution_is_rejected(tmp_path):
     reason="gazebot.render.video (the MuJoCo renderer) is not available yet",
 )
 def test_real_renderer_at_tiny_resolution_renders_distinct_videos(tmp_path):
-    from gazebot.render.video import render_handover_video
+    from gazebot.sim.record import render_handover_video
 
     plan = make_plan(behaviors=["hand", "face-hand-face"], condition="posture", participants=4)
     plan = [s for s in plan if s.participant == 1][:1]  # one session: 2 videos, 2 workers

@@ -1,0 +1,217 @@
+"""The one handover loop shared by ``gazebot demo``, ``gazebot render video`` and the study's
+renders: the simulation runs the handover, the gaze engine drives head and eyes every control tick,
+and an observer camera records an H.264 MP4 (yuv420p) off-screen.
+
+Deterministic for a seed: the giver's timing, the engine's random choices and the blinks all derive
+from it, and physics and software rendering are deterministic. The video is written atomically
+(:func:`gazebot.render.video.open_h264_writer`): a failed run leaves no file behind.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from contextlib import nullcontext
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from gazebot.kinematics.config import RobotConfig
+from gazebot.render.timeline import TickRecord
+from gazebot.types import Event
+
+if TYPE_CHECKING:
+    from gazebot.sim.simulation import HandoverSimulation
+
+CONTROL_HZ = 120.0  # tracking rate of the seed's motion capture setup
+MAX_DURATION_S = 30.0  # a handover that has not finished by then is cut (and reported)
+
+
+@dataclass
+class HandoverRecording:
+    """Result of :func:`record_handover`."""
+
+    ticks: list[TickRecord]
+    video: Path | None
+    frames: int
+    fps: float
+    width: int
+    height: int
+    completed: bool  # the handover finished before MAX_DURATION_S
+    robot_events: list[Event] = field(default_factory=list)
+
+
+def _check_size(width: int, height: int, fps: float) -> None:
+    for name, v in (("width", width), ("height", height)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < 16 or v % 2:
+            raise ValueError(f"video {name} must be an even number of pixels >= 16, got {v!r}")
+    if not (math.isfinite(fps) and 1.0 <= fps <= CONTROL_HZ):
+        raise ValueError(f"fps must be between 1 and {CONTROL_HZ:g}, got {fps}")
+
+
+def _direction_change(prev: np.ndarray | None, cur: np.ndarray) -> float:
+    if prev is None or not (np.all(np.isfinite(prev)) and np.all(np.isfinite(cur))):
+        return 0.0
+    a, b = np.linalg.norm(prev), np.linalg.norm(cur)
+    if a < 1e-9 or b < 1e-9:
+        return 0.0
+    return float(np.arccos(np.clip(prev.dot(cur) / (a * b), -1.0, 1.0)))
+
+
+def expected_duration(sim) -> float:
+    """Rough length (s) of the handover ``sim`` will run, for the progress bar: the giver's start,
+    the slower of the two reaches, the grasp, the transfer, the slower retreat and the tail."""
+    plan, ctl, cfg = sim.giver.plan, sim.controller, sim.config.controller
+    robot_reach = ctl.planned_duration(ctl.home, ctl.handover, cfg.reach_min_duration_s)
+    robot_back = ctl.planned_duration(ctl.handover, ctl.home, cfg.retreat_min_duration_s)
+    reach = max(plan.reach_s, 0.25 * plan.reach_s + robot_reach) + cfg.gripper_close_s
+    return (
+        plan.start_t
+        + reach
+        + plan.transfer_s
+        + max(plan.retreat_s, 0.25 * plan.retreat_s + robot_back)
+        + sim.config.tail_s
+    )
+
+
+def record_handover(
+    robot: str | Path | RobotConfig = "sawyer",
+    behavior: str | Path = "face-hand-face",
+    scene: str | Path = "default",
+    out_path: str | Path | None = None,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+    fps: float = 30.0,
+    progress: bool = True,
+    on_tick: Callable[[HandoverSimulation, TickRecord], None] | None = None,
+) -> HandoverRecording:
+    """Run one handover with the gaze engine in the loop; record the video when ``out_path``.
+
+    ``robot`` is a name, a robot YAML path or a parsed config; it is loaded once and the same
+    config drives the simulation, the gaze engine and the eye display. ``on_tick(sim, tick)``,
+    when given, sees the simulation after each control tick's head and eye commands (e.g. to
+    inspect or render it); it must not step the simulation.
+
+    Returns the per-tick timeline, the frame count and the robot's events.
+    """
+    from gazebot.sim.gl_check import ensure_gl_backend
+
+    ensure_gl_backend()
+    from tqdm import tqdm
+
+    from gazebot.engine import GazeEngine
+    from gazebot.render.blink import BlinkModel
+    from gazebot.render.video import open_h264_writer
+    from gazebot.sim.robot import load_sim_robot
+    from gazebot.sim.simulation import HandoverSimulation
+
+    _check_size(width, height, fps)
+    sim_robot = load_sim_robot(robot)
+    sim = HandoverSimulation(robot=sim_robot, scene=scene, seed=seed)
+    engine = GazeEngine.from_config(robot=sim_robot.spec, behavior=behavior, seed=seed)
+    blinks = BlinkModel(seed)
+    dt = 1.0 / CONTROL_HZ
+    gaze_site = sim.data.site(sim.robot.gaze_site)
+    tail = sim.config.tail_s
+    ticks: list[TickRecord] = []
+    events: list[Event] = []
+    frames, done_at, prev_dir = 0, None, None
+    label = f"{sim_robot.name} {Path(str(behavior)).stem}"
+    try:
+        writer_ctx = (
+            open_h264_writer(out_path, fps, (width, height))
+            if out_path is not None
+            else nullcontext(None)
+        )
+        with (
+            writer_ctx as writer,
+            tqdm(
+                total=int(expected_duration(sim) * fps) + 1 if writer is not None else None,
+                unit="frame",
+                desc=label,
+                disable=not progress,
+                leave=False,
+            ) as bar,
+        ):
+            while True:
+                frame = sim.tracking()
+                for event in sim.robot_events():
+                    events.append(event)
+                    engine.notify(event)
+                # The measured arm pose: on Sawyer the head rides on right_j0.
+                cmd = engine.step(frame, arm=sim.joint_state())
+                sim.apply_head(cmd.head)
+                direction = np.asarray(cmd.target_point, float) - gaze_site.xpos
+                blink = blinks.update(sim.t, _direction_change(prev_dir, direction))
+                prev_dir = direction
+                distance = float(np.linalg.norm(direction))
+                # The eyes converge on the target (EYES' vergence) when its distance is known.
+                sim.apply_eyes(
+                    cmd.eye_yaw,
+                    cmd.eye_pitch,
+                    blink,
+                    distance if math.isfinite(distance) else None,
+                )
+                state = sim.joint_state()
+                ticks.append(
+                    TickRecord(
+                        t=sim.t,
+                        phase=cmd.phase.value,
+                        target=cmd.target,
+                        head=dict(cmd.head),
+                        eye_yaw=cmd.eye_yaw,
+                        eye_pitch=cmd.eye_pitch,
+                        target_point=np.asarray(cmd.target_point, float).copy(),
+                        hand=sim.giver.hand.copy(),
+                        face=sim.scene.giver.face_point.copy(),
+                        head_measured={j: state[j] for j in cmd.head if j in state},
+                        events=tuple(e.kind.value for e in cmd.events),
+                    )
+                )
+                if on_tick is not None:
+                    on_tick(sim, ticks[-1])
+                # Frame k shows the first tick at or after k / fps.
+                if writer is not None and sim.t >= frames / fps - 1e-9:
+                    writer.append(sim.render(width=width, height=height))
+                    frames += 1
+                    bar.update(1)
+                if done_at is None and sim.done:
+                    done_at = sim.t
+                if (done_at is not None and sim.t >= done_at + tail) or sim.t >= MAX_DURATION_S:
+                    break
+                sim.step(dt)
+            if bar.total is not None and bar.n != bar.total:
+                bar.total = bar.n  # the estimate was off: end the bar where the video ended
+                bar.refresh()
+    finally:
+        sim.close()
+    return HandoverRecording(
+        ticks=ticks,
+        video=Path(out_path) if out_path is not None else None,
+        frames=frames,
+        fps=fps,
+        width=width,
+        height=height,
+        completed=done_at is not None,
+        robot_events=events,
+    )
+
+
+def render_handover_video(
+    robot: str | Path | RobotConfig,
+    behavior: str | Path,
+    scene: str | Path,
+    out_path: str | Path,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+    fps: float = 30.0,
+    progress: bool = True,
+) -> Path:
+    """Render one full handover to ``out_path`` (H.264 MP4, yuv420p) and return the path; on an
+    error no file is left at ``out_path``."""
+    record_handover(robot, behavior, scene, out_path, seed, width, height, fps, progress)
+    return Path(out_path)

@@ -1,0 +1,50 @@
+"""The behaviors package reads the fitted human model without depending on the annotations."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import gazebot.behaviors
+
+
+def test_no_behaviors_module_imports_annotations_anywhere():
+    """Not at import time, not inside a function, not under TYPE_CHECKING: no package cycle."""
+    offenders = []
+    for path in Path(gazebot.behaviors.__file__).parent.glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                names = [node.module or ""]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            else:
+                continue
+            offenders += [
+                f"{path.name}:{node.lineno}" for n in names if n.startswith("gazebot.annotations")
+            ]
+    assert offenders == []
+
+
+def test_behaviors_and_the_human_model_load_without_importing_annotations():
+    code = (
+        "import sys, gazebot.behaviors, gazebot.behaviors.human\n"
+        "from gazebot.behaviors import load_behavior\n"
+        "spec = load_behavior('human-receiver')\n"
+        "assert spec.human.patterns, 'no patterns'\n"
+        "bad = sorted(m for m in sys.modules if m.startswith('gazebot.annotations'))\n"
+        "print(','.join(bad))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.strip()
+    assert out == ""
+
+
+def test_fitting_code_lives_in_annotations_not_behaviors():
+    import gazebot.behaviors.human as human
+    from gazebot.annotations import fit
+
+    assert not hasattr(human, "fit_human_model")
+    assert callable(fit.fit_human_model) and callable(fit.human_behavior_document)
