@@ -242,8 +242,7 @@ class GazeController:
         self._clock += dt
         return dt
 
-    @staticmethod
-    def _parse(target_point: np.ndarray | None) -> tuple[float, float, float] | None:
+    def _parse(self, target_point: np.ndarray | None) -> tuple[float, float, float] | None:
         if target_point is None:
             return None
         p = target_point
@@ -254,7 +253,10 @@ class GazeController:
             if p.shape != (3,):
                 raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
         x, y, z = p.tolist()
-        return (x, y, z) if math.isfinite(x) and math.isfinite(y) and math.isfinite(z) else None
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            return None
+        # A corrupted, absurdly far sample is held like a missing one.
+        return (x, y, z) if max(abs(x), abs(y), abs(z)) <= self.ik.max_distance else None
 
     def _gaze_frame(self) -> list[list[float]]:
         """Gaze frame rows at the head command (cached: the eyes of one tick and the re-plan of

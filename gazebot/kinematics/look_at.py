@@ -33,6 +33,8 @@ class IKConfig:
         max_step: Largest joint change per iteration (rad); keeps far targets stable.
         posture_gain: Null-space pull toward the rest posture per iteration (0..1).
         min_distance: Targets closer than this to the gaze origin (m) have no direction.
+        max_distance: Targets farther than this from the base origin (m) are treated as invalid
+            (a corrupted sample; squaring such coordinates would overflow).
         min_step: A step smaller than this (rad) means the head cannot do better.
         posture_off: Reducible pointing error (rad) below which the posture pull stops.
         tracking_tolerance: Looser stop (rad) for a target that moved slightly since the last
@@ -46,6 +48,7 @@ class IKConfig:
     max_step: float = 0.5
     posture_gain: float = 0.1
     min_distance: float = 1e-3
+    max_distance: float = 1e4
     min_step: float = 1e-9
     posture_off: float = 1e-3
     tracking_tolerance: float = 1e-4
@@ -449,6 +452,10 @@ def solve_ik(
         q = robot.rest.copy()
     if not np.all(np.isfinite(t)):
         return _invalid(robot, q, "target is not finite: holding the previous head pose")
+    if float(np.max(np.abs(t))) > cfg.max_distance:
+        return _invalid(
+            robot, q, f"target is farther than {cfg.max_distance:g} m: holding the previous pose"
+        )
 
     out = solve_ik_raw(robot, tuple(t.tolist()), q.tolist(), cfg)
     if not out.valid:

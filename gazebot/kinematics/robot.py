@@ -66,7 +66,12 @@ class RobotModel:
         self.name = config.name
         self.config = config
         self.mjcf_path = Path(mjcf_path)
-        full = pin.buildModelFromMJCF(str(self.mjcf_path))
+        try:
+            full = pin.buildModelFromMJCF(str(self.mjcf_path))
+        except (RuntimeError, ValueError) as exc:  # Pinocchio's parser errors
+            raise ConfigError(
+                self.mjcf_path, "<mjcf>", "a robot MJCF Pinocchio can load", str(exc)
+            ) from exc
         self.full_model = full
         self.head_joints = list(config.head_joints)
         self.arm_joints = list(config.arm_joints)
@@ -248,15 +253,6 @@ class RobotModel:
             pin.computeJointJacobians(self.model, self.data, q)
         J = pin.getFrameJacobian(self.model, self.data, self.gaze_frame_id, pin.LOCAL_WORLD_ALIGNED)
         return J[:, self._head_sel].tolist()
-
-    def gaze_jacobian_lists(
-        self, q_head: Sequence[float]
-    ) -> tuple[list[list[float]], list[float], list[list[float]]]:
-        """:meth:`gaze_jacobian` as plain lists (rotation rows, origin, 6 Jacobian rows over the
-        head joints)."""
-        frame = self.gaze_frame_lists(q_head)
-        rows = self.gaze_jacobian_rows()
-        return [r[:3] for r in frame], [r[3] for r in frame], rows
 
     def gaze_jacobian(self, q_head: np.ndarray) -> tuple[GazePose, np.ndarray]:
         """Gaze pose and its frame Jacobian (6 x n_head) in LOCAL_WORLD_ALIGNED: linear velocity

@@ -260,19 +260,59 @@ def _find_transfers(s: Signals, c: PhaseConfig) -> list[_Transfer]:
 
 
 def _refine_start(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
-    """Where the approach stops: the relative speed settles after the seed-rule crossing."""
+    """Where the approach stops: the relative speed settles after the seed-rule crossing.
+
+    Only the tail seen before the first tracking gap counts: a settle time found after a gap is
+    late by up to the gap's length, and the extrapolation below would scale that error up. When
+    the speed does not settle in the seen tail (a gap, or noise above ``settle_speed``), the
+    stop is extrapolated from the slowest seen sample instead.
+    """
+    hidden = _stop_in_gap_before(s, c, a)
+    if hidden is not None:
+        return hidden
     dt = 1.0 / c.offline_rate
     stop = min(b, a + int(c.max_refine / dt))
     seg = s.rel_speed[a : stop + 1]
-    below = np.flatnonzero(seg < c.settle_speed)
-    if below.size == 0:
-        return float(s.t[a])
+    gaps = np.flatnonzero(~np.isfinite(seg))
+    seen = seg[: int(gaps[0])] if gaps.size else seg
+    t_a = float(s.t[a])
+    # The tail ends where the speed settles below ``settle_speed``, or where it stops falling
+    # below ``settle_floor_speed`` (tracking noise above ``settle_speed`` would otherwise date
+    # a random later dip, and the extrapolation would scale that delay up).
+    below = seen < c.settle_speed
+    if seen.size >= 2:
+        below[:-1] |= (seen[1:] >= seen[:-1]) & (seen[:-1] < c.settle_floor_speed)
+    if not below.any():
+        below[-1] = True
+    i_s = a + int(np.argmax(below))
+    v_s = max(float(seen[i_s - a]), c.settle_speed)
     # On the minimum-jerk tail the speed falls as (t_stop - t)^2: the times it crosses the
-    # seed's threshold and the settle speed extrapolate to the stop (scaled down: smoothing and
+    # seed's threshold and a lower speed extrapolate to the stop (scaled down: smoothing and
     # the (1 - t/T)^2 factor make the real tail flatter than a parabola).
-    t_a, t_s = float(s.t[a]), float(s.t[a + below[0]])
-    ratio = math.sqrt(c.transfer_speed_max / c.settle_speed) - 1.0
+    ratio = math.sqrt(c.transfer_speed_max / max(v_s, 1e-9)) - 1.0
+    if ratio <= 0.05:
+        return t_a  # the speed did not fall: nothing to extrapolate
+    t_s = float(s.t[i_s])
     return t_s + min(c.stop_extrapolation * (t_s - t_a) / ratio, c.max_refine)
+
+
+def _stop_in_gap_before(s: Signals, c: PhaseConfig, a: int) -> float | None:
+    """The approach's stop when it hides in a tracking gap ending at grid index ``a`` (``None``
+    if ``a`` follows a seen sample, or the hands have not settled at ``a``): from the last sample seen before
+    the gap, still approaching at speed ``v`` with ``x`` left to go, the minimum-jerk tail
+    (``x ~ (t_stop - t)^3``) stops ``3 x / v`` later; at the latest when the gap ends."""
+    if a == 0 or np.isfinite(s.rel_speed[a - 1]) or not s.rel_speed[a] < c.settle_speed:
+        return None  # seen crossing, or still approaching after the gap
+    seen = np.flatnonzero(np.isfinite(s.rel_speed[:a]))
+    t_a = float(s.t[a])
+    if seen.size == 0:
+        return None
+    i = int(seen[-1])
+    x = float(np.linalg.norm(s.rel[a] - s.rel[i]))
+    v = float(s.rel_speed[i])
+    if not (math.isfinite(x) and v > 1e-6):
+        return t_a
+    return min(float(s.t[i]) + 3.0 * x / v, t_a)
 
 
 def _refine_end(s: Signals, c: PhaseConfig, a: int, b: int, t_start: float) -> float:

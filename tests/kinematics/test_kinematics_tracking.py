@@ -48,3 +48,32 @@ def test_a_target_that_stops_ends_with_a_fully_solved_goal(jaco2):
     for i in range(120, 130):  # the target stands still
         state = ctrl.update(i / 120, target)
     assert _head_error(jaco2, state.head_goal, target) <= IKConfig().tolerance + 1e-7
+
+
+def test_absurdly_far_target_is_held_like_a_missing_sample(jaco2):
+    from gazebot.kinematics import solve_ik
+
+    sol = solve_ik(jaco2, np.array([1e308, 1e308, 1e308]))
+    assert not sol.valid and "farther" in sol.message
+    ctrl = GazeController(jaco2)
+    good = ctrl.update(0.0, np.array([0.8, 0.1, 1.2]))
+    held = ctrl.update(0.1, np.array([1e300, 0.0, 0.0]))
+    assert not held.target_valid
+    assert all(math.isfinite(v) for v in held.head.values())
+    assert held.head_goal == good.head_goal
+
+
+def test_robot_yaml_pointing_at_a_broken_mjcf_names_the_file(tmp_path):
+    import yaml
+
+    from gazebot.config import ConfigError, configs_dir
+
+    mjcf = tmp_path / "empty.xml"
+    mjcf.write_text("<mujoco><worldbody/></mujoco>")
+    cfg = yaml.safe_load((configs_dir() / "robots" / "jaco2.yaml").read_text())
+    cfg["mjcf"] = str(mjcf)
+    path = tmp_path / "broken.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    with pytest.raises(ConfigError) as err:
+        RobotModel.load(path)
+    assert "empty.xml" in str(err.value)
