@@ -60,8 +60,8 @@ class PhaseConfig(BaseModel):
             where the hands settle below it (the seed's 15 cm/s is crossed earlier, on the
             minimum-jerk tail).
         settle_floor_speed: Offline, an approach whose relative speed stops falling below
-            this (m/s) has settled too: with a few mm of tracking noise the speed's floor lies
-            above ``settle_speed``.
+            this (m/s; never below ``settle_speed``) has settled too: with a few mm of tracking
+            noise the speed's floor lies above ``settle_speed``.
         settle_timeout: Online, a transfer candidate that never settles is confirmed after this
             long anyway (if the hands stopped closing), dated at the seed-rule crossing (s).
         stop_extrapolation: The approach's stop is extrapolated past the settle time from the
@@ -130,8 +130,6 @@ class PhaseConfig(BaseModel):
             raise ValueError("load_share_robot >= load_share_shared")
         if self.settle_speed >= self.transfer_speed_max:
             raise ValueError("settle_speed < transfer_speed_max")
-        if not self.settle_speed <= self.settle_floor_speed <= self.transfer_speed_max:
-            raise ValueError("settle_speed <= settle_floor_speed <= transfer_speed_max")
         if self.rest_speed > self.reach_onset_speed:
             raise ValueError("rest_speed <= reach_onset_speed")
         return self

@@ -15,17 +15,26 @@ relative speed is below ``transfer_speed_max`` (15 cm/s). Steps:
    (e.g. a robot gripper returning home near a resting giver).
 4. Boundaries are refined with the minimum-jerk profile: the seed's 15 cm/s is crossed on the
    tail of the approach, before contact, so the transfer starts where the relative speed
-   settles below ``settle_speed``, pushed on by the parabolic-tail extrapolation of the two
-   crossings (``stop_extrapolation``); the release is back-dated from where the hands' relative
-   position has left the held pose by ``release_distance`` with ``t0 = t - 3 x / v``, as the
-   hands leave rest along a minimum-jerk start (``x ~ (t - t0)^3``). If the release falls in a
-   tracking gap of the receiver, the giver's own motion onset dates it. A refinement that would
+   settles below ``settle_speed`` (or stops falling below ``settle_floor_speed``: tracking noise
+   can hold it above ``settle_speed``), pushed on by the parabolic-tail extrapolation of the two
+   crossings (``stop_extrapolation``). Only the tail seen before a tracking gap counts; an
+   approach that stops inside a gap is dated from the last sample before it. The release is
+   back-dated from where the hands' relative position has left the held pose by
+   ``release_distance`` with ``t0 = t - 3 x / v``, as the hands leave rest along a minimum-jerk
+   start (``x ~ (t - t0)^3``). If the release falls in a tracking gap, the separation seen
+   before the gap dates it, else the giver's own motion onset after it. A refinement that would
    shrink a transfer below ``min_transfer`` is dropped for the rule's own run.
 5. The reach starts at the giver's motion onset before the transfer (speed above
-   ``reach_onset_speed``, back-dated the same way from the last rest sample *seen*: an onset
-   hidden in a tracking gap is dated across the gap, not at its end); the retreat ends when the
-   giver's hand is back at rest (the mirror image), when the next reach starts, or when the
-   data end.
+   ``reach_onset_speed`` after the last slow sample *seen*, back-dated the same way from the
+   last rest sample seen: an onset hidden in a tracking gap is dated across the gap, not at its
+   end); the retreat ends at the earliest of the giver's hand back at rest (the mirror image,
+   with hysteresis down to ``rest_speed``), the hand ``retreat_far_distance`` from where the
+   transfer happened (as online), the next reach, and the data end.
+6. A recording that ends mid-handover ends in the phase under way, at its last sample, with
+   nothing invented after it: if the hands never part by ``release_distance`` before the data
+   end (or the tracking is lost for good with nothing moving), the transfer runs to the end and
+   there is no retreat; if the hands are still closing and no transfer was found, a lone reach
+   runs to the end.
 
 The robot's gripper/load-share columns are not used offline: at low sampling rates their first
 sample after the release is later than the back-dated kinematic estimate (the online detector
@@ -202,6 +211,7 @@ class _Transfer:
     end: int
     t_start: float
     t_end: float
+    open_end: bool = False  # the data end before the release: the transfer runs to the end
 
 
 def _find_transfers(s: Signals, c: PhaseConfig) -> list[_Transfer]:
@@ -250,7 +260,10 @@ def _find_transfers(s: Signals, c: PhaseConfig) -> list[_Transfer]:
         if out and a <= out[-1].end:
             continue  # same transfer seen from a neighbouring dip
         t_start = _refine_start(s, c, a, b)
-        t_end = _refine_end(s, c, a, b, t_start)
+        t_end, open_end = _refine_end(s, c, a, b, t_start)
+        if open_end:
+            out.append(_Transfer(a, b, t_start, float(s.t[-1]), True))
+            break  # the hands never part again in this recording
         if t_end - t_start < c.min_transfer:
             # The refinement assumes clean minimum-jerk edges; when it collapses a short
             # transfer (fast giver, sparse samples) the seed rule's own run stands.
@@ -281,7 +294,8 @@ def _refine_start(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
     # a random later dip, and the extrapolation would scale that delay up).
     below = seen < c.settle_speed
     if seen.size >= 2:
-        below[:-1] |= (seen[1:] >= seen[:-1]) & (seen[:-1] < c.settle_floor_speed)
+        floor = max(c.settle_floor_speed, c.settle_speed)
+        below[:-1] |= (seen[1:] >= seen[:-1]) & (seen[:-1] < floor)
     if not below.any():
         below[-1] = True
     i_s = a + int(np.argmax(below))
@@ -297,10 +311,12 @@ def _refine_start(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
 
 
 def _stop_in_gap_before(s: Signals, c: PhaseConfig, a: int) -> float | None:
-    """The approach's stop when it hides in a tracking gap ending at grid index ``a`` (``None``
-    if ``a`` follows a seen sample, or the hands have not settled at ``a``): from the last sample seen before
-    the gap, still approaching at speed ``v`` with ``x`` left to go, the minimum-jerk tail
-    (``x ~ (t_stop - t)^3``) stops ``3 x / v`` later; at the latest when the gap ends."""
+    """The approach's stop when it hides in a tracking gap ending at grid index ``a``.
+
+    ``None`` if ``a`` follows a seen sample, or the hands have not settled at ``a`` (still
+    approaching after the gap). Else, from the last sample seen before the gap, approaching at
+    speed ``v`` with ``x`` left to go, the minimum-jerk tail (``x ~ (t_stop - t)^3``) stops
+    ``3 x / v`` later; at the latest when the gap ends."""
     if a == 0 or np.isfinite(s.rel_speed[a - 1]) or not s.rel_speed[a] < c.settle_speed:
         return None  # seen crossing, or still approaching after the gap
     seen = np.flatnonzero(np.isfinite(s.rel_speed[:a]))
@@ -315,8 +331,14 @@ def _stop_in_gap_before(s: Signals, c: PhaseConfig, a: int) -> float | None:
     return min(float(s.t[i]) + 3.0 * x / v, t_a)
 
 
-def _refine_end(s: Signals, c: PhaseConfig, a: int, b: int, t_start: float) -> float:
-    """Back-date the release from the rule's exit with the minimum-jerk start ``3 x / v``."""
+def _refine_end(s: Signals, c: PhaseConfig, a: int, b: int, t_start: float) -> tuple[float, bool]:
+    """Back-date the release from the rule's exit with the minimum-jerk start ``3 x / v``.
+
+    Returns ``(t_end, open_end)``. ``open_end`` is True when the data end before the release is
+    seen (the separation never reaches ``release_distance``, or the tracking is lost for good
+    with no motion of the giver after it): the transfer then runs to the end of the data
+    instead of being back-dated from a separation that never happened.
+    """
     settled = (s.t[a : b + 1] >= t_start) & (s.rel_speed[a : b + 1] < c.settle_speed)
     idx = np.flatnonzero(settled) + a
     if idx.size == 0:
@@ -327,27 +349,41 @@ def _refine_end(s: Signals, c: PhaseConfig, a: int, b: int, t_start: float) -> f
     j = b
     while j + 1 < n and np.linalg.norm(s.rel[j] - held) < c.release_distance:
         if not np.isfinite(s.rel_speed[j + 1]):
-            # The release is hidden in a tracking gap of the receiver: fall back on the
-            # giver's own motion onset, when the giver's hand is seen.
-            return max(_giver_onset_after(s, c, j), t_start)
+            # The release is hidden in a tracking gap. When the hands were already parting
+            # before it, back-date from the last sample seen (a motion onset found after the
+            # gap is late by up to the gap's length); else fall back on the giver's own
+            # motion onset, when the giver's hand is seen.
+            sep = float(np.linalg.norm(s.rel[j] - held))
+            v = float(s.rel_speed[j])
+            if sep >= 0.5 * c.release_distance and v > 1e-6:
+                return max(float(s.t[j]) - min(3.0 * sep / v, c.max_refine), t_start), False
+            onset = _giver_onset_after(s, c, j)
+            if onset is None and not np.isfinite(s.rel_speed[j + 1 :]).any():
+                return float(s.t[-1]), True  # tracking lost until the end, nothing moved
+            return max(float(s.t[j]) if onset is None else onset, t_start), False
         j += 1
+    if j == n - 1 and not np.linalg.norm(s.rel[j] - held) >= c.release_distance:
+        return float(s.t[-1]), True
     sep = float(np.linalg.norm(s.rel[j] - held))
     v = float(s.rel_speed[j])
     back = 3.0 * sep / v if v > 1e-6 and math.isfinite(sep) else 0.0
     t_end = float(s.t[j]) - min(back, c.max_refine)
-    return max(t_end, t_start)
+    return max(t_end, t_start), False
 
 
-def _giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float:
-    """Start of the giver's first motion after grid index ``j`` (``t[j]`` if none is seen)."""
+def _giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
+    """Start of the giver's first motion after grid index ``j`` (``None`` if none is seen)."""
     v = s.giver_speed[j:]
     fast = np.flatnonzero(v >= c.reach_onset_speed)
     if fast.size == 0:
-        return float(s.t[j])
+        return None
     i = j + int(fast[0])
     x = float(np.linalg.norm(s.giver[i] - s.giver[j]))
     back = 3.0 * x / float(v[fast[0]]) if math.isfinite(x) else 0.0
-    return max(float(s.t[i]) - min(back, c.max_refine), float(s.t[j]))
+    # Across a tracking gap the motion may have started anywhere in it: the cap grows by the
+    # time not seen (never before the last sample seen, ``j``).
+    unseen = float(np.count_nonzero(~np.isfinite(v[: fast[0]]))) / c.offline_rate
+    return max(float(s.t[i]) - min(back, c.max_refine + unseen), float(s.t[j]))
 
 
 def _onset_before(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
@@ -357,10 +393,18 @@ def _onset_before(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
     if hi <= lo or not np.nanmax(v, initial=0.0) >= c.reach_onset_speed:
         return float(s.t[lo])
     peak = int(np.nanargmax(v))
-    slow = np.flatnonzero(~(v[: peak + 1] >= c.reach_onset_speed))  # NaN counts as slow
-    if slow.size == 0:
-        return float(s.t[lo])  # already moving when the data start
-    i_c = lo + int(slow[-1]) + 1
+    # The crossing follows the last sample *seen* slow: a tracking gap inside the reach is
+    # not its onset (the fastest part may come after such a gap).
+    head = v[: peak + 1]
+    seen = np.isfinite(head)
+    slow = np.flatnonzero(seen & (head < c.reach_onset_speed))
+    if slow.size:
+        i_c = lo + int(slow[-1]) + 1 + int(np.argmax(seen[slow[-1] + 1 :]))
+    else:
+        slow = np.flatnonzero(~seen)  # only a gap before the motion: it may hide the onset
+        if slow.size == 0:
+            return float(s.t[lo])  # already moving when the data start
+        i_c = lo + int(slow[-1]) + 1
     # The last *seen* rest: when the onset hides in a tracking gap, the displacement across
     # the gap still dates it (not before that rest sample).
     rest = np.flatnonzero(s.giver_speed[lo:i_c] < c.rest_speed)
@@ -381,16 +425,50 @@ def _rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
     fast = np.flatnonzero(v >= c.reach_onset_speed)
     if hi <= lo or fast.size == 0:
         return float(s.t[hi])
-    slow = np.flatnonzero(~(v[fast[0] :] >= c.reach_onset_speed))
-    if slow.size == 0:
+    # The motion lasts until the hand is at rest (hysteresis: a slow hand's speed may dip
+    # below ``reach_onset_speed`` on the way); it decelerates through that speed at its last
+    # fast sample.
+    tail = v[fast[0] :]
+    rest = np.flatnonzero(tail < c.rest_speed)
+    if rest.size == 0 and not (tail[-1] < c.reach_onset_speed):
         return float(s.t[hi])  # still moving when the data (or the window) end
-    i_c = lo + int(fast[0] + slow[0]) - 1
-    rest = np.flatnonzero(~(s.giver_speed[i_c : hi + 1] >= c.rest_speed))
-    i_r = i_c + int(rest[0]) if rest.size else hi
+    i_r = lo + int(fast[0]) + (int(rest[0]) if rest.size else tail.size - 1)
+    moving = np.flatnonzero(s.giver_speed[lo + int(fast[0]) : i_r + 1] >= c.reach_onset_speed)
+    i_c = lo + int(fast[0]) + int(moving[-1])
     x = float(np.linalg.norm(s.giver[i_r] - s.giver[i_c]))
     speed = float(s.giver_speed[i_c])
     fwd = 3.0 * x / speed if math.isfinite(x) and speed > 0 else 0.0
     return min(float(s.t[i_c]) + min(fwd, c.max_refine), float(s.t[hi]))
+
+
+def _far_after(s: Signals, c: PhaseConfig, i_end: int) -> float:
+    """First time after grid index ``i_end`` (the release) that the giver's hand is
+    ``retreat_far_distance`` from where the transfer happened (``inf`` if never)."""
+    seen = np.flatnonzero(np.isfinite(s.giver[: i_end + 1]).all(axis=1))
+    if seen.size == 0:
+        return math.inf
+    moved = np.linalg.norm(s.giver[i_end:] - s.giver[int(seen[-1])], axis=1)
+    far = np.flatnonzero(moved >= c.retreat_far_distance)  # NaN: not seen far
+    return float(s.t[i_end + int(far[0])]) if far.size else math.inf
+
+
+def _trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
+    """Onset of a reach still under way when the data end (after grid index ``lo``), or
+    ``None``: the giver's hand moved (``reach_onset_speed``), the hands closed by at least
+    ``min_approach`` from their farthest since ``lo``, and they are at their closest at the end
+    (no transfer was found, so the reach has not ended)."""
+    d = s.distance[lo:]
+    seen = np.flatnonzero(np.isfinite(d))
+    if seen.size < 3:
+        return None
+    i_max = int(np.nanargmax(d))
+    last = float(d[seen[-1]])
+    tail_min = float(np.nanmin(d[i_max:]))
+    if d[i_max] - last < c.min_approach or last > tail_min + 0.5 * c.min_approach:
+        return None
+    if not np.nanmax(s.giver_speed[lo + i_max :], initial=0.0) >= c.reach_onset_speed:
+        return None  # only the receiver came closer
+    return _onset_before(s, c, lo, lo + int(seen[-1]))
 
 
 def segment(trajectory: Trajectory, config: PhaseConfig | None = None) -> list[Segment]:
@@ -398,37 +476,60 @@ def segment(trajectory: Trajectory, config: PhaseConfig | None = None) -> list[S
 
     The trajectory is sorted by time first (duplicates dropped, see :meth:`Trajectory.cleaned`).
     Returns segments in time order; within a handover they are contiguous (reach end = transfer
-    start, transfer end = retreat start), and handovers never overlap. A recording without a
-    transfer yields no segments.
+    start, transfer end = retreat start), and handovers never overlap. The retreat ends at the
+    earlier of the giver's hand coming to rest and its being ``retreat_far_distance`` from
+    where the transfer happened (or when the next reach starts).
+
+    A recording cut short ends in the phase under way, which ends at the last sample, and
+    invents nothing after it: cut mid-retreat, the retreat runs to the end; cut mid-transfer
+    (the hands never part by ``release_distance``), the transfer runs to the end and has no
+    retreat; cut mid-reach (the hands still closing, no transfer), a lone reach runs to the end.
+    A recording with neither a transfer nor a reach under way at its end yields no segments.
     """
     c = config if config is not None else PhaseConfig()
     traj, _, _ = trajectory.cleaned()
     if len(traj) < 3:
         return []
     s = compute_signals(traj, c)
+    t_last = float(traj.t[-1])
+    grid_end = float(s.t[-1])
+
+    def at_end(x: float) -> float:
+        # The grid's last point is within half a step of the last sample: name it exactly.
+        return t_last if x >= grid_end - 1e-9 else x
+
     transfers = _find_transfers(s, c)
     out: list[Segment] = []
     t_idx = s.t
     prev_end_idx = 0
     for k, tr in enumerate(transfers):
-        i_start = int(np.searchsorted(t_idx, tr.t_start))
-        i_end = min(int(np.searchsorted(t_idx, tr.t_end)), len(t_idx) - 1)
+        t_start = min(tr.t_start, t_last)  # an extrapolated stop never passes the data end
+        i_start = int(np.searchsorted(t_idx, t_start))
         reach_start = _onset_before(s, c, prev_end_idx, max(i_start - 1, prev_end_idx))
         if out:
             reach_start = max(reach_start, out[-1].end)
+        out.append(Segment(Phase.REACH, min(reach_start, t_start), t_start, k))
+        if tr.open_end:
+            out.append(Segment(Phase.TRANSFER, t_start, t_last, k))
+            break
+        i_end = min(int(np.searchsorted(t_idx, tr.t_end)), len(t_idx) - 1)
         nxt = transfers[k + 1].start if k + 1 < len(transfers) else len(t_idx) - 1
-        retreat_end = _rest_after(s, c, i_end, max(nxt, i_end))
-        retreat_end = max(retreat_end, tr.t_end)
-        out.append(Segment(Phase.REACH, min(reach_start, tr.t_start), tr.t_start, k))
+        retreat_end = min(_rest_after(s, c, i_end, max(nxt, i_end)), _far_after(s, c, i_end))
+        retreat_end = at_end(max(retreat_end, tr.t_end))
         out.append(Segment(Phase.TRANSFER, tr.t_start, tr.t_end, k))
         out.append(Segment(Phase.RETREAT, tr.t_end, retreat_end, k))
         prev_end_idx = int(np.searchsorted(t_idx, retreat_end))
+    if not out or out[-1].phase is Phase.RETREAT:
+        onset = _trailing_reach(s, c, min(prev_end_idx, len(t_idx) - 1))
+        if onset is not None:
+            start = max(onset, out[-1].end) if out else onset
+            out.append(Segment(Phase.REACH, min(start, t_last), t_last, len(out) // 3))
     # The next reach may begin before the retreat looked finished: clip the retreat.
-    for i in range(2, len(out) - 1, 3):
-        nxt_reach = out[i + 1]
-        if out[i].end > nxt_reach.start:
-            fixed = max(nxt_reach.start, out[i].start)
-            out[i] = Segment(Phase.RETREAT, out[i].start, fixed, out[i].handover)
+    for i in range(len(out) - 1):
+        ret, nxt_reach = out[i], out[i + 1]
+        if ret.phase is Phase.RETREAT and ret.end > nxt_reach.start:
+            fixed = max(nxt_reach.start, ret.start)
+            out[i] = Segment(Phase.RETREAT, ret.start, fixed, ret.handover)
             if nxt_reach.start < fixed:
                 out[i + 1] = Segment(Phase.REACH, fixed, nxt_reach.end, nxt_reach.handover)
     return out

@@ -20,6 +20,18 @@ def varied_set():
 
 
 @pytest.fixture(scope="session")
+def seeds_set():
+    """Three more seeds of the same generator (120 recordings): bounds that hold for one fixture
+    seed only are not bounds (seeds 2 and 3 found the late-start outliers)."""
+    return [c for seed in (1, 2, 3) for c in synthetic_set(40, seed=seed)]
+
+
+@pytest.fixture(scope="session")
+def seeds_offline_results(seeds_set, config):
+    return [segment(c.trajectory, config) for c in seeds_set]
+
+
+@pytest.fixture(scope="session")
 def offline_results(varied_set, config):
     return [segment(c.trajectory, config) for c in varied_set]
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
+import numpy as np
 import pytest
 
 from gazebot.cli import phases as cli
@@ -77,3 +78,31 @@ def test_dispatcher_reports_errors_with_exit_code_2(tmp_path, capsys):
         pytest.skip(f"gazebot CLI dispatcher not importable yet: {exc}")
     assert main(["phases", str(tmp_path / "missing.csv")]) == 2
     assert "gazebot: error:" in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def cut_csv(tmp_path_factory):
+    """The reviewer's recording cut mid-transfer: at 2.98 s, the true release is at 3.26 s."""
+    case = generate(3, SyntheticOptions(rate=100))
+    tr = case.trajectory
+    cut = tr.take(np.flatnonzero(tr.t <= 2.98))
+    path = cut.to_csv(tmp_path_factory.mktemp("cli_cut") / "cut.csv")
+    return path, float(cut.t[-1]), case
+
+
+def test_json_of_a_recording_cut_mid_transfer_ends_in_the_transfer(cut_csv, capsys):
+    path, t_last, case = cut_csv
+    assert _run([str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [o["phase"] for o in out] == ["reach", "transfer"]
+    assert out[1]["end"] == pytest.approx(t_last)
+    assert abs(out[1]["start"] - case.truth[0].transfer_start) <= 0.1
+
+
+def test_online_json_of_a_recording_cut_mid_transfer_ends_in_the_transfer(cut_csv, capsys):
+    path, t_last, case = cut_csv
+    assert _run([str(path), "--online", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [o["phase"] for o in out] == ["reach", "transfer"]
+    assert out[1]["end"] == pytest.approx(t_last)
+    assert all(o["start"] <= o["detected_at"] <= t_last for o in out)

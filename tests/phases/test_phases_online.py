@@ -353,8 +353,9 @@ def test_release_seen_only_after_a_restart_still_ends_the_handover_at_rest():
     for t in np.arange(4.0, 6.0, 0.01):
         s = min((t - 4.0) / 0.3, 1.0)
         hand = np.array([0.97, -0.3, 0.86]) + s * np.array([0.03, 0.0, -0.01])
-        frame = TrackingFrame.make(t, giver_hand=hand, receiver_hand=[0.4, 0, 1.0],
-                                   gripper_closed=True, load_share=1.0)
+        frame = TrackingFrame.make(
+            t, giver_hand=hand, receiver_hand=[0.4, 0, 1.0], gripper_closed=True, load_share=1.0
+        )
         events += det.update_all(frame)
     kinds = [e.kind for e in events]
     assert kinds == [EventKind.RETREAT_STARTED, EventKind.HANDOVER_DONE]
