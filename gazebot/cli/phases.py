@@ -73,11 +73,14 @@ def handle(args: argparse.Namespace) -> int:
     if args.online:
         head += f"  {'detected':>8}"
     print(head)
+    t_end = float(traj.t[-1]) if len(traj) else float("nan")
     for s in segments:
         line = (
             f"{s.handover:>8}  {s.phase.value:<9}{_fmt(s.start)}  {_fmt(s.end)}  {_fmt(s.duration)}"
         )
         if args.online:
             line += f"  {_fmt(s.detected_at)}"
+        if s.end >= t_end:
+            line += "  (to end of data)"  # the recording stops inside this phase
         print(line)
     return 0

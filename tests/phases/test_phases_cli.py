@@ -106,3 +106,14 @@ def test_online_json_of_a_recording_cut_mid_transfer_ends_in_the_transfer(cut_cs
     assert [o["phase"] for o in out] == ["reach", "transfer"]
     assert out[1]["end"] == pytest.approx(t_last)
     assert all(o["start"] <= o["detected_at"] <= t_last for o in out)
+
+
+@pytest.mark.parametrize("online", [False, True])
+def test_table_marks_a_phase_the_recording_stops_in(tmp_path, capsys, online):
+    case = generate(3)
+    cut = case.trajectory.take(slice(0, int(len(case.trajectory) * 0.45)))
+    path = cut.to_csv(tmp_path / "cut.csv")
+    assert _run([str(path)] + (["--online"] if online else [])) == 0
+    rows = capsys.readouterr().out.strip().splitlines()[1:]
+    assert rows[-1].split()[1] == "transfer" and rows[-1].endswith("(to end of data)")
+    assert not any(r.endswith("(to end of data)") for r in rows[:-1])
