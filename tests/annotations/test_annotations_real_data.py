@@ -51,6 +51,27 @@ def test_mean_phase_lengths_are_close_to_the_seed(summary):
     assert summary.phase_frames["receiver"]["reach"] == pytest.approx(7.53, abs=1.2)
 
 
+def test_reach_patterns_use_each_persons_own_reach_frames(summary):
+    # The own-reach window (see gazebot.annotations.reach for the windows tried against the seed).
+    assert summary.phase_frames["giver"]["reach"] == pytest.approx(7.889, abs=1e-3)
+    assert summary.phase_frames["receiver"]["reach"] == pytest.approx(6.432, abs=1e-3)
+    reach = summary.counts["reach"]
+    assert reach["giver"] == {
+        "Hand": 121,
+        "Face": 17,
+        "Short Face-Hand": 117,
+        "Long Face-Hand": 27,
+        "other": 6,
+    }
+    assert reach["receiver"] == {
+        "Hand": 231,
+        "Face": 6,
+        "Short Face-Hand": 41,
+        "Long Face-Hand": 6,
+        "other": 4,
+    }
+
+
 def test_hand_face_is_the_most_humanlike_builtin_for_receivers(annotations):
     names = ["face", "hand", "face-hand-face", "hand-face", "face-hand-face-as-studied"]
     shares = {n: replay(annotations, load_behavior(n), "receiver").share for n in names}
