@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import csv
 import functools
-import importlib.util
 import os
 from pathlib import Path
 
@@ -148,29 +147,22 @@ def test_invalid_resolution_is_rejected(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(
-    importlib.util.find_spec("gazebot.render.video") is None,
-    reason="gazebot.render.video (the MuJoCo renderer) is not available yet",
-)
 def test_real_renderer_at_tiny_resolution_renders_distinct_videos(tmp_path):
     from gazebot.sim.record import render_handover_video
 
     plan = make_plan(behaviors=["hand", "face-hand-face"], condition="posture", participants=4)
     plan = [s for s in plan if s.participant == 1][:1]  # one session: 2 videos, 2 workers
-    try:
-        report = render_study(
-            plan,
-            tmp_path,
-            render_handover_video,
-            64,
-            48,
-            10,
-            workers=2,
-            card_seconds=0.2,
-            progress=False,
-        )
-    except ImportError as exc:  # the SIM package is written in parallel with this one
-        pytest.skip(f"the MuJoCo renderer's dependencies are not complete yet: {exc}")
+    report = render_study(
+        plan,
+        tmp_path,
+        render_handover_video,
+        64,
+        48,
+        10,
+        workers=2,
+        card_seconds=0.2,
+        progress=False,
+    )
     assert len(report.videos) == 2 and len(report.rendered) == 2
     clips = [_frames(p) for p in report.videos.values()]
     assert all(len(c) > 5 and c[0].shape == (48, 64, 3) for c in clips)
