@@ -7,39 +7,15 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from phase_truth import PHASE_KINDS, event_errors
 
 from gazebot.phases import PhaseConfig, PhaseDetector, run_online, segments_from_events
 from gazebot.phases.synthetic import SyntheticOptions, generate, synthetic_set
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
 
-PHASE_KINDS = (
-    EventKind.REACH_STARTED,
-    EventKind.TRANSFER_STARTED,
-    EventKind.RETREAT_STARTED,
-    EventKind.HANDOVER_DONE,
-)
-TRUTH_FIELD = {
-    EventKind.REACH_STARTED: "reach_start",
-    EventKind.TRANSFER_STARTED: "transfer_start",
-    EventKind.RETREAT_STARTED: "transfer_end",
-    EventKind.HANDOVER_DONE: "retreat_end",
-}
-
 
 def _phase_events(events):
     return [e for e in events if e.kind in PHASE_KINDS]
-
-
-def _errors(cases, results, kind):
-    """(|t - truth|, detected_at - truth) arrays for one event kind over the set."""
-    err, lat = [], []
-    for case, res in zip(cases, results, strict=True):
-        evs = [e for e in res.events if e.kind is kind]
-        for e, h in zip(evs, case.truth, strict=True):
-            truth = getattr(h, TRUTH_FIELD[kind])
-            err.append(abs(e.t - truth))
-            lat.append(e.detected_at - truth)
-    return np.array(err), np.array(lat)
 
 
 def _frames(case):
@@ -64,7 +40,7 @@ def test_events_are_never_detected_before_they_happen(online_results):
 
 @pytest.mark.parametrize("kind", [EventKind.TRANSFER_STARTED, EventKind.RETREAT_STARTED])
 def test_transfer_events_are_accurate_from_motion_alone(varied_set, online_results, kind):
-    err, lat = _errors(varied_set, online_results, kind)
+    err, lat = event_errors(varied_set, online_results, kind)
     # Measured: transfer start |err| median 25 / p90 100 / max 236 ms; release 35 / 111 / 199.
     assert np.median(err) <= 0.04
     assert np.percentile(err, 90) <= 0.12
@@ -72,7 +48,7 @@ def test_transfer_events_are_accurate_from_motion_alone(varied_set, online_resul
 
 
 def test_transfer_start_is_detected_within_250ms(varied_set, online_results):
-    _, lat = _errors(varied_set, online_results, EventKind.TRANSFER_STARTED)
+    _, lat = event_errors(varied_set, online_results, EventKind.TRANSFER_STARTED)
     assert np.median(lat) <= 0.05  # back-dated to the stop, confirmed ~ at contact
     assert np.mean(lat <= 0.25) >= 0.95
 
@@ -81,8 +57,8 @@ def test_reach_and_release_latency_from_motion_alone(varied_set, online_results)
     # A minimum-jerk motion needs time to show: 0.75-1.5 cm of travel (more under heavy noise)
     # before a reach or a release is believed. Measured medians: reach 192 ms, release 224 ms
     # (test_phases_online_latency.py pins the rest).
-    _, reach = _errors(varied_set, online_results, EventKind.REACH_STARTED)
-    _, release = _errors(varied_set, online_results, EventKind.RETREAT_STARTED)
+    _, reach = event_errors(varied_set, online_results, EventKind.REACH_STARTED)
+    _, release = event_errors(varied_set, online_results, EventKind.RETREAT_STARTED)
     assert np.median(reach) <= 0.2 and np.percentile(reach, 90) <= 0.32
     assert np.median(release) <= 0.23 and np.percentile(release, 90) <= 0.33
 
@@ -90,7 +66,7 @@ def test_reach_and_release_latency_from_motion_alone(varied_set, online_results)
 def test_robot_evidence_brings_all_transfer_events_within_250ms():
     cases = synthetic_set(20, seed=11, robot_evidence=True)
     results = [run_online(c.trajectory) for c in cases]
-    err, lat = _errors(cases, results, EventKind.RETREAT_STARTED)
+    err, lat = event_errors(cases, results, EventKind.RETREAT_STARTED)
     assert lat.max() <= 0.25
     assert np.percentile(err, 90) <= 0.12
     # With the robot's gripper state, the transfer starts when the gripper closes (both hold

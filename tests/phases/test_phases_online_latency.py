@@ -5,34 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from phase_truth import PHASE_KINDS, event_errors
 
 from gazebot.phases import Trajectory, run_online
 from gazebot.phases.synthetic import synthetic_set
 from gazebot.types import EventKind
-
-PHASE_KINDS = (
-    EventKind.REACH_STARTED,
-    EventKind.TRANSFER_STARTED,
-    EventKind.RETREAT_STARTED,
-    EventKind.HANDOVER_DONE,
-)
-TRUTH_FIELD = {
-    EventKind.REACH_STARTED: "reach_start",
-    EventKind.RETREAT_STARTED: "transfer_end",
-    EventKind.HANDOVER_DONE: "retreat_end",
-}
-
-
-def _latency(cases, results, kind):
-    """(detected_at - truth, |t - truth|) over the set for one event kind."""
-    lat, err = [], []
-    for case, res in zip(cases, results, strict=True):
-        evs = [e for e in res.events if e.kind is kind]
-        for e, h in zip(evs, case.truth, strict=True):
-            truth = getattr(h, TRUTH_FIELD[kind])
-            lat.append(e.detected_at - truth)
-            err.append(abs(e.t - truth))
-    return np.array(lat), np.array(err)
 
 
 @pytest.mark.parametrize(
@@ -48,7 +25,7 @@ def _latency(cases, results, kind):
     ],
 )
 def test_online_latency_on_the_varied_set(varied_set, online_results, kind, median, p90, share):
-    lat, _ = _latency(varied_set, online_results, kind)
+    _, lat = event_errors(varied_set, online_results, kind)
     assert len(lat) == sum(len(c.truth) for c in varied_set)
     assert np.median(lat) <= median
     assert np.percentile(lat, 90) <= p90
@@ -56,7 +33,7 @@ def test_online_latency_on_the_varied_set(varied_set, online_results, kind, medi
 
 
 def test_predicted_landing_dates_the_end_of_the_retreat(varied_set, online_results):
-    lat, err = _latency(varied_set, online_results, EventKind.HANDOVER_DONE)
+    err, lat = event_errors(varied_set, online_results, EventKind.HANDOVER_DONE)
     # Measured |err| median 35, p90 119, max 179 ms (rest-hold dating: 47 / 131 / 207 ms).
     assert np.median(err) <= 0.045 and np.percentile(err, 90) <= 0.13 and err.max() <= 0.2
     assert lat.max() <= 0.12  # never waits for a rest hold
