@@ -26,6 +26,7 @@ class Segment:
         end: Phase end (s); the next phase of the same handover starts here.
         handover: Index of the handover in the recording (0 for the first).
         detected_at: Online only: when the phase start was detected (s); ``None`` offline.
+        open: The data end inside this phase: its end is the last sample, not an observed end.
     """
 
     phase: Phase
@@ -33,6 +34,7 @@ class Segment:
     end: float
     handover: int = 0
     detected_at: float | None = None
+    open: bool = False
 
     @property
     def duration(self) -> float:
