@@ -88,7 +88,7 @@ class PhaseConfig(BaseModel):
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
     min_transfer: float = Field(0.08, ge=0)
-    settle_fraction: float = Field(0.08, gt=0, lt=1)
+    settle_fraction: float = Field(0.03, gt=0, lt=1)
     settle_floor_factor: float = Field(1.5, ge=1)
     hold_floor_quantile: float = Field(0.25, ge=0, le=1)
     release_distance: float = Field(0.015, ge=0)

@@ -40,7 +40,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     t_start = core.t_start if math.isfinite(core.t_start) else float(s.t[a])
     v_settle = settle_speed(s, c, core.lo, a, b)
     i0 = max(a, int(np.searchsorted(s.t, t_start)))
-    still = np.flatnonzero(s.rel_speed[i0 : b + 1] <= v_settle * c.settle_floor_factor) + i0
+    still = np.flatnonzero(s.rel_speed[i0 : b + 1] <= v_settle) + i0
     i_h = int(still[-1]) if still.size else b
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)
