@@ -96,7 +96,7 @@ def handle(args: argparse.Namespace) -> int:
         head += f"  {'detected':>8}"
     print(head)
     if not segments:
-        print("(no handover found)")
+        print("(no handover found: empty table)")
         return 0
     for s in segments:
         line = f"{s.handover:>8}  {s.phase.value:<9}{_fmt(s.start)}  {_fmt(s.end)}  {_fmt(s.duration)}"
