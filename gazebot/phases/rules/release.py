@@ -1,7 +1,9 @@
 """Transfer -> retreat: when the giver lets go.
 
-The held pose is the median relative position (receiver - giver) over the last settled
-samples of the hold; its RMS jitter there measures the tracking noise. The
+The held pose is the median relative position (receiver - giver) over the last samples of the
+hold where the hands were still together (relative speed within ``settle_floor_factor`` times
+the hold's floor); its RMS jitter there measures the tracking noise. The release is not before
+that last still sample. The
 release is seen once the relative position has left the held pose by ``release_distance``, or
 ``release_noise_factor`` times that jitter if larger, and is back-dated with the minimum-jerk
 start ``t0 = t - 3 x / v`` (the hands leave rest along ``x ~ (t - t0)^3``; at most
@@ -18,7 +20,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals
-from gazebot.phases.rules.transfer import TransferCore, settle_speed
+from gazebot.phases.rules.transfer import TransferCore, hold_floor
 
 
 def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np.ndarray) -> float:
@@ -38,10 +40,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     """
     a, b = core.start, core.end
     t_start = core.t_start if math.isfinite(core.t_start) else float(s.t[a])
-    v_settle = settle_speed(s, c, core.lo, a, b)
-    i0 = max(a, int(np.searchsorted(s.t, t_start)))
-    still = np.flatnonzero(s.rel_speed[i0 : b + 1] <= v_settle) + i0
-    i_h = int(still[-1]) if still.size else b
+    # The hands were still together (within the hold's own noise) up to i_h: the release is
+    # not before it.
+    v_still = c.settle_floor_factor * hold_floor(s, c, a, b)
+    i0 = min(max(a, int(np.searchsorted(s.t, t_start))), b)
+    still = np.flatnonzero(s.rel_speed[i0 : b + 1] <= v_still) + i0
+    i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)
     held = np.nanmedian(s.rel[idx], axis=0)

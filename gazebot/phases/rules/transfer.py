@@ -137,13 +137,19 @@ def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
     return out
 
 
+def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
+    """The relative speed floor of the hold ``[a, b]`` (m/s): marker noise and both hands
+    carrying the object, the ``hold_floor_quantile`` of its relative speed."""
+    hold = s.rel_speed[a : b + 1]
+    hold = hold[np.isfinite(hold)]
+    return float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
+
+
 def settle_speed(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
     """The relative speed below which the approach of the core ``[a, b]`` has stopped (m/s)."""
     peak = float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
-    hold = s.rel_speed[a : b + 1]
-    hold = hold[np.isfinite(hold)]
-    floor = float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
-    return min(max(c.settle_fraction * peak, c.settle_floor_factor * floor), c.transfer_speed_max)
+    floor = c.settle_floor_factor * hold_floor(s, c, a, b)
+    return min(max(c.settle_fraction * peak, floor), c.transfer_speed_max)
 
 
 def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
