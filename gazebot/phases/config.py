@@ -51,6 +51,10 @@ class PhaseConfig(BaseModel):
             the held pose (m) ...
         release_noise_factor: ... and at least this many times the held pose's RMS jitter.
         reach_onset_speed: gazebot: giver hand speed marking a reach onset or retreat end (m/s).
+        reach_confirm_distance: gazebot: a reach under way is reported once the hands have
+            closed by this much (m) ...
+        approach_ratio: ... and the giver's hand itself moved toward the receiver by this
+            fraction of it.
         rest_speed: gazebot: the giver's hand is at rest below this speed (m/s).
         retreat_far_distance: gazebot: the retreat also ends once the giver's hand is this far
             from where the transfer happened (m).
@@ -94,6 +98,8 @@ class PhaseConfig(BaseModel):
     release_distance: float = Field(0.015, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     reach_onset_speed: float = Field(0.15, gt=0)
+    reach_confirm_distance: float = Field(0.02, gt=0)
+    approach_ratio: float = Field(0.5, ge=0, le=1)
     rest_speed: float = Field(0.05, gt=0)
     retreat_far_distance: float = Field(0.60, gt=0)
     max_refine: float = Field(0.4, ge=0)
