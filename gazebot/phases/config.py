@@ -95,7 +95,7 @@ class PhaseConfig(BaseModel):
     settle_fraction: float = Field(0.03, gt=0, lt=1)
     settle_floor_factor: float = Field(1.5, ge=1)
     hold_floor_quantile: float = Field(0.25, ge=0, le=1)
-    release_distance: float = Field(0.015, ge=0)
+    release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     reach_onset_speed: float = Field(0.15, gt=0)
     reach_confirm_distance: float = Field(0.02, gt=0)
