@@ -90,13 +90,13 @@ def handle(args: argparse.Namespace) -> int:
         json.dump(doc, sys.stdout, indent=1)
         sys.stdout.write("\n")
         return 0
-    print(f"{rec.describe()}; method {config.method}{' (online)' if args.online else ''}")
-    head = f"{'handover':>8}  {'phase':<9}{'start s':>8}  {'end s':>8}  {'dur. s':>8}"
+    print(f"# {rec.describe()}; method {config.method}{' (online)' if args.online else ''}")
+    head = f"{'handover':>8}  {'phase':<9}{'start':>8}  {'end':>8}  {'duration':>8}"
     if args.online:
         head += f"  {'detected':>8}"
     print(head)
     if not segments:
-        print("(no handover found: empty table)")
+        print("(no handover found)")
         return 0
     for s in segments:
         line = f"{s.handover:>8}  {s.phase.value:<9}{_fmt(s.start)}  {_fmt(s.end)}  {_fmt(s.duration)}"

@@ -79,5 +79,5 @@ def segments_from_events(events: Iterable[Event], t_end: float) -> list[Segment]
             open_phase = (_START_KIND[ev.kind], ev.t, ev.detected_at)
     if open_phase is not None and math.isfinite(t_end):
         phase, start, det = open_phase
-        out.append(Segment(phase, start, max(start, t_end), max(handover, 0), det))
+        out.append(Segment(phase, start, max(start, t_end), max(handover, 0), det, open=True))
     return out
