@@ -47,6 +47,8 @@ class PhaseConfig(BaseModel):
         settle_floor_factor: ... or below this many times the hold's speed floor, if higher.
         hold_floor_quantile: gazebot: the hold's speed floor is this quantile of the relative
             speed over the seed-rule run (0..1).
+        stop_extrapolation: gazebot: share of the parabolic-tail extrapolation from the settle
+            crossing to the hold's floor applied (0: none; 1: the parabola's own).
         release_distance: gazebot: the release needs the hands' relative position this far from
             the held pose (m) ...
         release_noise_factor: ... and at least this many times the held pose's RMS jitter.
@@ -95,6 +97,7 @@ class PhaseConfig(BaseModel):
     settle_fraction: float = Field(0.03, gt=0, lt=1)
     settle_floor_factor: float = Field(1.5, ge=1)
     hold_floor_quantile: float = Field(0.25, ge=0, le=1)
+    stop_extrapolation: float = Field(0.5, ge=0, le=2)
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     reach_onset_speed: float = Field(0.15, gt=0)

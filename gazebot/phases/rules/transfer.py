@@ -152,11 +152,26 @@ def settle_speed(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
     return min(max(c.settle_fraction * peak, floor), c.transfer_speed_max)
 
 
+def _crossing(s: Signals, i: int, level: float) -> float:
+    """Time the relative speed fell through ``level`` between grid points ``i - 1`` and ``i``."""
+    if i > 0 and np.isfinite(s.rel_speed[i - 1]):
+        v0, v1 = float(s.rel_speed[i - 1]), float(s.rel_speed[i])
+        if v0 > level >= v1 and v0 > v1:
+            return float(s.t[i - 1]) + (v0 - level) / (v0 - v1) * s.dt
+    return float(s.t[i])
+
+
 def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
     """When the approach into the core ``[a, b]`` stopped (s); NaN if not yet seen to settle.
 
-    Only the tail seen before the first tracking gap counts. An approach that stopped inside a
-    tracking gap is dated from the last sample seen before it (:func:`stop_in_gap_before`).
+    The relative speed's crossing of the settle speed ``v_s``; when that lies above the hold's
+    floor ``v_f`` (``settle_floor_factor`` x floor: a clean approach), the approach's tail,
+    parabolic near its end (``v ~ (t_stop - t)^2``), is extrapolated from the crossings of
+    the seed's ``transfer_speed_max`` (t_a) and ``v_s`` (t_s) to where it meets ``v_f``:
+    ``t_s + stop_extrapolation (t_s - t_a) (sqrt(v_s) - sqrt(v_f)) / (sqrt(v_a) - sqrt(v_s))``
+    (at most ``max_refine``). Only the tail seen before the first tracking gap counts. An
+    approach that stopped inside a tracking gap is dated from the last sample seen before it
+    (:func:`stop_in_gap_before`).
     """
     v_settle = settle_speed(s, c, lo, a, b)
     hidden = stop_in_gap_before(s, a, v_settle)
@@ -166,17 +181,20 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
     gaps = np.flatnonzero(~np.isfinite(seg))
     seen = seg[: int(gaps[0])] if gaps.size else seg
     below = np.flatnonzero(seen < v_settle)
-    if below.size:
-        i = a + int(below[0])
-        if i > a and np.isfinite(s.rel_speed[i - 1]):
-            # Linear between the grid points around the crossing.
-            v0, v1 = float(s.rel_speed[i - 1]), float(s.rel_speed[i])
-            if v0 > v1:
-                return float(s.t[i - 1]) + (v0 - v_settle) / (v0 - v1) * s.dt
-        return float(s.t[i])
-    if gaps.size:
-        return float(s.t[a + int(np.argmin(seen))]) if seen.size else float(s.t[a])
-    return math.nan
+    if below.size == 0:
+        if gaps.size:
+            return float(s.t[a + int(np.argmin(seen))]) if seen.size else float(s.t[a])
+        return math.nan
+    i = a + int(below[0])
+    t_s = _crossing(s, i, v_settle)
+    t_a = _crossing(s, a, c.transfer_speed_max)
+    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
+    v_a = c.transfer_speed_max
+    if v_f < v_settle < v_a and t_s > t_a:
+        ext = (t_s - t_a) * (math.sqrt(v_settle) - math.sqrt(v_f))
+        ext /= math.sqrt(v_a) - math.sqrt(v_settle)
+        t_s += min(c.stop_extrapolation * ext, c.max_refine)
+    return t_s
 
 
 def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
