@@ -107,7 +107,7 @@ class PhaseConfig(BaseModel):
     retreat_far_distance: float = Field(0.60, gt=0)
     max_refine: float = Field(0.4, ge=0)
     max_retreat: float = Field(4.0, gt=0)
-    smoothing: float = Field(0.16, gt=0)
+    smoothing: float = Field(0.12, gt=0)
     analysis_rate: float = Field(100.0, gt=0, le=2000)
     max_gap_hold: float = Field(0.25, ge=0)
     frozen_speed: float = Field(0.05, ge=0)
