@@ -58,6 +58,10 @@ class PhaseConfig(BaseModel):
         approach_ratio: ... and the giver's hand itself moved toward the receiver by this
             fraction of it.
         rest_speed: gazebot: the giver's hand is at rest below this speed (m/s).
+        rest_hold: Online, a hand whose retreat began before the detector saw it is at rest
+            after this long under ``rest_speed`` (s).
+        done_fraction: Online, a retreat whose speed fell below this fraction of its peak is
+            about to land: it ends at the mirrored onset.
         retreat_far_distance: gazebot: the retreat also ends once the giver's hand is this far
             from where the transfer happened (m).
         max_refine: gazebot: largest back-dating of a motion onset or release (s).
@@ -104,6 +108,8 @@ class PhaseConfig(BaseModel):
     reach_confirm_distance: float = Field(0.02, gt=0)
     approach_ratio: float = Field(0.5, ge=0, le=1)
     rest_speed: float = Field(0.05, gt=0)
+    rest_hold: float = Field(0.15, ge=0)
+    done_fraction: float = Field(0.15, ge=0, lt=1)
     retreat_far_distance: float = Field(0.60, gt=0)
     max_refine: float = Field(0.4, ge=0)
     max_retreat: float = Field(4.0, gt=0)

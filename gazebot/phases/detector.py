@@ -40,6 +40,9 @@ from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals, compute_signals
 from gazebot.phases.methods import GazebotSegmenter, make_segmenter
 from gazebot.phases.prediction import predict_end
+from gazebot.phases.rules.release import transfer_end
+from gazebot.phases.rules.retreat import retreat_done
+from gazebot.phases.rules.transfer import TransferCore
 from gazebot.phases.segment import Segment, segments_from_events
 from gazebot.phases.trajectory import Trajectory
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
@@ -266,11 +269,41 @@ class PhaseDetector:
         self._signals = s
         if isinstance(self.segmenter, GazebotSegmenter):
             cut = self.segmenter.signals(traj, partial=True)
-            segs = [] if cut is None else self.segmenter.segment_signals(cut, now, partial=True)
+            if cut is not None:
+                # Once the hands are in contact, the release and retreat-end rules run from the
+                # phase's own start; before, the whole method finds the next handover.
+                self._rules_after_contact(cut, now)
+                if self.phase not in (Phase.TRANSFER, Phase.RETREAT):
+                    self._advance(self.segmenter.segment_signals(cut, now, True), now, True)
+                    self._rules_after_contact(cut, now)
         else:
-            segs = self.segmenter.segment_sorted(traj, partial=True)
-        self._advance(segs, now)
+            self._advance(self.segmenter.segment_sorted(traj, partial=True), now)
         self.expected_phase_end = predict_end(self.phase, self.phase_start, s, now, c)
+
+    def _rules_after_contact(self, s: Signals, now: float) -> bool:
+        """``gazebot`` in a transfer or retreat: apply the release and retreat-end rules from
+        the current phase's start (so a phase adopted by :meth:`resync`, or older than the
+        window, ends like any other). True if the phase is one of these two."""
+        c = self.config
+        for _ in range(2):
+            if self.phase is Phase.TRANSFER:
+                i0 = min(int(np.searchsorted(s.t, self.phase_start)), s.t.shape[0] - 1)
+                n = s.t.shape[0]
+                core = TransferCore(0, i0, n - 1, n - 1, max(self.phase_start, float(s.t[0])))
+                t_end, open_end = transfer_end(s, c, core)
+                if open_end or t_end >= float(s.t[-1]):
+                    return True
+                self._start(Phase.RETREAT, t_end, now, "motion")
+                continue
+            if self.phase is Phase.RETREAT:
+                done = retreat_done(s, c, self.phase_start)
+                if done is not None:
+                    self._done(done[0], now, done[1])
+                elif now - self.phase_start > c.max_retreat:
+                    self._done(now, now, "timeout")
+                return True
+            return False
+        return True
 
     def _find(self, segs: list[Segment], phase: Phase, after: float) -> Segment | None:
         for seg in segs:
@@ -278,7 +311,9 @@ class PhaseDetector:
                 return seg
         return None
 
-    def _advance(self, segs: list[Segment], now: float) -> None:
+    def _advance(self, segs: list[Segment], now: float, stop_at_contact: bool = False) -> None:
+        """Emit the phase starts ``segs`` show after the current phase (at most one handover);
+        ``stop_at_contact``: stop once in a transfer (the caller's rules take over)."""
         c = self.config
         for _ in range(4):  # at most one full handover per analysis
             ph = self.phase
@@ -310,6 +345,8 @@ class PhaseDetector:
                     self._done(now, now, "aborted")
                 return
             if ph is Phase.TRANSFER:
+                if stop_at_contact:
+                    return
                 ret = self._find(segs, Phase.RETREAT, self._floor)
                 if ret is not None:
                     self._start(Phase.RETREAT, ret.start, now, "motion")
