@@ -115,6 +115,8 @@ class PhaseDetector:
         self._signals: Signals | None = None
         self._reach_missing_since = math.nan
         self._floor = -math.inf  # the next phase never starts before this
+        # The current phase began before this detector saw the hands move (resync, restart).
+        self._joined_late = False
 
     # ----------------------------------------------------------------- public API
     @property
@@ -156,10 +158,13 @@ class PhaseDetector:
         if between and phase in (Phase.REACH, Phase.TRANSFER):
             self.handover += 1
         self._enter(phase, event.t)
+        self._joined_late = True
         self._queue.clear()
 
     # ----------------------------------------------------------------- internals
     def _enter(self, phase: Phase, t0: float) -> None:
+        # Joined late: fewer than two samples seen before the phase's start.
+        self._joined_late = len(self._t) < 3 or self._t[1] >= t0
         self.phase = phase
         self.phase_start = t0
         self._floor = t0
@@ -296,7 +301,7 @@ class PhaseDetector:
                 self._start(Phase.RETREAT, t_end, now, "motion")
                 continue
             if self.phase is Phase.RETREAT:
-                done = retreat_done(s, c, self.phase_start)
+                done = retreat_done(s, c, self.phase_start, self._joined_late)
                 if done is not None:
                     self._done(done[0], now, done[1])
                 elif now - self.phase_start > c.max_retreat:

@@ -68,6 +68,10 @@ class GazebotSegmenter(Segmenter):
         trailing_ok = True
         for k, core in enumerate(cores):
             t_start = core.t_start
+            if partial and math.isfinite(t_start) and t_start > grid_end - c.min_transfer:
+                # Online: a transfer is confirmed once the hands have held for min_transfer
+                # (the hold's floor, which dates the start, needs a few samples of it).
+                t_start = math.nan
             if not math.isfinite(t_start):
                 if partial:
                     # The approach has not settled yet: still a reach.

@@ -49,14 +49,16 @@ def far_after(s: Signals, c: PhaseConfig, i_end: int) -> float:
     return float(s.t[i_end + int(far[0])]) if far.size else math.inf
 
 
-def retreat_done(s: Signals, c: PhaseConfig, t_release: float) -> tuple[float, str] | None:
+def retreat_done(
+    s: Signals, c: PhaseConfig, t_release: float, joined_late: bool = False
+) -> tuple[float, str] | None:
     """The end of a retreat that started at ``t_release``, as far as the data show it:
     ``(time, source)`` with source ``rest``, ``far`` or ``landing`` (:func:`_landing`), or
     ``None`` while it goes on.
 
-    When the release predates the data (an engine restarted mid-retreat), the hand's motion
-    since the release is unknown: a hand at rest (under ``rest_speed`` for ``rest_hold``)
-    ends the retreat.
+    When the release predates the data, or ``joined_late`` (an engine restarted mid-retreat),
+    the hand's motion since the release is unknown: a hand at rest (under ``rest_speed`` for
+    ``rest_hold``) ends the retreat.
     """
     n = s.t.shape[0]
     if n < 2:
@@ -66,7 +68,8 @@ def retreat_done(s: Signals, c: PhaseConfig, t_release: float) -> tuple[float, s
         return None
     t_rest, seen = rest_after(s, c, i0, n - 1)
     landing = _landing(s, c, i0, t_release)
-    t_far = far_after(s, c, i0) if t_release >= s.t[0] else math.inf
+    late = joined_late or t_release < s.t[0]
+    t_far = far_after(s, c, i0) if not late else math.inf
     best: tuple[float, str] | None = None
     if seen and t_rest < s.t[-1]:
         best = (t_rest, "rest")
@@ -74,15 +77,15 @@ def retreat_done(s: Signals, c: PhaseConfig, t_release: float) -> tuple[float, s
         best = (t_far, "far")
     if landing is not None and (best is None or landing < best[0]):
         best = (landing, "landing")
-    if best is None and t_release < s.t[0]:
+    if best is None and late:
         v = s.giver_speed
         hold = int(round(c.rest_hold * c.analysis_rate))
         slow = np.isfinite(v) & (v < c.rest_speed)
         if n > hold and slow[-hold - 1 :].all():
             k = n - 1
-            while k > 0 and slow[k - 1]:
+            while k > i0 and slow[k - 1]:
                 k -= 1
-            best = (float(s.t[k]), "rest")
+            best = (max(float(s.t[k]), t_release), "rest")
     return best
 
 

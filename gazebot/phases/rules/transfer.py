@@ -145,6 +145,11 @@ def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
     return float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
 
 
+def v_settle_fraction(s: Signals, c: PhaseConfig, lo: int, a: int) -> float:
+    """``settle_fraction`` of the approach's peak relative speed (m/s)."""
+    return c.settle_fraction * float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
+
+
 def settle_speed(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
     """The relative speed below which the approach of the core ``[a, b]`` has stopped (m/s)."""
     peak = float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
@@ -186,9 +191,18 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
             return float(s.t[a + int(np.argmin(seen))]) if seen.size else float(s.t[a])
         return math.nan
     i = a + int(below[0])
+    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
+    # The core's first part is the approach's tail: once the crossing is known, the hold's
+    # floor is measured on the samples after it (a short, early hold otherwise reads high).
+    for _ in range(2):
+        v_f = c.settle_floor_factor * hold_floor(s, c, i, b)
+        v_new = min(max(v_f, v_settle_fraction(s, c, lo, a)), c.transfer_speed_max)
+        below = np.flatnonzero(seen < v_new)
+        if v_new >= v_settle or below.size == 0:
+            break
+        v_settle, i = v_new, a + int(below[0])
     t_s = _crossing(s, i, v_settle)
     t_a = _crossing(s, a, c.transfer_speed_max)
-    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
     v_a = c.transfer_speed_max
     if v_f < v_settle < v_a and t_s > t_a:
         ext = (t_s - t_a) * (math.sqrt(v_settle) - math.sqrt(v_f))
