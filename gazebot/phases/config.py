@@ -42,6 +42,8 @@ class PhaseConfig(BaseModel):
         approach_fraction: gazebot: ... closing at least this fraction of the distance the
             hands started from.
         min_transfer: gazebot: shortest transfer kept (s).
+        still_closing: Online, hands that closed more than this over the last
+            ``min_transfer`` are still approaching: no transfer yet (m).
         settle_fraction: gazebot: the transfer starts where the relative speed falls below this
             fraction of the approach's peak relative speed ...
         settle_floor_factor: ... or below this many times the hold's speed floor, if higher.
@@ -98,6 +100,7 @@ class PhaseConfig(BaseModel):
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
     min_transfer: float = Field(0.08, ge=0)
+    still_closing: float = Field(0.005, ge=0)
     settle_fraction: float = Field(0.03, gt=0, lt=1)
     settle_floor_factor: float = Field(1.5, ge=1)
     hold_floor_quantile: float = Field(0.25, ge=0, le=1)
