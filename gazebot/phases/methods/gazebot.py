@@ -68,7 +68,7 @@ class GazebotSegmenter(Segmenter):
         trailing_ok = True
         for k, core in enumerate(cores):
             t_start = core.t_start
-            if partial and math.isfinite(t_start):
+            if partial and math.isfinite(t_start) and core.end >= n - 2:
                 # Online: a transfer is confirmed once the hands have held for min_transfer
                 # (the hold's floor, which dates the start, needs a few samples of it) without
                 # closing further (a giver waiting for a slowly arriving receiver).
