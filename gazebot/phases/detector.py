@@ -270,10 +270,11 @@ class PhaseDetector:
         if n < 3:
             return
         traj = Trajectory(np.fromiter(self._t, float, n), np.array(self._g), np.array(self._r))
-        s = compute_signals(traj, c)
-        self._signals = s
         if isinstance(self.segmenter, GazebotSegmenter):
             cut = self.segmenter.signals(traj, partial=True)
+            # The last edge_guard of the smoothed speed sags (one-sided window): predictions
+            # read the same trusted part as the rules.
+            self._signals = cut
             if cut is not None:
                 # Once the hands are in contact, the release and retreat-end rules run from the
                 # phase's own start; before, the whole method finds the next handover.
@@ -282,8 +283,9 @@ class PhaseDetector:
                     self._advance(self.segmenter.segment_signals(cut, now, True), now, True)
                     self._rules_after_contact(cut, now)
         else:
+            self._signals = compute_signals(traj, c)
             self._advance(self.segmenter.segment_sorted(traj, partial=True), now)
-        self.expected_phase_end = predict_end(self.phase, self.phase_start, s, now, c)
+        self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
 
     def _rules_after_contact(self, s: Signals, now: float) -> bool:
         """``gazebot`` in a transfer or retreat: apply the release and retreat-end rules from
