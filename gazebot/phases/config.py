@@ -121,7 +121,7 @@ class PhaseConfig(BaseModel):
     max_gap_hold: float = Field(0.25, ge=0)
     frozen_speed: float = Field(0.05, ge=0)
     online_period: float = Field(0.02, ge=0)
-    online_window: float = Field(8.0, gt=1)
+    online_window: float = Field(5.0, gt=1)
     edge_guard: float = Field(0.04, ge=0)
     load_share_shared: float = Field(0.1, ge=0, le=1)
     load_share_robot: float = Field(0.9, ge=0, le=1)

@@ -223,7 +223,9 @@ class PhaseDetector:
                 last = min(last_g, last_r)
                 if t - last > c.max_gap_hold:
                     self.tracking = False
-                    missing = [n for n, ok in (("giver_hand", g_ok), ("receiver_hand", r_ok)) if not ok]
+                    missing = [
+                        n for n, ok in (("giver_hand", g_ok), ("receiver_hand", r_ok)) if not ok
+                    ]
                     info = {"handover": max(self.handover, 0), "missing": missing}
                     self._queue.append(Event(EventKind.TRACKING_LOST, last, t, info))
             if not self.tracking:
@@ -270,6 +272,11 @@ class PhaseDetector:
         if n < 3:
             return
         traj = Trajectory(np.fromiter(self._t, float, n), np.array(self._g), np.array(self._r))
+        if self.phase in (Phase.TRANSFER, Phase.RETREAT) and math.isfinite(self.phase_start):
+            # After contact the rules need the hold and what follows, not the whole window.
+            keep = np.flatnonzero(traj.t >= self.phase_start - c.reach_duration)
+            if keep.size >= 3 and keep[0] > 0:
+                traj = traj.take(keep)
         if isinstance(self.segmenter, GazebotSegmenter):
             cut = self.segmenter.signals(traj, partial=True)
             # The last edge_guard of the smoothed speed sags (one-sided window): predictions
