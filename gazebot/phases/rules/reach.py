@@ -52,8 +52,8 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     ``lo`` and are at their closest now, and the giver's hand has itself moved toward the
     receiver by ``approach_ratio`` of that distance, the hands closing and the giver's hand
     moving faster than ``reach_onset_speed`` within the last ``smoothing`` window (or, when
-    the receiver did the closing, the giver's hand moved faster than ``reach_onset_speed`` and the hands closed by
-    ``min_approach``)."""
+    the receiver did the closing, the giver's hand moved faster than ``reach_onset_speed``
+    and the hands closed by ``min_approach``)."""
     d = s.distance[lo:]
     seen = np.flatnonzero(np.isfinite(d))
     if seen.size < 3:

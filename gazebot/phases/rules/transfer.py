@@ -3,8 +3,8 @@
 A handover is a dip of the hands' distance at least ``min_approach`` deep (the recording's ends
 count as high ground) that closes at least ``approach_fraction`` of the distance the hands
 started from (a pause of a slow approach is no handover). Its minimum is the seed's "minimum
-distance" (section 7.2.5), whatever it is: on real motion capture the hand frames sit on the back of the hand or at the wrist and the
-object has size, so they never come closer than 0.3-0.5 m; no absolute contact distance is
+distance" (section 7.2.5), whatever it is: on real motion capture the hand frames sit on the
+back of the hand or at the wrist and the object has size, so they never come closer than 0.3-0.5 m; no absolute contact distance is
 assumed. Within the dip, the seed's rule (within ``transfer_distance_margin`` of the minimum,
 relative speed under ``transfer_speed_max``) gives the transfer's core; runs split by short
 blips under ``transfer_exit_speed`` or by tracking gaps merge. The giver's hand must have moved
