@@ -4,18 +4,20 @@ A handover is a dip of the hands' distance at least ``min_approach`` deep (the r
 count as high ground) that closes at least ``approach_fraction`` of the distance the hands
 started from (a pause of a slow approach is no handover). Its minimum is the seed's "minimum
 distance" (section 7.2.5), whatever it is: on real motion capture the hand frames sit on the
-back of the hand or at the wrist and the object has size, so they never come closer than 0.3-0.5 m; no absolute contact distance is
-assumed. Within the dip, the seed's rule (within ``transfer_distance_margin`` of the minimum,
-relative speed under ``transfer_speed_max``) gives the transfer's core; runs split by short
-blips under ``transfer_exit_speed`` or by tracking gaps merge. The giver's hand must have moved
-(``reach_onset_speed``) before the core: a receiver (robot) returning home near a resting
-giver makes a dip too; the receiver may move more than the giver.
+back of the hand or at the wrist and the object has size, so they never come closer than
+0.3-0.5 m; no absolute contact distance is assumed. Within the dip, the seed's rule (within
+``transfer_distance_margin`` of the minimum, relative speed under ``transfer_speed_max``)
+gives the transfer's core; runs split by short blips under ``transfer_exit_speed`` or by
+tracking gaps merge. The giver's hand must have moved (``reach_onset_speed``) before the core:
+a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
+more than the giver.
 
 The seed's 15 cm/s is crossed on the tail of the approach, before contact. The transfer starts
 where the approach has stopped: the relative speed falls below ``settle_fraction`` of the
 approach's own peak relative speed (scale-free: fast and slow approaches alike), or below
 ``settle_floor_factor`` times the hold's speed floor (marker noise and both hands carrying the
-object keep the relative speed of a real hold at 3-7 cm/s).
+object keep the relative speed of a real hold at 3-7 cm/s), whichever is higher; a clean
+approach's parabolic tail is then extrapolated down to the floor (:func:`transfer_start`).
 """
 
 from __future__ import annotations
