@@ -53,9 +53,10 @@ def start_sim_node(bus, sim):
 
 def start_engine_node(bus, behavior="face-hand-face"):
     from gazebot.engine import GazeEngine
+    from gazebot.runtime import GazeLoop
 
     drv = ZenohRobotDriver(bus.connector(), bus.config().keys, "engine")
-    node = EngineNode(GazeEngine.from_config("sawyer", behavior), drv)
+    node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", behavior)), drv)
     stop = threading.Event()
     th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
 

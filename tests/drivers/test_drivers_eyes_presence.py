@@ -13,6 +13,7 @@ from drivers_fakes import FakeEngine, free_port
 from gazebot.drivers.base import RobotDriver
 from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
 from gazebot.drivers.payloads import EyeStateMsg, PayloadError, TrackingMsg
+from gazebot.runtime import GazeLoop
 from gazebot.types import TrackingFrame
 
 
@@ -110,7 +111,8 @@ def test_engine_node_sends_the_distance_from_the_gaze_site_to_the_target_and_ren
     drv = MemoryDriver()
     drv.frames = True
     renderer = RecordingRenderer()
-    node = EngineNode(engine, drv, EngineNodeConfig(eye_frame_rate=1e6), eye_renderer=renderer)
+    node = EngineNode(GazeLoop(engine), drv, EngineNodeConfig(eye_frame_rate=1e6),
+                      eye_renderer=renderer)
     commands = []
     original = engine.step
 
@@ -130,13 +132,6 @@ def test_engine_node_sends_the_distance_from_the_gaze_site_to_the_target_and_ren
     assert renderer.calls[-1]["distance"] == pytest.approx(drv.eyes[-1].distance)
 
 
-def test_engine_node_without_a_gaze_pose_sends_unknown_distance():
-    drv = MemoryDriver()
-    node = EngineNode(FakeEngine(), drv, EngineNodeConfig())
-    node.on_tracking(_tracking(0.0))
-    assert drv.eyes[-1].distance is None
-
-
 # -- no robot seen -------------------------------------------------------------------------
 class Clock:
     def __init__(self) -> None:
@@ -151,7 +146,7 @@ def test_no_robot_seen_warns_once_and_degrades_the_status():
     drv = MemoryDriver()
     warnings: list[str] = []
     cfg = EngineNodeConfig(no_robot_warning=3.0, heartbeat_period=0.5, resync=False)
-    node = EngineNode(FakeEngine(), drv, cfg, warn=warnings.append, clock=clock)
+    node = EngineNode(GazeLoop(FakeEngine()), drv, cfg, warn=warnings.append, clock=clock)
     node.start()
     for now in (0.5, 1.0, 2.9):
         clock.now = now
@@ -178,7 +173,8 @@ def test_robot_seen_in_time_gives_no_warning():
     drv = MemoryDriver()
     warnings: list[str] = []
     node = EngineNode(
-        FakeEngine(), drv, EngineNodeConfig(resync=False), warn=warnings.append, clock=clock
+        GazeLoop(FakeEngine()), drv, EngineNodeConfig(resync=False), warn=warnings.append,
+        clock=clock
     )
     node.start()
     clock.now = 1.0

@@ -1,0 +1,214 @@
+"""The one runtime loop: tracking and robot state in, safe head, eye and blink commands out.
+
+Every consumer drives the robot's head and eyes through :class:`GazeLoop`: the in-process
+handover recording (``gazebot demo``, ``gazebot render video``, ``gazebot study render``), the
+engine node on the bus (``gazebot run``, ``gazebot sim --with-engine``) and the in-process
+simulated driver. What it adds to :meth:`gazebot.engine.GazeEngine.step`:
+
+* **Blinks**: one :class:`~gazebot.render.blink.BlinkModel`, fed with how far the gaze direction
+  (from the head's ``gaze`` frame at the commanded head pose to the target point) turned since
+  the previous tick.
+* **Vergence distance**: from the same ``gaze`` frame origin to the target point (``None`` when
+  the target is unknown or at the display itself).
+* **Tracking loss**: a tick without a sample (``frame=None``, the transport heard nothing) is a
+  missing sample for the phase detector, which bridges short gaps and reports ``tracking_lost``
+  after ``max_gap_hold``; the behavior then applies its own ``tracking_lost`` policy (hold for
+  ``hold_s``, then look at its target, by default the last known face). There is no other
+  fallback: the behavior's timings are the only ones.
+* **Safety**: a head goal outside the joint limits is clipped into them, eye angles into the
+  eye range, the blink into 0..1; a command with any non-finite value is never returned (the
+  tick returns ``None`` and counts it in :attr:`GazeLoop.unsafe`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from gazebot.render.blink import BlinkModel
+from gazebot.types import Event, GazeCommand, Phase, TrackingFrame, is_valid_point
+
+TrackingState = Literal["waiting", "ok", "hold", "lost"]
+
+
+@dataclass(frozen=True)
+class LoopCommand:
+    """One tick's command for the head, the eyes and the lids (SI units, robot base frame).
+
+    Attributes:
+        t: Robot time (s) of the tick.
+        phase: Handover phase.
+        target: Gaze target kind (``face``, ``hand``, ...).
+        target_point: The point looked at (m).
+        head: Head joint goals (rad), finite and within the joint limits.
+        eye_yaw: Eye yaw (rad, + = robot's left), within the eye range.
+        eye_pitch: Eye pitch (rad, + = down), within the eye range.
+        blink: Lid closure, 0 open .. 1 closed.
+        distance: Distance (m) from the ``gaze`` frame to the target, for vergence; ``None``
+            when unknown.
+        tracking: ``ok``, ``hold`` (tracking lost, the behavior holds the gaze) or ``lost``
+            (the behavior looks at its ``tracking_lost`` target).
+        answers_sample: Whether the tick answered a tracking sample (``False``: silence).
+        residual: Angle between the line of sight and the target (rad).
+        events: Events that fired during the tick.
+    """
+
+    t: float
+    phase: Phase
+    target: str
+    target_point: np.ndarray
+    head: dict[str, float]
+    eye_yaw: float
+    eye_pitch: float
+    blink: float
+    distance: float | None
+    tracking: TrackingState
+    answers_sample: bool
+    residual: float = 0.0
+    events: tuple[Event, ...] = ()
+
+
+def _direction_change(prev: np.ndarray | None, cur: np.ndarray | None) -> float:
+    """Angle (rad) between two gaze directions; 0 when either is unknown or degenerate."""
+    if prev is None or cur is None:
+        return 0.0
+    a, b = float(np.linalg.norm(prev)), float(np.linalg.norm(cur))
+    if a < 1e-9 or b < 1e-9:
+        return 0.0
+    return float(np.arccos(np.clip(prev.dot(cur) / (a * b), -1.0, 1.0)))
+
+
+class GazeLoop:
+    """Turns tracking samples (or their absence) into :class:`LoopCommand` s.
+
+    Args:
+        engine: A :class:`gazebot.engine.GazeEngine` (``step``, ``notify``, ``reset``, ``resync``,
+            ``tracking_state``, and ``robot`` with ``head_joints``, ``lower``, ``upper``,
+            ``eyes.clip``, ``head_vector`` and ``gaze_pose``).
+        blink: The blink model; ``None`` for ``BlinkModel(seed)``.
+        seed: Seed of the default blink model.
+    """
+
+    def __init__(self, engine: Any, blink: BlinkModel | None = None, seed: int = 0) -> None:
+        self.engine = engine
+        self.blinks = blink if blink is not None else BlinkModel(seed)
+        self.unsafe = 0  # commands refused for non-finite values
+        self.clipped = 0  # commands brought into the joint or eye limits
+        self.ticks = 0
+        self._prev_dir: np.ndarray | None = None
+        self._t = -math.inf
+
+    @classmethod
+    def from_config(
+        cls,
+        robot: Any = "sawyer",
+        behavior: Any = "face-hand-face",
+        phases: Any = None,
+        seed: int = 0,
+    ) -> GazeLoop:
+        """A loop around ``GazeEngine.from_config(robot, behavior, phases, seed=seed)`` with
+        ``BlinkModel(seed)``."""
+        from gazebot.engine import GazeEngine
+
+        return cls(GazeEngine.from_config(robot, behavior, phases, seed=seed), seed=seed)
+
+    @property
+    def robot(self) -> Any:
+        return self.engine.robot
+
+    @property
+    def phase(self) -> Phase:
+        return self.engine.phase
+
+    def notify(self, events: Sequence[Event]) -> None:
+        """Hand robot events (e.g. ``robot_reach_started``) to the engine's next tick."""
+        for event in events:
+            self.engine.notify(event)
+
+    def reset(self, head: Mapping[str, float] | None = None) -> None:
+        """Forget the handover, the head pose (``head``: the measured one) and the blink line."""
+        self.engine.reset(head)
+        self.blinks.reset()
+        self._prev_dir = None
+        self._t = -math.inf
+
+    def resync(self, events: list[Event]) -> None:
+        """Catch up with a handover under way (see :meth:`GazeEngine.resync`)."""
+        self.engine.resync(events)
+
+    def tick(
+        self,
+        t: float,
+        frame: TrackingFrame | None = None,
+        arm: Mapping[str, float] | None = None,
+    ) -> LoopCommand | None:
+        """Advance to robot time ``t`` (s) with ``frame`` (``None``: no sample arrived).
+
+        ``arm`` is the measured arm joint positions (rad), for robots whose arm carries the head.
+        Returns the command, or ``None`` when the engine produced a non-finite one (never sent).
+        """
+        answers = frame is not None
+        if frame is None:
+            # Silence is a missing sample: the detector bridges it, then reports tracking_lost.
+            frame = TrackingFrame(t=float(t))
+        cmd = self.engine.step(frame, arm=arm)
+        self.ticks += 1
+        return self._finish(cmd, answers)
+
+    def _finish(self, cmd: GazeCommand, answers: bool) -> LoopCommand | None:
+        if not (cmd.is_finite() and math.isfinite(cmd.t)):
+            self.unsafe += 1
+            return None
+        robot = self.robot
+        head, clipped = self._safe_head(cmd.head)
+        yaw, pitch, eyes_clipped = robot.eyes.clip(cmd.eye_yaw, cmd.eye_pitch)
+        if clipped or eyes_clipped:
+            self.clipped += 1
+        origin = robot.gaze_pose(robot.head_vector(head)).position
+        direction = None
+        distance = None
+        if is_valid_point(cmd.target_point):
+            direction = np.asarray(cmd.target_point, float) - origin
+            d = float(np.linalg.norm(direction))
+            # A target at the display itself has no defined vergence: unknown.
+            distance = d if math.isfinite(d) and d > 1e-3 else None
+        # Blink times never go back (the engine's t never does either).
+        t = self._t = max(cmd.t, self._t)
+        shift = _direction_change(self._prev_dir, direction)
+        if direction is not None:
+            self._prev_dir = direction
+        blink = min(max(float(self.blinks.update(t, shift)), 0.0), 1.0)
+        return LoopCommand(
+            t=cmd.t,
+            phase=cmd.phase,
+            target=cmd.target,
+            target_point=np.asarray(cmd.target_point, float),
+            head=head,
+            eye_yaw=float(yaw),
+            eye_pitch=float(pitch),
+            blink=blink,
+            distance=distance,
+            tracking=self.engine.tracking_state(cmd.t),
+            answers_sample=answers,
+            residual=float(cmd.residual),
+            events=cmd.events,
+        )
+
+    def _safe_head(self, head: Mapping[str, float]) -> tuple[dict[str, float], bool]:
+        robot = self.robot
+        out: dict[str, float] = {}
+        clipped = False
+        for name, lo, hi in zip(robot.head_joints, robot.lower, robot.upper, strict=True):
+            if name not in head:
+                continue
+            q = float(head[name])
+            x = min(max(q, float(lo)), float(hi))
+            clipped = clipped or x != q
+            out[name] = x
+        if set(head) - set(out):
+            raise ValueError(f"engine commanded unknown head joints {sorted(set(head) - set(out))}")
+        return out, clipped
