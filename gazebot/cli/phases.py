@@ -8,6 +8,8 @@ import math
 import sys
 from typing import TYPE_CHECKING
 
+from gazebot.cli.errors import UsageError
+
 if TYPE_CHECKING:
     from gazebot.phases import Segment
 
@@ -45,7 +47,7 @@ def handle(args: argparse.Namespace) -> int:
         traj = load_trajectory_csv(args.file)
     except UnicodeDecodeError as exc:
         # The bare codec message names neither the file nor what to do about it.
-        raise ValueError(
+        raise UsageError(
             f"{args.file}: not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset "
             f"{exc.start}); save the CSV as UTF-8"
         ) from None

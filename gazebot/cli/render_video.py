@@ -7,6 +7,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from gazebot.cli.errors import UsageError
+
 
 def register(kinds: argparse._SubParsersAction) -> None:
     parser = kinds.add_parser(
@@ -26,10 +28,14 @@ def register(kinds: argparse._SubParsersAction) -> None:
 
 def run_render_video(args: argparse.Namespace) -> int:
     from gazebot.sim.gl_check import OffscreenRenderingError
-    from gazebot.sim.record import render_handover_video
+    from gazebot.sim.record import check_video_size, render_handover_video
 
     if args.out.suffix.lower() != ".mp4":
-        raise ValueError(f"--out must name an .mp4 file, got {args.out}")
+        raise UsageError(f"--out must name an .mp4 file, got {args.out}")
+    try:
+        check_video_size(args.width, args.height, args.fps)
+    except ValueError as exc:
+        raise UsageError(f"--width/--height/--fps: {exc}") from None
     try:
         path = render_handover_video(
             args.robot,

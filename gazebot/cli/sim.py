@@ -10,6 +10,7 @@ import threading
 from typing import Any
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
+from gazebot.cli.errors import UsageError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -59,7 +60,7 @@ class PygameView:
             self.screen = pygame.display.set_mode(self.size)
         except pygame.error as exc:
             pygame.display.quit()
-            raise ValueError(f"cannot open a window ({exc}); use --headless") from exc
+            raise UsageError(f"cannot open a window ({exc}); use --headless") from exc
         pygame.display.set_caption("gazebot sim")
 
     def __call__(self, sim: Any) -> bool:
@@ -104,7 +105,7 @@ def handle(args: argparse.Namespace) -> int:
             thread.start()
             # Start the handover once the engine listens (and has taken the head pose).
             if not engine_node.ready.wait(10.0):
-                raise ValueError("the in-process engine node did not start within 10 s")
+                raise UsageError("the in-process engine node did not start within 10 s")
         print(
             f"gazebot sim: robot {sim.robot.name} scene {args.scene} on gazebot/{cfg.robot_id}/ "
             f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})"

@@ -7,6 +7,7 @@ import json
 import math
 from pathlib import Path
 
+from gazebot.cli.errors import UsageError
 from gazebot.study.conditions import CONDITION_LEVELS, DEFAULT_BEHAVIORS
 
 
@@ -108,7 +109,7 @@ def _finite(value: float, option: str, low: float = 0.0, high: float = math.inf)
     """``value`` if finite and in (low, high); ``ValueError`` naming ``option`` otherwise."""
     if not (math.isfinite(value) and low < value < high):
         bound = f"in ({low:g}, {high:g})" if math.isfinite(high) else f"> {low:g}"
-        raise ValueError(f"{option} must be a finite number {bound}, got {value}")
+        raise UsageError(f"{option} must be a finite number {bound}, got {value}")
     return value
 
 
@@ -121,7 +122,7 @@ def _check_behaviors(names: list[str]) -> None:
             load_behavior(name)
         except FileNotFoundError:
             available = ", ".join(i.name for i in list_behaviors())
-            raise ValueError(
+            raise UsageError(
                 f"--behaviors: unknown behavior {name!r}; available: {available}"
             ) from None
 
@@ -137,7 +138,7 @@ def _plan(args: argparse.Namespace) -> int:
     for item in args.scene:
         level, sep, scene = item.partition("=")
         if not sep or not level or not scene:
-            raise ValueError(f"--scene expects LEVEL=SCENE, got {item!r}")
+            raise UsageError(f"--scene expects LEVEL=SCENE, got {item!r}")
         scenes[level] = scene
     plan = make_plan(
         behaviors, args.condition, args.participants, args.seed, args.robot, scenes, args.video_seed
@@ -181,7 +182,7 @@ def _render(args: argparse.Namespace) -> int:
             if not (configs_dir() / "scenes" / f"{scene}.yaml").is_file() and not (
                 scene.endswith((".yaml", ".yml")) and Path(scene).is_file()
             ):
-                raise ValueError(
+                raise UsageError(
                     f"{args.plan}: unknown scene {scene!r} (no configs/scenes/{scene}.yaml)"
                 )
         fn = default_renderer()
@@ -271,7 +272,7 @@ def _fit_wins(args: argparse.Namespace) -> int:
     ]
     if bad:
         i, j, t = bad[0]
-        raise ValueError(
+        raise UsageError(
             f"{args.wins}: cells ({i}, {j}) + ({j}, {i}) = {t:g}, expected "
             f"--participants {n:g} (every participant compares every pair once)"
         )

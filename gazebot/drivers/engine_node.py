@@ -317,7 +317,7 @@ class EngineNode:
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
         cmd = self.loop.tick(msg.t, msg.to_frame(),
-                             arm=joints.position if joints is not None else None)
+                             joints=joints.position if joints is not None else None)
         self.frames_processed += 1
         if cmd is not None:
             self._send(cmd, answers=msg.seq)

@@ -6,10 +6,11 @@ engine node on the bus (``gazebot run``, ``gazebot sim --with-engine``) and the 
 simulated driver. What it adds to :meth:`gazebot.engine.GazeEngine.step`:
 
 * **Blinks**: one :class:`~gazebot.render.blink.BlinkModel`, fed with how far the gaze direction
-  (from the head's ``gaze`` frame at the commanded head pose to the target point) turned since
-  the previous tick.
+  (from the head's ``gaze`` frame to the target point) turned since the previous tick.
 * **Vergence distance**: from the same ``gaze`` frame origin to the target point (``None`` when
-  the target is unknown or at the display itself).
+  the target is unknown or at the display itself). The ``gaze`` frame is placed at the measured
+  head joints when the tick's ``joints`` has them all (where the display really is), else at
+  the commanded head pose.
 * **Tracking loss**: a tick without a sample (``frame=None``, the transport heard nothing) is a
   missing sample for the phase detector, which bridges short gaps and reports ``tracking_lost``
   after ``max_gap_hold``; the behavior then applies its own ``tracking_lost`` policy (hold for
@@ -144,22 +145,25 @@ class GazeLoop:
         self,
         t: float,
         frame: TrackingFrame | None = None,
-        arm: Mapping[str, float] | None = None,
+        joints: Mapping[str, float] | None = None,
     ) -> LoopCommand | None:
         """Advance to robot time ``t`` (s) with ``frame`` (``None``: no sample arrived).
 
-        ``arm`` is the measured arm joint positions (rad), for robots whose arm carries the head.
-        Returns the command, or ``None`` when the engine produced a non-finite one (never sent).
+        ``joints`` is the robot's measured joint positions (rad) by name: the arm joints that
+        carry the head (Sawyer's ``right_j0``) and the head joints. Returns the command, or
+        ``None`` when the engine produced a non-finite one (never sent).
         """
         answers = frame is not None
         if frame is None:
             # Silence is a missing sample: the detector bridges it, then reports tracking_lost.
             frame = TrackingFrame(t=float(t))
-        cmd = self.engine.step(frame, arm=arm)
+        cmd = self.engine.step(frame, arm=joints)
         self.ticks += 1
-        return self._finish(cmd, answers)
+        return self._finish(cmd, answers, joints)
 
-    def _finish(self, cmd: GazeCommand, answers: bool) -> LoopCommand | None:
+    def _finish(
+        self, cmd: GazeCommand, answers: bool, joints: Mapping[str, float] | None
+    ) -> LoopCommand | None:
         if not (cmd.is_finite() and math.isfinite(cmd.t)):
             self.unsafe += 1
             return None
@@ -168,7 +172,7 @@ class GazeLoop:
         yaw, pitch, eyes_clipped = robot.eyes.clip(cmd.eye_yaw, cmd.eye_pitch)
         if clipped or eyes_clipped:
             self.clipped += 1
-        origin = robot.gaze_pose(robot.head_vector(head)).position
+        origin = robot.gaze_pose(robot.head_vector(self._display_pose(head, joints))).position
         direction = None
         distance = None
         if is_valid_point(cmd.target_point):
@@ -197,6 +201,16 @@ class GazeLoop:
             residual=float(cmd.residual),
             events=cmd.events,
         )
+
+    def _display_pose(
+        self, head: dict[str, float], joints: Mapping[str, float] | None
+    ) -> dict[str, float]:
+        """The measured head joints when all are known and finite, else the commanded ones."""
+        if joints:
+            measured = {n: joints.get(n, math.nan) for n in self.robot.head_joints}
+            if all(math.isfinite(v) for v in measured.values()):
+                return measured
+        return head
 
     def _safe_head(self, head: Mapping[str, float]) -> tuple[dict[str, float], bool]:
         robot = self.robot

@@ -43,7 +43,8 @@ class HandoverRecording:
     robot_events: list[Event] = field(default_factory=list)
 
 
-def _check_size(width: int, height: int, fps: float) -> None:
+def check_video_size(width: int, height: int, fps: float) -> None:
+    """Raise ``ValueError`` unless ``width`` x ``height`` px at ``fps`` is a video we record."""
     for name, v in (("width", width), ("height", height)):
         if isinstance(v, bool) or not isinstance(v, int) or v < 16 or v % 2:
             raise ValueError(f"video {name} must be an even number of pixels >= 16, got {v!r}")
@@ -100,7 +101,7 @@ def record_handover(
     from gazebot.sim.robot import load_sim_robot
     from gazebot.sim.simulation import HandoverSimulation
 
-    _check_size(width, height, fps)
+    check_video_size(width, height, fps)
     sim_robot = load_sim_robot(robot)
     sim = HandoverSimulation(robot=sim_robot, scene=scene, seed=seed)
     if loop is None:
@@ -133,7 +134,7 @@ def record_handover(
                 events.extend(robot_events)
                 loop.notify(robot_events)
                 # The measured arm pose: on Sawyer the head rides on right_j0.
-                cmd = loop.tick(frame.t, frame, arm=sim.joint_state())
+                cmd = loop.tick(frame.t, frame, joints=sim.joint_state())
                 if cmd is not None:  # None: an unsafe command, never applied
                     sim.apply_head(cmd.head)
                     sim.apply_eyes(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)
