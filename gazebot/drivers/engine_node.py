@@ -36,6 +36,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from gazebot.drivers.base import RobotDriver
+from gazebot.drivers.payloads import VERSION as PAYLOAD_VERSION
 from gazebot.drivers.payloads import (
     EventMsg,
     EyeFrameMsg,
@@ -166,6 +167,7 @@ class EngineNode:
         self._last_eye_frame = -math.inf
         self._behavior_state: str | None = None
         self._target: str | None = None
+        self._version_warned = False
         self._peers: dict[str, bool] = {}
         self._skip_events: set[tuple[str, int, float]] = set()
         self.ready = threading.Event()  # set once started (and resynchronised)
@@ -398,11 +400,24 @@ class EngineNode:
 
     def _check_robot_seen(self) -> None:
         """Warn once if no tracking sample or joint state arrived ``no_robot_warning`` s after
-        the start: otherwise a wrong endpoint would look like a quiet robot."""
+        the start: otherwise a wrong endpoint would look like a quiet robot. A robot whose
+        samples arrive in another payload version is reported as such, at once."""
         if self.robot_seen:
             return
         if self.frames_processed or self.driver.joint_state() is not None:
             self.robot_seen = True
+            return
+        foreign = self.driver.foreign_versions()
+        if foreign and not self._version_warned:
+            self._version_warned = True
+            versions = sorted({repr(v) for v in foreign.values()})
+            text = (
+                f"a robot is on the bus but speaks payload version {', '.join(versions)} on "
+                f"{', '.join(sorted(foreign))} (this engine speaks {PAYLOAD_VERSION}): its "
+                "samples are dropped; run the same gazebot version on both sides"
+            )
+            self._warn("payload_version_mismatch", text, keys=sorted(foreign),
+                       versions=[foreign[k] for k in sorted(foreign)], expected=PAYLOAD_VERSION)
             return
         after = self.clock() - self._run_started
         if after < self.config.no_robot_warning or self.warnings:
@@ -412,8 +427,11 @@ class EngineNode:
             f"no robot seen after {after:.1f} s: no tracking or joint state received "
             f"(peers: {peers or 'none'}); is the robot running and the bus endpoint right?"
         )
+        self._warn("no_robot", text, after=after, peers=peers)
+
+    def _warn(self, kind: str, text: str, **info: Any) -> None:
         self.warnings.append(text)
-        self.emit("no_robot", after=after, peers=peers)
+        self.emit(kind, **info)
         if self.warn is not None:
             self.warn(text)
         else:

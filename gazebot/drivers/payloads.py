@@ -58,6 +58,15 @@ class PayloadError(ValueError):
         super().__init__(f"malformed {model} payload: {reason}")
 
 
+class PayloadVersionError(PayloadError):
+    """A well-formed payload of another protocol version (``version``: what it says, ``None``
+    when it is not a JSON object with a ``v``)."""
+
+    def __init__(self, model: str, version: Any):
+        self.version = version
+        super().__init__(model, f"v: payload version {version!r}, this gazebot speaks {VERSION}")
+
+
 def point_or_none(p: Any) -> Point | None:
     """``[x, y, z]`` for a finite point, ``None`` for a missing (NaN/None) one."""
     if p is None:
@@ -104,7 +113,11 @@ class Msg(BaseModel):
         try:
             msg = cls.model_validate_json(raw if isinstance(raw, str) else bytes(raw))
         except ValidationError as exc:
-            err = exc.errors()[0]
+            errors = exc.errors()
+            for err in errors:  # another version first: its other fields may differ too
+                if tuple(err["loc"]) == ("v",) and err["type"] != "missing":
+                    raise PayloadVersionError(cls.__name__, err.get("input")) from None
+            err = errors[0]
             where = ".".join(str(p) for p in err["loc"]) or "<root>"
             raise PayloadError(cls.__name__, f"{where}: {err['msg']}") from None
         # A payload from the bus must say its version; Python callers may leave the default.

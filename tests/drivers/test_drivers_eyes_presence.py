@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import time
 
 import numpy as np
 import pytest
@@ -230,3 +231,54 @@ def test_run_cli_with_unreachable_connect_warns_and_reports_it_in_json(capsys):
     assert summary["robot_seen"] is False and summary["peers"] == {}
     assert len(summary["warnings"]) == 1 and "no robot seen" in summary["warnings"][0]
     assert "gazebot run: warning: no robot seen" in captured.err and nowhere in captured.err
+
+
+# -- another payload version ---------------------------------------------------------------
+def test_a_payload_of_another_version_is_told_apart_from_a_malformed_one():
+    from gazebot.drivers.payloads import PayloadVersionError
+
+    with pytest.raises(PayloadVersionError, match="payload version 2") as info:
+        TrackingMsg.decode(b'{"v":2,"seq":0,"t":0.0,"stamp":0.0,"hand":[1,2,3]}')
+    assert info.value.version == 2
+    with pytest.raises(PayloadError) as info:
+        TrackingMsg.decode(b'{"seq":0,"t":0.0,"stamp":0.0}')
+    assert not isinstance(info.value, PayloadVersionError)
+
+
+class OtherVersionRobot(MemoryDriver):
+    def foreign_versions(self):
+        return {"gazebot/sim/tracking": 2}
+
+
+def test_a_robot_speaking_another_payload_version_is_reported_as_such_at_once():
+    clock = Clock()
+    drv = OtherVersionRobot()
+    warnings: list[str] = []
+    cfg = EngineNodeConfig(no_robot_warning=3.0, resync=False)
+    node = EngineNode(GazeLoop(FakeEngine()), drv, cfg, warn=warnings.append, clock=clock)
+    node.start()
+    for now in (0.1, 0.2, 5.0, 9.0):
+        clock.now = now
+        node.tick()
+    assert len(warnings) == 1
+    assert "payload version 2 on gazebot/sim/tracking" in warnings[0]
+    assert "no robot seen" not in warnings[0]
+    [event] = [e for e in drv.events if e.kind == "payload_version_mismatch"]
+    assert event.info["versions"] == [2] and event.info["expected"] == 1
+    assert not [e for e in drv.events if e.kind == "no_robot"]
+
+
+@pytest.mark.zenoh
+def test_zenoh_driver_remembers_the_version_a_robot_spoke(bus):
+    from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+
+    drv = ZenohRobotDriver(bus.connector(), bus.config().keys)
+    bus.closers.append(drv.close)
+    robot = bus.listener()
+    key = bus.config().keys.tracking
+    deadline = time.monotonic() + 30
+    while not drv.foreign_versions():
+        robot.put(key, b'{"v":3,"seq":0,"t":0.0,"stamp":0.0}')
+        assert time.monotonic() < deadline
+        time.sleep(0.02)
+    assert drv.foreign_versions() == {key: 3} and drv.dropped()[key] >= 1
