@@ -104,8 +104,8 @@ def handle(args: argparse.Namespace) -> int:
                                       name="engine-node", daemon=True)
             thread.start()
             # Start the handover once the engine listens (and has taken the head pose).
-            if not engine_node.ready.wait(10.0):
-                raise UsageError("the in-process engine node did not start within 10 s")
+            if not engine_node.ready.wait(60.0):
+                raise TimeoutError("the in-process engine node did not start within 60 s")
         print(
             f"gazebot sim: robot {sim.robot.name} scene {args.scene} on gazebot/{cfg.robot_id}/ "
             f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})"

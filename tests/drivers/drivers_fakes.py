@@ -23,8 +23,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def wait_until(pred: Callable[[], object], timeout: float = 3.0, poll: float = 0.005) -> bool:
-    """Poll ``pred`` until it is truthy or ``timeout`` s passed; returns its last truthiness."""
+def wait_until(pred: Callable[[], object], timeout: float = 30.0, poll: float = 0.005) -> bool:
+    """Poll ``pred`` until it is truthy or ``timeout`` s passed; returns its last truthiness.
+
+    The deadline is generous on purpose: it only bounds a failing test, and a busy 2-core CI
+    machine can stall a thread for seconds."""
     end = time.monotonic() + timeout
     while True:
         if pred():
@@ -47,6 +50,16 @@ class FakeGaze:
             pan = float(np.clip(math.atan2(point[1], point[0]), -PAN_LIMIT, PAN_LIMIT))
             self.head = {"head_pan": pan}
         return SimpleNamespace(head=dict(self.head), eye_yaw=0.0, eye_pitch=0.0, residual=0.0)
+
+
+class FakeClock:
+    """A monotonic clock the test moves by hand (peer timeouts without wall-clock races)."""
+
+    def __init__(self, now: float = 0.0) -> None:
+        self.now = now
+
+    def __call__(self) -> float:
+        return self.now
 
 
 class FakeEyes:

@@ -132,6 +132,9 @@ def test_display_records_30_frames_a_second_of_sim_with_engine_and_pupils_follow
                 bus.endpoint, "--duration", "9", "--seed", "1"]
     sim_thread = threading.Thread(target=main, args=(sim_args,), daemon=True)
     sim_thread.start()
+    # The display starts once the engine speaks (a loaded machine may take a while to start
+    # the simulation): all six seconds then show a running handover.
+    assert wait_until(lambda: sent, timeout=60)
     out = tmp_path / "out.mp4"
     rc = main(["display", "--robot", "sawyer", "--id", bus.robot_id, "--connect", bus.endpoint,
                "--duration", "6", "--record", str(out), "--json"])

@@ -104,13 +104,14 @@ def test_recorded_handover_gives_the_same_commands_in_process_and_over_zenoh(
         for event in events:
             ep.publish_robot_event(event)
         seen_events += len(events)
-        wait(lambda: len([m for m in drv.history() if m.source == "sim"]) >= seen_events,
+        n, t = seen_events, frame.t
+        wait(lambda n=n: len([m for m in drv.history() if m.source == "sim"]) >= n,
              f"robot events of sample {i}")
-        ep.publish_joint_state(frame.t, joints)
-        wait(lambda: (js := drv.joint_state()) is not None and js.t == frame.t,
+        ep.publish_joint_state(t, joints)
+        wait(lambda t=t: (js := drv.joint_state()) is not None and js.t == t,
              f"joint state of sample {i}")
         msg = ep.publish_tracking(frame)
-        wait(lambda: len(heads) > i and len(eyes) > i, f"no answer to sample {i}")
+        wait(lambda i=i: len(heads) > i and len(eyes) > i, f"no answer to sample {i}")
         assert heads[i].answers == msg.seq
     got = [
         _key(h.head, e.yaw, e.pitch, e.blink, e.distance, h.target, h.phase)
