@@ -73,14 +73,18 @@ class LoopCommand:
     events: tuple[Event, ...] = ()
 
 
-def _direction_change(prev: np.ndarray | None, cur: np.ndarray | None) -> float:
+def _direction_change(prev: tuple[float, float, float] | None,
+                      cur: tuple[float, float, float] | None) -> float:
     """Angle (rad) between two gaze directions; 0 when either is unknown or degenerate."""
     if prev is None or cur is None:
         return 0.0
-    a, b = float(np.linalg.norm(prev)), float(np.linalg.norm(cur))
+    # Plain floats: this runs every tick, where numpy's per-call overhead would dominate.
+    a = math.sqrt(prev[0] * prev[0] + prev[1] * prev[1] + prev[2] * prev[2])
+    b = math.sqrt(cur[0] * cur[0] + cur[1] * cur[1] + cur[2] * cur[2])
     if a < 1e-9 or b < 1e-9:
         return 0.0
-    return float(np.arccos(np.clip(prev.dot(cur) / (a * b), -1.0, 1.0)))
+    c = (prev[0] * cur[0] + prev[1] * cur[1] + prev[2] * cur[2]) / (a * b)
+    return math.acos(min(max(c, -1.0), 1.0))
 
 
 class GazeLoop:
@@ -89,7 +93,7 @@ class GazeLoop:
     Args:
         engine: A :class:`gazebot.engine.GazeEngine` (``step``, ``notify``, ``reset``, ``resync``,
             ``tracking_state``, and ``robot`` with ``head_joints``, ``lower``, ``upper``,
-            ``eyes.clip``, ``head_vector`` and ``gaze_pose``).
+            ``rest``, ``eyes.clip`` and ``gaze_frame_lists``).
         blink: The blink model; ``None`` for ``BlinkModel(seed)``.
         seed: Seed of the default blink model.
     """
@@ -100,8 +104,13 @@ class GazeLoop:
         self.unsafe = 0  # commands refused for non-finite values
         self.clipped = 0  # commands brought into the joint or eye limits
         self.ticks = 0
-        self._prev_dir: np.ndarray | None = None
+        self._prev_dir: tuple[float, float, float] | None = None
         self._t = -math.inf
+        robot = engine.robot
+        self._limits = [(str(n), float(lo), float(hi))
+                        for n, lo, hi in zip(robot.head_joints, robot.lower, robot.upper,
+                                             strict=True)]
+        self._rest = [float(r) for r in robot.rest]
 
     @classmethod
     def from_config(
@@ -172,14 +181,15 @@ class GazeLoop:
         yaw, pitch, eyes_clipped = robot.eyes.clip(cmd.eye_yaw, cmd.eye_pitch)
         if clipped or eyes_clipped:
             self.clipped += 1
-        origin = robot.gaze_pose(robot.head_vector(self._display_pose(head, joints))).position
+        rows = robot.gaze_frame_lists(self._display_pose(head, joints))
         direction = None
         distance = None
         if is_valid_point(cmd.target_point):
-            direction = np.asarray(cmd.target_point, float) - origin
-            d = float(np.linalg.norm(direction))
+            x, y, z = cmd.target_point.tolist()
+            direction = (x - rows[0][3], y - rows[1][3], z - rows[2][3])
+            d = math.sqrt(direction[0] ** 2 + direction[1] ** 2 + direction[2] ** 2)
             # A target at the display itself has no defined vergence: unknown.
-            distance = d if math.isfinite(d) and d > 1e-3 else None
+            distance = d if d > 1e-3 else None
         # Blink times never go back (the engine's t never does either).
         t = self._t = max(cmd.t, self._t)
         shift = _direction_change(self._prev_dir, direction)
@@ -204,25 +214,28 @@ class GazeLoop:
 
     def _display_pose(
         self, head: dict[str, float], joints: Mapping[str, float] | None
-    ) -> dict[str, float]:
-        """The measured head joints when all are known and finite, else the commanded ones."""
+    ) -> list[float]:
+        """Head vector where the display is: the measured head joints when all are known and
+        finite, else the commanded (safe) ones."""
         if joints:
-            measured = {n: joints.get(n, math.nan) for n in self.robot.head_joints}
-            if all(math.isfinite(v) for v in measured.values()):
-                return measured
-        return head
+            measured = [joints.get(n, math.nan) for n, _, _ in self._limits]
+            if all(math.isfinite(v) for v in measured):
+                return [min(max(v, lo), hi)
+                        for v, (_, lo, hi) in zip(measured, self._limits, strict=True)]
+        return [head.get(n, r) for (n, _, _), r in zip(self._limits, self._rest, strict=True)]
 
     def _safe_head(self, head: Mapping[str, float]) -> tuple[dict[str, float], bool]:
-        robot = self.robot
+        """``head`` clipped into the joint limits, and whether anything was clipped."""
+        unknown = set(head).difference(n for n, _, _ in self._limits)
+        if unknown:
+            raise ValueError(f"engine commanded unknown head joints {sorted(unknown)}")
         out: dict[str, float] = {}
         clipped = False
-        for name, lo, hi in zip(robot.head_joints, robot.lower, robot.upper, strict=True):
+        for name, lo, hi in self._limits:
             if name not in head:
                 continue
             q = float(head[name])
-            x = min(max(q, float(lo)), float(hi))
+            x = min(max(q, lo), hi)
             clipped = clipped or x != q
             out[name] = x
-        if set(head) - set(out):
-            raise ValueError(f"engine commanded unknown head joints {sorted(set(head) - set(out))}")
         return out, clipped

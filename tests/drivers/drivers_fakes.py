@@ -74,16 +74,14 @@ class FakeRobot:
     head_joints = ["head_pan"]
     lower = np.array([-PAN_LIMIT])
     upper = np.array([PAN_LIMIT])
+    rest = np.array([0.0])
     eyes = FakeEyes()
 
     def __init__(self) -> None:
         self.points = {"face": np.array([1.0, 0.0, 1.5])}
 
-    def head_vector(self, head: dict) -> np.ndarray:
-        return np.array([head.get("head_pan", 0.0)])
-
-    def gaze_pose(self, q: np.ndarray) -> SimpleNamespace:
-        return SimpleNamespace(position=np.array([0.0, 0.0, 1.5]))
+    def gaze_frame_lists(self, q) -> list[list[float]]:
+        return [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.5]]
 
 
 class FakeEngine:
