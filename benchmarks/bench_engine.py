@@ -13,8 +13,8 @@ import numpy as np
 
 from benchmarks.common import Result, median_time
 from gazebot import GazeEngine
-from gazebot.runtime import GazeLoop
 from gazebot.phases.synthetic import SyntheticOptions, generate
+from gazebot.runtime import GazeLoop
 
 
 def _hand_written_peer(frames):

@@ -104,6 +104,43 @@ def _jpeg(path: Path, width: int, height: int) -> Callable[[], None]:
     return frames
 
 
+def _head_screen(poses) -> Result:
+    """One ``gazebot display`` frame, headless: animator + OpenCV eyes + blit + status line +
+    flip (no bus, no pacing), against the same with the eyes drawn by pygame."""
+    from types import SimpleNamespace
+
+    from benchmarks.eyes_pygame_peer import PygameEyeRenderer
+    from gazebot.render.head_display import EyeAnimator, HeadScreen, status_text
+
+    screen = HeadScreen(EyeRenderer.for_robot("sawyer"))
+    pg = PygameEyeRenderer.for_robot("sawyer")
+    anim = EyeAnimator()
+    clock = {"t": 0.0}
+    states = [SimpleNamespace(yaw=y, pitch=p, blink=b, distance=d) for y, p, b, d in poses]
+
+    def ours() -> None:
+        for st in states:
+            clock["t"] += 1 / 60
+            pose = anim.update(clock["t"], st, 0.01)
+            screen.show(pose, status_text("sawyer", "gazebot/sim/eyes", pose, 0.01))
+
+    def peer() -> None:
+        for st in states:
+            clock["t"] += 1 / 60
+            pose = anim.update(clock["t"], st, 0.01)
+            pg.draw(screen.screen, pose.yaw, pose.pitch, pose.blink, pose.distance)
+            text = screen._font.render(status_text("sawyer", "k", pose, 0.01), True, (0, 0, 0))
+            screen.screen.blit(text, (8, 570))
+            screen.pg.display.flip()
+
+    try:
+        o, p = _paired_fps(ours, peer, len(states))
+    finally:
+        screen.close()
+    return Result("gazebot display frame, headless 1024x600 (sawyer): OpenCV eyes", o, p,
+                  "frames/s", "the same frame with pygame-ce eyes", higher_is_better=True)
+
+
 def run() -> list[Result]:
     threads = cv2.getNumThreads()
     cv2.setNumThreads(1)
@@ -133,6 +170,7 @@ def _run() -> list[Result]:
         results.append(Result(f"eyes into an RGB array {label}: OpenCV", ours, peer,
                               "frames/s", "pygame-ce drawing + tobytes",
                               higher_is_better=True))
+    results.append(_head_screen(poses))
     with tempfile.TemporaryDirectory() as tmp:
         hd = Path(tmp) / "eyes_1280x720.jpg"
         img = EyeRenderer(1280, 720, "sawyer").render(0.2, 0.1)
