@@ -96,7 +96,11 @@ _EVENT_SOURCES = {
 }
 # Phase moves within one handover: the gaze carries over (all others start a new handover or
 # end it).
-_CARRY = {(Phase.REACH, Phase.TRANSFER), (Phase.REACH, Phase.RETREAT), (Phase.TRANSFER, Phase.RETREAT)}
+_CARRY = {
+    (Phase.REACH, Phase.TRANSFER),
+    (Phase.REACH, Phase.RETREAT),
+    (Phase.TRANSFER, Phase.RETREAT),
+}
 # Robot motions whose planned duration estimates the end of a phase.
 _ROBOT_MOTION = {
     Phase.REACH: EventKind.ROBOT_REACH_STARTED,
@@ -226,12 +230,22 @@ def machine_definition(spec: BehaviorSpec) -> dict[str, Any]:
         )
     hold = f"held {spec.tracking_lost.hold_s:g} s"
     transitions += [
-        {"trigger": EventKind.TRACKING_LOST.value, "source": f"{_TRACKING}_ok",
-         "dest": f"{_TRACKING}_hold"},
-        {"trigger": "timer", "source": f"{_TRACKING}_hold", "dest": f"{_TRACKING}_lost",
-         "conditions": [hold]},
-        {"trigger": EventKind.TRACKING_RESTORED.value, "source": [f"{_TRACKING}_hold",
-         f"{_TRACKING}_lost"], "dest": f"{_TRACKING}_ok"},
+        {
+            "trigger": EventKind.TRACKING_LOST.value,
+            "source": f"{_TRACKING}_ok",
+            "dest": f"{_TRACKING}_hold",
+        },
+        {
+            "trigger": "timer",
+            "source": f"{_TRACKING}_hold",
+            "dest": f"{_TRACKING}_lost",
+            "conditions": [hold],
+        },
+        {
+            "trigger": EventKind.TRACKING_RESTORED.value,
+            "source": [f"{_TRACKING}_hold", f"{_TRACKING}_lost"],
+            "dest": f"{_TRACKING}_ok",
+        },
     ]
     return {"states": states, "transitions": transitions, "initial": _ROOT}
 
@@ -345,8 +359,9 @@ class BehaviorMachine:
         self._held: GazeTarget | None = None
         self._last_target: GazeTarget | None = None
         self._known: dict[str, np.ndarray] = {}
-        self._machine.set_state([f"{_HANDOVER}_idle_{_state_name(self.spec.before)}",
-                                 f"{_TRACKING}_ok"])
+        self._machine.set_state(
+            [f"{_HANDOVER}_idle_{_state_name(self.spec.before)}", f"{_TRACKING}_ok"]
+        )
 
     def _draw_plan(self) -> dict[Phase, list[Segment]]:
         """The segments of the next handover (drawn from the data model for ``human``)."""
@@ -375,7 +390,11 @@ class BehaviorMachine:
         """Every value :attr:`state` can take."""
         out = []
         for phase, gaze in self._leaf.values():
-            out += [f"{phase.value}_{gaze}", f"{phase.value}_{gaze}_hold", f"{phase.value}_{gaze}_lost"]
+            out += [
+                f"{phase.value}_{gaze}",
+                f"{phase.value}_{gaze}_hold",
+                f"{phase.value}_{gaze}_lost",
+            ]
         return out
 
     @property
