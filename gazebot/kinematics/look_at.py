@@ -268,8 +268,6 @@ def solve_ik_raw(
     stepped = False  # the looser tracking stop applies only after a step
     # Only the pose is needed to test convergence; the Jacobian is computed for the steps (a
     # warm start on a slowly moving target converges in one step: one Jacobian, two poses).
-    # ``current``: robot.data holds the kinematics of ``qs`` (else the Jacobian recomputes them).
-    current = frame is None
     if frame is None:
         frame = robot.gaze_frame_lists(qs)
         rows = None
@@ -288,7 +286,7 @@ def solve_ik_raw(
         if stepped and cos >= cos_loose:
             break
         if rows is None:
-            rows = robot.gaze_jacobian_rows(None if current else qs)
+            rows = robot.gaze_jacobian_rows(qs)
         e0, e1, r0, r1 = _pointing_error(frame, (px, py, pz), rows, target)
         if not nudged and e0 * e0 + e1 * e1 > 2.0:
             g2 = sum((a * e0 + b * e1) ** 2 for a, b in zip(r0, r1, strict=True))
@@ -301,7 +299,7 @@ def solve_ik_raw(
                         nudged = True
                         break
                 if nudged:
-                    frame, rows, current = robot.gaze_frame_lists(qs), None, True
+                    frame, rows = robot.gaze_frame_lists(qs), None
                     continue
         # The active set below only matters when some joint is at a limit.
         at_limit = False
@@ -390,7 +388,7 @@ def solve_ik_raw(
             break
         qs = q_new
         stepped = True
-        frame, rows, current = robot.gaze_frame_lists(qs), None, True
+        frame, rows = robot.gaze_frame_lists(qs), None
 
     (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = frame
     dx, dy, dz = tx - px, ty - py, tz - pz
@@ -402,7 +400,7 @@ def solve_ik_raw(
     residual = angle_between((1.0, 0.0, 0.0), local)
     reached = residual <= tol
     if jacobian and rows is None:
-        rows = robot.gaze_jacobian_rows(None if current else qs)
+        rows = robot.gaze_jacobian_rows(qs)
     return RawSolution(
         qs,
         True,

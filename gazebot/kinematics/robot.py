@@ -130,6 +130,8 @@ class RobotModel:
         contiguous = self.head_idx.tolist() == list(range(first, first + len(self.head_idx)))
         self._head_sel = slice(first, first + len(self.head_idx)) if contiguous else self.head_idx
         self._arm_revision = 0
+        # (head vector, arm revision) whose forward kinematics :attr:`data` holds, or None.
+        self._kinematics_of: tuple[tuple[float, ...], int] | None = None
 
     @classmethod
     def load(cls, name_or_yaml: str | Path | RobotConfig = "sawyer") -> RobotModel:
@@ -223,6 +225,7 @@ class RobotModel:
     # --- kinematics ---------------------------------------------------------------------------
     def gaze_pose(self, q_head: np.ndarray) -> GazePose:
         """Pose of the gaze frame for head vector ``q_head``."""
+        self._kinematics_of = None
         pin.forwardKinematics(self.model, self.data, self.configuration(q_head))
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
         return GazePose(M.translation.copy(), M.rotation.copy())
@@ -232,25 +235,30 @@ class RobotModel:
         R_i2, p_i]`` (rotation columns = x, y, z; origin ``p``).
 
         The hot paths (look-at solver, gaze controller) use lists: with 3-vectors and <= 4 joints,
-        numpy's per-call overhead would dominate. Also leaves :attr:`data` at this configuration
-        for :meth:`gaze_jacobian_rows`.
+        numpy's per-call overhead would dominate.
         """
         q = self._q_work
         q[self._head_sel] = q_head
         pin.forwardKinematics(self.model, self.data, q)
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
+        self._kinematics_of = (tuple(q_head), self._arm_revision)
         return M.homogeneous[:3].tolist()
 
-    def gaze_jacobian_rows(self, q_head: Sequence[float] | None = None) -> list[list[float]]:
+    def gaze_jacobian_rows(self, q_head: Sequence[float]) -> list[list[float]]:
         """The 6 rows (linear, angular; LOCAL_WORLD_ALIGNED) of the gaze frame Jacobian over the
-        head joints at ``q_head``; ``None``: at the configuration of the last
-        :meth:`gaze_frame_lists` call (reuses its forward kinematics)."""
-        if q_head is None:
+        head joints at ``q_head``.
+
+        When :attr:`data` already holds the forward kinematics of ``q_head`` (the last call was
+        :meth:`gaze_frame_lists` at the same head vector and arm pose) they are reused; any other
+        call order recomputes them, so results never depend on which call came before.
+        """
+        if self._kinematics_of == (tuple(q_head), self._arm_revision):
             pin.computeJointJacobians(self.model, self.data)
         else:
             q = self._q_work
             q[self._head_sel] = q_head
             pin.computeJointJacobians(self.model, self.data, q)
+            self._kinematics_of = (tuple(q_head), self._arm_revision)
         J = pin.getFrameJacobian(self.model, self.data, self.gaze_frame_id, pin.LOCAL_WORLD_ALIGNED)
         return J[:, self._head_sel].tolist()
 
@@ -258,6 +266,7 @@ class RobotModel:
         """Gaze pose and its frame Jacobian (6 x n_head) in LOCAL_WORLD_ALIGNED: linear velocity
         of the gaze origin then angular velocity, both in base-frame axes."""
         q = self.configuration(q_head)
+        self._kinematics_of = None
         # computeJointJacobians runs the forward kinematics too (data.oMi), so the frame placement
         # and its Jacobian come from the same configuration.
         pin.computeJointJacobians(self.model, self.data, q)
