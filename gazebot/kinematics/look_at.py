@@ -271,8 +271,13 @@ def solve_ik_raw(
     if frame is None:
         frame = robot.gaze_frame_lists(qs)
         rows = None
+    # A head that holds still (eyes-only gaze mode, or no head joints) takes no step: the eyes do
+    # all the pointing from where it is.
+    max_iterations = cfg.max_iterations if n and robot.head_moves else 0
+    if not max_iterations:
+        converged = stalled = True
     # Plain-Python floats on purpose: with n <= 4 joints numpy's per-call overhead would dominate.
-    for iterations in range(1, cfg.max_iterations + 1):  # noqa: B007 (reported afterwards)
+    for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported afterwards)
         (r00, _, _, px), (r10, _, _, py), (r20, _, _, pz) = frame
         dx, dy, dz = tx - px, ty - py, tz - pz
         dist = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -392,6 +397,9 @@ def solve_ik_raw(
 
     (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = frame
     dx, dy, dz = tx - px, ty - py, tz - pz
+    if not max_iterations and math.sqrt(dx * dx + dy * dy + dz * dz) < cfg.min_distance:
+        nan = math.nan
+        return RawSolution(qs, False, (nan, nan, nan), nan, 0, False, False, False)
     local = (
         r00 * dx + r10 * dy + r20 * dz,
         r01 * dx + r11 * dy + r21 * dz,
@@ -470,6 +478,9 @@ def solve_ik(
     message = ""
     if clamped:
         message = f"head joint limit reached ({', '.join(limited)}); the eyes take the rest"
+    elif not reached and not robot.head_moves:
+        why = "no head joints" if not robot.head_joints else f"gaze mode {robot.gaze_mode}"
+        message = f"the head holds still ({why}); the eyes take the rest"
     elif not reached and stalled:
         message = "the head cannot turn closer (missing degrees of freedom); the eyes take the rest"
     elif not converged:

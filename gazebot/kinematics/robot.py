@@ -56,7 +56,11 @@ class RobotModel:
         head_bounds: ``(lower, upper, rest)`` as lists of floats (read-only arrays above).
         eye_yaw_range, eye_pitch_range: Eye ranges (rad) as ``(min, max)``.
         eye_velocity_limit: Eye speed limit (rad/s).
-        eyes: The display eyes (range and speed) as a :class:`DisplayEyes`.
+        eyes: The display eyes (range and speed) as a :class:`DisplayEyes`; in ``head-only``
+            mode their range is zero (fixed eyes).
+        gaze_mode: ``head-and-eyes``, ``head-only`` or ``eyes-only`` (from the YAML).
+        head_moves: Whether the look-at solver may turn the head (``False`` in ``eyes-only``
+            mode or without head joints: the head holds still).
         gaze_frame_id: Pinocchio frame id of the ``gaze`` site.
         points: Default points (face, handover_location, rest, ...) as (3,) arrays.
         arm_joints: Arm joint names; ``arm_home``/``arm_handover``: poses (rad) by joint.
@@ -112,8 +116,17 @@ class RobotModel:
         for arr in (self.lower, self.upper, self.rest):
             arr.flags.writeable = False
         self.head_bounds = (self.lower.tolist(), self.upper.tolist(), self.rest.tolist())
-        self.eye_yaw_range = tuple(math.radians(v) for v in config.eyes.yaw_range_deg)
-        self.eye_pitch_range = tuple(math.radians(v) for v in config.eyes.pitch_range_deg)
+        self.gaze_mode = config.gaze_mode
+        self.head_moves = bool(self.head_joints) and self.gaze_mode != "eyes-only"
+        fixed_eyes = self.gaze_mode == "head-only"
+        self.eye_yaw_range = (
+            (0.0, 0.0) if fixed_eyes else tuple(math.radians(v) for v in config.eyes.yaw_range_deg)
+        )
+        self.eye_pitch_range = (
+            (0.0, 0.0)
+            if fixed_eyes
+            else tuple(math.radians(v) for v in config.eyes.pitch_range_deg)
+        )
         self.eye_velocity_limit = math.radians(config.eyes.velocity_limit_deg_s)
         self.eyes = DisplayEyes(self.eye_yaw_range, self.eye_pitch_range, self.eye_velocity_limit)
         self.points = {k: np.asarray(v, dtype=float) for k, v in config.points.items()}
