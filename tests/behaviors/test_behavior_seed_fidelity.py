@@ -4,7 +4,6 @@ each is its own behavior (no two give the same target timeline) and shifts when 
 from __future__ import annotations
 
 import itertools
-import math
 from dataclasses import dataclass
 
 import numpy as np
