@@ -60,6 +60,7 @@ used, then the face, then ``rest``; the point is NaN only if none was ever known
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -135,16 +136,15 @@ def _gaze_targets(spec: BehaviorSpec) -> list[str]:
     return ordered
 
 
-def _describe(at: AtFraction | AtEvent | AtNever, phase: Phase) -> str:
+def _describe(at: AtFraction | AtEvent, phase: Phase) -> str:
     if isinstance(at, AtFraction):
         return f"{at.fraction:g} of the {phase.value}"
-    if isinstance(at, AtEvent):
-        return at.after.value + (f" + {at.delay:g} s" if at.delay else "")
-    return "never"
+    return at.after.value + (f" + {at.delay:g} s" if at.delay else "")
 
 
 def _slots(spec: BehaviorSpec) -> dict[Phase, list[tuple[int, str, str]]]:
-    """Per phase, every ``(segment index, target, condition label)`` a handover can have."""
+    """Per phase, every ``(segment index, target, label)`` that can start in a handover
+    (``never`` segments cannot)."""
     out: dict[Phase, list[tuple[int, str, str]]] = {p: [] for p in SEGMENT_PHASES}
     if spec.human is not None:
         for phase in SEGMENT_PHASES:
@@ -153,20 +153,38 @@ def _slots(spec: BehaviorSpec) -> dict[Phase, list[tuple[int, str, str]]]:
                 for i, target in enumerate(getattr(pattern, phase.value)):
                     if (i, target) not in seen:
                         seen.add((i, target))
-                        when = "start" if i == 0 else f"drawn shift {i}"
-                        out[phase].append((i, target, f"{phase.value} {when} -> {target}"))
+                        out[phase].append((i, target, "start" if i == 0 else f"drawn shift {i}"))
         return out
     for phase in SEGMENT_PHASES:
         segs = [s for s in spec.segments if s.phase == phase.value]
         for i, seg in enumerate(segs):
-            when = _describe(spec.resolve(seg), phase)
-            out[phase].append((i, seg.target, f"#{i} at {when}"))
+            at = spec.resolve(seg)
+            if not isinstance(at, AtNever):
+                out[phase].append((i, seg.target, _describe(at, phase)))
     return out
 
 
-def machine_definition(spec: BehaviorSpec) -> dict[str, Any]:
+#: Builds a transition condition from its key and label: ``("segment", phase, index, target)``,
+#: ``("detector", phase)`` or ``("held",)``.
+ConditionFactory = Callable[[tuple, str], Callable[[], bool]]
+
+
+def _label_only(key: tuple, label: str) -> Callable[[], bool]:
+    """A condition that only carries its label (for drawing; never evaluated)."""
+
+    def condition() -> bool:
+        raise RuntimeError("a drawn machine is not run")
+
+    condition.__name__ = label
+    return condition
+
+
+def machine_definition(
+    spec: BehaviorSpec, condition: ConditionFactory = _label_only
+) -> dict[str, Any]:
     """The states, transitions and initial state of ``spec``'s machine (``transitions``
-    keyword arguments). Condition names are labels the runtime model resolves to callables."""
+    keyword arguments); ``condition`` builds each transition condition (a callable whose
+    ``__name__`` is the label the diagram shows)."""
     targets = _gaze_targets(spec)
     before, after = _state_name(spec.before), _state_name(spec.after)
     gaze = [_state_name(t) for t in targets]
@@ -210,13 +228,13 @@ def machine_definition(spec: BehaviorSpec) -> dict[str, Any]:
             }
         )
     for phase, slots in _slots(spec).items():
-        for _, target, label in slots:
+        for index, target, label in slots:
             transitions.append(
                 {
                     "trigger": "timer",
                     "source": leaf(phase),
                     "dest": leaf(phase, _state_name(target)),
-                    "conditions": [label],
+                    "conditions": [condition(("segment", phase, index, target), label)],
                 }
             )
     for phase in _PHASE_ORDER:
@@ -225,7 +243,7 @@ def machine_definition(spec: BehaviorSpec) -> dict[str, Any]:
                 "trigger": "detector",
                 "source": _HANDOVER,
                 "dest": leaf(phase),
-                "conditions": [f"detector in {phase.value}"],
+                "conditions": [condition(("detector", phase), f"detector in {phase.value}")],
             }
         )
     hold = f"held {spec.tracking_lost.hold_s:g} s"
@@ -239,7 +257,7 @@ def machine_definition(spec: BehaviorSpec) -> dict[str, Any]:
             "trigger": "timer",
             "source": f"{_TRACKING}_hold",
             "dest": f"{_TRACKING}_lost",
-            "conditions": [hold],
+            "conditions": [condition(("held",), hold)],
         },
         {
             "trigger": EventKind.TRACKING_RESTORED.value,
@@ -250,31 +268,29 @@ def machine_definition(spec: BehaviorSpec) -> dict[str, Any]:
     return {"states": states, "transitions": transitions, "initial": _ROOT}
 
 
-def diagram(spec: BehaviorSpec, engine: str = "mermaid") -> str:
-    """The machine of ``spec`` drawn by ``transitions``' own diagram support: Mermaid
-    ``stateDiagram-v2`` text (``engine="mermaid"``) or Graphviz dot source (``"graphviz"``,
-    needs the ``graphviz`` Python package)."""
+def diagram(spec: BehaviorSpec) -> str:
+    """The machine of ``spec`` as Mermaid ``stateDiagram-v2`` text, drawn by ``transitions``' own
+    diagram support (``HierarchicalGraphMachine`` with ``graph_engine="mermaid"``) from the same
+    :func:`machine_definition` the behavior runs on."""
     from transitions.extensions import HierarchicalGraphMachine
 
-    if engine not in ("mermaid", "graphviz"):
-        raise ValueError(f"diagram engine 'mermaid' or 'graphviz', not {engine!r}")
-    machine = HierarchicalGraphMachine(
-        model=None,
+    class Drawn:
+        """A model for the drawing only (never triggered)."""
+
+    model = Drawn()
+    HierarchicalGraphMachine(
+        model=model,
         **machine_definition(spec),
         auto_transitions=False,
-        graph_engine=engine,
+        graph_engine="mermaid",
         show_conditions=True,
         title=f"gaze behavior {spec.name}",
     )
-    graph = machine.get_graph()
-    if engine == "mermaid":
-        return str(graph.draw(None))
-    return str(graph.source)
+    return str(model.get_graph().draw(None))  # type: ignore[attr-defined]
 
 
 class _Model:
-    """The object whose ``state`` the ``transitions`` machine drives; the transition conditions
-    are attributes named by their labels."""
+    """The object whose ``state`` the ``transitions`` machine drives."""
 
     state: list[str]
 
@@ -304,13 +320,7 @@ class BehaviorMachine:
         self._firing = (Phase.IDLE, -1)  # the segment the next ``timer`` trigger may start
         self._hold_over = False
         self._detector_phase = Phase.IDLE
-        for phase, slots in _slots(spec).items():
-            for index, target, label in slots:
-                setattr(self._model, label, self._slot_condition(phase, index, target))
-        for phase in _PHASE_ORDER:
-            setattr(self._model, f"detector in {phase.value}", self._detector_condition(phase))
-        setattr(self._model, f"held {spec.tracking_lost.hold_s:g} s", lambda: self._hold_over)
-        definition = machine_definition(spec)
+        definition = machine_definition(spec, self._condition)
         self._machine = HierarchicalMachine(
             model=self._model,
             **definition,
@@ -326,16 +336,33 @@ class BehaviorMachine:
         self._tracking_leaf = {f"{_TRACKING}_{s}": s for s in _TRACKING_STATES}
         self.reset(seed)
 
-    def _slot_condition(self, phase: Phase, index: int, target: str):
-        def due() -> bool:
-            if self._firing != (phase, index):
-                return False
-            return self._active[index].segment.target == target
+    def _condition(self, key: tuple, label: str) -> Callable[[], bool]:
+        """The runtime condition of a transition (see :data:`ConditionFactory`)."""
+        if key[0] == "segment":
+            _, phase, index, target = key
 
-        return due
+            def due() -> bool:
+                # The segment the timer fires for, with this target (the drawn pattern's).
+                return (
+                    self._firing == (phase, index) and self._active[index].segment.target == target
+                )
 
-    def _detector_condition(self, phase: Phase):
-        return lambda: self._detector_phase is phase
+            condition = due
+        elif key[0] == "detector":
+            phase = key[1]
+
+            def seen() -> bool:
+                return self._detector_phase is phase
+
+            condition = seen
+        else:
+
+            def held() -> bool:
+                return self._hold_over
+
+            condition = held
+        condition.__name__ = label
+        return condition
 
     def reset(self, seed: int | None = None) -> None:
         """Forget everything (back to ``idle``), optionally with a new seed; cheaper than building
@@ -684,14 +711,11 @@ def _as3(p: object) -> np.ndarray | None:
         return None
 
 
-def write_diagram(spec: BehaviorSpec, path: Path, engine: str | None = None) -> str:
-    """Write :func:`diagram` to ``path`` (Mermaid by default; ``.dot``/``.gv`` files get
-    Graphviz); a ``.md`` file gets the Mermaid text in a fenced block. Returns the engine used."""
+def write_diagram(spec: BehaviorSpec, path: Path) -> None:
+    """Write :func:`diagram` to ``path``; a ``.md`` file gets it in a fenced ``mermaid`` block
+    (rendered by GitHub and most Markdown viewers), any other file the bare Mermaid text."""
     path = Path(path)
-    if engine is None:
-        engine = "graphviz" if path.suffix in (".dot", ".gv") else "mermaid"
-    text = diagram(spec, engine)
-    if path.suffix == ".md":
-        text = f"```mermaid\n{text.strip()}\n```\n"
+    text = diagram(spec).strip() + "\n"
+    if path.suffix.lower() == ".md":
+        text = f"```mermaid\n{text}```\n"
     path.write_text(text, encoding="utf-8")
-    return engine
