@@ -39,8 +39,8 @@ Rules for imperfect event streams (``handle`` never raises):
   the earlier of the two. Other robot events never change the phase; the latest of each kind in
   the current handover anchors ``{after: EVENT}`` segments and gives ``planned_duration``.
 - ``GazeContext.phase`` wins: when ``target(ctx)`` sees another phase than the events said, the
-  machine moves to ``ctx.phase`` (started at ``ctx.phase_start``), except back to idle while the
-  robot's reach has started the handover (the detector has not seen the giver move yet).
+  machine moves to ``ctx.phase`` (started at ``ctx.phase_start``), except back to idle or done
+  while the robot's reach has started the handover (the detector has not seen the giver move yet).
 
 "Halfway" (and any fraction of a phase) needs the phase's end online. The estimates:
 ``ctx.expected_phase_end`` (the phase detector's prediction from the giver's and the gripper's
@@ -592,8 +592,12 @@ class BehaviorMachine:
                     start = min(start, self._robot_reach_t)
                 self._phase_start = start
             return
-        if phase is Phase.IDLE and current is Phase.REACH and math.isfinite(self._robot_reach_t):
-            return  # the robot's reach started the handover; the giver has not moved yet
+        if (
+            phase in (Phase.IDLE, Phase.DONE)
+            and current is Phase.REACH
+            and math.isfinite(self._robot_reach_t)
+        ):
+            return  # the robot's reach started this handover; the giver has not moved yet
         self._run_timers(start)
         kind = _EVENT_OF_PHASE.get(phase)
         if kind is None or not self._trigger(kind.value):

@@ -315,3 +315,33 @@ def test_face_hand_face_retreat_halfway_follows_the_giver_not_the_slower_robot()
     m.handle(ev("robot_retreat_started", 2.6, planned_duration=2.4))
     assert kind(m, 2.99, E, 2.5, 3.5) == "hand"
     assert kind(m, 3.0, E, 2.5, 3.5) == "face"  # halfway of the giver's 2.5-3.5 s retreat
+
+
+def test_the_robots_reach_starts_the_reach_before_the_detector_sees_the_giver():
+    # Seed 6.3: the robot starts its reach and the giver responds; the detector still says idle
+    # (first handover) or done (the next one) until the giver moves.
+    m = machine("short-face-hand")
+    assert kind(m, 0.5, Phase.IDLE, 0.0) == "face"
+    m.handle(ev("robot_reach_started", 1.0, planned_duration=1.2))
+    assert kind(m, 1.0, Phase.IDLE, 0.0) == "hand" and m.phase is R
+    m.handle(ev("reach_started", 1.4))  # the giver's reach: the handover's reach began at 1.0
+    assert kind(m, 1.5, R, 1.4) == "hand"
+    for kind_, t in (("transfer_started", 2.3), ("retreat_started", 3.0), ("handover_done", 4.0)):
+        m.handle(ev(kind_, t))
+    assert kind(m, 5.0, D, 4.0) == "face"
+    m.handle(ev("robot_reach_started", 10.0, planned_duration=1.2))
+    assert kind(m, 10.01, D, 4.0) == "hand" and m.phase is R
+
+
+def test_the_reach_start_is_the_earlier_of_the_robots_and_the_givers():
+    m = machine("face-hand-face")
+    m.handle(ev("robot_reach_started", 1.0, planned_duration=1.0))  # robot arrives at 2.0 s
+    m.handle(ev("reach_started", 1.4))
+    # Halfway through the 1.0-2.0 s reach (not 1.4-2.0 s): 1.5 s.
+    assert kind(m, 1.49, R, 1.4, 1.9) == "face"
+    assert kind(m, 1.5, R, 1.4, 1.9) == "hand"
+    m = machine("face-hand-face")
+    m.handle(ev("reach_started", 1.0))
+    m.handle(ev("robot_reach_started", 0.8, planned_duration=1.2))  # reported late, started first
+    assert kind(m, 1.39, R, 1.0, 1.5) == "face"
+    assert kind(m, 1.4, R, 1.0, 1.5) == "hand"  # halfway through 0.8-2.0 s
