@@ -108,6 +108,7 @@ _ROBOT_MOTION = {
     Phase.RETREAT: EventKind.ROBOT_RETREAT_STARTED,
 }
 _TRACKING_STATES = ("ok", "hold", "lost")
+_TRACKING_OK, _TRACKING_HOLD = f"{_TRACKING}_ok", f"{_TRACKING}_hold"
 
 
 def _finite(x: object) -> bool:
@@ -437,7 +438,7 @@ class BehaviorMachine:
     @property
     def lost(self) -> bool:
         """True while tracking is lost."""
-        return self._model.state[1] != f"{_TRACKING}_ok"
+        return self._model.state[1] != _TRACKING_OK
 
     def handle(self, event: Event) -> None:
         """Apply one event (phase or robot); never raises (see the module docstring)."""
@@ -468,8 +469,8 @@ class BehaviorMachine:
         self._run_timers(t, ctx.expected_phase_end)
         handover, tracking = self._model.state
         lost_kind = self.spec.tracking_lost.target
-        if tracking != f"{_TRACKING}_ok":
-            if tracking == f"{_TRACKING}_hold" and self._held is not None:
+        if tracking != _TRACKING_OK:
+            if tracking == _TRACKING_HOLD and self._held is not None:
                 return self._held
             return GazeTarget(lost_kind, self._point(lost_kind, ctx))
         kind = self._target_of[self._leaf[handover][1]]
