@@ -128,3 +128,30 @@ def test_eyes_only_through_the_engine_on_a_handover():
         assert cmd.head == rest
         yaws.append(cmd.eye_yaw)
     assert np.ptp(yaws) > math.radians(2)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["demo"],
+        ["render", "video", "--behavior", "hand", "--out", "x.mp4"],
+        ["run"],
+        ["sim", "--headless"],
+    ],
+)
+def test_every_consumer_command_takes_a_gaze_mode(argv):
+    from gazebot.cli import build_parser
+
+    args = build_parser().parse_args([*argv, "--gaze-mode", "eyes-only"])
+    assert args.gaze_mode == "eyes-only"
+    robot = with_gaze_mode(args.robot, args.gaze_mode)
+    assert RobotModel.load(robot).gaze_mode == "eyes-only"
+    assert build_parser().parse_args(argv).gaze_mode is None  # default: the robot YAML's
+
+
+def test_a_bad_gaze_mode_on_the_command_line_is_a_clear_error(capsys, tmp_path):
+    from gazebot.cli import main
+
+    assert main(["demo", "--gaze-mode", "neck-only", "--out", str(tmp_path / "demo")]) == 2
+    err = capsys.readouterr().err
+    assert "head-and-eyes" in err and "neck-only" in err
