@@ -26,6 +26,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="gaze behavior name or YAML (default: %(default)s)",
     )
     parser.add_argument("--scene", default="default", help="scene name or YAML (default: default)")
+    parser.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )
     parser.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
     parser.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
@@ -84,10 +90,11 @@ def run_demo(args: argparse.Namespace) -> int:
 
 
 def _record(args: argparse.Namespace, out: Path):
+    from gazebot.kinematics.config import with_gaze_mode
     from gazebot.sim.record import record_handover
 
     return record_handover(
-        robot=args.robot,
+        robot=with_gaze_mode(args.robot, args.gaze_mode),
         behavior=args.behavior,
         scene=args.scene,
         out_path=out / "handover.mp4",
