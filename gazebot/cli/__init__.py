@@ -21,6 +21,7 @@ COMMAND_MODULES = (
     "ik",
     "render",
     "sim",
+    "reach_plan",
     "run",
     "study",
 )
