@@ -108,8 +108,13 @@ class ReachController(ABC):
         return u if n <= u_max else u * (u_max / n)
 
     def steps(self, seconds: float) -> int:
-        """Whole control steps in ``seconds`` (rounded: 2.0 s at 0.2 s is 10 steps)."""
-        return int(round(seconds / self.dt + 1e-9))
+        """Control steps in ``seconds``, rounded down (a deadline: never later than asked;
+        2.0 s at 0.2 s is 10 steps, 2.5 s is 12)."""
+        return int(math.floor(seconds / self.dt + 1e-6))
+
+    def steps_up(self, seconds: float) -> int:
+        """Control steps in ``seconds``, rounded up (a wait: never shorter than asked)."""
+        return int(math.ceil(seconds / self.dt - 1e-6))
 
 
 def integrate(x0: np.ndarray, velocities: np.ndarray, dt: float) -> np.ndarray:

@@ -124,7 +124,7 @@ class TimedMPC(ReachController):
         and to the stall time (<= 0 once passed)."""
         k = self.steps(t)
         n_reach = self.steps(self.config.reach_time_s) - k
-        n_stall = self.steps(self.stall_time_s) - k
+        n_stall = self.steps_up(self.stall_time_s) - k
         return max(self.mpc.horizon, n_reach), n_reach, n_stall
 
     def plan(self, obs: ReachObservation) -> VelocityPlan:

@@ -5,7 +5,7 @@ durations (``GiverConfig``), so every seed gives a slightly different, human-lik
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 
 import numpy as np
@@ -61,6 +61,18 @@ class SimulatedGiver:
         self._share_end = np.inf
         self.hand = self.rest.copy()
         self.released_at: float | None = None
+        self.reach_started_at: float | None = None
+
+    def respond_at(self, t: float) -> None:
+        """Start the reach at ``t`` (s) if it has not started: the giver answering a
+        robot-initiated handover (their plan's ``start_t`` is then ``inf`` until this call)."""
+        if self.state is GiverState.IDLE:
+            self.plan = replace(self.plan, start_t=float(t))
+
+    def let_go(self, t: float) -> None:
+        """End the transfer now (the robot pulls the object away right after grasping it)."""
+        if self.state is GiverState.SHARE:
+            self._share_end = min(self._share_end, float(t))
 
     @property
     def holds_object(self) -> bool:
@@ -73,6 +85,7 @@ class SimulatedGiver:
         if self.state is GiverState.IDLE and t >= p.start_t:
             self._segment = MinJerkSegment(self.rest, self.offer, p.start_t, p.reach_s)
             self.state = GiverState.REACH
+            self.reach_started_at = p.start_t
         if self.state is GiverState.REACH and self._segment is not None and self._segment.done(t):
             self.state = GiverState.OFFER
         if self.state is GiverState.OFFER and robot_grasped:

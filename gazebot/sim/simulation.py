@@ -11,21 +11,31 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from gazebot.kinematics.config import RobotConfig
+from gazebot.sim.cartesian_reach import CartesianReach
 from gazebot.sim.controller import ControllerState, HandoverController, Sensed
 from gazebot.sim.display import DisplayTexture
 from gazebot.sim.giver import GiverPlan, GiverState, SimulatedGiver
 from gazebot.sim.offscreen import OffscreenRenderer
 from gazebot.sim.robot import SimRobot, load_sim_robot
 from gazebot.sim.scene import OBSERVER, Scene, build_scene
-from gazebot.sim.scene_config import SceneConfig, TrackingNoiseConfig, load_scene
+from gazebot.sim.scene_config import (
+    ControllerConfig,
+    Initiator,
+    ReachControllerName,
+    RetreatTrigger,
+    SceneConfig,
+    TrackingNoiseConfig,
+    load_scene,
+)
 from gazebot.sim.tracking import TrackingNoise
-from gazebot.types import Event, TrackingFrame
+from gazebot.types import Event, EventKind, TrackingFrame
 
 
 def nearest_equivalent(q: np.ndarray, goal: np.ndarray, ranges: np.ndarray) -> np.ndarray:
@@ -94,8 +104,22 @@ class HandoverSimulation:
 
         rng = np.random.default_rng([self.seed, 0])
         plan = GiverPlan.draw(self.config.giver, rng)
+        self.robot_initiated = self.config.initiator is Initiator.ROBOT
+        if self.robot_initiated:
+            # The giver waits for the robot's reach (respond_at), then a reaction time.
+            plan = replace(plan, start_t=math.inf)
         self.giver = SimulatedGiver(self.layout.rest_hand, self.layout.offer_hand, plan)
-        self.controller = HandoverController(self.home, self.robot.handover, self.config.controller)
+        ctrl = self.config.controller
+        self.controller = HandoverController(
+            self.home,
+            self.robot.handover,
+            ctrl,
+            reach=self._cartesian_reach(ctrl),
+            start_at=ctrl.robot_start_s if self.robot_initiated else None,
+            target=np.asarray(self.robot.config.points["handover_location"], float)
+            if "handover_location" in self.robot.config.points
+            else None,
+        )
         self._noise = TrackingNoise(
             tracking_noise or self.config.tracking, np.random.default_rng([self.seed, 1])
         )
@@ -112,6 +136,36 @@ class HandoverSimulation:
         mujoco.mj_forward(m, self.data)
 
     # ----------------------------------------------------------------------------- helpers
+    def _cartesian_reach(self, ctrl: ControllerConfig) -> CartesianReach | None:
+        """The seed's reach controller on the arm, or None for the joint-space reach."""
+        if ctrl.reach_controller is ReachControllerName.JOINT:
+            return None
+        from gazebot.controllers import load_controllers_config, make_controller
+        from gazebot.controllers.arm_ik import ArmIK
+
+        cfg = load_controllers_config(ctrl.controllers)
+        update = {}
+        if ctrl.reach_time_s is not None:
+            update["reach_time_s"] = ctrl.reach_time_s
+        if ctrl.stall_time_s is not None:
+            update["stall_time_s"] = ctrl.stall_time_s
+        if update:
+            cfg = type(cfg).model_validate({**cfg.model_dump(), **update})
+        m = self.model
+        ranges = np.array([m.jnt_range[m.joint(j).id] for j in self.robot.arm_joints])
+        ik = ArmIK(
+            self.robot.mjcf,
+            self.robot.arm_joints,
+            self.robot.gripper_site,
+            max_joint_speed=np.deg2rad(ctrl.max_joint_speed_deg),
+            lower=np.maximum(ranges[:, 0], self._arm_lo),
+            upper=np.minimum(ranges[:, 1], self._arm_hi),
+        )
+        # The STL handover zone is centred on the robot's base: the first arm joint's body.
+        mujoco.mj_kinematics(m, self.data)
+        base = self.data.xpos[m.jnt_bodyid[m.joint(self.robot.arm_joints[0]).id]].copy()
+        return CartesianReach(make_controller(ctrl.reach_controller.value, cfg), ik, base)
+
     def _actuator(self, name: str) -> int:
         act = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
         if act < 0:
@@ -195,9 +249,13 @@ class HandoverSimulation:
             hand_object_gap=float(
                 np.linalg.norm(self.giver.hand + self.layout.object_offset - obj)
             ),
+            object_pos=obj.copy(),
         )
         cmd = self.controller.update(t, self.data.qpos[self._arm_qpos], sensed)
-        self._events.extend(self.controller.pop_events())
+        events = self.controller.pop_events()
+        for e in events:
+            self._on_robot_event(e)
+        self._events.extend(events)
         if not self._arm_external:
             self.data.ctrl[self._arm_act] = np.clip(cmd.arm, self._arm_lo, self._arm_hi)
         self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, cmd.gripper)
@@ -207,6 +265,32 @@ class HandoverSimulation:
         mujoco.mj_kinematics(self.model, self.data)
         self._place_kinematic()
         mujoco.mj_kinematics(self.model, self.data)
+
+    def _on_robot_event(self, event: Event) -> None:
+        """The giver's side of the robot's events (methods a replayed giver may lack)."""
+        if event.kind is EventKind.ROBOT_REACH_STARTED and self.robot_initiated:
+            respond = getattr(self.giver, "respond_at", None)
+            if respond is not None:
+                respond(event.t + self.config.giver.reaction_time_s)
+        if (
+            event.kind is EventKind.ROBOT_RETREAT_STARTED
+            and self.config.controller.retreat is RetreatTrigger.AFTER_GRASP
+        ):
+            let_go = getattr(self.giver, "let_go", None)
+            if let_go is not None:
+                let_go(event.t)
+
+    @property
+    def reach_start_time(self) -> float | None:
+        """The seed's reach-start time (6.4: "the difference between the start of the human
+        hand's reaching motion and the start of the robot arm's reaching motion"): the giver's
+        reach start minus the robot's (s; positive when the robot started first), None until
+        both have started."""
+        giver = getattr(self.giver, "reach_started_at", None)
+        robot = self.controller.reach_started_at
+        if giver is None or robot is None:
+            return None
+        return float(giver - robot)
 
     def tracking(self) -> TrackingFrame:
         """What a motion-capture system would report now (robot base frame, m)."""
