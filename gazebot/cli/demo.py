@@ -30,7 +30,64 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     parser.add_argument("--json", action="store_true", help="print a JSON summary to stdout")
+    parser.add_argument(
+        "--controller",
+        choices=["joint", "pv", "mcj", "mce", "stl"],
+        help="the robot's reach controller (default: the scene's; seed chapters 3-4)",
+    )
+    parser.add_argument(
+        "--reach-time", type=float, help="'Reach before', s from the handover's start"
+    )
+    parser.add_argument(
+        "--stall-time", type=float, help="'Don't move until', s from the handover's start (mce)"
+    )
+    parser.add_argument(
+        "--retreat",
+        choices=["after-release", "after-grasp"],
+        help="when the robot retreats (seed 6.3: after the release; 6.4.3: after grasping)",
+    )
     parser.set_defaults(func=run_demo)
+
+
+def scene_with_overrides(args: argparse.Namespace):
+    """The scene named by ``--scene`` with the controller options applied (validated), or the
+    scene name itself when no option is given."""
+    overrides = {
+        key: value
+        for key, value in (
+            ("reach_controller", getattr(args, "controller", None)),
+            ("reach_time_s", getattr(args, "reach_time", None)),
+            ("stall_time_s", getattr(args, "stall_time", None)),
+            ("retreat", getattr(args, "retreat", None)),
+        )
+        if value is not None
+    }
+    if not overrides:
+        return args.scene
+    from pydantic import ValidationError
+
+    from gazebot.sim.scene_config import SceneConfig, load_scene
+
+    scene = load_scene(args.scene)
+    data = scene.model_dump()
+    data["controller"].update(overrides)
+    timed = "reach_time_s" in overrides or "stall_time_s" in overrides
+    if (
+        timed
+        and str(
+            getattr(
+                data["controller"]["reach_controller"],
+                "value",
+                data["controller"]["reach_controller"],
+            )
+        )
+        == "joint"
+    ):
+        raise ValueError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+    try:
+        return SceneConfig.model_validate(data)
+    except ValidationError as exc:
+        raise ValueError(f"invalid controller options: {exc}") from exc
 
 
 def run_demo(args: argparse.Namespace) -> int:
@@ -47,6 +104,13 @@ def run_demo(args: argparse.Namespace) -> int:
     except OffscreenRenderingError as exc:
         print(f"gazebot: error: {exc}", file=sys.stderr)
         return 2
+    from gazebot.controllers import INFEASIBLE_MESSAGE
+    from gazebot.types import EventKind
+
+    infeasible = [e for e in rec.robot_events if e.kind is EventKind.ROBOT_REACH_INFEASIBLE]
+    if infeasible:
+        # The seed's failure feedback (3.2), to the user before anything else.
+        print(INFEASIBLE_MESSAGE, file=sys.stderr if args.json else sys.stdout)
     csv_path = write_timeline_csv(rec.ticks, out / "timeline.csv")
     title = f"{Path(str(args.robot)).stem} - {Path(str(args.behavior)).stem} - {args.scene}"
     png_path = plot_timeline(rec.ticks, out / "timeline.png", title=title)
@@ -63,6 +127,8 @@ def run_demo(args: argparse.Namespace) -> int:
             for p, a, b in phase_spans(rec.ticks)
         ],
         "robot_events": [e.to_json() for e in rec.robot_events],
+        "reach_infeasible": bool(infeasible),
+        "reach_start_time_s": _last_reach_start_time(rec.ticks),
         "wall_time_s": round(time.perf_counter() - t0, 2),
     }
     if args.json:
@@ -81,13 +147,21 @@ def run_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _last_reach_start_time(ticks) -> float | None:
+    """The seed's reach-start time (giver's reach start - robot's, s) once both started."""
+    import math
+
+    value = ticks[-1].reach_start_time if ticks else math.nan
+    return None if math.isnan(value) else round(value, 4)
+
+
 def _record(args: argparse.Namespace, out: Path):
     from gazebot.sim.record import record_handover
 
     return record_handover(
         robot=args.robot,
         behavior=args.behavior,
-        scene=args.scene,
+        scene=scene_with_overrides(args),
         out_path=out / "handover.mp4",
         seed=args.seed,
         width=args.width,

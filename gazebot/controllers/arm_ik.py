@@ -104,7 +104,9 @@ class ArmIK:
         J = pin.getFrameJacobian(self.model, self.data, self.frame_id, pin.LOCAL_WORLD_ALIGNED)
         J = J[:, self._vidx]
         twist = np.zeros(6)
-        twist[:3] = np.asarray(velocity, float) + self.k_pos * (np.asarray(position) - oMf.translation)
+        twist[:3] = np.asarray(velocity, float) + self.k_pos * (
+            np.asarray(position) - oMf.translation
+        )
         twist[3:] = self.k_rot * pin.log3(np.asarray(rotation) @ oMf.rotation.T)
         JJt = J @ J.T + self.damping**2 * np.eye(6)
         qdot = J.T @ np.linalg.solve(JJt, twist)

@@ -17,6 +17,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from gazebot.controllers.base import INFEASIBLE_MESSAGE
 from gazebot.kinematics.config import RobotConfig
 from gazebot.sim.cartesian_reach import CartesianReach
 from gazebot.sim.controller import ControllerState, HandoverController, Sensed
@@ -36,6 +37,29 @@ from gazebot.sim.scene_config import (
 )
 from gazebot.sim.tracking import TrackingNoise
 from gazebot.types import Event, EventKind, TrackingFrame
+
+
+def _feedback_banner(frame: np.ndarray, text: str) -> np.ndarray:
+    """``frame`` with the robot's failure feedback (seed 3.2) in a banner along the top."""
+    import cv2
+
+    out = np.ascontiguousarray(frame).copy()
+    h, w = out.shape[:2]
+    scale = max(0.35, w / 1400.0)
+    (tw, th), base = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)
+    bar = th + base + 12
+    out[:bar] = (out[:bar] * 0.35 + np.array([150, 20, 20]) * 0.65).astype(np.uint8)
+    cv2.putText(
+        out,
+        text,
+        (max(4, (w - tw) // 2), th + 6),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        scale,
+        (255, 255, 255),
+        1,
+        cv2.LINE_AA,
+    )
+    return out
 
 
 def nearest_equivalent(q: np.ndarray, goal: np.ndarray, ranges: np.ndarray) -> np.ndarray:
@@ -408,7 +432,10 @@ class HandoverSimulation:
             renderer.make_current()
             self.display.upload(renderer.context)
             renderer.texture_version[self.display.id] = self.display.version
-        return renderer.render(self.data, camera)
+        frame = renderer.render(self.data, camera)
+        if camera == OBSERVER and self.controller.infeasible_at is not None:
+            frame = _feedback_banner(frame, INFEASIBLE_MESSAGE)
+        return frame
 
     def close(self) -> None:
         """Free the GL contexts (also done when the object is garbage collected)."""
