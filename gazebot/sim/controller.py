@@ -24,6 +24,7 @@ class ControllerState(str, Enum):
     REACHING = "reaching"
     AT_HANDOVER = "at_handover"  # waiting for the object to come close
     GRASPING = "grasping"  # closing the gripper
+    RELEASING = "releasing"  # robot-to-human: opening the gripper
     HOLDING = "holding"  # grasped; waiting for the giver to let go
     RETREATING = "retreating"
     DONE = "done"
@@ -61,6 +62,11 @@ class HandoverController:
         start_at: Start the handover at this time (s) instead of on the giver's motion
             (robot-initiated handovers).
         target: The predefined handover location (m), for ``predetermined`` STL strategies.
+        giver: The robot hands the object over (robot-to-human): it starts holding it, reaches,
+            opens the gripper once the person's hand is at the object (seed 3.3.4: "The robot
+            released the vial if the human's hand was within a certain distance from the robot's
+            gripper") and retreats once it has let go. ``Sensed.object_gap`` is then the
+            distance from the object to the person's hand.
     """
 
     def __init__(
@@ -71,6 +77,7 @@ class HandoverController:
         reach: CartesianReach | None = None,
         start_at: float | None = None,
         target: np.ndarray | None = None,
+        giver: bool = False,
     ) -> None:
         self.home = np.asarray(home, float)
         self.handover = np.asarray(handover, float)
@@ -81,7 +88,8 @@ class HandoverController:
         self._segment: MinJerkSegment | None = None
         self._hand0: np.ndarray | None = None
         self._grasp_t0 = np.nan
-        self._gripper = 0.0
+        self.giver = bool(giver)
+        self._gripper = 1.0 if self.giver else 0.0
         self._events: list[Event] = []
         self.reach = reach
         self.start_at = start_at
@@ -90,6 +98,7 @@ class HandoverController:
         self.reach_started_at: float | None = None  # the robot's reach start (first motion)
         self.infeasible_at: float | None = None
         self._last_t: float | None = None
+        self._last_q = self.home.copy()
 
     def planned_duration(self, start: np.ndarray, goal: np.ndarray, minimum: float) -> float:
         """Duration of a minimum-jerk move whose fastest joint peaks at the speed limit."""
@@ -125,7 +134,7 @@ class HandoverController:
         goal = sensed.object_pos if sensed.object_pos is not None else sensed.giver_hand
         if not np.all(np.isfinite(goal)):  # lost the hand: hold still
             return self.reach.hold()
-        step = self.reach.update(t, dt, goal, target=self.target)
+        step = self.reach.update(t, dt, goal, target=self.target, robot_holds_object=self.grasped)
         if step.plan is not None and not step.plan.feasible and self.infeasible_at is None:
             self.infeasible_at = t
             self._emit(
@@ -140,11 +149,29 @@ class HandoverController:
             self._emit(EventKind.ROBOT_REACH_STARTED, t, planned_duration=max(0.0, left))
         return step.q
 
+    def _giver_transfer(self, t: float, s: ControllerState, sensed: Sensed) -> ControllerState:
+        """Robot-to-human: open the gripper once the person's hand is at the object, then
+        retreat home ("within t_9 seconds after the human has received the object")."""
+        cfg = self.config
+        if s is ControllerState.AT_HANDOVER and sensed.object_gap <= cfg.grasp_distance_m:
+            self._grasp_t0 = t
+            s = ControllerState.RELEASING
+        if s is ControllerState.RELEASING:
+            self._gripper = max(0.0, 1.0 - (t - self._grasp_t0) / cfg.gripper_close_s)
+            if self._gripper <= 0.0:
+                self._emit(EventKind.ROBOT_RELEASED, t)
+                start = self.reach.hold() if self.reach is not None else self._last_q
+                duration = self._move(t, start, self.home, cfg.retreat_min_duration_s)
+                self._emit(EventKind.ROBOT_RETREAT_STARTED, t, planned_duration=duration)
+                s = ControllerState.RETREATING
+        return s
+
     def update(self, t: float, q: np.ndarray, sensed: Sensed) -> ArmCommand:
         """Advance to time ``t`` (s) with the measured arm joints ``q`` (rad)."""
         cfg, s = self.config, self.state
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
         self._last_t = t
+        self._last_q = np.asarray(q, float)
         arm_goal: np.ndarray | None = None
         if self._hand0 is None and np.all(np.isfinite(sensed.giver_hand)):
             self._hand0 = sensed.giver_hand.copy()
@@ -169,7 +196,9 @@ class HandoverController:
         if s is ControllerState.REACHING and self._segment is not None and self._segment.done(t):
             self._emit(EventKind.ROBOT_REACH_ENDED, t)
             s = ControllerState.AT_HANDOVER
-        if s is ControllerState.AT_HANDOVER and sensed.object_gap <= cfg.grasp_distance_m:
+        if self.giver:
+            s = self._giver_transfer(t, s, sensed)
+        elif s is ControllerState.AT_HANDOVER and sensed.object_gap <= cfg.grasp_distance_m:
             self._grasp_t0 = t
             s = ControllerState.GRASPING
         if s is ControllerState.GRASPING:
@@ -177,9 +206,13 @@ class HandoverController:
             if self._gripper >= 1.0:
                 self._emit(EventKind.ROBOT_GRASPED, t)
                 s = ControllerState.HOLDING
-        retreat_now = s is ControllerState.HOLDING and (
-            cfg.retreat is RetreatTrigger.AFTER_GRASP
-            or sensed.hand_object_gap >= cfg.release_trigger_m
+        retreat_now = (
+            s is ControllerState.HOLDING
+            and not self.giver
+            and (
+                cfg.retreat is RetreatTrigger.AFTER_GRASP
+                or sensed.hand_object_gap >= cfg.release_trigger_m
+            )
         )
         if retreat_now:
             start = self.reach.hold() if self.reach is not None else q
@@ -201,6 +234,14 @@ class HandoverController:
 
     @property
     def grasped(self) -> bool:
+        """Whether the robot's gripper holds the object."""
+        if self.giver:
+            return self.state in (
+                ControllerState.WAITING,
+                ControllerState.REACHING,
+                ControllerState.AT_HANDOVER,
+                ControllerState.RELEASING,
+            )
         return self.state in (
             ControllerState.HOLDING,
             ControllerState.RETREATING,

@@ -50,9 +50,13 @@ class SimulatedGiver:
         rest: Hand position holding the object before and after the handover.
         offer: Hand position when offering the object at the handover location.
         plan: Timing of this handover.
+        cued: Wait for :meth:`respond_at` instead of starting at ``plan.start_t``
+            (robot-initiated handovers).
     """
 
-    def __init__(self, rest: np.ndarray, offer: np.ndarray, plan: GiverPlan) -> None:
+    def __init__(
+        self, rest: np.ndarray, offer: np.ndarray, plan: GiverPlan, cued: bool = False
+    ) -> None:
         self.rest = np.asarray(rest, float)
         self.offer = np.asarray(offer, float)
         self.plan = plan
@@ -62,12 +66,14 @@ class SimulatedGiver:
         self.hand = self.rest.copy()
         self.released_at: float | None = None
         self.reach_started_at: float | None = None
+        self._cued = cued
 
     def respond_at(self, t: float) -> None:
         """Start the reach at ``t`` (s) if it has not started: the giver answering a
-        robot-initiated handover (their plan's ``start_t`` is then ``inf`` until this call)."""
+        robot-initiated handover (a ``cued`` giver waits for this call)."""
         if self.state is GiverState.IDLE:
             self.plan = replace(self.plan, start_t=float(t))
+            self._cued = False
 
     def let_go(self, t: float) -> None:
         """End the transfer now (the robot pulls the object away right after grasping it)."""
@@ -82,7 +88,7 @@ class SimulatedGiver:
     def update(self, t: float, robot_grasped: bool) -> None:
         """Advance to time ``t`` (s); ``robot_grasped`` is whether the robot holds the object."""
         p = self.plan
-        if self.state is GiverState.IDLE and t >= p.start_t:
+        if self.state is GiverState.IDLE and not self._cued and t >= p.start_t:
             self._segment = MinJerkSegment(self.rest, self.offer, p.start_t, p.reach_s)
             self.state = GiverState.REACH
             self.reach_started_at = p.start_t

@@ -109,6 +109,14 @@ class Initiator(str, Enum):
     ROBOT = "robot"
 
 
+class Direction(str, Enum):
+    """Who gives: the human (human-to-robot, the gaze studies) or the robot (robot-to-human, the
+    seed's chapter 3 task: the simulated person takes the object from the robot)."""
+
+    HUMAN_TO_ROBOT = "human-to-robot"
+    ROBOT_TO_HUMAN = "robot-to-human"
+
+
 class ControllerConfig(_Strict):
     """The robot's handover controller (seed 6.3.2/6.4.3): reach once the handover starts, grasp
     when the object is close, retreat home after the giver lets go (or after grasping)."""
@@ -161,6 +169,7 @@ class SceneConfig(_Strict):
     object: ObjectKind = ObjectKind.SMALL_BOX
     table: bool | None = Field(default=None, description="None: a table when sitting")
     initiator: Initiator = Initiator.GIVER
+    direction: Direction = Direction.HUMAN_TO_ROBOT
     giver: GiverConfig = Field(default_factory=GiverConfig)
     controller: ControllerConfig = Field(default_factory=ControllerConfig)
     tracking: TrackingNoiseConfig = Field(default_factory=TrackingNoiseConfig)

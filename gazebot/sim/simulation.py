@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import replace
 from pathlib import Path
 
 import mujoco
@@ -23,11 +22,13 @@ from gazebot.sim.cartesian_reach import CartesianReach
 from gazebot.sim.controller import ControllerState, HandoverController, Sensed
 from gazebot.sim.display import DisplayTexture
 from gazebot.sim.giver import GiverPlan, GiverState, SimulatedGiver
+from gazebot.sim.receiver import ReceiverState, SimulatedReceiver
 from gazebot.sim.offscreen import OffscreenRenderer
 from gazebot.sim.robot import SimRobot, load_sim_robot
 from gazebot.sim.scene import OBSERVER, Scene, build_scene
 from gazebot.sim.scene_config import (
     ControllerConfig,
+    Direction,
     Initiator,
     ReachControllerName,
     RetreatTrigger,
@@ -129,10 +130,13 @@ class HandoverSimulation:
         rng = np.random.default_rng([self.seed, 0])
         plan = GiverPlan.draw(self.config.giver, rng)
         self.robot_initiated = self.config.initiator is Initiator.ROBOT
-        if self.robot_initiated:
-            # The giver waits for the robot's reach (respond_at), then a reaction time.
-            plan = replace(plan, start_t=math.inf)
-        self.giver = SimulatedGiver(self.layout.rest_hand, self.layout.offer_hand, plan)
+        self.robot_to_human = self.config.direction is Direction.ROBOT_TO_HUMAN
+        # A robot-initiated giver waits for the robot's reach (respond_at) plus a reaction time.
+        # ``giver`` is the simulated person: in a robot-to-human scene, the one who takes it.
+        human = SimulatedReceiver if self.robot_to_human else SimulatedGiver
+        self.giver = human(
+            self.layout.rest_hand, self.layout.offer_hand, plan, cued=self.robot_initiated
+        )
         ctrl = self.config.controller
         self.controller = HandoverController(
             self.home,
@@ -143,7 +147,10 @@ class HandoverSimulation:
             target=np.asarray(self.robot.config.points["handover_location"], float)
             if "handover_location" in self.robot.config.points
             else None,
+            giver=self.robot_to_human,
         )
+        if self.robot_to_human:
+            self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, 1.0)
         self._noise = TrackingNoise(
             tracking_noise or self.config.tracking, np.random.default_rng([self.seed, 1])
         )
@@ -154,8 +161,10 @@ class HandoverSimulation:
         self._renderers: dict[tuple[int, int], OffscreenRenderer] = {}
         self._events: list[Event] = []
         self._object_rel: tuple[np.ndarray, np.ndarray] | None = None  # object in gripper frame
+        self._object_in_hand: np.ndarray | None = None  # robot-to-human: object minus hand
         self._arm_external = False
         self._t = 0.0
+        mujoco.mj_kinematics(m, self.data)  # the gripper's pose, for an object it starts holding
         self._place_kinematic()
         mujoco.mj_forward(m, self.data)
 
@@ -169,6 +178,8 @@ class HandoverSimulation:
 
         cfg = load_controllers_config(ctrl.controllers)
         update = {}
+        if self.config.direction is Direction.ROBOT_TO_HUMAN:
+            update["stl"] = {**cfg.stl.model_dump(), "role": "giver"}  # Table 4.3's giver rows
         if ctrl.reach_time_s is not None:
             update["reach_time_s"] = ctrl.reach_time_s
         if ctrl.stall_time_s is not None:
@@ -222,6 +233,9 @@ class HandoverSimulation:
         hand = self.giver.hand
         self.scene.giver.pose_arm(self.data, hand)
         mocap = self.scene.object_mocap
+        if self.robot_to_human:
+            self._place_object_robot_giver(hand)
+            return
         if self.giver.holds_object or not self.controller.grasped:
             self.data.mocap_pos[mocap] = hand + self.layout.object_offset
             self.data.mocap_quat[mocap] = [1.0, 0.0, 0.0, 0.0]
@@ -244,6 +258,30 @@ class HandoverSimulation:
         mujoco.mju_mulQuat(quat, g_quat, rel_quat)
         self.data.mocap_quat[mocap] = quat
 
+    def _place_object_robot_giver(self, hand: np.ndarray) -> None:
+        """Robot-to-human: the object rides in the gripper until the robot lets go, then in the
+        person's hand (keeping where it was in the hand when taken)."""
+        mocap = self.scene.object_mocap
+        if not self.controller.grasped:
+            if self._object_in_hand is None:
+                self._object_in_hand = self.data.mocap_pos[mocap] - hand
+            self.data.mocap_pos[mocap] = hand + self._object_in_hand
+            return
+        g_pos, g_quat = self._gripper_pose()
+        if self._object_rel is None:  # the start: the object sits in the gripper, upright
+            inv = np.zeros(4)
+            mujoco.mju_negQuat(inv, g_quat)
+            rel_quat = np.zeros(4)
+            mujoco.mju_mulQuat(rel_quat, inv, np.array([1.0, 0.0, 0.0, 0.0]))
+            self._object_rel = (np.zeros(3), rel_quat)
+        rel_pos, rel_quat = self._object_rel
+        world = np.zeros(3)
+        mujoco.mju_rotVecQuat(world, rel_pos, g_quat)
+        self.data.mocap_pos[mocap] = g_pos + world
+        quat = np.zeros(4)
+        mujoco.mju_mulQuat(quat, g_quat, rel_quat)
+        self.data.mocap_quat[mocap] = quat
+
     # ----------------------------------------------------------------------------- state
     @property
     def t(self) -> float:
@@ -253,7 +291,8 @@ class HandoverSimulation:
     @property
     def done(self) -> bool:
         """True once the robot is back home with the object and the giver has retreated."""
-        return self.controller.state is ControllerState.DONE and self.giver.state is GiverState.DONE
+        human_done = self.giver.state in (GiverState.DONE, ReceiverState.DONE)
+        return self.controller.state is ControllerState.DONE and human_done
 
     @property
     def head_joints(self) -> tuple[str, ...]:
@@ -264,17 +303,13 @@ class HandoverSimulation:
         if not (math.isfinite(dt) and dt > 0.0):
             raise ValueError(f"step dt must be a positive number of seconds, got {dt}")
         t = self._t + dt
-        self.giver.update(t, self.controller.grasped)
         obj = self.data.mocap_pos[self.scene.object_mocap]
         gripper = self.data.site_xpos[self._gripper_site]
-        sensed = Sensed(
-            giver_hand=self.giver.hand.copy(),
-            object_gap=float(np.linalg.norm(obj - gripper)),
-            hand_object_gap=float(
-                np.linalg.norm(self.giver.hand + self.layout.object_offset - obj)
-            ),
-            object_pos=obj.copy(),
-        )
+        if self.robot_to_human:
+            sensed = self._sense_robot_giver(t, obj)
+        else:
+            self.giver.update(t, self.controller.grasped)
+            sensed = self._sense_robot_receiver(obj, gripper)
         cmd = self.controller.update(t, self.data.qpos[self._arm_qpos], sensed)
         events = self.controller.pop_events()
         for e in events:
@@ -289,6 +324,32 @@ class HandoverSimulation:
         mujoco.mj_kinematics(self.model, self.data)
         self._place_kinematic()
         mujoco.mj_kinematics(self.model, self.data)
+
+    def _sense_robot_giver(self, t: float, obj: np.ndarray) -> Sensed:
+        """Robot-to-human: the person takes the object once it is within grasp, the robot lets
+        go once the person's hand is at it; ``object_pos`` is where the object goes (in the
+        hand), ``object_gap`` how far it still is."""
+        into_hand = self.giver.hand + self.layout.object_offset
+        gap = float(np.linalg.norm(obj - into_hand))
+        released = not self.controller.grasped
+        self.giver.update(t, gap <= self.config.controller.grasp_distance_m, released)
+        into_hand = self.giver.hand + self.layout.object_offset
+        return Sensed(
+            giver_hand=self.giver.hand.copy(),
+            object_gap=float(np.linalg.norm(obj - into_hand)),
+            hand_object_gap=0.0,
+            object_pos=into_hand,
+        )
+
+    def _sense_robot_receiver(self, obj: np.ndarray, gripper: np.ndarray) -> Sensed:
+        return Sensed(
+            giver_hand=self.giver.hand.copy(),
+            object_gap=float(np.linalg.norm(obj - gripper)),
+            hand_object_gap=float(
+                np.linalg.norm(self.giver.hand + self.layout.object_offset - obj)
+            ),
+            object_pos=obj.copy(),
+        )
 
     def _on_robot_event(self, event: Event) -> None:
         """The giver's side of the robot's events (methods a replayed giver may lack)."""
@@ -317,10 +378,19 @@ class HandoverSimulation:
         return float(giver - robot)
 
     def tracking(self) -> TrackingFrame:
-        """What a motion-capture system would report now (robot base frame, m)."""
+        """What a motion-capture system would report now (robot base frame, m): the person's
+        hand and face, the gripper, and the object's taker's grip and load share (the robot's in
+        a human-to-robot scene, the person's in a robot-to-human one)."""
         noise = self._noise.apply
         grasped = self.controller.grasped
-        if not grasped:
+        if self.robot_to_human:
+            # The person is in the giver_* fields (the robot looks at their face and hand), and
+            # the grip and load share are the taker's (the person's), so the phase detector sees
+            # the usual sequence: reach, transfer while both hold, retreat once the robot let go.
+            takes = self.giver.holds_object
+            share = 0.0 if not takes else (0.5 if grasped else 1.0)
+            grasped = takes
+        elif not grasped:
             share = 0.0
         elif self.giver.holds_object:
             share = 0.5

@@ -94,3 +94,31 @@ def test_feedback_banner_marks_the_frame():
     frame = np.zeros((120, 320, 3), np.uint8)
     out = _feedback_banner(frame, "I will not be able to reach in the specified time limit")
     assert out.shape == frame.shape and out[:5].any() and not out[-20:].any()
+
+
+@pytest.mark.parametrize("controller", ["joint", "mce"])
+def test_robot_to_human_scene_the_person_takes_the_object(controller):
+    from gazebot.sim.receiver import ReceiverState
+    from gazebot.sim.simulation import HandoverSimulation
+
+    sim = HandoverSimulation(
+        robot="jaco2", scene=_scene("robot-to-human", reach_controller=controller), seed=0
+    )
+    gripper = sim.data.site(sim.robot.gripper_site)
+    obj = sim.data.mocap_pos[sim.scene.object_mocap]
+    assert np.linalg.norm(obj - gripper.xpos) < 1e-6  # starts in the robot's gripper
+    shares, events = [], []
+    while sim.t < 9.0 and not sim.done:
+        sim.step(1 / 30)
+        events += sim.robot_events()
+        shares.append(sim.tracking().load_share)
+    assert sim.done and sim.giver.state is ReceiverState.DONE
+    kinds = [e.kind for e in events]
+    assert kinds.index(EventKind.ROBOT_RELEASED) < kinds.index(EventKind.ROBOT_RETREAT_STARTED)
+    # the taker's (the person's) share: nothing, then with the robot, then alone
+    first_half = shares.index(0.5)
+    assert set(shares[:first_half]) == {0.0} and shares[-1] == 1.0
+    # the object ends in the person's hand, back at rest
+    assert np.linalg.norm(obj - (sim.giver.hand + sim.layout.object_offset)) < 0.06
+    assert np.linalg.norm(sim.giver.hand - sim.layout.rest_hand) < 1e-6
+    assert sim.reach_start_time == pytest.approx(0.3, abs=0.05)  # robot first, then the person
