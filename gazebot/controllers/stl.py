@@ -15,21 +15,19 @@ The "eventually" is encoded with one binary per future step (big-M on the l1 dis
 triggered window, including one opened in the past and not yet met, needs a near step. Windows
 that end beyond the horizon are left to later steps (as the receding-horizon synthesis of
 Raman et al. does). "If no feasible control input is found, the robot stops." Solved with HiGHS
-through cvxpy; the problem is built once and re-solved with new parameters.
+(``scipy.optimize.milp``; the matrices in :mod:`gazebot.controllers.stl_milp`).
 """
 
 from __future__ import annotations
 
 import time
 
-import cvxpy as cp
 import numpy as np
 
 from gazebot.controllers.base import ReachController, ReachObservation, VelocityPlan, integrate
 from gazebot.controllers.config import ControllersConfig, Role
 from gazebot.controllers.human_model import LinearHandModel
-
-BIG_M = 20.0  # m: bounds any l1 distance in a robot's workspace
+from gazebot.controllers.stl_milp import ReachMILP, solve_reach_milp
 
 
 class STLController(ReachController):
@@ -41,36 +39,12 @@ class STLController(ReachController):
         super().__init__(config)
         self.stl = config.stl
         self.model = LinearHandModel(config.dt_s, config.stl.history_steps)
-        self._build()
         self.reset()
 
     def reset(self) -> None:
         self.model.reset()
+        self.last_milp: ReachMILP | None = None  # the last step's problem (benchmarks, debugging)
         self._pending: int | None = None  # step the oldest unmet trigger fired
-
-    def _build(self) -> None:
-        H, dt, u_max = self.stl.horizon, self.dt, self.config.u_max_m_s
-        self._U = cp.Variable((H, 3), name="u")
-        self._b = cp.Variable(H, boolean=True, name="near")  # near at x_1..x_H
-        Au = cp.Variable((H, 3), name="abs_u")
-        D = cp.Variable((H, 3), name="abs_gap")
-        self._x0 = cp.Parameter(3, name="x0")
-        self._target = cp.Parameter((H, 3), name="target")  # at x_1..x_H
-        self._W = cp.Parameter((H + 1, H), name="windows")
-        self._r = cp.Parameter(H + 1, name="required")
-        lower = np.tril(np.ones((H, H))) * dt
-        X = np.ones((H, 1)) @ cp.reshape(self._x0, (1, 3), order="C") + lower @ self._U
-        cons = [
-            self._U <= u_max,
-            self._U >= -u_max,
-            Au >= self._U,
-            Au >= -self._U,
-            D >= X - self._target,
-            D >= self._target - X,
-            cp.sum(D, axis=1) <= self.stl.eps_p_m - self.stl.margin_m + BIG_M * (1 - self._b),
-            self._W @ self._b >= self._r,
-        ]
-        self._problem = cp.Problem(cp.Minimize(cp.sum(Au)), cons)
 
     def _triggered(self, hand: np.ndarray, holds: bool, center: np.ndarray) -> np.ndarray:
         """The strategy's trigger at each hand sample (Table 4.3 antecedents)."""
@@ -115,23 +89,22 @@ class STLController(ReachController):
             if trig[s] and s + n1 <= H:
                 W[s, s - 1 : s + n1] = 1.0  # b index j-1 is x_j
                 r[s] = 1.0
-        status = "optimal"
         U = None
+        status = "deadline_passed"
         if feasible_so_far:
-            self._x0.value = x0
-            self._target.value = target[1:]
-            self._W.value = W
-            self._r.value = r
-            try:
-                self._problem.solve(solver=cp.HIGHS, mip_rel_gap=self.stl.mip_gap)
-                status = str(self._problem.status)
-            except cp.SolverError as exc:
-                status = f"solver_error: {exc}"
-            if status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) and self._U.value is not None:
-                U = self.cap(np.asarray(self._U.value, float))
-                status = "optimal"
-        else:
-            status = "deadline_passed"
+            problem = ReachMILP(
+                x0=x0,
+                target=target[1:],
+                windows=W,
+                required=r,
+                dt=self.dt,
+                u_max=self.config.u_max_m_s,
+                eps=eps - self.stl.margin_m,
+            )
+            self.last_milp = problem
+            U, status = solve_reach_milp(problem, self.stl.mip_gap)
+            if U is not None:
+                U = self.cap(U)
         feasible = U is not None
         if U is None:
             U = np.zeros((H, 3))  # "If no feasible control input is found, the robot stops."

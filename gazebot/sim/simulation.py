@@ -22,8 +22,8 @@ from gazebot.sim.cartesian_reach import CartesianReach
 from gazebot.sim.controller import ControllerState, HandoverController, Sensed
 from gazebot.sim.display import DisplayTexture
 from gazebot.sim.giver import GiverPlan, GiverState, SimulatedGiver
-from gazebot.sim.receiver import ReceiverState, SimulatedReceiver
 from gazebot.sim.offscreen import OffscreenRenderer
+from gazebot.sim.receiver import ReceiverState, SimulatedReceiver
 from gazebot.sim.robot import SimRobot, load_sim_robot
 from gazebot.sim.scene import OBSERVER, Scene, build_scene
 from gazebot.sim.scene_config import (
