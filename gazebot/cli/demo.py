@@ -99,8 +99,11 @@ def run_demo(args: argparse.Namespace) -> int:
         raise ValueError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    from gazebot.sim.stl_monitor import HandoverMonitor
+
+    monitor = HandoverMonitor()  # the seed's Table 4.2 specs over the run (4.2.1 robustness)
     try:
-        rec = _record(args, out)
+        rec = _record(args, out, monitor)
     except OffscreenRenderingError as exc:
         print(f"gazebot: error: {exc}", file=sys.stderr)
         return 2
@@ -129,6 +132,7 @@ def run_demo(args: argparse.Namespace) -> int:
         "robot_events": [e.to_json() for e in rec.robot_events],
         "reach_infeasible": bool(infeasible),
         "reach_start_time_s": _last_reach_start_time(rec.ticks),
+        "stl_robustness": {k: round(v, 4) for k, v in monitor.robustness().items()},
         "wall_time_s": round(time.perf_counter() - t0, 2),
     }
     if args.json:
@@ -139,6 +143,8 @@ def run_demo(args: argparse.Namespace) -> int:
             f"handover {summary['duration_s']:.2f} s ({phases}), {rec.frames} frames, "
             f"{summary['wall_time_s']:.1f} s wall"
         )
+        rob = ", ".join(f"{k} {v:+.3f}" for k, v in summary["stl_robustness"].items())
+        print(f"STL robustness (Table 4.2, positive = met): {rob}")
         for path in (rec.video, csv_path, png_path):
             print(f"wrote {path}")
     if not rec.completed:
@@ -155,13 +161,14 @@ def _last_reach_start_time(ticks) -> float | None:
     return None if math.isnan(value) else round(value, 4)
 
 
-def _record(args: argparse.Namespace, out: Path):
+def _record(args: argparse.Namespace, out: Path, monitor=None):
     from gazebot.sim.record import record_handover
 
     return record_handover(
         robot=args.robot,
         behavior=args.behavior,
         scene=scene_with_overrides(args),
+        on_tick=None if monitor is None else monitor.on_tick,
         out_path=out / "handover.mp4",
         seed=args.seed,
         width=args.width,

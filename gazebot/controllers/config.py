@@ -84,6 +84,12 @@ class STLConfig(_Strict):
     delta_1: float = Field(default=0.2, ge=0, le=1, description="load share: released at or below")
     delta_2: float = Field(default=0.8, ge=0, le=1, description="load share: held above")
     mip_gap: float = Field(default=1e-4, ge=0, lt=1)
+    transfer_time_s: float = Field(
+        default=1.0, gt=0, description="t_2 / t_8: grasp (or release) this soon in the transfer"
+    )
+    retreat_time_s: float = Field(
+        default=2.5, gt=0, description="t_3 / t_9: at the drop-off (or home) this soon"
+    )
 
     @model_validator(mode="after")
     def _ordered(self) -> STLConfig:

@@ -122,3 +122,25 @@ def test_robot_to_human_scene_the_person_takes_the_object(controller):
     assert np.linalg.norm(obj - (sim.giver.hand + sim.layout.object_offset)) < 0.06
     assert np.linalg.norm(sim.giver.hand - sim.layout.rest_hand) < 1e-6
     assert sim.reach_start_time == pytest.approx(0.3, abs=0.05)  # robot first, then the person
+
+
+def _monitored(scene):
+    from gazebot.sim.simulation import HandoverSimulation
+    from gazebot.sim.stl_monitor import HandoverMonitor
+
+    sim = HandoverSimulation(robot="jaco2", scene=scene, seed=0)
+    monitor = HandoverMonitor()
+    while sim.t < 8.0 and not sim.done:
+        sim.step(1 / 30)
+        monitor.sample(sim)
+    return monitor.robustness()
+
+
+def test_stl_monitor_over_a_run_positive_when_met_negative_when_missed():
+    met = _monitored(_scene(reach_controller="mce", reach_time_s=2.5, stall_time_s=0.5))
+    assert met["reach"] > 0 and met["transfer"] > 0 and met["retreat"] > 0
+    missed = _monitored(_scene(reach_controller="mce", reach_time_s=0.3))
+    assert missed["reach"] < 0
+    # a retreat deadline shorter than the retreat move is missed too
+    late = _scene(reach_controller="mce", reach_time_s=2.5, retreat_min_duration_s=3.0)
+    assert _monitored(late)["retreat"] < 0
