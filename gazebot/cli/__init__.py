@@ -23,6 +23,7 @@ COMMAND_MODULES = (
     "ik",
     "render",
     "sim",
+    "reach_plan",
     "run",
     "display",
     "study",
