@@ -36,16 +36,35 @@ def test_fit_wins_json_reproduces_table_6_2(tmp_path, capsys, measure):
     path = _write_table(tmp_path / "w.csv", names, TABLE_6_2[measure]["wins"])
     assert run(["study", "fit-wins", str(path), "--participants", "24", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert set(doc) == {"conditions", "p", "chi2", "df", "p_value"}
+    assert set(doc) == {"conditions", "p", "chi2", "df", "p_value", "pair_totals_differ"}
+    assert doc["pair_totals_differ"] == []
     assert doc["conditions"] == names and doc["df"] == 3
     assert [round(p, 2) for p in doc["p"]] == TABLE_6_2[measure]["P"]
     assert round(doc["p_value"], 2) == TABLE_6_2[measure]["p_value"]
 
 
-def test_fit_wins_rejects_totals_that_do_not_match_participants(tmp_path):
-    path = _write_table(tmp_path / "w.csv", ["a", "b"], [[0, 10], [10, 0]])
-    with pytest.raises(ValueError, match="expected --participants 24"):
-        run(["study", "fit-wins", str(path), "--participants", "24"])
+def test_fit_wins_with_a_pair_answered_23_of_24_warns_and_uses_its_own_total(tmp_path, capsys):
+    """Like the seed's Table B.3, where one pair was answered by 23 of 24 participants."""
+    import numpy as np
+
+    from gazebot.study.bradley_terry import fit_bradley_terry
+    from gazebot.study.stats import likelihood_ratio_chi2
+
+    names = ["Face", "Hand", "L-FH", "S-FH"]
+    wins = np.array(TABLE_6_2["likability"]["wins"], dtype=float)
+    wins[0, 1] -= 1  # Face vs Hand: 14 + 9 = 23 answers
+    path = _write_table(tmp_path / "w.csv", names, wins.tolist())
+    assert run(["study", "fit-wins", str(path), "--participants", "24", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "(Face, Hand) + (Hand, Face) = 23, not --participants 24" in captured.err
+    doc = json.loads(captured.out)
+    assert doc["pair_totals_differ"] == [["Face", "Hand", 23.0]]
+    fit = fit_bradley_terry(wins, names)
+    np.testing.assert_allclose(doc["p"], fit.p)
+    assert doc["chi2"] == pytest.approx(likelihood_ratio_chi2(wins, fit.p).chi2)
+    # One win fewer for Face lowers its P_i below the complete table's, and only a little.
+    full = fit_bradley_terry(np.array(TABLE_6_2["likability"]["wins"]), names)
+    assert full.p[0] - 0.02 < doc["p"][0] < full.p[0]
 
 
 def test_plan_command_writes_balanced_plan(tmp_path, capsys):
