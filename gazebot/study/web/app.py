@@ -240,6 +240,8 @@ def create_app(study_dir: str, admin_token: str | None = None) -> Flask:
         # conditional=True: Range requests (206 Partial Content), ETag and Last-Modified.
         resp = send_file(path, mimetype="video/mp4", conditional=True, max_age=3600)
         resp.headers["Accept-Ranges"] = "bytes"
+        # The file name holds the behavior's name: the study is blind.
+        resp.headers.pop("Content-Disposition", None)
         return resp
 
     # ---- experimenter ----
