@@ -35,13 +35,15 @@ class StudyServer:
     """``python -m gazebot study serve DIR --port 0`` in a subprocess; ``base`` is its URL once
     it listens. ``kill()`` sends SIGKILL (no shutdown code runs)."""
 
-    def __init__(self, study_dir: Path, token: str = "test-token") -> None:
+    def __init__(self, study_dir: Path, token: str = "test-token", port: int = 0) -> None:
         self.study_dir = study_dir
         self.token = token
+        self.port = port
         self.proc: subprocess.Popen | None = None
         self.base = ""
 
     def start(self, timeout_s: float = 30.0) -> StudyServer:
+        """Start the server (on the port of the last start, if any) and wait until it listens."""
         env = {**os.environ, "PYTHONPATH": str(REPO), "PYTHONUNBUFFERED": "1"}
         self.proc = subprocess.Popen(
             [
@@ -52,7 +54,7 @@ class StudyServer:
                 "serve",
                 str(self.study_dir),
                 "--port",
-                "0",
+                str(self.port),
                 "--admin-token",
                 self.token,
             ],
@@ -72,6 +74,7 @@ class StudyServer:
             m = re.search(r"at (http://\S+)/p/N", line)
             if m:
                 self.base = m.group(1)
+                self.port = int(self.base.rsplit(":", 1)[1])
                 self.proc.stdout.readline()  # the experimenter line
                 return self
         self.stop()
