@@ -23,6 +23,7 @@ Times are UTC seconds since the epoch (floats).
 from __future__ import annotations
 
 import sqlite3
+import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -101,6 +102,9 @@ class ResponseStore:
     def __init__(self, path: str | Path, timeout_s: float = 10.0) -> None:
         self.path = Path(path)
         self.timeout_s = timeout_s
+        # Writers of this process take turns here: SQLite's own busy handler would put a
+        # waiting writer to sleep for milliseconds; other processes still meet its lock.
+        self._write_lock = threading.Lock()
         with self._connect() as con:
             con.execute("PRAGMA journal_mode=WAL")
             con.executescript(_SCHEMA)
@@ -117,7 +121,7 @@ class ResponseStore:
 
     @contextmanager
     def _transaction(self) -> Iterator[sqlite3.Connection]:
-        with self._connect() as con:
+        with self._write_lock, self._connect() as con:
             con.execute("BEGIN IMMEDIATE")
             try:
                 yield con
