@@ -103,6 +103,9 @@ def _wait_for_questions(d) -> None:
         "return [document.getElementById('v1').ended, document.getElementById('v2').ended]"
     )
     assert ended == [True, True]
+    # One video at a time: the first is put away when the second plays.
+    assert not d.find_element(By.ID, "v1").is_displayed()
+    assert d.find_element(By.ID, "v2").is_displayed()
 
 
 def _click_answers(d, answers: dict[str, int], comment: str) -> None:

@@ -179,3 +179,33 @@ def test_render_command_rejects_unknown_scene_before_rendering(tmp_path):
     with pytest.raises(ValueError, match="unknown scene 'no-such-scene'"):
         run(["study", "render", str(plan), "--out", str(tmp_path / "out"), "--no-progress"])
     assert not (tmp_path / "out").exists()
+
+
+def test_plan_of_the_seed_6_3_design_needs_no_condition_and_no_out(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    argv = "study plan --behaviors face,hand,short-face-hand,long-face-hand --participants 24"
+    assert run([*argv.split(), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["sessions_per_participant"] == 12 and doc["condition"] == ""
+    assert doc["gaze_mode"] == "head-only"
+    with (tmp_path / "plan.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 24 * 12
+    for p in range(1, 25):
+        pairs = [(r["first"], r["second"]) for r in rows if r["participant"] == str(p)]
+        assert len(pairs) == len(set(pairs)) == 12  # each ordered pair once
+
+
+def test_plan_with_a_condition_defaults_to_the_as_studied_behaviors(tmp_path, capsys):
+    argv = ["study", "plan", "--condition", "posture", "--participants", "12"]
+    assert run([*argv, "--out", str(tmp_path / "p.csv"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["behaviors"] == ["hand-face-as-studied", "face-hand-face-as-studied", "hand"]
+    assert doc["gaze_mode"] == "eyes-only"
+
+
+def test_serve_and_export_on_a_folder_that_is_not_a_rendered_study_say_so(tmp_path):
+    with pytest.raises(ValueError, match="is not a rendered study"):
+        run(["study", "export", str(tmp_path), "--out", str(tmp_path / "r.csv")])
+    with pytest.raises(ValueError, match="is not a rendered study"):
+        run(["study", "serve", str(tmp_path), "--port", "0"])
