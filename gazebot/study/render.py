@@ -38,7 +38,14 @@ from gazebot.study.pair_video import make_pair_video
 from gazebot.study.plan import Session, write_plan
 from gazebot.study.questionnaire import write_participant_page, write_questionnaire
 
-__all__ = ["RenderReport", "VideoSpec", "code_version", "default_renderer", "render_study"]
+__all__ = [
+    "RenderReport",
+    "VideoSpec",
+    "code_version",
+    "default_renderer",
+    "render_handover_in_gaze_mode",
+    "render_study",
+]
 
 
 @dataclass(frozen=True)
@@ -56,23 +63,63 @@ class RenderReport:
     questionnaire_md: Path
 
 
-def default_renderer() -> RenderFn:
-    """The SIM package's MuJoCo renderer (imported lazily: it pulls in MuJoCo)."""
+def render_handover_in_gaze_mode(
+    robot: str,
+    behavior: str,
+    scene: str,
+    out_path: str | Path,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+    fps: int = 30,
+    progress: bool = True,
+    gaze_mode: str = "head-and-eyes",
+) -> Path:
+    """The SIM package's MuJoCo handover renderer on ``robot`` with its gaze mode set to the
+    plan's (the robot config's ``gaze_mode``, as ``--gaze-mode`` sets it on the other commands)."""
+    from gazebot.sim.record import render_handover_video
+
     try:
-        from gazebot.sim.record import render_handover_video
+        from gazebot.kinematics.config import with_gaze_mode
+    except ImportError:  # a gazebot without gaze modes: only the robot's own mode exists
+        if gaze_mode != "head-and-eyes":
+            raise ValueError(f"this gazebot cannot render gaze mode {gaze_mode!r}") from None
+        robot_arg = robot
+    else:
+        robot_arg = with_gaze_mode(robot, gaze_mode)
+    return render_handover_video(
+        robot_arg,
+        behavior,
+        scene,
+        out_path,
+        seed=seed,
+        width=width,
+        height=height,
+        fps=fps,
+        progress=progress,
+    )
+
+
+def default_renderer() -> RenderFn:
+    """The MuJoCo renderer in the plan's gaze mode (:func:`render_handover_in_gaze_mode`); MuJoCo
+    is imported in the workers, when a video is rendered."""
+    try:
+        import gazebot.sim.record  # noqa: F401 - fail here, not in a worker
     except ImportError as exc:
         raise ValueError(
             f"the MuJoCo handover renderer is not available ({exc}); "
             "use --renderer synthetic for a dry run"
         ) from exc
-    return render_handover_video
+    return render_handover_in_gaze_mode
 
 
-def _render_video_job(render_fn: RenderFn, spec: VideoSpec, out_path: Path) -> Path:
+def _render_video_job(
+    render_fn: RenderFn, spec: VideoSpec, out_path: Path, pass_mode: bool = True
+) -> Path:
     """Worker: render into a temporary name, then rename, so the cache never holds a partial
-    file."""
+    file. ``pass_mode``: give the renderer the spec's ``gaze_mode``."""
     tmp = out_path.with_name(out_path.stem + f".part{os.getpid()}.mp4")
-    extra = {"gaze_mode": spec.gaze_mode} if spec.gaze_mode != "head-and-eyes" else {}
+    extra = {"gaze_mode": spec.gaze_mode} if pass_mode else {}
     try:
         render_fn(
             spec.robot,
@@ -172,7 +219,8 @@ def render_study(
         raise ValueError(f"card_seconds must be positive, got {card_seconds}")
     render_fn = render_fn or default_renderer()
     modes = sorted({s.gaze_mode for s in plan} - {"head-and-eyes"})
-    if modes and not accepts_gaze_mode(render_fn):
+    pass_mode = accepts_gaze_mode(render_fn)
+    if modes and not pass_mode:
         raise ValueError(
             f"the plan asks for gaze mode {modes[0]!r}, but the renderer "
             f"{getattr(render_fn, '__name__', render_fn)!r} takes no gaze_mode"
@@ -198,7 +246,7 @@ def render_study(
     videos = {sp: video_dir / sp.file_name(version) for sp in specs}
     todo = [sp for sp in specs if not videos[sp].is_file()]
     _run_jobs(
-        [(_render_video_job, (render_fn, sp, videos[sp])) for sp in todo],
+        [(_render_video_job, (render_fn, sp, videos[sp], pass_mode)) for sp in todo],
         workers,
         progress,
         "handover videos",

@@ -147,7 +147,7 @@ def test_invalid_resolution_is_rejected(tmp_path):
 
 @pytest.mark.slow
 def test_real_renderer_at_tiny_resolution_renders_distinct_videos(tmp_path):
-    from gazebot.sim.record import render_handover_video
+    from gazebot.study.render import default_renderer
 
     plan = make_plan(
         behaviors=["hand", "face-hand-face"],
@@ -159,7 +159,7 @@ def test_real_renderer_at_tiny_resolution_renders_distinct_videos(tmp_path):
     report = render_study(
         plan,
         tmp_path,
-        render_handover_video,
+        default_renderer(),
         64,
         48,
         10,
