@@ -98,6 +98,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     sv.add_argument(
         "--admin-token", default=None, help="token for /admin from other hosts (default: random)"
     )
+    sv.add_argument(
+        "--token-only",
+        action="store_true",
+        help="ask for the token on /admin from this machine too (behind a local reverse proxy)",
+    )
     sv.set_defaults(func=_serve)
 
     ex = study.add_parser("export", help="write the answers of a served study as a responses CSV")
@@ -378,7 +383,14 @@ def _serve(args: argparse.Namespace) -> int:
         raise ValueError(f"--port must be in 0..65535, got {args.port}")
     if args.threads < 1:
         raise ValueError(f"--threads must be >= 1, got {args.threads}")
-    serve(str(args.dir), args.host, args.port, args.threads, args.admin_token)
+    serve(
+        str(args.dir),
+        args.host,
+        args.port,
+        args.threads,
+        args.admin_token,
+        local_admin=not args.token_only,
+    )
     return 0
 
 

@@ -265,3 +265,11 @@ def test_table_6_1_reproduced_through_the_served_6_3_study(tmp_path):
         assert np.round(r.fit.p, 2).tolist() == pytest.approx(data["P"], abs=1e-9)
         assert r.chi2.p_value < 1e-4  # "all of the chi2 values are large (p < 0.0001)"
     json.dumps(result.to_json())
+
+
+def test_token_only_admin_refuses_loopback_without_the_token(fresh):
+    app = create_app(str(fresh), admin_token="tok", local_admin=False)
+    c = app.test_client()
+    c.environ_base["REMOTE_ADDR"] = "127.0.0.1"
+    assert c.get("/admin").status_code == 403
+    assert c.get("/admin?token=tok").status_code == 200

@@ -46,7 +46,7 @@ from gazebot.study.questionnaire import (
     instructions,
     questions,
 )
-from gazebot.study.store import ResponseStore
+from gazebot.study.store import Progress, ResponseStore
 
 ADMIN_COOKIE = "gazebot_admin"
 MAX_COMMENT = 4000  # characters kept of a comment
@@ -61,9 +61,11 @@ class Step:
     session: int | None = None
 
 
-def current_step(study: StudyFolder, store: ResponseStore, participant: int) -> Step:
-    """The participant's next step, from the stored progress only."""
-    prog = store.progress(participant)
+def current_step(
+    study: StudyFolder, store: ResponseStore, participant: int, prog: Progress | None = None
+) -> Step:
+    """The participant's next step, from the stored progress only (``prog``: already read)."""
+    prog = prog or store.progress(participant)
     if prog.consent_at is None:
         return Step("consent")
     if prog.instructions_at is None:
@@ -88,10 +90,23 @@ def _is_loopback(addr: str | None) -> bool:
         return False
 
 
-def create_app(study_dir: str, admin_token: str | None = None) -> Flask:
+def _step_label(prog: Progress, step: Step) -> str:
+    """What the experimenter's table says a participant is at."""
+    if prog.finished_at is not None:
+        return "finished"
+    if prog.mode is None:
+        return "not started"
+    if step.kind == "session":
+        return "practice" if step.session == PRACTICE else f"session {step.session}"
+    return step.kind
+
+
+def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool = True) -> Flask:
     """The Flask app of the rendered study in ``study_dir`` (answers in
-    ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` from other
-    machines (default: a random one, in ``app.config["ADMIN_TOKEN"]``)."""
+    ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` (default: a
+    random one, in ``app.config["ADMIN_TOKEN"]``); ``local_admin``: also open it without the token
+    to requests from the loopback interface (turn off behind a reverse proxy on the same
+    machine, where every request comes from there)."""
     study = load_study(study_dir)
     store = study.store()
     app = Flask(__name__)
@@ -157,9 +172,10 @@ def create_app(study_dir: str, admin_token: str | None = None) -> Flask:
     @app.get("/p/<int:participant>")
     def participant_page(participant: int):
         participant_or_404(participant)
-        if store.progress(participant).mode == "in-person":
+        prog = store.progress(participant)
+        if prog.mode == "in-person":
             return in_person_page(participant)
-        step = current_step(study, store, participant)
+        step = current_step(study, store, participant, prog)
         if step.kind == "consent":
             return page("consent.html", participant=participant)
         if step.kind == "instructions":
@@ -215,7 +231,7 @@ def create_app(study_dir: str, admin_token: str | None = None) -> Flask:
             return in_person_page(participant)
         if k in prog.answered:  # a double submit or a resent form: already stored, go on
             return redirect(url_for("participant_page", participant=participant), 303)
-        step = current_step(study, store, participant)
+        step = current_step(study, store, participant, prog)
         if step.kind != "session" or step.session != k:
             return page(
                 "message.html",
@@ -251,7 +267,7 @@ def create_app(study_dir: str, admin_token: str | None = None) -> Flask:
         def wrapped(*args, **kwargs):
             token = request.args.get("token") or request.cookies.get(ADMIN_COOKIE) or ""
             good = hmac.compare_digest(token.encode(), app.config["ADMIN_TOKEN"].encode())
-            if not (good or _is_loopback(request.remote_addr)):
+            if not (good or (local_admin and _is_loopback(request.remote_addr))):
                 abort(403, description="The experimenter's pages need the token printed at start.")
             resp = make_response(view(*args, **kwargs))
             if good and request.args.get("token"):
@@ -266,25 +282,13 @@ def create_app(study_dir: str, admin_token: str | None = None) -> Flask:
         rows = []
         for p in study.participants:
             prog = store.progress(p)
-            step = current_step(study, store, p)
-            answered = len([k for k in prog.answered if k != PRACTICE])
             rows.append(
                 {
                     "participant": p,
                     "mode": prog.mode or "",
-                    "answered": answered,
+                    "answered": len([k for k in prog.answered if k != PRACTICE]),
                     "total": n_sessions[p],
-                    "step": "finished"
-                    if prog.finished_at
-                    else "not started"
-                    if prog.mode is None
-                    else (
-                        "practice"
-                        if step.session == PRACTICE
-                        else f"session {step.session}"
-                        if step.kind == "session"
-                        else step.kind
-                    ),
+                    "step": _step_label(prog, current_step(study, store, p, prog)),
                     "last": _utc(prog.last_activity),
                 }
             )

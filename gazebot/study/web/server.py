@@ -16,15 +16,16 @@ def serve(
     threads: int = 4,
     admin_token: str | None = None,
     out: TextIO | None = None,
+    local_admin: bool = True,
 ) -> None:
     """Serve the rendered study in ``study_dir`` until interrupted. Prints the participant and
     experimenter addresses (with the admin token) once the socket listens; ``port`` 0 picks a
-    free port."""
+    free port. ``local_admin``: see :func:`~gazebot.study.web.app.create_app`."""
     from waitress import create_server
 
     out = out or sys.stdout
     token = admin_token or secrets.token_urlsafe(16)
-    app = create_app(study_dir, admin_token=token)
+    app = create_app(study_dir, admin_token=token, local_admin=local_admin)
     server = create_server(app, host=host, port=port, threads=threads, ident="gazebot-study")
     shown = f"[{host}]" if ":" in host else host
     base = f"http://{shown}:{server.effective_port}"
