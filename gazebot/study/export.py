@@ -45,8 +45,8 @@ def export_responses(
     answered session, by participant and session; columns :data:`EXPORT_COLUMNS`); return the
     path and the number of rows. ``group`` is the participant's mode (``video``/``in-person``)
     when the study has both, so that ``analyze`` compares them as independent groups, else
-    empty. ``seconds``: from first showing the session page to the submit (empty for answers
-    entered in person). The practice session (session 0) is left out unless
+    empty. ``seconds``: from first showing the session page (in person: the experimenter's page for
+    that pair) to the submit. The practice session (session 0) is left out unless
     ``include_practice``; ``analyze`` would count it as a study session."""
     study = load_study(study_dir)
     out = check_output_file(out, "responses", ".csv")

@@ -273,3 +273,20 @@ def test_token_only_admin_refuses_loopback_without_the_token(fresh):
     c.environ_base["REMOTE_ADDR"] = "127.0.0.1"
     assert c.get("/admin").status_code == 403
     assert c.get("/admin?token=tok").status_code == 200
+
+
+def test_export_names_the_mode_as_group_when_a_study_has_both(fresh, tmp_path):
+    c = client(fresh)
+    start(c, 1)
+    c.post("/p/1/session/0", data=ANSWERS)
+    c.post("/p/1/session/1", data=ANSWERS)
+    first = load_study(fresh).sessions_of(3)[0]
+    c.get("/admin/in-person/3")  # the experimenter's page for the live pair
+    c.post("/admin/in-person/3", data={**ANSWERS, "session": str(first.session)})
+    out, n = export_responses(fresh, tmp_path / "r.csv")
+    with out.open() as fh:
+        rows = {r["participant"]: r for r in csv.DictReader(fh)}
+    assert n == 2
+    assert (rows["1"]["group"], rows["1"]["mode"]) == ("video", "video")
+    assert rows["3"]["group"] == "in-person" and float(rows["3"]["seconds"]) >= 0
+    assert {r.group for r in read_responses(out)} == {"video", "in-person"}

@@ -307,6 +307,8 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
     def in_person_form(participant: int, errors=None, values=None, status: int = 200):
         prog = store.progress(participant)
         nxt = next_in_person(participant)
+        if nxt is not None and prog.mode != "video":
+            store.mark_shown(participant, nxt.session)  # the time of the live pair starts
         return page(
             "in_person.html",
             status,
