@@ -91,11 +91,11 @@ def scene_with_overrides(args: argparse.Namespace):
         )
         == "joint"
     ):
-        raise ValueError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+        raise UsageError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
     try:
         return SceneConfig.model_validate(data)
     except ValidationError as exc:
-        raise ValueError(f"invalid controller options: {exc}") from exc
+        raise UsageError(f"invalid controller options: {exc}") from exc
 
 
 def run_demo(args: argparse.Namespace) -> int:

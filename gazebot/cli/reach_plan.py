@@ -10,6 +10,8 @@ import argparse
 import json
 from pathlib import Path
 
+from gazebot.cli.errors import UsageError
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     from gazebot.controllers import CONTROLLER_NAMES
@@ -88,7 +90,7 @@ def controllers_config_from_args(args: argparse.Namespace):
     try:
         return ControllersConfig.model_validate(data)
     except Exception as exc:  # pydantic's message names the field
-        raise ValueError(f"invalid controller options: {exc}") from exc
+        raise UsageError(f"invalid controller options: {exc}") from exc
 
 
 def run_reach_plan(args: argparse.Namespace) -> int:
@@ -102,7 +104,7 @@ def run_reach_plan(args: argparse.Namespace) -> int:
     hand0 = np.array(args.hand, float)
     for name, v in (("--start", start), ("--hand", hand0)):
         if not np.all(np.isfinite(v)):
-            raise ValueError(f"{name} must be finite, got {v.tolist()}")
+            raise UsageError(f"{name} must be finite, got {v.tolist()}")
     hand = hand0
     if args.hand_velocity is not None:
         vel = np.array(args.hand_velocity, float)
@@ -110,7 +112,7 @@ def run_reach_plan(args: argparse.Namespace) -> int:
     controller = make_controller(args.controller, cfg)
     duration = args.duration if args.duration is not None else cfg.reach_time_s + 1.0
     if not duration > 0:
-        raise ValueError(f"--duration must be positive, got {duration}")
+        raise UsageError(f"--duration must be positive, got {duration}")
     target = None if args.target is None else np.array(args.target, float)
     run = run_reach(controller, start, hand, duration, target=target)
     tol = cfg.stl.eps_p_m if args.controller == "stl" else cfg.mcj.eps_x_m

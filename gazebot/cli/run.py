@@ -54,10 +54,9 @@ def handle(args: argparse.Namespace) -> int:
         resync=not args.no_resync,
         no_robot_warning=args.no_robot_warning,
     )
-    from gazebot.runtime import GazeLoop
-
     # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
     from gazebot.kinematics.config import with_gaze_mode
+    from gazebot.runtime import GazeLoop
 
     robot = with_gaze_mode(args.robot, args.gaze_mode)
     loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
