@@ -86,3 +86,38 @@ def test_demo_options_override_the_scene_controller():
                 scene="default", controller=None, reach_time=2.0, stall_time=None, retreat=None
             )
         )
+
+
+@pytest.mark.parametrize(
+    "extra,names",
+    [
+        (["--controller", "stl", "--strategy", "proactive-predetermined"], "--target"),
+        (["--controller", "stl", "--target", "nan", "0", "0"], "--target"),
+        (["--controller", "mcj", "--hand-velocity", "0", "inf", "0"], "--hand-velocity"),
+        (["--controller", "mcj", "--stall-time", "0.5"], "--stall-time"),
+        (["--controller", "pv", "--duration", "1e9"], "--duration"),
+    ],
+)
+def test_reach_plan_bad_input_is_a_usage_error_naming_the_option(capsys, extra, names):
+    rc = main(["reach-plan", "--start", "0", "0", "0", "--hand", "1", "0", "0", *extra])
+    assert rc == 2
+    assert names in capsys.readouterr().err
+
+
+def test_reach_plan_reports_arrival_at_a_predetermined_location(capsys):
+    rc, out = _plan(
+        capsys,
+        "--controller",
+        "stl",
+        "--strategy",
+        "proactive-predetermined",
+        "--target",
+        "0.8",
+        "0",
+        "0",
+        "--reach-time",
+        "2",
+    )
+    assert rc == 0 and out["feasible"] and out["goal"] == "target"
+    assert out["reached_at_s"] is not None and out["reached_at_s"] <= 2.0 + 1e-9
+    assert out["final_gap_m"] <= 0.01
