@@ -102,3 +102,33 @@ def test_transfer_and_retreat_specs_sign():
     )
     assert transfer_spec(cfg, 0.3, Role.GIVER).robustness(sig) > 0
     assert transfer_spec(cfg, 0.2, Role.GIVER).robustness(sig) < 0
+
+
+def _monitor_rows(n: int, hand: np.ndarray) -> dict[str, list]:
+    """A receiving robot at the object (in the gripper's reach) that never closes its gripper."""
+    zero = np.zeros(3)
+    return {
+        "t": [0.1 * k for k in range(n)],
+        "p_r": [zero] * n,
+        "p_h": [hand] * n,
+        "p_o": [zero] * n,
+        "alpha": [0.0] * n,
+        "g_r": [1.0] * n,
+        "p_d": [zero] * n,
+        "p_home": [zero] * n,
+    }
+
+
+def test_run_monitor_transfer_binds_only_while_the_human_holds_or_shares_the_object():
+    from gazebot.sim.stl_monitor import HandoverMonitor
+
+    cfg = load_controllers_config()
+    # Table 4.2: (||p_o - p_r|| < eps and (o_h or o_s)) => <>[0, t_2] grasped. Object on the
+    # ground (o_g: released and away from the hand): the transfer spec does not bind.
+    dropped = HandoverMonitor(config=cfg, eps=0.05, dt=0.1)
+    dropped.rows = _monitor_rows(30, np.array([1.0, 0.0, 0.0]))
+    assert dropped.robustness()["transfer"] > 0
+    # Object in the human's hand at the gripper and no grasp within t_2: violated.
+    held = HandoverMonitor(config=cfg, eps=0.05, dt=0.1)
+    held.rows = _monitor_rows(30, np.zeros(3))
+    assert held.robustness()["transfer"] < 0
