@@ -137,9 +137,7 @@ def run_reach_plan(args: argparse.Namespace) -> int:
     to_target = target is not None and not (
         args.controller == "stl" and cfg.stl.strategy.towards_human
     )
-    goals = np.broadcast_to(target, run.positions.shape) if to_target else run.hands
-    gap = np.linalg.norm(run.positions - goals, axis=1)
-    hit = np.nonzero(gap <= tol + 1e-6)[0]
+    goal = target if to_target else None
     result = {
         "controller": args.controller,
         "feasible": run.feasible,
@@ -150,8 +148,8 @@ def run_reach_plan(args: argparse.Namespace) -> int:
         "reach_time_s": None if args.controller == "pv" else cfg.reach_time_s,
         "stall_time_s": cfg.stall_time_s if args.controller == "mce" else None,
         "goal": "target" if to_target else "hand",
-        "reached_at_s": round(float(run.times[hit[0]]), 4) if hit.size else None,
-        "final_gap_m": round(float(gap[-1]), 5),
+        "reached_at_s": run.reached_at(tol + 1e-6, goal),
+        "final_gap_m": round(float(run.gap(goal)[-1]), 5),
         "path": [
             [round(float(t), 4), *np.round(p, 5).tolist()]
             for t, p in zip(run.times, run.positions, strict=True)
