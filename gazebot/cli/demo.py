@@ -94,9 +94,14 @@ def scene_with_overrides(args: argparse.Namespace):
 
 
 def run_demo(args: argparse.Namespace) -> int:
+    from gazebot.kinematics.config import GAZE_MODES
     from gazebot.render.timeline import phase_spans, plot_timeline, write_timeline_csv
     from gazebot.sim.gl_check import OffscreenRenderingError
 
+    if args.gaze_mode is not None and args.gaze_mode not in GAZE_MODES:
+        raise UsageError(
+            f"--gaze-mode must be one of {', '.join(GAZE_MODES)}, not {args.gaze_mode!r}"
+        )
     out: Path = args.out
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out} exists and is not a folder")
