@@ -87,10 +87,9 @@ class _AllBehaviors:
         return next(iter(cmds.values()))
 
 
-@pytest.fixture(scope="module")
-def handover():
-    """One robot-initiated handover recorded with all seed behaviors; returns
-    (targets by behavior, robot events, the giver's reach start, the reach-start time)."""
+def _record(scene: str):
+    """One handover of ``scene`` recorded with all seed behaviors; returns (targets by
+    behavior, robot events, the giver's reach start, the reach-start time)."""
     from gazebot.sim.record import record_handover
     from gazebot.sim.robot import load_sim_robot
 
@@ -99,7 +98,7 @@ def handover():
     rec = record_handover(
         robot="sawyer",
         behavior=SEED_BEHAVIORS[0],
-        scene="robot-initiated",
+        scene=scene,
         out_path=None,
         progress=False,
         loop=loop,
@@ -108,6 +107,12 @@ def handover():
     assert rec.completed and rec.video is None
     giver_start = seen["sim"].giver.reach_started_at
     return loop.targets, rec.robot_events, giver_start, rec.ticks[-1].reach_start_time
+
+
+@pytest.fixture(scope="module")
+def handover():
+    """The seed's 6.3 handover: the robot starts its reach, the giver responds."""
+    return _record("robot-initiated")
 
 
 def _first(events, kind) -> float:
@@ -156,13 +161,27 @@ def test_long_face_hand_turns_to_the_hand_when_the_robot_reach_ends(handover):
     assert all(k == "hand" for t, k in timeline if t >= reach_end + SHIFT_TOL_S)
 
 
-def test_as_studied_behaviors_shift_on_the_robots_grasp_and_retreat(handover):
-    targets, events, _, _ = handover
-    grasp = _first(events, EventKind.ROBOT_GRASPED)
+def _check_as_studied(targets, events) -> None:
+    reach_end = _first(events, EventKind.ROBOT_REACH_ENDED)
     retreat = _first(events, EventKind.ROBOT_RETREAT_STARTED)
     fhf = targets["face-hand-face-as-studied"]
-    assert _shift_times(fhf, "hand") == [pytest.approx(grasp, abs=SHIFT_TOL_S)]
+    assert _shift_times(fhf, "hand") == [pytest.approx(reach_end, abs=SHIFT_TOL_S)]
     assert _shift_times(fhf, "face") == [pytest.approx(retreat, abs=SHIFT_TOL_S)]
     hf = targets["hand-face-as-studied"]
     assert hf[0][1] == "hand"
     assert _shift_times(hf, "face") == [pytest.approx(retreat, abs=SHIFT_TOL_S)]
+
+
+def test_as_studied_behaviors_shift_on_the_robots_reach_end_and_retreat(handover):
+    _check_as_studied(*handover[:2])
+
+
+def test_as_studied_behaviors_differ_when_the_robot_retreats_right_after_grasping():
+    # Seed 6.4.3: "The robot retreated to its home position after grasping the object": the
+    # grasp and the retreat start coincide, and Face-Hand-Face still shows the hand in between.
+    targets, events, _, _ = _record("retreat-after-grasp")
+    grasp = _first(events, EventKind.ROBOT_GRASPED)
+    assert _first(events, EventKind.ROBOT_RETREAT_STARTED) == pytest.approx(grasp)
+    for a, b in itertools.combinations(SEED_BEHAVIORS, 2):
+        assert [k for _, k in targets[a]] != [k for _, k in targets[b]], (a, b)
+    _check_as_studied(targets, events)
