@@ -72,6 +72,8 @@ class HandoverMonitor:
             "p_o": obj,
             "alpha": alpha,
             "g_r": 1.0 - float(ctrl._gripper),
+            # The person's hand: closed on the object (g*) while holding it, else open.
+            "g_h": self.config.stl.grip_width if person else 1.0,
             "p_d": self.home,
             "p_home": self.home,
         }
@@ -126,4 +128,4 @@ def robot_timing(sim) -> ControllersConfig:
     return cfg
 
 
-_KEYS = ("t", "p_r", "p_h", "p_o", "alpha", "g_r", "p_d", "p_home")
+_KEYS = ("t", "p_r", "p_h", "p_o", "alpha", "g_r", "g_h", "p_d", "p_home")

@@ -132,3 +132,28 @@ def test_run_monitor_transfer_binds_only_while_the_human_holds_or_shares_the_obj
     held = HandoverMonitor(config=cfg, eps=0.05, dt=0.1)
     held.rows = _monitor_rows(30, np.zeros(3))
     assert held.robustness()["transfer"] < 0
+
+
+def test_object_states_without_a_force_sensor_follow_table_4_1():
+    from gazebot.controllers.stl_logic import object_states
+
+    cfg = load_controllers_config().stl.model_copy(update={"force_sensor": False})
+    at, away = np.zeros(3), np.array([0.5, 0.0, 0.0])
+    # samples: robot grips it, human grips it, both grip it, nobody (on the ground)
+    sig = Signal(
+        0.1,
+        {
+            "p_o": np.zeros((4, 3)),
+            "p_r": np.array([at, away, at, away]),
+            "p_h": np.array([away, at, at, away]),
+            "g_r": np.array([0.0, 1.0, 0.0, 1.0]),
+            "g_h": np.array([1.0, 0.0, 0.0, 1.0]),
+        },
+    )
+    states = object_states(cfg, cfg.eps_p_m)
+    for k, name in enumerate(("o_r", "o_h", "o_s", "o_g")):
+        positive = {n for n, f in states.items() if f.rho(sig)[k] > 0}
+        assert positive == {name}, (k, positive)
+    # a gripper at the object but open does not hold it
+    open_gripper = Signal(0.1, {**sig.values, "g_r": np.ones(4)})
+    assert states["o_r"].rho(open_gripper)[0] < 0
