@@ -77,7 +77,7 @@ def test_session_page_shows_the_seed_questions_and_no_behavior_names(fresh):
     assert "Which handover did you like better? (1st or 2nd)" in page
     assert "wanted the giver to give the object? (1st or 2nd)" in page
     assert "Any other comments (optional)" in page
-    for name in ("face", "hand", "short-face-hand", "sawyer", ".mp4\">"):
+    for name in ("face", "hand", "short-face-hand", "sawyer", '.mp4">'):
         assert f"{name}_" not in page and f"/{name}" not in page
     assert page.count("<video") == 2 and "disabled" in page  # questions wait for both videos
 
@@ -315,3 +315,14 @@ def test_export_and_analyze_commands_on_a_served_study(fresh, tmp_path, capsys):
     doc = json.loads(capsys.readouterr().out)
     assert doc["per_level"][""]["likability"]["participants"] == 2
     assert set(doc["bias_per_question"]) == {"q1", "q2", "q3", "q4", "q5"}
+
+
+def test_the_study_folders_consent_text_replaces_the_default(fresh):
+    (fresh / "consent.txt").write_text("Approved text, part one.\n\nPart <two>.\n")
+    try:
+        page = client(fresh).get("/p/5").get_data(as_text=True)
+    finally:
+        (fresh / "consent.txt").unlink()
+    assert "<p>Approved text, part one.</p>" in page and "<p>Part &lt;two&gt;.</p>" in page
+    assert "You are invited" not in page
+    assert "You are invited" in client(fresh).get("/p/5").get_data(as_text=True)
