@@ -11,6 +11,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from gazebot.cli.errors import UsageError
 from gazebot.config import ConfigError
 from gazebot.study.conditions import (
     CONDITION_LEVELS,
@@ -20,15 +21,11 @@ from gazebot.study.conditions import (
     default_behaviors,
 )
 
-try:  # the command line's input-error type; a plain ValueError where it does not exist yet
-    from gazebot.cli.errors import UsageError
-except ImportError:  # pragma: no cover - depends on the CLI package's version
-    UsageError = ValueError  # type: ignore[misc, assignment]
-
 
 def _input_errors(command: Callable[[argparse.Namespace], int]) -> Callable:
     """The study package raises ``ValueError`` (naming file, line and field) for bad input files
-    and options: report those as the command line's input errors, not as bugs."""
+    and options: report those as the command line's input errors (:class:`UsageError`), not as
+    bugs."""
 
     @functools.wraps(command)
     def run(args: argparse.Namespace) -> int:
@@ -183,10 +180,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _finite(value: float, option: str, low: float = 0.0, high: float = math.inf) -> float:
-    """``value`` if finite and in (low, high); ``ValueError`` naming ``option`` otherwise."""
+    """``value`` if finite and in (low, high); ``UsageError`` naming ``option`` otherwise."""
     if not (math.isfinite(value) and low < value < high):
         bound = f"in ({low:g}, {high:g})" if math.isfinite(high) else f"> {low:g}"
-        raise ValueError(f"{option} must be a finite number {bound}, got {value}")
+        raise UsageError(f"{option} must be a finite number {bound}, got {value}")
     return value
 
 
@@ -199,7 +196,7 @@ def _check_behaviors(names: list[str]) -> None:
             load_behavior(name)
         except FileNotFoundError:
             available = ", ".join(i.name for i in list_behaviors())
-            raise ValueError(
+            raise UsageError(
                 f"--behaviors: unknown behavior {name!r}; available: {available}"
             ) from None
 
@@ -223,7 +220,7 @@ def _plan(args: argparse.Namespace) -> int:
             scenes[""] = level  # no condition: the single scenario's scene
             continue
         if not sep or not level or not scene:
-            raise ValueError(f"--scene expects LEVEL=SCENE, got {item!r}")
+            raise UsageError(f"--scene expects LEVEL=SCENE, got {item!r}")
         scenes[level] = scene
     plan = make_plan(
         behaviors,
@@ -278,7 +275,7 @@ def _render(args: argparse.Namespace) -> int:
             if not (configs_dir() / "scenes" / f"{scene}.yaml").is_file() and not (
                 scene.endswith((".yaml", ".yml")) and Path(scene).is_file()
             ):
-                raise ValueError(
+                raise UsageError(
                     f"{args.plan}: unknown scene {scene!r} (no configs/scenes/{scene}.yaml)"
                 )
         fn = default_renderer()
@@ -404,9 +401,9 @@ def _serve(args: argparse.Namespace) -> int:
     from gazebot.study.web.server import serve
 
     if not 0 <= args.port <= 65535:
-        raise ValueError(f"--port must be in 0..65535, got {args.port}")
+        raise UsageError(f"--port must be in 0..65535, got {args.port}")
     if args.threads < 1:
-        raise ValueError(f"--threads must be >= 1, got {args.threads}")
+        raise UsageError(f"--threads must be >= 1, got {args.threads}")
     serve(
         str(args.dir),
         args.host,
