@@ -4,12 +4,15 @@ end."""
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from gazebot.cli.errors import UsageError
+from gazebot.config import ConfigError
 from gazebot.study.conditions import (
     CONDITION_LEVELS,
     DEFAULT_BEHAVIORS,
@@ -17,6 +20,23 @@ from gazebot.study.conditions import (
     REACH_BEHAVIORS,
     default_behaviors,
 )
+
+
+def _input_errors(command: Callable[[argparse.Namespace], int]) -> Callable:
+    """The study package raises ``ValueError`` (naming file, line and field) for bad input files
+    and options: report those as the command line's input errors (:class:`UsageError`), not as
+    bugs."""
+
+    @functools.wraps(command)
+    def run(args: argparse.Namespace) -> int:
+        try:
+            return command(args)
+        except (ConfigError, UsageError):
+            raise
+        except ValueError as exc:
+            raise UsageError(str(exc)) from exc
+
+    return run
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -67,7 +87,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--out", type=Path, default=Path("plan.csv"), help="plan CSV file (default: plan.csv)"
     )
     p.add_argument("--json", action="store_true", help="print the balance summary as JSON")
-    p.set_defaults(func=_plan)
+    p.set_defaults(func=_input_errors(_plan))
 
     r = study.add_parser("render", help="render a plan's videos, pair videos and questionnaires")
     r.add_argument("plan", type=Path)
@@ -89,7 +109,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="pin the cache key's code version (default: a hash of gazebot's sources and configs)",
     )
     r.add_argument("--no-progress", action="store_true")
-    r.set_defaults(func=_render)
+    r.set_defaults(func=_input_errors(_render))
 
     sv = study.add_parser("serve", help="run a rendered study in the browser (answers in SQLite)")
     sv.add_argument("dir", type=Path, help="a folder written by `gazebot study render`")
@@ -104,7 +124,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="ask for the token on /admin from this machine too (behind a local reverse proxy)",
     )
-    sv.set_defaults(func=_serve)
+    sv.set_defaults(func=_input_errors(_serve))
 
     ex = study.add_parser("export", help="write the answers of a served study as a responses CSV")
     ex.add_argument("dir", type=Path)
@@ -114,7 +134,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also the practice session (session 0; for inspection, not for analyze)",
     )
-    ex.set_defaults(func=_export)
+    ex.set_defaults(func=_input_errors(_export))
 
     a = study.add_parser("analyze", help="Bradley-Terry analysis of a responses CSV")
     a.add_argument("responses", type=Path)
@@ -144,7 +164,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="p-values of the proportion difference tests: one-sided in the observed direction "
         "(default, as the seed's Tables B.7-B.12) or two-sided",
     )
-    a.set_defaults(func=_analyze)
+    a.set_defaults(func=_input_errors(_analyze))
 
     f = study.add_parser("fit-wins", help="Bradley-Terry fit of a win-count matrix CSV")
     f.add_argument("wins", type=Path)
@@ -156,11 +176,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "total is fitted with its own total, with a warning",
     )
     f.add_argument("--json", action="store_true")
-    f.set_defaults(func=_fit_wins)
+    f.set_defaults(func=_input_errors(_fit_wins))
 
 
 def _finite(value: float, option: str, low: float = 0.0, high: float = math.inf) -> float:
-    """``value`` if finite and in (low, high); ``ValueError`` naming ``option`` otherwise."""
+    """``value`` if finite and in (low, high); ``UsageError`` naming ``option`` otherwise."""
     if not (math.isfinite(value) and low < value < high):
         bound = f"in ({low:g}, {high:g})" if math.isfinite(high) else f"> {low:g}"
         raise UsageError(f"{option} must be a finite number {bound}, got {value}")
@@ -381,9 +401,9 @@ def _serve(args: argparse.Namespace) -> int:
     from gazebot.study.web.server import serve
 
     if not 0 <= args.port <= 65535:
-        raise ValueError(f"--port must be in 0..65535, got {args.port}")
+        raise UsageError(f"--port must be in 0..65535, got {args.port}")
     if args.threads < 1:
-        raise ValueError(f"--threads must be >= 1, got {args.threads}")
+        raise UsageError(f"--threads must be >= 1, got {args.threads}")
     serve(
         str(args.dir),
         args.host,

@@ -184,9 +184,7 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
                 _wait_for_questions(d)
                 _click_answers(d, answers, f"comment {s.session}")
             # Two clicks in a row on the submit button: the page sends one form.
-            d.execute_script(
-                "var b = document.getElementById('next'); b.click(); b.click();"
-            )
+            d.execute_script("var b = document.getElementById('next'); b.click(); b.click();")
             _wait(
                 lambda s=s: _heading(d) not in ("", f"Session {s.session} of {len(sessions)}"),
                 what="the next page after a double click",

@@ -77,7 +77,7 @@ def test_session_page_shows_the_seed_questions_and_no_behavior_names(fresh):
     assert "Which handover did you like better? (1st or 2nd)" in page
     assert "wanted the giver to give the object? (1st or 2nd)" in page
     assert "Any other comments (optional)" in page
-    for name in ("face", "hand", "short-face-hand", "sawyer", ".mp4\">"):
+    for name in ("face", "hand", "short-face-hand", "sawyer", '.mp4">'):
         assert f"{name}_" not in page and f"/{name}" not in page
     assert page.count("<video") == 2 and "disabled" in page  # questions wait for both videos
 
@@ -290,3 +290,39 @@ def test_export_names_the_mode_as_group_when_a_study_has_both(fresh, tmp_path):
     assert (rows["1"]["group"], rows["1"]["mode"]) == ("video", "video")
     assert rows["3"]["group"] == "in-person" and float(rows["3"]["seconds"]) >= 0
     assert {r.group for r in read_responses(out)} == {"video", "in-person"}
+
+
+def test_export_and_analyze_commands_on_a_served_study(fresh, tmp_path, capsys):
+    import argparse
+
+    from gazebot.cli import study as study_cli
+
+    def run(argv):
+        parser = argparse.ArgumentParser(prog="gazebot")
+        study_cli.register(parser.add_subparsers(dest="command"))
+        args = parser.parse_args(argv)
+        return args.func(args)
+
+    c = client(fresh)
+    for pid in (1, 2):
+        start(c, pid)
+        for k in range(0, 7):
+            c.post(f"/p/{pid}/session/{k}", data={**ANSWERS, "q1": str(1 + (k + pid) % 2)})
+    out = tmp_path / "responses.csv"
+    assert run(["study", "export", str(fresh), "--out", str(out)]) == 0
+    assert "wrote 12 answered sessions" in capsys.readouterr().out
+    assert run(["study", "analyze", str(out), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["per_level"][""]["likability"]["participants"] == 2
+    assert set(doc["bias_per_question"]) == {"q1", "q2", "q3", "q4", "q5"}
+
+
+def test_the_study_folders_consent_text_replaces_the_default(fresh):
+    (fresh / "consent.txt").write_text("Approved text, part one.\n\nPart <two>.\n")
+    try:
+        page = client(fresh).get("/p/5").get_data(as_text=True)
+    finally:
+        (fresh / "consent.txt").unlink()
+    assert "<p>Approved text, part one.</p>" in page and "<p>Part &lt;two&gt;.</p>" in page
+    assert "You are invited" not in page
+    assert "You are invited" in client(fresh).get("/p/5").get_data(as_text=True)
