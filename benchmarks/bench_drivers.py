@@ -52,6 +52,7 @@ def _latency() -> list[Result]:
     from gazebot.drivers.session import EPHEMERAL_ENDPOINT, BusConfig, open_session
     from gazebot.drivers.zenoh_driver import ZenohRobotDriver
     from gazebot.engine import GazeEngine
+    from gazebot.runtime import GazeLoop
 
     frames = _record_frames(N_SAMPLES / 120)
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
@@ -60,7 +61,7 @@ def _latency() -> list[Result]:
         BusConfig("bench", listen=(EPHEMERAL_ENDPOINT,), connect=(endpoint,)))
     driver = ZenohRobotDriver(engine_session, BusConfig("bench").keys, "engine")
     keys = driver.keys
-    node = EngineNode(GazeEngine.from_config("sawyer", "face-hand-face"), driver)
+    node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face")), driver)
     stop = threading.Event()
     engine_thread = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
     entities = []

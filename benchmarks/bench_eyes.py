@@ -1,10 +1,13 @@
-"""Eye frames per second: drawing live (``EyeRenderer``) against playing pre-rendered JPEG frames
-(``cv2.imread`` of an eye frame + ``cv2.resize`` to the display + BGR->RGB), measured in one run.
+"""Eye drawing: OpenCV (``gazebot.render.EyeRenderer``, what gazebot draws with everywhere)
+against the same eyes drawn with pygame-ce (``benchmarks/eyes_pygame_peer.py``: same geometry,
+style and precomputed static layers, per-frame drawing with SDL primitives), in one run:
 
-The JPEGs are written to a temporary folder at benchmark time: an HD 1280x720 eye frame (the kind
-of asset a pre-rendered player ships, resized down to the screen) and, as the hardest peer, a frame
-already at the screen's size. Both sides produce the same RGB display image. Also timed: encoding
-a frame for a real head screen (JPEG against PNG).
+* onto the head screen (a 32-bit pygame surface, what ``gazebot display`` shows): OpenCV renders
+  an RGB array that is blitted onto the screen; pygame draws onto the screen directly;
+* into an RGB array (the MuJoCo display texture, ``gazebot render eyes``, eye frames on the bus).
+
+Also: live drawing against playing pre-rendered JPEG eye frames (``cv2.imread`` + resize to the
+screen + BGR->RGB), the alternative of shipping rendered assets.
 
 Ours and the peer are timed in alternating rounds (medians), so load from other processes on a
 shared machine hits both alike; OpenCV runs single-threaded here for a per-core comparison.
@@ -12,7 +15,7 @@ shared machine hits both alike; OpenCV runs single-threaded here for a per-core 
 
 from __future__ import annotations
 
-import math
+import os
 import statistics
 import tempfile
 from collections.abc import Callable
@@ -22,7 +25,9 @@ import cv2
 import numpy as np
 
 from benchmarks.common import Result, median_time
-from gazebot.render import BlinkModel, EyeRenderer, encode_frame
+from gazebot.render import EyeRenderer
+
+os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
 N = 60  # frames per timed round
 ROUNDS = 9
@@ -50,7 +55,7 @@ def _paired_fps(ours: Callable[[], None], peer: Callable[[], None], n: int) -> t
     return n / statistics.median(t_ours), n / statistics.median(t_peer)
 
 
-def _live(renderer: EyeRenderer, poses) -> Callable[[], None]:
+def _cv_array(renderer: EyeRenderer, poses) -> Callable[[], None]:
     def frames() -> None:
         for yaw, pitch, blink, dist in poses:
             renderer.render(yaw, pitch, blink, dist)
@@ -58,17 +63,33 @@ def _live(renderer: EyeRenderer, poses) -> Callable[[], None]:
     return frames
 
 
-def _pipeline(renderer: EyeRenderer, poses) -> Callable[[], None]:
-    """Blink model + render, as the simulation/driver loop runs it at 60 Hz."""
-    model = BlinkModel(seed=0)
-    state = {"t": 0.0, "prev": (0.0, 0.0)}
+def _cv_screen(renderer: EyeRenderer, screen, poses) -> Callable[[], None]:
+    import pygame
+
+    # As gazebot display does it: render into one array that backs a surface, blit that.
+    img = np.zeros(renderer.shape, np.uint8)
+    frame = pygame.image.frombuffer(img, (renderer.width, renderer.height), "RGB")
 
     def frames() -> None:
-        for yaw, pitch, _, dist in poses:
-            state["t"] += 1.0 / 60.0
-            shift = math.hypot(yaw - state["prev"][0], pitch - state["prev"][1])
-            state["prev"] = (yaw, pitch)
-            renderer.render(yaw, pitch, model.update(state["t"], shift), dist)
+        for yaw, pitch, blink, dist in poses:
+            renderer.render(yaw, pitch, blink, dist, out=img)
+            screen.blit(frame, (0, 0))
+
+    return frames
+
+
+def _pg_screen(renderer, screen, poses) -> Callable[[], None]:
+    def frames() -> None:
+        for yaw, pitch, blink, dist in poses:
+            renderer.draw(screen, yaw, pitch, blink, dist)
+
+    return frames
+
+
+def _pg_array(renderer, poses) -> Callable[[], None]:
+    def frames() -> None:
+        for yaw, pitch, blink, dist in poses:
+            renderer.render(yaw, pitch, blink, dist)
 
     return frames
 
@@ -83,12 +104,41 @@ def _jpeg(path: Path, width: int, height: int) -> Callable[[], None]:
     return frames
 
 
-def _encode(frame: np.ndarray, fmt: str, quality: int, n: int) -> Callable[[], None]:
-    def frames() -> None:
-        for _ in range(n):
-            encode_frame(frame, fmt, quality)
+def _head_screen(poses) -> Result:
+    """One ``gazebot display`` frame, headless: animator + OpenCV eyes + blit + status line +
+    flip (no bus, no pacing), against the same with the eyes drawn by pygame."""
+    from types import SimpleNamespace
 
-    return frames
+    from benchmarks.eyes_pygame_peer import PygameEyeRenderer
+    from gazebot.render.head_display import EyeAnimator, HeadScreen, status_text
+
+    screen = HeadScreen(EyeRenderer.for_robot("sawyer"))
+    pg = PygameEyeRenderer.for_robot("sawyer")
+    anim = EyeAnimator()
+    clock = {"t": 0.0}
+    states = [SimpleNamespace(yaw=y, pitch=p, blink=b, distance=d) for y, p, b, d in poses]
+
+    def ours() -> None:
+        for st in states:
+            clock["t"] += 1 / 60
+            pose = anim.update(clock["t"], st, 0.01)
+            screen.show(pose, status_text("sawyer", "gazebot/sim/eyes", pose, 0.01))
+
+    def peer() -> None:
+        for st in states:
+            clock["t"] += 1 / 60
+            pose = anim.update(clock["t"], st, 0.01)
+            pg.draw(screen.screen, pose.yaw, pose.pitch, pose.blink, pose.distance)
+            text = screen._font.render(status_text("sawyer", "k", pose, 0.01), True, (0, 0, 0))
+            screen.screen.blit(text, (8, 570))
+            screen.pg.display.flip()
+
+    try:
+        o, p = _paired_fps(ours, peer, len(states))
+    finally:
+        screen.close()
+    return Result("gazebot display frame, headless 1024x600 (sawyer): OpenCV eyes", o, p,
+                  "frames/s", "the same frame with pygame-ce eyes", higher_is_better=True)
 
 
 def run() -> list[Result]:
@@ -101,55 +151,33 @@ def run() -> list[Result]:
 
 
 def _run() -> list[Result]:
+    import pygame
+
+    from benchmarks.eyes_pygame_peer import PygameEyeRenderer
+
     poses = _poses(N)
     results = []
+    for robot, style in (("sawyer", None), ("jaco2", None), ("sawyer", "cartoon")):
+        cv = EyeRenderer.for_robot(robot, style=style)
+        pg = PygameEyeRenderer.for_robot(robot, style=style)
+        screen = pygame.Surface((cv.width, cv.height), 0, 32)
+        label = f"{cv.width}x{cv.height} ({cv.style.name})"
+        ours, peer = _paired_fps(_cv_screen(cv, screen, poses), _pg_screen(pg, screen, poses), N)
+        results.append(Result(f"eyes onto the head screen {label}: OpenCV + blit", ours, peer,
+                              "frames/s", "pygame-ce drawing onto the screen",
+                              higher_is_better=True))
+        ours, peer = _paired_fps(_cv_array(cv, poses), _pg_array(pg, poses), N)
+        results.append(Result(f"eyes into an RGB array {label}: OpenCV", ours, peer,
+                              "frames/s", "pygame-ce drawing + tobytes",
+                              higher_is_better=True))
+    results.append(_head_screen(poses))
     with tempfile.TemporaryDirectory() as tmp:
         hd = Path(tmp) / "eyes_1280x720.jpg"
         img = EyeRenderer(1280, 720, "sawyer").render(0.2, 0.1)
         cv2.imwrite(str(hd), img[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 90])
-        native = Path(tmp) / "eyes_1024x600.jpg"
-        frame = EyeRenderer.for_robot("sawyer").render(0.2, 0.1)
-        cv2.imwrite(str(native), frame[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 90])
-        hd_name = "pre-rendered JPEG 1280x720: imread + resize"
-        for robot, style in (("sawyer", None), ("jaco2", None), ("sawyer", "cartoon")):
-            r = EyeRenderer.for_robot(robot, style=style)
-            ours, peer = _paired_fps(_live(r, poses), _jpeg(hd, r.width, r.height), N)
-            name = f"live eyes {r.width}x{r.height} ({r.style.name})"
-            results.append(Result(name, ours, peer, "frames/s", hd_name, higher_is_better=True))
         r = EyeRenderer.for_robot("sawyer")
-        ours, peer = _paired_fps(_live(r, poses), _jpeg(native, r.width, r.height), N)
-        results.append(
-            Result(
-                "live eyes 1024x600 (sawyer) vs a screen-size JPEG",
-                ours,
-                peer,
-                "frames/s",
-                "pre-rendered JPEG 1024x600: imread + resize (same size)",
-                higher_is_better=True,
-            )
-        )
-        ours, peer = _paired_fps(_pipeline(r, poses), _jpeg(hd, r.width, r.height), N)
-        results.append(
-            Result(
-                "blink model + live eyes 1024x600 (sawyer)",
-                ours,
-                peer,
-                "frames/s",
-                hd_name,
-                higher_is_better=True,
-            )
-        )
-    n = 10
-    ours, peer = _paired_fps(_encode(frame, "jpeg", 85, n), _encode(frame, "png", 90, n), n)
-    results.append(
-        Result(
-            "encode_frame JPEG q85 1024x600 (to a real head screen)",
-            ours,
-            peer,
-            "frames/s",
-            "encode_frame PNG (zlib level 1)",
-            higher_is_better=True,
-            note=f"{len(encode_frame(frame, 'jpeg', 85)) / 1024:.0f} kB per JPEG frame",
-        )
-    )
+        ours, peer = _paired_fps(_cv_array(r, poses), _jpeg(hd, r.width, r.height), N)
+        results.append(Result("live eyes 1024x600 (sawyer)", ours, peer, "frames/s",
+                              "pre-rendered JPEG 1280x720: imread + resize",
+                              higher_is_better=True))
     return results

@@ -19,6 +19,7 @@ from gazebot.kinematics import GazeController, GazeShiftConfig, RobotConfig, Rob
 from gazebot.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.types import (
     Event,
+    EventKind,
     GazeCommand,
     GazeContext,
     Phase,
@@ -79,6 +80,7 @@ class GazeEngine:
         self._memory = _PointMemory()
         self._pending: list[Event] = []
         self._last_t = -math.inf
+        self._lost_since = math.nan
         self._fixed_points = {k: np.asarray(v, float) for k, v in robot.points.items()}
 
     @classmethod
@@ -133,8 +135,7 @@ class GazeEngine:
         events = self.detector.update_all(frame)
         events.extend(self._pending)
         self._pending.clear()
-        for event in events:
-            self.behavior.handle(event)
+        self._handle(events)
 
         if math.isfinite(frame.t):
             t = self._last_t = max(frame.t, self._last_t)
@@ -160,6 +161,22 @@ class GazeEngine:
             residual=state.residual,
             events=tuple(events),
         )
+
+    def _handle(self, events: list[Event]) -> None:
+        for event in events:
+            self.behavior.handle(event)
+            if event.kind is EventKind.TRACKING_LOST and not math.isfinite(self._lost_since):
+                self._lost_since = event.t
+        if not self.behavior.lost:
+            self._lost_since = math.nan
+
+    def tracking_state(self, t: float) -> str:
+        """``ok``; ``hold`` while tracking is lost and the behavior still holds the gaze (its
+        ``tracking_lost.hold_s``); ``lost`` once it looks at its ``tracking_lost`` target."""
+        if not self.behavior.lost:
+            return "ok"
+        since = self._lost_since if math.isfinite(self._lost_since) else t
+        return "hold" if t < since + self.behavior_spec.tracking_lost.hold_s else "lost"
 
     def look_at(
         self,
@@ -194,7 +211,7 @@ class GazeEngine:
         phase and robot events published before the restart, oldest first."""
         for event in sorted(events, key=lambda e: e.t):
             self.detector.resync(event)
-            self.behavior.handle(event)
+            self._handle([event])
 
     def reset(self, head: Mapping[str, float] | None = None) -> None:
         """Forget the current handover (e.g. after a restart) and optionally the head pose."""
@@ -204,3 +221,4 @@ class GazeEngine:
         self._memory = _PointMemory()
         self._pending.clear()
         self._last_t = -math.inf
+        self._lost_since = math.nan

@@ -206,3 +206,30 @@ def test_a_sample_revealing_several_phase_events_delivers_them_all_at_once():
     assert [k for _, k in kinds] == ["reach_started", "transfer_started"]
     assert kinds[0][0] == kinds[1][0]
     assert cmd.phase == Phase.TRANSFER and cmd.target == "hand"
+
+
+def test_look_at_points_the_real_head_and_eyes_at_a_fixed_point_keeping_the_phase(engine):
+    engine.reset()
+    frames = handover_frames()
+    for f in frames[: int(1.5 * 120)]:  # into the reach
+        engine.step(f)
+    phase = engine.phase
+    assert phase is Phase.REACH
+    point = np.array([1.0, 0.6, 1.2])  # to the robot's left
+    t0 = frames[int(1.5 * 120) - 1].t
+    cmds = [engine.look_at(t0 + i / 120, point, target="dropoff") for i in range(1, 3 * 120)]
+    last = cmds[-1]
+    assert all(c.is_finite() for c in cmds)
+    assert last.target == "dropoff" and last.phase is phase and engine.phase is phase
+    np.testing.assert_allclose(last.target_point, point)
+    # the gaze shift takes time (timing and limits apply), then the line of sight is on it
+    assert cmds[0].residual > math.radians(5)
+    assert last.residual < math.radians(1.0)
+    lo, hi = engine.robot.lower, engine.robot.upper
+    for c in cmds:
+        q = engine.robot.head_vector(c.head)
+        assert np.all(q >= lo - 1e-9) and np.all(q <= hi + 1e-9)
+    assert last.head["head_pan"] > cmds[0].head["head_pan"]  # turned toward the left
+    # a time going back is answered at the last time, never earlier
+    assert engine.look_at(t0, point).t == last.t
+    assert engine.look_at(math.nan, point).t == last.t

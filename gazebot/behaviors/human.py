@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from gazebot.behaviors.spec import AtFraction, Segment, check_target_name
+from gazebot.behaviors.segment import AtFraction, Segment, check_target_name
 
 PHASES = ("reach", "transfer", "retreat")
 
@@ -94,9 +94,6 @@ class HumanGazeModel(_Strict):
                 if key not in known:
                     raise ValueError(f"patterns: {p.name} needs a shift {key} in 'shifts'")
         return self
-
-    def max_segments_per_phase(self) -> int:
-        return max((len(getattr(p, ph)) for p in self.patterns for ph in PHASES), default=1)
 
     def targets(self) -> set[str]:
         return {t for p in self.patterns for ph in PHASES for t in getattr(p, ph)}

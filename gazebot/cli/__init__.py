@@ -10,7 +10,10 @@ import importlib
 import os
 import sys
 
+from gazebot.cli.errors import UsageError
 from gazebot.config import ConfigError
+from gazebot.phases.trajectory import TrajectoryFormatError
+from gazebot.recordings import RecordingError
 
 # Command groups, in the order ``gazebot --help`` lists them.
 COMMAND_MODULES = (
@@ -21,7 +24,9 @@ COMMAND_MODULES = (
     "ik",
     "render",
     "sim",
+    "reach_plan",
     "run",
+    "display",
     "study",
 )
 
@@ -50,8 +55,9 @@ def main(argv: list[str] | None = None) -> int:
         # the interpreter's final flush does not complain again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except (ConfigError, ValueError, OSError) as exc:
-        # OSError covers missing files, directories where a file was expected, permissions.
+    except (ConfigError, TrajectoryFormatError, RecordingError, UsageError, OSError) as exc:
+        # Input errors only: a malformed file, a wrong option, a missing file, a directory where
+        # a file was expected, permissions. Any other exception is a bug: it keeps its traceback.
         print(f"gazebot: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -6,6 +6,8 @@ import argparse
 import json
 import math
 
+from gazebot.cli.errors import UsageError
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``ik`` command."""
@@ -43,11 +45,11 @@ def handle(args: argparse.Namespace) -> int:
 
     target = [float(v) for v in args.target]
     if not all(math.isfinite(v) for v in target):
-        raise ValueError(f"--target must be three finite numbers (m), got {target}")
+        raise UsageError(f"--target must be three finite numbers (m), got {target}")
     robot = RobotModel.load(args.robot)
     sol = solve_ik(robot, target)
     if not sol.valid:
-        raise ValueError(f"cannot look at {target}: {sol.message}")
+        raise UsageError(f"cannot look at {target}: {sol.message}")
     if args.json:
         print(json.dumps(sol.to_json()))
         return 0

@@ -7,6 +7,9 @@ import json
 import math
 from pathlib import Path
 
+from gazebot.cli.errors import UsageError
+from gazebot.config import ConfigError
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
@@ -49,22 +52,28 @@ def handler(args: argparse.Namespace) -> int:
 
     for name in ("yaw", "pitch", "blink"):
         if not math.isfinite(getattr(args, name)):
-            raise ValueError(f"--{name} must be a finite number, got {getattr(args, name)}")
+            raise UsageError(f"--{name} must be a finite number, got {getattr(args, name)}")
     if not 0.0 <= args.blink <= 1.0:
-        raise ValueError(f"--blink must be in 0..1, got {args.blink}")
+        raise UsageError(f"--blink must be in 0..1, got {args.blink}")
     out = Path(args.out)
     if out.suffix.lower() not in (".png", ".jpg", ".jpeg"):
-        raise ValueError(f"--out must end in .png, .jpg or .jpeg, got {out}")
-    renderer = EyeRenderer.for_robot(
-        args.robot, width=args.width, height=args.height, style=args.style
-    )
-    img = renderer.render(
-        math.radians(args.yaw), math.radians(args.pitch), blink=args.blink, distance=args.distance
-    )
+        raise UsageError(f"--out must end in .png, .jpg or .jpeg, got {out}")
+    try:
+        renderer = EyeRenderer.for_robot(
+            args.robot, width=args.width, height=args.height, style=args.style
+        )
+        img = renderer.render(
+            math.radians(args.yaw), math.radians(args.pitch), blink=args.blink,
+            distance=args.distance,
+        )
+    except ConfigError:
+        raise
+    except ValueError as exc:  # the renderer rejects the given size or distance
+        raise UsageError(str(exc)) from None
     if out.parent and not out.parent.is_dir():
         raise FileNotFoundError(f"output folder does not exist: {out.parent}")
     if not cv2.imwrite(str(out), img[..., ::-1]):
-        raise ValueError(f"could not write the image {out}")
+        raise UsageError(f"could not write the image {out}")
     summary = {
         "out": str(out),
         "robot": args.robot,

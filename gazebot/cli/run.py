@@ -6,9 +6,8 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
 
-from gazebot.cli.sim import add_bus_arguments, bus_config, positive
+from gazebot.cli.bus import add_bus_arguments, bus_config, positive
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -21,14 +20,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
     p.add_argument("--behavior", default="face-hand-face", help="behavior name or YAML file")
+    p.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )
     p.add_argument("--phases", default=None, help="phase config YAML (default configs/phases.yaml)")
     p.add_argument("--seed", type=int, default=0, help="seed of behavior timings and blinks")
     p.add_argument("--duration", type=positive, default=None,
                    help="seconds to run (default: until Ctrl-C)")
-    p.add_argument("--hold-timeout", type=positive, default=0.25,
-                   help="s without tracking before holding the gaze (default 0.25)")
-    p.add_argument("--face-timeout", type=positive, default=1.0,
-                   help="s without tracking before looking at the last face (default 1.0)")
+    p.add_argument("--silence-after", type=positive, default=0.15, metavar="S",
+                   help="s without tracking before the engine ticks without samples, so the "
+                   "behavior's tracking-loss policy applies (default 0.15)")
     p.add_argument("--no-robot-warning", type=positive, default=3.0, metavar="S",
                    help="warn on stderr if no robot data arrived after S seconds (default 3)")
     p.add_argument("--no-resync", action="store_true",
@@ -40,69 +44,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=handle)
 
 
-class LazyEyeRenderer:
-    """Builds the robot's eye renderer on first use (only when someone wants frames)."""
-
-    def __init__(self, robot: str) -> None:
-        self.robot = robot
-        self._renderer: Any = None
-
-    def render(
-        self, yaw: float, pitch: float, blink: float = 0.0, distance: float | None = None
-    ) -> Any:
-        if self._renderer is None:
-            from gazebot.render import EyeRenderer
-
-            self._renderer = EyeRenderer.for_robot(self.robot)
-        return self._renderer.render(yaw, pitch, blink=blink, distance=distance)
-
-
-def build_engine_node(
-    robot: str,
-    behavior: str,
-    driver: Any,
-    seed: int = 0,
-    phases: str | None = None,
-    config: Any = None,
-    eye_frames: bool = True,
-    engine: Any = None,
-    warn: Any = None,
-) -> Any:
-    """A :class:`~gazebot.drivers.engine_node.EngineNode` running ``engine`` (default:
-    ``GazeEngine.from_config(robot, behavior, phases, seed=seed)``), with blinks and lazily
-    rendered eye frames; ``warn(text)`` receives operator warnings (no robot seen)."""
-    from gazebot.drivers.engine_node import EngineNode
-    from gazebot.engine import GazeEngine
-
-    if engine is None:
-        engine = GazeEngine.from_config(robot=robot, behavior=behavior, phases=phases, seed=seed)
-    try:
-        from gazebot.render import BlinkModel
-
-        blink = BlinkModel(seed)
-    except ImportError:  # eyes package absent: the eyes never blink
-        blink = None
-    renderer = LazyEyeRenderer(engine.robot.name) if eye_frames else None
-    return EngineNode(engine, driver, config, blink=blink, eye_renderer=renderer, warn=warn)
-
-
 def handle(args: argparse.Namespace) -> int:
-    from gazebot.drivers.engine_node import EngineNodeConfig
+    from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
     from gazebot.drivers.zenoh_driver import ZenohRobotDriver
 
-    if args.face_timeout < args.hold_timeout:
-        raise ValueError("--face-timeout must be >= --hold-timeout")
     cfg = bus_config(args, listens_by_default=False)
     node_cfg = EngineNodeConfig(
-        hold_timeout=args.hold_timeout,
-        face_timeout=args.face_timeout,
+        silence_after=args.silence_after,
         resync=not args.no_resync,
         no_robot_warning=args.no_robot_warning,
     )
-    from gazebot.engine import GazeEngine
+    # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
+    from gazebot.kinematics.config import with_gaze_mode
+    from gazebot.runtime import GazeLoop
 
-    # Build the engine before joining the bus: samples arriving meanwhile would only go stale.
-    engine = GazeEngine.from_config(args.robot, args.behavior, args.phases, seed=args.seed)
+    robot = with_gaze_mode(args.robot, args.gaze_mode)
+    loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
     driver = ZenohRobotDriver.open(cfg, "engine")
     try:
         endpoints = f"listen {list(cfg.listen)}, connect {list(cfg.connect)}"
@@ -110,9 +67,8 @@ def handle(args: argparse.Namespace) -> int:
         def warn(text: str) -> None:
             print(f"gazebot run: warning: {text} ({endpoints})", file=sys.stderr, flush=True)
 
-        node = build_engine_node(args.robot, args.behavior, driver, seed=args.seed,
-                                 config=node_cfg, eye_frames=not args.no_eye_frames,
-                                 engine=engine, warn=warn)
+        node = (EngineNode.with_eye_frames(loop, driver, node_cfg, warn=warn)
+                if not args.no_eye_frames else EngineNode(loop, driver, node_cfg, warn=warn))
         print(
             f"gazebot run: {args.behavior} on {node.engine.robot.name} at gazebot/{cfg.robot_id}/ "
             f"({endpoints})",

@@ -9,58 +9,8 @@ import sys
 import threading
 from typing import Any
 
-from gazebot.drivers.session import DEFAULT_ENDPOINT, EPHEMERAL_ENDPOINT, BusConfig
-
-
-def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool) -> None:
-    """``--id``, ``--listen``, ``--connect``, ``--multicast``: how the node joins the bus.
-
-    By default the robot side (``gazebot sim``) listens on ``tcp/127.0.0.1:7447`` and engine
-    nodes (``gazebot run``) connect to it, listening on an ephemeral port so that other
-    connected nodes reach them too.
-    """
-    listen_default = DEFAULT_ENDPOINT if listens_by_default else EPHEMERAL_ENDPOINT
-    connect_default = "none" if listens_by_default else DEFAULT_ENDPOINT
-    parser.add_argument("--id", default="sim", help="robot id: keys live under gazebot/<id>/")
-    parser.add_argument(
-        "--listen",
-        action="append",
-        metavar="EP",
-        help=f"endpoint to listen on, repeatable (default: {listen_default})",
-    )
-    parser.add_argument(
-        "--connect",
-        action="append",
-        metavar="EP",
-        help=f"peer or router endpoint to connect to, repeatable (default: {connect_default})",
-    )
-    parser.add_argument(
-        "--multicast", action="store_true", help="enable multicast scouting (off by default)"
-    )
-
-
-def bus_config(args: argparse.Namespace, listens_by_default: bool) -> BusConfig:
-    """The :class:`BusConfig` of parsed ``add_bus_arguments`` options."""
-    listen = args.listen if args.listen is not None else (
-        [DEFAULT_ENDPOINT] if listens_by_default else [EPHEMERAL_ENDPOINT])
-    connect = args.connect if args.connect is not None else (
-        [] if listens_by_default else [DEFAULT_ENDPOINT])
-    return BusConfig(
-        robot_id=args.id,
-        listen=tuple(listen),
-        connect=tuple(connect),
-        multicast_scouting=args.multicast,
-    )
-
-
-def positive(value: str) -> float:
-    try:
-        x = float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {value!r}") from None
-    if not x > 0 or x != x:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {value!r}")
-    return x
+from gazebot.cli.bus import add_bus_arguments, bus_config, positive
+from gazebot.cli.errors import UsageError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -75,6 +25,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the giver and the tracking noise")
     p.add_argument("--with-engine", action="store_true", help="run a gaze engine in-process too")
     p.add_argument("--behavior", default="face-hand-face", help="behavior for --with-engine")
+    p.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )
     p.add_argument("--headless", action="store_true", help="no window")
     p.add_argument(
         "--eye-frames",
@@ -110,7 +66,7 @@ class PygameView:
             self.screen = pygame.display.set_mode(self.size)
         except pygame.error as exc:
             pygame.display.quit()
-            raise ValueError(f"cannot open a window ({exc}); use --headless") from exc
+            raise UsageError(f"cannot open a window ({exc}); use --headless") from exc
         pygame.display.set_caption("gazebot sim")
 
     def __call__(self, sim: Any) -> bool:
@@ -143,17 +99,22 @@ def handle(args: argparse.Namespace) -> int:
         node = SimNode(sim, endpoint, SimNodeConfig(speed=args.speed), view=view)
         node.publish_state()
         if args.with_engine:
-            from gazebot.cli.run import build_engine_node
+            from gazebot.drivers.engine_node import EngineNode
             from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+            from gazebot.runtime import GazeLoop
 
             driver = ZenohRobotDriver(endpoint.session, cfg.keys, "engine")
-            engine_node = build_engine_node(args.robot, args.behavior, driver, seed=args.seed)
+            from gazebot.kinematics.config import with_gaze_mode
+
+            robot = with_gaze_mode(args.robot, args.gaze_mode)
+            loop = GazeLoop.from_config(robot, args.behavior, seed=args.seed)
+            engine_node = EngineNode.with_eye_frames(loop, driver)
             thread = threading.Thread(target=engine_node.run, kwargs={"stop": stop},
                                       name="engine-node", daemon=True)
             thread.start()
             # Start the handover once the engine listens (and has taken the head pose).
-            if not engine_node.ready.wait(10.0):
-                raise ValueError("the in-process engine node did not start within 10 s")
+            if not engine_node.ready.wait(60.0):
+                raise TimeoutError("the in-process engine node did not start within 60 s")
         print(
             f"gazebot sim: robot {sim.robot.name} scene {args.scene} on gazebot/{cfg.robot_id}/ "
             f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})"

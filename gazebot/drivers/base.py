@@ -10,6 +10,7 @@ of :mod:`gazebot.drivers.keys`) and :class:`~gazebot.drivers.sim_driver.SimRobot
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import Any
 
 from gazebot.drivers.payloads import (
     ArmCommandMsg,
@@ -85,6 +86,10 @@ class RobotDriver(ABC):
 
     def dropped(self) -> dict[str, int]:
         """Malformed payloads dropped so far, by key."""
+        return {}
+
+    def foreign_versions(self) -> dict[str, Any]:
+        """Keys on which the robot spoke another payload version (dropped), with that version."""
         return {}
 
     def close(self) -> None:  # noqa: B027 - nothing to release by default

@@ -1,12 +1,16 @@
-"""The engine node: runs a :class:`gazebot.engine.GazeEngine` on the tracking a robot driver
+"""The engine node: runs the :class:`gazebot.runtime.GazeLoop` on the tracking a robot driver
 delivers and sends back head commands, eye state (and frames when asked), events and heartbeats.
 
 Faults (each pinned by ``tests/drivers``):
 
-* tracking stops: after ``hold_timeout`` the node holds the gaze (no new head goals; event
-  ``tracking_stale``, status ``tracking: hold``); after ``face_timeout`` it looks at the last known
-  face position (event ``tracking_timeout`` with ``info.face``, head commands with
-  ``mode: last_face``, status ``tracking: lost``) until samples return (``tracking_resumed``).
+* tracking stops: after ``silence_after`` s without a sample the node ticks the loop without one
+  at ``silence_rate`` Hz, so the loop's one tracking-loss policy applies (the phase detector
+  bridges ``max_gap_hold``, then the behavior holds the gaze for its ``tracking_lost.hold_s``:
+  event ``tracking_stale``, status ``tracking: hold``; then it looks at its ``tracking_lost``
+  target, by default the last known face: event ``tracking_timeout`` with ``info.face``, status
+  ``tracking: lost``). Head commands meanwhile say ``mode: tracking_lost``; when samples return,
+  ``tracking_resumed``. A sample older than a silence tick already answered is too late and
+  is dropped by the phase detector (its time is the robot clock estimated from the wall clock).
 * engine restart: at start the node takes the head pose from the joint state and replays the
   current handover's phase and robot events from the other nodes' event history
   (``GazeEngine.resync``), then reports ``engine_resynced``.
@@ -29,11 +33,10 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal, Protocol
-
-import numpy as np
+from typing import Any, Literal
 
 from gazebot.drivers.base import RobotDriver
+from gazebot.drivers.payloads import VERSION as PAYLOAD_VERSION
 from gazebot.drivers.payloads import (
     EventMsg,
     EyeFrameMsg,
@@ -45,24 +48,12 @@ from gazebot.drivers.payloads import (
     jsonable,
     point_or_none,
 )
-from gazebot.types import Event, EventKind, GazeCommand, is_valid_point
+from gazebot.runtime import GazeLoop, LoopCommand
+from gazebot.types import Event, EventKind
 
 log = logging.getLogger("gazebot.drivers")
 
 TrackingState = Literal["waiting", "ok", "hold", "lost"]
-
-
-class EngineLike(Protocol):
-    """What the node needs of :class:`gazebot.engine.GazeEngine`."""
-
-    robot: Any  # .name, .head_joints, .points
-    behavior: Any  # .state
-
-    def step(self, frame: Any, arm: Any = None) -> GazeCommand: ...
-    def look_at(self, t: float, point: Any, target: str = "face") -> GazeCommand: ...
-    def notify(self, event: Event) -> None: ...
-    def resync(self, events: list[Event]) -> None: ...
-    def reset(self, head: Any = None) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -70,9 +61,10 @@ class EngineNodeConfig:
     """Timing of the engine node (s, Hz).
 
     Attributes:
-        hold_timeout: Silence of the tracking after which the gaze is held.
-        face_timeout: Silence after which the node looks at the last known face.
-        fallback_rate: Head command rate while looking at the last face.
+        silence_after: Silence of the tracking (s) after which the node ticks the loop without
+            a sample (the tracking-loss timings themselves are the phase detector's and the
+            behavior's).
+        silence_rate: Rate (Hz) of those ticks while the silence lasts.
         heartbeat_period: Period of the status heartbeat.
         resync: Catch up with a handover under way at start (events + joint state).
         resync_timeout: How long to wait at start for the joint state and the event history.
@@ -83,9 +75,8 @@ class EngineNodeConfig:
             (s) after the start.
     """
 
-    hold_timeout: float = 0.25
-    face_timeout: float = 1.0
-    fallback_rate: float = 30.0
+    silence_after: float = 0.15
+    silence_rate: float = 30.0
     heartbeat_period: float = 0.5
     resync: bool = True
     resync_timeout: float = 1.0
@@ -94,15 +85,13 @@ class EngineNodeConfig:
     no_robot_warning: float = 3.0
 
     def __post_init__(self) -> None:
-        for name in ("hold_timeout", "face_timeout", "fallback_rate", "heartbeat_period",
+        for name in ("silence_after", "silence_rate", "heartbeat_period",
                      "resync_timeout", "eye_frame_rate", "clock_reset", "no_robot_warning"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(
                     f"EngineNodeConfig.{name} must be a positive number, got {value!r}"
                 )
-        if self.face_timeout < self.hold_timeout:
-            raise ValueError("EngineNodeConfig.face_timeout must be >= hold_timeout")
 
 
 def current_handover(events: Sequence[Event]) -> list[Event]:
@@ -116,14 +105,30 @@ def current_handover(events: Sequence[Event]) -> list[Event]:
     return ordered[last:] if last == len(ordered) - 1 else ordered[last + 1 :]
 
 
+class _LazyEyeRenderer:
+    """The robot's eye renderer, built on first use (only when someone wants frames)."""
+
+    def __init__(self, robot: str) -> None:
+        self.robot = robot
+        self._renderer: Any = None
+
+    def render(
+        self, yaw: float, pitch: float, blink: float = 0.0, distance: float | None = None
+    ) -> Any:
+        if self._renderer is None:
+            from gazebot.render import EyeRenderer
+
+            self._renderer = EyeRenderer.for_robot(self.robot)
+        return self._renderer.render(yaw, pitch, blink=blink, distance=distance)
+
+
 class EngineNode:
-    """Drive one robot with one engine.
+    """Drive one robot with one runtime loop.
 
     Args:
-        engine: The gaze engine (``GazeEngine`` or anything with its interface).
+        loop: The runtime loop (engine, blinks, safety, tracking-loss policy).
         driver: The robot (``ZenohRobotDriver`` over the bus, ``SimRobotDriver`` in process).
         config: Timeouts and rates.
-        blink: Optional blink model with ``update(t, gaze_shift_rad) -> 0..1``.
         eye_renderer: Optional renderer with ``render(yaw, pitch, blink=, distance=) -> (H, W, 3)
             uint8``, used only while the robot wants eye frames.
         warn: Called with a one-line message for conditions an operator must see (no robot).
@@ -132,19 +137,18 @@ class EngineNode:
 
     def __init__(
         self,
-        engine: EngineLike,
+        loop: GazeLoop,
         driver: RobotDriver,
         config: EngineNodeConfig | None = None,
         *,
-        blink: Any = None,
         eye_renderer: Any = None,
         warn: Callable[[str], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        self.engine = engine
+        self.loop = loop
+        self.engine = loop.engine
         self.driver = driver
         self.config = config or EngineNodeConfig()
-        self.blink = blink
         self.eye_renderer = eye_renderer
         self.warn = warn
         self.clock = clock
@@ -153,22 +157,33 @@ class EngineNode:
         self.tracking: TrackingState = "waiting"
         self.commands_sent = 0
         self.frames_processed = 0
-        self.unsafe_commands = 0
         self._started = clock()
         self._run_started = self._started
         self._seq = {"head": 0, "eyes": 0, "frame": 0, "event": 0, "status": 0}
         self._last_frame_wall = math.nan
         self._last_t = math.nan
-        self._last_face: np.ndarray | None = None
-        self._last_fallback = -math.inf
+        self._last_silence_tick = -math.inf
         self._last_beat = -math.inf
         self._last_eye_frame = -math.inf
-        self._last_gaze: tuple[float, float] | None = None
         self._behavior_state: str | None = None
         self._target: str | None = None
+        self._version_warned = False
         self._peers: dict[str, bool] = {}
         self._skip_events: set[tuple[str, int, float]] = set()
         self.ready = threading.Event()  # set once started (and resynchronised)
+
+    @classmethod
+    def with_eye_frames(
+        cls,
+        loop: GazeLoop,
+        driver: RobotDriver,
+        config: EngineNodeConfig | None = None,
+        warn: Callable[[str], None] | None = None,
+    ) -> EngineNode:
+        """A node that renders the robot's eye frames (built on first use, only while someone
+        subscribes to them)."""
+        return cls(loop, driver, config, eye_renderer=_LazyEyeRenderer(loop.robot.name),
+                   warn=warn)
 
     # -- helpers ---------------------------------------------------------------------------
     def _next(self, name: str) -> int:
@@ -232,9 +247,9 @@ class EngineNode:
         events = [e for m in history if m.category in ("phase", "robot")
                   if (e := m.to_event()) is not None]
         replay = current_handover(events)
-        self.engine.reset(head)
+        self.loop.reset(head)
         if replay:
-            self.engine.resync(replay)
+            self.loop.resync(replay)
         self.emit(
             "engine_resynced",
             t=replay[-1].t if replay else 0.0,
@@ -267,8 +282,9 @@ class EngineNode:
     def _wait_budget(self) -> float:
         now = self.clock()
         budget = min(0.05, max(0.0, self._last_beat + self.config.heartbeat_period - now))
-        if self.tracking == "lost":
-            due = self._last_fallback + 1 / self.config.fallback_rate
+        if self.tracking != "waiting":
+            due = max(self._last_frame_wall + self.config.silence_after,
+                      self._last_silence_tick + 1 / self.config.silence_rate)
             budget = min(budget, max(0.0, due - now))
         return budget
 
@@ -279,7 +295,7 @@ class EngineNode:
             if (ev.source, ev.seq, ev.stamp) in self._skip_events:
                 continue
             if ev.category == "robot" and (event := ev.to_event()) is not None:
-                self.engine.notify(event)
+                self.loop.notify([event])
         if msg is not None:
             self.on_tracking(msg)
         else:
@@ -290,91 +306,75 @@ class EngineNode:
             self._heartbeat()
 
     def on_tracking(self, msg: TrackingMsg) -> None:
-        """Step the engine with one sample and send the command."""
+        """Tick the loop with one sample and send the command."""
         now = self.clock()
         if msg.t < self._last_t - self.config.clock_reset:
             # The robot's clock went back (e.g. the simulator restarted): the engine would
             # ignore every sample as out of order, so start over from the robot's state.
             self.emit("tracking_clock_reset", t=msg.t, previous_t=self._last_t)
             self._last_t = math.nan
-            self._last_face = None
             self.resync()
-        if self.tracking in ("hold", "lost"):
-            self.emit("tracking_resumed", t=msg.t, silence=now - self._last_frame_wall)
-        self.tracking = "ok"
         self._last_frame_wall = now
         self._last_t = msg.t
-        frame = msg.to_frame()
-        if is_valid_point(frame.giver_face):
-            self._last_face = frame.giver_face
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
-        cmd = self.engine.step(frame, arm=joints.position if joints is not None else None)
+        cmd = self.loop.tick(msg.t, msg.to_frame(),
+                             joints=joints.position if joints is not None else None)
         self.frames_processed += 1
+        if cmd is not None:
+            self._send(cmd, answers=msg.seq)
+
+    def on_silence(self) -> None:
+        """No sample arrived: after ``silence_after``, tick the loop without one (its
+        tracking-loss policy decides where to look)."""
+        if self.tracking == "waiting":
+            return
+        now = self.clock()
+        if (now - self._last_frame_wall < self.config.silence_after
+                or now - self._last_silence_tick < 1 / self.config.silence_rate):
+            return
+        self._last_silence_tick = now
+        cmd = self.loop.tick(self._now_t())
+        if cmd is not None:
+            self._send(cmd, answers=None)
+
+    @property
+    def unsafe_commands(self) -> int:
+        """Commands the loop refused (non-finite): never sent."""
+        return self.loop.unsafe
+
+    def _track(self, cmd: LoopCommand) -> None:
+        """Report the tracking state's changes as fault events."""
+        before, now = self.tracking, cmd.tracking
+        if before == now:
+            return
+        self.tracking = now
+        silence = self.clock() - self._last_frame_wall
+        if now == "ok":
+            if before in ("hold", "lost"):
+                self.emit("tracking_resumed", t=cmd.t, silence=silence)
+            return
+        if before in ("ok", "waiting"):
+            self.emit("tracking_stale", t=cmd.t, silence=silence, last_t=self._last_t)
+        if now == "lost":
+            self.emit("tracking_timeout", t=cmd.t, silence=silence, target=cmd.target,
+                      face=point_or_none(cmd.target_point))
+
+    def _send(self, cmd: LoopCommand, answers: int | None) -> None:
+        self._track(cmd)
         for event in cmd.events:
             if category_of(event.kind.value) == "phase":
                 self.driver.publish_event(
                     EventMsg.from_event(event, self.driver.node, self._next("event"), time.time())
                 )
-        self._send(cmd, answers=msg.seq, mode="behavior")
-        state = str(getattr(self.engine.behavior, "state", ""))
-        if state != self._behavior_state:
-            self._behavior_state = state
-            self.emit("behavior_state", t=cmd.t, category="behavior", state=state)
-        if cmd.target != self._target:
-            self._target = cmd.target
-            self.emit("gaze_target", t=cmd.t, category="behavior", target=cmd.target,
-                      point=point_or_none(cmd.target_point))
-
-    def on_silence(self) -> None:
-        """No sample arrived: hold the gaze, then look at the last face."""
-        if self.tracking == "waiting":
-            return
-        now = self.clock()
-        silence = now - self._last_frame_wall
-        if self.tracking == "ok" and silence >= self.config.hold_timeout:
-            self.tracking = "hold"
-            self.emit("tracking_stale", silence=silence, last_t=self._last_t)
-        if self.tracking == "hold" and silence >= self.config.face_timeout:
-            self.tracking = "lost"
-            self.emit("tracking_timeout", silence=silence, face=point_or_none(self._face()))
-        if self.tracking == "lost" and now - self._last_fallback >= 1 / self.config.fallback_rate:
-            self._last_fallback = now
-            self._look_at_last_face()
-
-    def _face(self) -> np.ndarray:
-        if self._last_face is not None:
-            return self._last_face
-        points = getattr(self.engine.robot, "points", {}) or {}
-        return np.asarray(points.get("face", (1.0, 0.0, 1.5)), float)
-
-    def _look_at_last_face(self) -> None:
-        face = self._face()
-        t = self._now_t()
-        cmd = self.engine.look_at(t, face, target="face")
-        self._send(cmd, answers=None, mode="last_face")
-
-    def _send(self, cmd: GazeCommand, answers: int | None, mode: str) -> None:
-        if not cmd.is_finite():
-            # Never forward a non-finite goal: keep the previous one.
-            self.unsafe_commands += 1
-            log.error("engine produced a non-finite command at t=%.3f; not sent", cmd.t)
-            return
         stamp = time.time()
+        mode = "behavior" if cmd.tracking == "ok" else "tracking_lost"
         self.driver.send_head(
             HeadCommandMsg.from_command(cmd, self._next("head"), stamp, answers, mode)
         )
-        shift = 0.0
-        if self._last_gaze is not None:
-            shift = math.hypot(cmd.eye_yaw - self._last_gaze[0], cmd.eye_pitch - self._last_gaze[1])
-        self._last_gaze = (cmd.eye_yaw, cmd.eye_pitch)
-        blink = 0.0
-        if self.blink is not None:
-            blink = float(np.clip(self.blink.update(cmd.t, shift), 0.0, 1.0))
-        distance = self._target_distance(cmd)
         self.driver.send_eyes(
             EyeStateMsg(seq=self._next("eyes"), t=cmd.t, stamp=stamp, yaw=cmd.eye_yaw,
-                        pitch=cmd.eye_pitch, blink=blink, distance=distance)
+                        pitch=cmd.eye_pitch, blink=cmd.blink, distance=cmd.distance)
         )
         now = self.clock()
         if (
@@ -384,36 +384,40 @@ class EngineNode:
         ):
             self._last_eye_frame = now
             img = self.eye_renderer.render(
-                cmd.eye_yaw, cmd.eye_pitch, blink=blink, distance=distance
+                cmd.eye_yaw, cmd.eye_pitch, blink=cmd.blink, distance=cmd.distance
             )
             frame = EyeFrameMsg.from_image(img, self._next("frame"), cmd.t, stamp)
             self.driver.send_eye_frame(frame)
         self.commands_sent += 1
-
-    def _target_distance(self, cmd: GazeCommand) -> float | None:
-        """Distance (m) from the ``gaze`` site at the commanded head pose to the target point,
-        for the eyes' vergence; ``None`` when unknown (no valid target point, or a robot model
-        without ``gaze_pose``, like the test fakes)."""
-        robot = self.engine.robot
-        gaze_pose = getattr(robot, "gaze_pose", None)
-        if gaze_pose is None or not is_valid_point(cmd.target_point):
-            return None
-        try:
-            origin = gaze_pose(robot.head_vector(cmd.head)).position
-        except (KeyError, ValueError) as exc:
-            log.debug("no gaze pose for the eye distance: %s", exc)
-            return None
-        d = float(np.linalg.norm(np.asarray(cmd.target_point, float) - origin))
-        # A target at the display itself has no defined vergence: treat it as unknown.
-        return d if math.isfinite(d) and d > 1e-3 else None
+        state = str(getattr(self.engine.behavior, "state", ""))
+        if state != self._behavior_state:
+            self._behavior_state = state
+            self.emit("behavior_state", t=cmd.t, category="behavior", state=state)
+        if cmd.target != self._target:
+            self._target = cmd.target
+            self.emit("gaze_target", t=cmd.t, category="behavior", target=cmd.target,
+                      point=point_or_none(cmd.target_point))
 
     def _check_robot_seen(self) -> None:
         """Warn once if no tracking sample or joint state arrived ``no_robot_warning`` s after
-        the start: otherwise a wrong endpoint would look like a quiet robot."""
+        the start: otherwise a wrong endpoint would look like a quiet robot. A robot whose
+        samples arrive in another payload version is reported as such, at once."""
         if self.robot_seen:
             return
         if self.frames_processed or self.driver.joint_state() is not None:
             self.robot_seen = True
+            return
+        foreign = self.driver.foreign_versions()
+        if foreign and not self._version_warned:
+            self._version_warned = True
+            versions = sorted({repr(v) for v in foreign.values()})
+            text = (
+                f"a robot is on the bus but speaks payload version {', '.join(versions)} on "
+                f"{', '.join(sorted(foreign))} (this engine speaks {PAYLOAD_VERSION}): its "
+                "samples are dropped; run the same gazebot version on both sides"
+            )
+            self._warn("payload_version_mismatch", text, keys=sorted(foreign),
+                       versions=[foreign[k] for k in sorted(foreign)], expected=PAYLOAD_VERSION)
             return
         after = self.clock() - self._run_started
         if after < self.config.no_robot_warning or self.warnings:
@@ -423,8 +427,11 @@ class EngineNode:
             f"no robot seen after {after:.1f} s: no tracking or joint state received "
             f"(peers: {peers or 'none'}); is the robot running and the bus endpoint right?"
         )
+        self._warn("no_robot", text, after=after, peers=peers)
+
+    def _warn(self, kind: str, text: str, **info: Any) -> None:
         self.warnings.append(text)
-        self.emit("no_robot", after=after, peers=peers)
+        self.emit(kind, **info)
         if self.warn is not None:
             self.warn(text)
         else:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import base64
 import math
 from collections.abc import Mapping
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -25,6 +25,9 @@ from pydantic import (
 )
 
 from gazebot.types import Event, EventKind, GazeCommand, TrackingFrame, is_valid_point
+
+if TYPE_CHECKING:
+    from gazebot.runtime import LoopCommand
 
 VERSION = 1
 
@@ -53,6 +56,15 @@ class PayloadError(ValueError):
         self.model = model
         self.reason = reason
         super().__init__(f"malformed {model} payload: {reason}")
+
+
+class PayloadVersionError(PayloadError):
+    """A well-formed payload of another protocol version (``version``: what it says, ``None``
+    when it is not a JSON object with a ``v``)."""
+
+    def __init__(self, model: str, version: Any):
+        self.version = version
+        super().__init__(model, f"v: payload version {version!r}, this gazebot speaks {VERSION}")
 
 
 def point_or_none(p: Any) -> Point | None:
@@ -101,7 +113,11 @@ class Msg(BaseModel):
         try:
             msg = cls.model_validate_json(raw if isinstance(raw, str) else bytes(raw))
         except ValidationError as exc:
-            err = exc.errors()[0]
+            errors = exc.errors()
+            for err in errors:  # another version first: its other fields may differ too
+                if tuple(err["loc"]) == ("v",) and err["type"] != "missing":
+                    raise PayloadVersionError(cls.__name__, err.get("input")) from None
+            err = errors[0]
             where = ".".join(str(p) for p in err["loc"]) or "<root>"
             raise PayloadError(cls.__name__, f"{where}: {err['msg']}") from None
         # A payload from the bus must say its version; Python callers may leave the default.
@@ -167,8 +183,9 @@ class HeadCommandMsg(Msg):
 
     ``answers`` is the ``seq`` of the tracking sample this command answers (``null`` for
     commands not caused by a sample, e.g. the tracking-timeout fallback). ``mode`` is
-    ``behavior`` (the gaze behavior chose the target) or ``last_face`` (tracking timed out:
-    looking at the last known face position). ``phase``, ``target``, ``target_point`` and
+    ``behavior`` (the gaze behavior chose the target from tracking) or ``tracking_lost`` (the
+    behavior's tracking-loss policy: holding the gaze, then looking at its ``tracking_lost``
+    target, by default the last known face). ``phase``, ``target``, ``target_point`` and
     ``residual`` (rad) explain the command.
     """
 
@@ -177,7 +194,7 @@ class HeadCommandMsg(Msg):
     stamp: float
     answers: Seq | None = None
     head: dict[Name, float]
-    mode: Literal["behavior", "last_face"] = "behavior"
+    mode: Literal["behavior", "tracking_lost"] = "behavior"
     phase: Name
     target: Name
     target_point: Point | None = None
@@ -186,11 +203,11 @@ class HeadCommandMsg(Msg):
     @classmethod
     def from_command(
         cls,
-        cmd: GazeCommand,
+        cmd: GazeCommand | LoopCommand,
         seq: int,
         stamp: float,
         answers: int | None = None,
-        mode: Literal["behavior", "last_face"] = "behavior",
+        mode: Literal["behavior", "tracking_lost"] = "behavior",
     ) -> HeadCommandMsg:
         residual = float(cmd.residual)
         return cls(

@@ -40,18 +40,28 @@ class DropCounter:
         self.log_first = log_first
         self.log_every = log_every
         self._counts: dict[str, int] = {}
+        self._versions: dict[str, Any] = {}
         self._lock = threading.Lock()
 
-    def drop(self, key: str, reason: str) -> None:
+    def drop(self, key: str, reason: str, version: Any = None) -> None:
+        """Count a dropped payload on ``key``; ``version``: the protocol version it spoke when
+        that was the reason."""
         with self._lock:
             n = self._counts.get(key, 0) + 1
             self._counts[key] = n
+            if version is not None:
+                self._versions[key] = version
         if n <= self.log_first or n % self.log_every == 0:
             log.warning("dropped payload #%d on %s: %s", n, key, reason)
 
     def counts(self) -> dict[str, int]:
         with self._lock:
             return dict(self._counts)
+
+    def versions(self) -> dict[str, Any]:
+        """The other protocol version last seen on each key that had one."""
+        with self._lock:
+            return dict(self._versions)
 
     @property
     def total(self) -> int:
@@ -169,7 +179,7 @@ class ZenohNode:
             try:
                 msg = model.decode(sample.payload.to_bytes())
             except PayloadError as exc:
-                self.drops.drop(key, exc.reason)
+                self.drops.drop(key, exc.reason, getattr(exc, "version", None))
                 return
             try:
                 handler(msg)
@@ -277,6 +287,10 @@ class ZenohNode:
 
     def dropped(self) -> dict[str, int]:
         return self.drops.counts()
+
+    def foreign_versions(self) -> dict[str, Any]:
+        """Keys on which payloads of another protocol version arrived, with that version."""
+        return self.drops.versions()
 
     def heartbeat(
         self,

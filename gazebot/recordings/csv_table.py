@@ -34,8 +34,9 @@ def read_csv(path: str | Path, names: PointNames | None = None, unit: str = "m")
         with path.open(newline="", encoding="utf-8-sig") as fh:
             rows = list(csv.reader(fh))
     except UnicodeDecodeError as exc:
+        byte = exc.object[exc.start]
         raise RecordingError(
-            path, f"not UTF-8 text (byte offset {exc.start}); save it as UTF-8"
+            path, f"not UTF-8 text (byte {byte:#04x} at offset {exc.start}); save it as UTF-8"
         ) from None
     except OSError as exc:
         raise RecordingError(path, f"cannot read: {exc.strerror or exc}") from None

@@ -1,6 +1,7 @@
-"""The one handover loop shared by ``gazebot demo``, ``gazebot render video`` and the study's
-renders: the simulation runs the handover, the gaze engine drives head and eyes every control tick,
-and an observer camera records an H.264 MP4 (yuv420p) off-screen.
+"""The in-process handover recording shared by ``gazebot demo``, ``gazebot render video`` and the
+study's renders: the simulation runs the handover, :class:`gazebot.runtime.GazeLoop` (the same
+loop that drives a robot on the bus) commands head, eyes and blinks every control tick, and an
+observer camera records an H.264 MP4 (yuv420p) off-screen.
 
 Deterministic for a seed: the giver's timing, the engine's random choices and the blinks all derive
 from it, and physics and software rendering are deterministic. The video is written atomically
@@ -16,10 +17,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from gazebot.kinematics.config import RobotConfig
 from gazebot.render.timeline import TickRecord
+from gazebot.runtime import GazeLoop
 from gazebot.types import Event
 
 if TYPE_CHECKING:
@@ -43,21 +43,13 @@ class HandoverRecording:
     robot_events: list[Event] = field(default_factory=list)
 
 
-def _check_size(width: int, height: int, fps: float) -> None:
+def check_video_size(width: int, height: int, fps: float) -> None:
+    """Raise ``ValueError`` unless ``width`` x ``height`` px at ``fps`` is a video we record."""
     for name, v in (("width", width), ("height", height)):
         if isinstance(v, bool) or not isinstance(v, int) or v < 16 or v % 2:
             raise ValueError(f"video {name} must be an even number of pixels >= 16, got {v!r}")
     if not (math.isfinite(fps) and 1.0 <= fps <= CONTROL_HZ):
         raise ValueError(f"fps must be between 1 and {CONTROL_HZ:g}, got {fps}")
-
-
-def _direction_change(prev: np.ndarray | None, cur: np.ndarray) -> float:
-    if prev is None or not (np.all(np.isfinite(prev)) and np.all(np.isfinite(cur))):
-        return 0.0
-    a, b = np.linalg.norm(prev), np.linalg.norm(cur)
-    if a < 1e-9 or b < 1e-9:
-        return 0.0
-    return float(np.arccos(np.clip(prev.dot(cur) / (a * b), -1.0, 1.0)))
 
 
 def expected_duration(sim) -> float:
@@ -87,13 +79,16 @@ def record_handover(
     fps: float = 30.0,
     progress: bool = True,
     on_tick: Callable[[HandoverSimulation, TickRecord], None] | None = None,
+    loop: GazeLoop | None = None,
 ) -> HandoverRecording:
     """Run one handover with the gaze engine in the loop; record the video when ``out_path``.
 
     ``robot`` is a name, a robot YAML path or a parsed config; it is loaded once and the same
     config drives the simulation, the gaze engine and the eye display. ``on_tick(sim, tick)``,
     when given, sees the simulation after each control tick's head and eye commands (e.g. to
-    inspect or render it); it must not step the simulation.
+    inspect or render it); it must not step the simulation. ``loop`` replaces the default
+    :class:`~gazebot.runtime.GazeLoop` (``behavior`` and ``seed`` for its engine and blinks); it
+    must be built for the same robot.
 
     Returns the per-tick timeline, the frame count and the robot's events.
     """
@@ -102,23 +97,20 @@ def record_handover(
     ensure_gl_backend()
     from tqdm import tqdm
 
-    from gazebot.engine import GazeEngine
-    from gazebot.render.blink import BlinkModel
     from gazebot.render.video import open_h264_writer
     from gazebot.sim.robot import load_sim_robot
     from gazebot.sim.simulation import HandoverSimulation
 
-    _check_size(width, height, fps)
+    check_video_size(width, height, fps)
     sim_robot = load_sim_robot(robot)
     sim = HandoverSimulation(robot=sim_robot, scene=scene, seed=seed)
-    engine = GazeEngine.from_config(robot=sim_robot.spec, behavior=behavior, seed=seed)
-    blinks = BlinkModel(seed)
+    if loop is None:
+        loop = GazeLoop.from_config(robot=sim_robot.spec, behavior=behavior, seed=seed)
     dt = 1.0 / CONTROL_HZ
-    gaze_site = sim.data.site(sim.robot.gaze_site)
     tail = sim.config.tail_s
     ticks: list[TickRecord] = []
     events: list[Event] = []
-    frames, done_at, prev_dir = 0, None, None
+    frames, done_at = 0, None
     label = f"{sim_robot.name} {Path(str(behavior)).stem}"
     try:
         writer_ctx = (
@@ -138,40 +130,34 @@ def record_handover(
         ):
             while True:
                 frame = sim.tracking()
-                for event in sim.robot_events():
-                    events.append(event)
-                    engine.notify(event)
+                robot_events = sim.robot_events()
+                events.extend(robot_events)
+                loop.notify(robot_events)
                 # The measured arm pose: on Sawyer the head rides on right_j0.
-                cmd = engine.step(frame, arm=sim.joint_state())
-                sim.apply_head(cmd.head)
-                direction = np.asarray(cmd.target_point, float) - gaze_site.xpos
-                blink = blinks.update(sim.t, _direction_change(prev_dir, direction))
-                prev_dir = direction
-                distance = float(np.linalg.norm(direction))
-                # The eyes converge on the target (EYES' vergence) when its distance is known.
-                sim.apply_eyes(
-                    cmd.eye_yaw,
-                    cmd.eye_pitch,
-                    blink,
-                    distance if math.isfinite(distance) else None,
-                )
-                state = sim.joint_state()
-                ticks.append(
-                    TickRecord(
-                        t=sim.t,
-                        phase=cmd.phase.value,
-                        target=cmd.target,
-                        head=dict(cmd.head),
-                        eye_yaw=cmd.eye_yaw,
-                        eye_pitch=cmd.eye_pitch,
-                        target_point=np.asarray(cmd.target_point, float).copy(),
-                        hand=sim.giver.hand.copy(),
-                        face=sim.scene.giver.face_point.copy(),
-                        head_measured={j: state[j] for j in cmd.head if j in state},
-                        events=tuple(e.kind.value for e in cmd.events),
+                cmd = loop.tick(frame.t, frame, joints=sim.joint_state())
+                if cmd is not None:  # None: an unsafe command, never applied
+                    sim.apply_head(cmd.head)
+                    sim.apply_eyes(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)
+                    state = sim.joint_state()
+                    ticks.append(
+                        TickRecord(
+                            t=sim.t,
+                            phase=cmd.phase.value,
+                            target=cmd.target,
+                            head=dict(cmd.head),
+                            eye_yaw=cmd.eye_yaw,
+                            eye_pitch=cmd.eye_pitch,
+                            target_point=cmd.target_point.copy(),
+                            hand=sim.giver.hand.copy(),
+                            face=sim.scene.giver.face_point.copy(),
+                            head_measured={j: state[j] for j in cmd.head if j in state},
+                            events=tuple(e.kind.value for e in cmd.events),
+                            reach_start_time=(
+                                math.nan if sim.reach_start_time is None else sim.reach_start_time
+                            ),
+                        )
                     )
-                )
-                if on_tick is not None:
+                if on_tick is not None and ticks:
                     on_tick(sim, ticks[-1])
                 # Frame k shows the first tick at or after k / fps.
                 if writer is not None and sim.t >= frames / fps - 1e-9:

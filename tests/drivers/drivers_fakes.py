@@ -23,8 +23,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def wait_until(pred: Callable[[], object], timeout: float = 3.0, poll: float = 0.005) -> bool:
-    """Poll ``pred`` until it is truthy or ``timeout`` s passed; returns its last truthiness."""
+def wait_until(pred: Callable[[], object], timeout: float = 30.0, poll: float = 0.005) -> bool:
+    """Poll ``pred`` until it is truthy or ``timeout`` s passed; returns its last truthiness.
+
+    The deadline is generous on purpose: it only bounds a failing test, and a busy 2-core CI
+    machine can stall a thread for seconds."""
     end = time.monotonic() + timeout
     while True:
         if pred():
@@ -49,13 +52,47 @@ class FakeGaze:
         return SimpleNamespace(head=dict(self.head), eye_yaw=0.0, eye_pitch=0.0, residual=0.0)
 
 
-class FakeEngine:
-    """Looks at the face; ``reach_started`` when the giver's hand comes closer than 0.7 m."""
+class FakeClock:
+    """A monotonic clock the test moves by hand (peer timeouts without wall-clock races)."""
+
+    def __init__(self, now: float = 0.0) -> None:
+        self.now = now
+
+    def __call__(self) -> float:
+        return self.now
+
+
+class FakeEyes:
+    def clip(self, yaw: float, pitch: float) -> tuple[float, float, bool]:
+        return yaw, pitch, False
+
+
+class FakeRobot:
+    """Pan-only head whose ``gaze`` frame sits 1.5 m above the base."""
+
+    name = "fake"
+    head_joints = ["head_pan"]
+    lower = np.array([-PAN_LIMIT])
+    upper = np.array([PAN_LIMIT])
+    rest = np.array([0.0])
+    eyes = FakeEyes()
 
     def __init__(self) -> None:
-        self.robot = SimpleNamespace(
-            name="fake", head_joints=["head_pan"], points={"face": np.array([1.0, 0.0, 1.5])}
-        )
+        self.points = {"face": np.array([1.0, 0.0, 1.5])}
+
+    def gaze_frame_lists(self, q) -> list[list[float]]:
+        return [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.5]]
+
+
+class FakeEngine:
+    """Looks at the face; ``reach_started`` when the giver's hand comes closer than 0.7 m.
+
+    A step without any tracked point counts as tracking lost at once (``hold`` for 0.1 s, then
+    ``lost``), looking at the last face meanwhile."""
+
+    def __init__(self) -> None:
+        self.robot = FakeRobot()
+        self.lost_since: float | None = None
         self.gaze = FakeGaze()
         self.behavior = SimpleNamespace(state="start")
         self.phase = Phase.IDLE
@@ -65,9 +102,21 @@ class FakeEngine:
         self.frames: list[TrackingFrame] = []
         self._face = self.robot.points["face"]
 
+    def tracking_state(self, t: float) -> str:
+        if self.lost_since is None:
+            return "ok"
+        return "hold" if t < self.lost_since + 0.1 else "lost"
+
     def step(self, frame: TrackingFrame, arm: dict | None = None) -> GazeCommand:
         self.frames.append(frame)
         events = []
+        tracked = is_valid_point(frame.giver_hand) or is_valid_point(frame.giver_face)
+        if not tracked and self.lost_since is None:
+            self.lost_since = frame.t
+            events.append(Event(EventKind.TRACKING_LOST, frame.t, frame.t))
+        elif tracked and self.lost_since is not None:
+            self.lost_since = None
+            events.append(Event(EventKind.TRACKING_RESTORED, frame.t, frame.t))
         if (
             self.phase == Phase.IDLE
             and is_valid_point(frame.giver_hand)
@@ -84,13 +133,6 @@ class FakeEngine:
             eye_yaw=0.0, eye_pitch=0.0, events=tuple(events),
         )
 
-    def look_at(self, t: float, point: np.ndarray, target: str = "face") -> GazeCommand:
-        st = self.gaze.update(t, point)
-        return GazeCommand(
-            t=t, phase=self.phase, target=target, target_point=np.asarray(point, float),
-            head=st.head, eye_yaw=0.0, eye_pitch=0.0,
-        )
-
     def notify(self, event: Event) -> None:
         self.notified.append(event)
 
@@ -105,5 +147,6 @@ class FakeEngine:
     def reset(self, head: dict | None = None) -> None:
         self.reset_heads.append(head)
         self.phase = Phase.IDLE
+        self.lost_since = None
         if head:
             self.gaze.head = dict(head)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import time
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from drivers_fakes import FakeEngine, free_port
 from gazebot.drivers.base import RobotDriver
 from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
 from gazebot.drivers.payloads import EyeStateMsg, PayloadError, TrackingMsg
+from gazebot.runtime import GazeLoop
 from gazebot.types import TrackingFrame
 
 
@@ -110,7 +112,8 @@ def test_engine_node_sends_the_distance_from_the_gaze_site_to_the_target_and_ren
     drv = MemoryDriver()
     drv.frames = True
     renderer = RecordingRenderer()
-    node = EngineNode(engine, drv, EngineNodeConfig(eye_frame_rate=1e6), eye_renderer=renderer)
+    node = EngineNode(GazeLoop(engine), drv, EngineNodeConfig(eye_frame_rate=1e6),
+                      eye_renderer=renderer)
     commands = []
     original = engine.step
 
@@ -130,13 +133,6 @@ def test_engine_node_sends_the_distance_from_the_gaze_site_to_the_target_and_ren
     assert renderer.calls[-1]["distance"] == pytest.approx(drv.eyes[-1].distance)
 
 
-def test_engine_node_without_a_gaze_pose_sends_unknown_distance():
-    drv = MemoryDriver()
-    node = EngineNode(FakeEngine(), drv, EngineNodeConfig())
-    node.on_tracking(_tracking(0.0))
-    assert drv.eyes[-1].distance is None
-
-
 # -- no robot seen -------------------------------------------------------------------------
 class Clock:
     def __init__(self) -> None:
@@ -151,7 +147,7 @@ def test_no_robot_seen_warns_once_and_degrades_the_status():
     drv = MemoryDriver()
     warnings: list[str] = []
     cfg = EngineNodeConfig(no_robot_warning=3.0, heartbeat_period=0.5, resync=False)
-    node = EngineNode(FakeEngine(), drv, cfg, warn=warnings.append, clock=clock)
+    node = EngineNode(GazeLoop(FakeEngine()), drv, cfg, warn=warnings.append, clock=clock)
     node.start()
     for now in (0.5, 1.0, 2.9):
         clock.now = now
@@ -178,7 +174,8 @@ def test_robot_seen_in_time_gives_no_warning():
     drv = MemoryDriver()
     warnings: list[str] = []
     node = EngineNode(
-        FakeEngine(), drv, EngineNodeConfig(resync=False), warn=warnings.append, clock=clock
+        GazeLoop(FakeEngine()), drv, EngineNodeConfig(resync=False), warn=warnings.append,
+        clock=clock
     )
     node.start()
     clock.now = 1.0
@@ -234,3 +231,54 @@ def test_run_cli_with_unreachable_connect_warns_and_reports_it_in_json(capsys):
     assert summary["robot_seen"] is False and summary["peers"] == {}
     assert len(summary["warnings"]) == 1 and "no robot seen" in summary["warnings"][0]
     assert "gazebot run: warning: no robot seen" in captured.err and nowhere in captured.err
+
+
+# -- another payload version ---------------------------------------------------------------
+def test_a_payload_of_another_version_is_told_apart_from_a_malformed_one():
+    from gazebot.drivers.payloads import PayloadVersionError
+
+    with pytest.raises(PayloadVersionError, match="payload version 2") as info:
+        TrackingMsg.decode(b'{"v":2,"seq":0,"t":0.0,"stamp":0.0,"hand":[1,2,3]}')
+    assert info.value.version == 2
+    with pytest.raises(PayloadError) as info:
+        TrackingMsg.decode(b'{"seq":0,"t":0.0,"stamp":0.0}')
+    assert not isinstance(info.value, PayloadVersionError)
+
+
+class OtherVersionRobot(MemoryDriver):
+    def foreign_versions(self):
+        return {"gazebot/sim/tracking": 2}
+
+
+def test_a_robot_speaking_another_payload_version_is_reported_as_such_at_once():
+    clock = Clock()
+    drv = OtherVersionRobot()
+    warnings: list[str] = []
+    cfg = EngineNodeConfig(no_robot_warning=3.0, resync=False)
+    node = EngineNode(GazeLoop(FakeEngine()), drv, cfg, warn=warnings.append, clock=clock)
+    node.start()
+    for now in (0.1, 0.2, 5.0, 9.0):
+        clock.now = now
+        node.tick()
+    assert len(warnings) == 1
+    assert "payload version 2 on gazebot/sim/tracking" in warnings[0]
+    assert "no robot seen" not in warnings[0]
+    [event] = [e for e in drv.events if e.kind == "payload_version_mismatch"]
+    assert event.info["versions"] == [2] and event.info["expected"] == 1
+    assert not [e for e in drv.events if e.kind == "no_robot"]
+
+
+@pytest.mark.zenoh
+def test_zenoh_driver_remembers_the_version_a_robot_spoke(bus):
+    from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+
+    drv = ZenohRobotDriver(bus.connector(), bus.config().keys)
+    bus.closers.append(drv.close)
+    robot = bus.listener()
+    key = bus.config().keys.tracking
+    deadline = time.monotonic() + 30
+    while not drv.foreign_versions():
+        robot.put(key, b'{"v":3,"seq":0,"t":0.0,"stamp":0.0}')
+        assert time.monotonic() < deadline
+        time.sleep(0.02)
+    assert drv.foreign_versions() == {key: 3} and drv.dropped()[key] >= 1

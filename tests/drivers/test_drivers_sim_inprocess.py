@@ -12,6 +12,7 @@ from gazebot.drivers.sim_driver import SimRobotDriver
 
 def run_handover(seed: int):
     from gazebot.engine import GazeEngine
+    from gazebot.runtime import GazeLoop
     from gazebot.sim import HandoverSimulation
 
     with HandoverSimulation("sawyer", "default", seed=seed) as sim:
@@ -19,7 +20,8 @@ def run_handover(seed: int):
         sent: list[HeadCommandMsg] = []
         send = driver.send_head
         driver.send_head = lambda msg: (sent.append(msg), send(msg))[1]
-        node = EngineNode(GazeEngine.from_config("sawyer", "face-hand-face", seed=seed), driver)
+        node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face", seed=seed)),
+                          driver)
         node.start()
         while not sim.done and sim.t < 15:
             node.tick()

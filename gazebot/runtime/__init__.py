@@ -1,0 +1,8 @@
+"""The one runtime loop from tracking to the robot's head, eyes and lids (:class:`GazeLoop`),
+shared by the video recordings, the engine node on the bus and the in-process drivers."""
+
+from __future__ import annotations
+
+from gazebot.runtime.loop import GazeLoop, LoopCommand, TrackingState
+
+__all__ = ["GazeLoop", "LoopCommand", "TrackingState"]
