@@ -14,8 +14,9 @@ missed); a load share above ``load_share_robot`` starts the retreat. Once frames
 evidence, hand motion alone no longer starts a transfer (hands resting close together while the
 robot has not grasped are a giver waiting).
 
-A reach the analysis no longer shows for ``online_period`` + ``max_refine`` (the hands parted
-before any transfer) ends as ``handover_done`` with ``source = "aborted"``; a retreat longer
+A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
+back about as far apart as when it started (taken back before any transfer), ends as
+``handover_done`` with ``source = "aborted"``; a retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
 
 Bad samples: a frame with a non-finite time, or a time not after the last accepted one
@@ -355,7 +356,10 @@ class PhaseDetector:
                     self._reach_missing_since = math.nan
                 elif self._reach_missing_since != self._reach_missing_since:
                     self._reach_missing_since = now
-                elif now - self._reach_missing_since > c.online_period + c.max_refine:
+                elif (
+                    now - self._reach_missing_since > c.online_period + c.max_refine
+                    and self._hands_back_apart()
+                ):
                     self._done(now, now, "aborted")
                 return
             if ph is Phase.TRANSFER:
@@ -378,6 +382,21 @@ class PhaseDetector:
             if now - self.phase_start > c.max_retreat:
                 self._done(now, now, "timeout")
             return
+
+    def _hands_back_apart(self) -> bool:
+        """The hands are (almost) as far apart as when the current reach started: the reach
+        was taken back, not merely paused (a reach that pauses is still a reach)."""
+        s = self._signals
+        if s is None or s.t.shape[0] == 0:
+            return True
+        d = s.distance
+        ok = np.flatnonzero(np.isfinite(d))
+        if ok.size == 0:
+            return True
+        i0 = int(np.searchsorted(s.t, self.phase_start))
+        before = ok[ok <= i0]
+        d0 = float(d[before[-1]] if before.size else d[ok[0]])
+        return float(d[ok[-1]]) >= d0 - self.config.reach_confirm_distance
 
     def _done(self, t0: float, now: float, source: str) -> None:
         t0 = max(min(t0, now), self.phase_start)

@@ -153,3 +153,23 @@ def test_no_handover_gives_no_segments_with_every_method():
     for m in ("gazebot", "seed-7.2.5", "seed-4.4.3"):
         assert segment(traj, PhaseConfig(method=m)) == [] or m == "seed-4.4.3"
     assert segment(traj, PhaseConfig()) == []
+
+
+@needs_kth
+@pytest.mark.parametrize(
+    "giver, taker", [("giver_RFArm", "taker_RFArm"), ("giver_RHand", "taker_RFArm")]
+)
+def test_kth_with_forearm_markers_still_gives_one_handover(giver, taker):
+    # Another marker placement on the same recording: wrist-level frames, farther apart.
+    t0, t1 = force_truth(KTH)  # type: ignore[arg-type]
+    traj = load_recording(KTH, PointNames(giver, taker), rate=RATE).trajectory  # type: ignore[arg-type]
+    segs = segment(traj, PhaseConfig())
+    assert _phases(segs) == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT]
+    assert abs(segs[1].start - t0) <= 0.100 and abs(segs[1].end - t1) <= 0.100
+    kinds = [e.kind for e in run_online(traj, PhaseConfig()).events]
+    assert kinds == [
+        EventKind.REACH_STARTED,
+        EventKind.TRANSFER_STARTED,
+        EventKind.RETREAT_STARTED,
+        EventKind.HANDOVER_DONE,
+    ]
