@@ -89,7 +89,8 @@ class HandoverSimulation:
         tracking_noise: Overrides the scene's tracking noise (``None``: the scene's).
         giver_factory: Builds the person instead of the simulated one, called as
             ``(rest, offer, plan, cued)`` (e.g. :func:`gazebot.sim.giver_replay.replay_factory`
-            for recorded motion).
+            for recorded motion); ``None``: the scene's ``giver_motion`` if it has one (study
+            scenes), else the simulated giver.
     """
 
     def __init__(
@@ -138,6 +139,13 @@ class HandoverSimulation:
         # A robot-initiated giver waits for the robot's reach (respond_at) plus a reaction time.
         # ``giver`` is the simulated person: in a robot-to-human scene, the one who takes it.
         human = SimulatedReceiver if self.robot_to_human else SimulatedGiver
+        if giver_factory is None and self.config.giver_motion is not None:
+            from gazebot.sim.giver_replay import load_giver_motion
+
+            gm = self.config.giver_motion
+            giver_factory = load_giver_motion(
+                gm.file, gm.giver_hand, gm.receiver_hand, gm.giver_face, gm.unit, gm.rate_hz
+            )
         if giver_factory is not None:
             human = giver_factory  # e.g. a recorded giver (gazebot.sim.giver_replay)
         self.giver = human(

@@ -76,3 +76,17 @@ def test_demo_with_a_wrong_giver_name_fails_with_exit_2(recorded, tmp_path, caps
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"gazebot: error: {path}: no point named 'wrist'") and "giver_hand" in err
+
+
+def test_a_scene_with_giver_motion_replays_it(recorded, tmp_path):
+    # Study scenes are scene YAMLs: the same key drives them.
+    from gazebot.sim.giver_replay import ReplayedGiver
+    from gazebot.sim.scene_config import GiverMotionConfig, SceneConfig
+    from gazebot.sim.simulation import HandoverSimulation
+
+    sh, _ = recorded
+    path = sh.trajectory.to_csv(tmp_path / "giver.csv")
+    scene = SceneConfig(name="replay", giver_motion=GiverMotionConfig(file=str(path)))
+    with HandoverSimulation("sawyer", scene) as sim:
+        assert isinstance(sim.giver, ReplayedGiver)
+        assert np.allclose(sim.tracking().giver_hand, sim.layout.rest_hand, atol=0.01)
