@@ -73,7 +73,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "eyes-only with one); the instructions name the head or the eyes to match",
     )
     p.add_argument("--seed", type=int, default=0, help="randomisation seed")
-    p.add_argument("--robot", default="sawyer")
+    p.add_argument(
+        "--robot",
+        default=None,
+        help="robot config (default: the seed's: jaco2, the Jaco-2 with its head, without a "
+        "condition (6.3); sawyer with one (6.4))",
+    )
     p.add_argument("--video-seed", type=int, default=0, help="seed of every rendered handover")
     p.add_argument(
         "--scene",
@@ -240,6 +245,7 @@ def _plan(args: argparse.Namespace) -> int:
         "sessions_per_participant": len(plan) // args.participants,
         "behaviors": behaviors,
         "condition": args.condition or "",
+        "robot": plan[0].robot,
         "gaze_mode": plan[0].gaze_mode,
         "position_balanced": report.position_balanced,
         "carryover_balanced": report.carryover_balanced,
@@ -249,7 +255,8 @@ def _plan(args: argparse.Namespace) -> int:
     else:
         print(
             f"wrote {len(plan)} sessions ({len(plan) // args.participants} per participant) for "
-            f"{args.participants} participants to {args.out} (gaze mode {plan[0].gaze_mode}, "
+            f"{args.participants} participants to {args.out} (robot {plan[0].robot}, gaze mode "
+            f"{plan[0].gaze_mode}, "
             f"position balanced: {report.position_balanced}, "
             f"carry-over balanced: {report.carryover_balanced})"
         )

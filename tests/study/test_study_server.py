@@ -77,7 +77,7 @@ def test_session_page_shows_the_seed_questions_and_no_behavior_names(fresh):
     assert "Which handover did you like better? (1st or 2nd)" in page
     assert "wanted the giver to give the object? (1st or 2nd)" in page
     assert "Any other comments (optional)" in page
-    for name in ("face", "hand", "short-face-hand", "sawyer", '.mp4">'):
+    for name in ("face", "hand", "short-face-hand", "jaco2", "sawyer", '.mp4">'):
         assert f"{name}_" not in page and f"/{name}" not in page
     assert page.count("<video") == 2 and "disabled" in page  # questions wait for both videos
 
