@@ -346,7 +346,8 @@ def _analyze(args: argparse.Namespace) -> int:
     for m, b in result.bias.items():
         print(f"first/second bias {m}: S={b.s:.1f} p={b.p_value:.2f}")
     for q, b in result.bias_per_question.items():
-        print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_value:.2f}")
+        # The seed quotes z with its normal p (6.4.4: "like: z = -0.68, p = 0.50").
+        print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_z:.2f}")
     for c in result.comparisons:
         print(
             f"{c.measure} {c.behavior_i} vs {c.behavior_j} ({c.design}, n={c.n_a}/{c.n_b}): "

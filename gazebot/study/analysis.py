@@ -280,7 +280,14 @@ class StudyAnalysis:
                 for m, b in self.bias.items()
             },
             "bias_per_question": {
-                q: {"W": b.statistic, "S": b.s, "z": b.z, "n": b.n, "p_value": b.p_value}
+                q: {
+                    "W": b.statistic,
+                    "S": b.s,
+                    "z": b.z,
+                    "n": b.n,
+                    "p_value": b.p_value,
+                    "p_z": b.p_z,
+                }
                 for q, b in self.bias_per_question.items()
             },
             "sides": self.sides,

@@ -246,6 +246,7 @@ def test_bias_is_tested_per_question_as_in_6_4_and_sides_default_to_one(two_leve
     assert one.sides == "one" and one.to_json()["bias_per_question"]["q5"]["z"] == (
         one.bias_per_question["q5"].z
     )
+    assert one.to_json()["bias_per_question"]["q5"]["p_z"] == one.bias_per_question["q5"].p_z
     for c1, c2 in zip(one.comparisons, two.comparisons, strict=True):
         assert c1.difference.z == c2.difference.z
         assert c1.difference.p_value == pytest.approx(c2.difference.p_value / 2)
