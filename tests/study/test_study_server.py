@@ -192,6 +192,18 @@ def test_in_person_mode_enters_answers_in_plan_order_with_the_in_person_question
     assert study.store().progress(3).finished_at is not None
 
 
+def test_admin_table_shows_an_in_person_participants_next_live_pair_not_a_practice(fresh):
+    """In person there is no practice session: after two entered pairs the table says session
+    3 (it said "practice" for as long as the participant took part)."""
+    study = load_study(fresh)
+    c = client(fresh)
+    for s in study.sessions_of(3)[:2]:
+        resp = c.post("/admin/in-person/3", data={**ANSWERS, "session": str(s.session)})
+        assert resp.status_code == 303
+    row = "<td>3</td><td>in-person</td><td>2 / 6</td><td>session 3</td>"
+    assert row in c.get("/admin").get_data(as_text=True)
+
+
 def test_in_person_entry_for_an_online_participant_is_refused(fresh):
     c = client(fresh)
     start(c, 4)
