@@ -362,10 +362,17 @@ def analyze(
         result.per_level[sample] = {}
         for measure, questions in MEASURES.items():
             w = win_matrix(rows, behaviors, questions)
-            fit = fit_bradley_terry(w, behaviors)
+            n = len({r.who for r in rows})
+            try:
+                fit = fit_bradley_terry(w, behaviors)
+            except ValueError as exc:  # say which sample: a study may hold several
+                raise ValueError(
+                    f"sample {sample or '(single scenario)'!r} ({n} participants, "
+                    f"{len(rows)} sessions), {measure}: {exc}"
+                ) from None
             result.per_level[sample][measure] = MeasureResult(
                 measure=measure,
-                participants=len({r.who for r in rows}),
+                participants=n,
                 wins=w,
                 fit=fit,
                 chi2=likelihood_ratio_chi2(w, fit.p),

@@ -250,3 +250,17 @@ def test_bias_is_tested_per_question_as_in_6_4_and_sides_default_to_one(two_leve
     for c1, c2 in zip(one.comparisons, two.comparisons, strict=True):
         assert c1.difference.z == c2.difference.z
         assert c1.difference.p_value == pytest.approx(c2.difference.p_value / 2)
+
+
+def test_a_sample_without_a_finite_fit_is_named_in_the_error(tmp_path):
+    """An in-person group with two sessions entered so far: the error says which sample."""
+    path = tmp_path / "r.csv"
+    head = "participant,session,condition,level,first,second,q1,q2,q3,q4,q5,group\n"
+    rows = [
+        f"{p},{k},,,{a},{b},1,2,1,2,1,video"
+        for p in (1, 2)
+        for k, (a, b) in enumerate([("face", "hand"), ("hand", "face")], start=1)
+    ] + ["3,1,,,face,hand,1,1,1,1,1,in-person", "3,2,,,hand,face,2,2,2,2,2,in-person"]
+    path.write_text(head + "\n".join(rows) + "\n")
+    with pytest.raises(ValueError, match=r"sample 'in-person:' \(1 participants, 2 sessions\)"):
+        analyze(read_responses(path))
