@@ -348,6 +348,10 @@ def _analyze(args: argparse.Namespace) -> int:
     for q, b in result.bias_per_question.items():
         # The seed quotes z with its normal p (6.4.4: "like: z = -0.68, p = 0.50").
         print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_z:.2f}")
+    for g, tests in result.bias_by_group.items():
+        for k, b in tests.items():
+            p = b.p_z if k.startswith("q") else b.p_value
+            print(f"first/second bias, group {g}, {k}: S={b.s:.1f} z={b.z:.2f} p={p:.2f}")
     for c in result.comparisons:
         print(
             f"{c.measure} {c.behavior_i} vs {c.behavior_j} ({c.design}, n={c.n_a}/{c.n_b}): "

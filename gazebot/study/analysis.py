@@ -252,6 +252,9 @@ class StudyAnalysis:
     per_level: dict[str, dict[str, MeasureResult]] = field(default_factory=dict)
     bias: dict[str, BiasTest] = field(default_factory=dict)
     bias_per_question: dict[str, BiasTest] = field(default_factory=dict)
+    #: With several ``group`` s: the bias tests of each group on its own (measures and
+    #: questions), as the seed reports each study's (6.4.4 video, 6.4.5 in person).
+    bias_by_group: dict[str, dict[str, BiasTest]] = field(default_factory=dict)
     comparisons: list[LevelComparison] = field(default_factory=list)
     sides: str = "one"
 
@@ -289,6 +292,20 @@ class StudyAnalysis:
                     "p_z": b.p_z,
                 }
                 for q, b in self.bias_per_question.items()
+            },
+            "bias_by_group": {
+                g: {
+                    k: {
+                        "W": b.statistic,
+                        "S": b.s,
+                        "z": b.z,
+                        "n": b.n,
+                        "p_value": b.p_value,
+                        "p_z": b.p_z,
+                    }
+                    for k, b in tests.items()
+                }
+                for g, tests in self.bias_by_group.items()
             },
             "sides": self.sides,
             "level_comparisons": [
@@ -342,7 +359,8 @@ def analyze(
     difference and equivalence tests (margin ``margin``) per pair of behaviors: matched or
     unmatched as the module doc explains. ``behaviors`` fixes the order of the conditions
     (default: :func:`behaviors_of`). The bias test is run per measure and per question (the seed
-    reports it per measure in 6.3 and per question in 6.4). ``sides``: p-values of the difference
+    reports it per measure in 6.3 and per question in 6.4), over all participants and, with
+    several groups, per group. ``sides``: p-values of the difference
     tests, ``"one"`` (one-sided in the observed direction, as the seed's Tables B.7-B.12) or
     ``"two"``."""
     if sides not in ("one", "two"):
@@ -383,6 +401,15 @@ def analyze(
     for q in QUESTIONS:
         diffs = position_differences(responses, (q,), bias_unit)
         result.bias_per_question[q] = position_bias_test(diffs)
+    groups = list(dict.fromkeys(r.group for r in responses))
+    if len(groups) > 1:  # independent studies: each its own bias test, as the seed reports them
+        for g in groups:
+            rows = [r for r in responses if r.group == g]
+            tests = dict(MEASURES) | {q: (q,) for q in QUESTIONS}
+            result.bias_by_group[g] = {
+                k: position_bias_test(position_differences(rows, qs, bias_unit))
+                for k, qs in tests.items()
+            }
     for a, b in comparable_samples(responses):
         result.comparisons += _compare(a, b, behaviors, margin, sides)
     return result

@@ -264,3 +264,24 @@ def test_a_sample_without_a_finite_fit_is_named_in_the_error(tmp_path):
     path.write_text(head + "\n".join(rows) + "\n")
     with pytest.raises(ValueError, match=r"sample 'in-person:' \(1 participants, 2 sessions\)"):
         analyze(read_responses(path))
+
+
+def test_bias_is_also_tested_per_group_as_the_seed_tests_each_study(tmp_path):
+    """Video participants who always pick the 2nd, in-person ones who pick either: the video
+    group's bias shows on its own, the in-person group's does not."""
+    path = tmp_path / "r.csv"
+    head = "participant,session,condition,level,first,second,q1,q2,q3,q4,q5,group\n"
+    pairs = [("face", "hand"), ("hand", "face")]
+    rows = []
+    for p in range(1, 11):
+        for k, (a, b) in enumerate(pairs, start=1):
+            rows.append(f"{p},{k},,,{a},{b},2,2,2,2,2,video")
+            even = "1" if (p + k) % 2 else "2"
+            rows.append(f"{p},{k},,,{a},{b},{','.join([even] * 5)},in-person")
+    path.write_text(head + "\n".join(rows) + "\n")
+    result = analyze(read_responses(path))
+    assert set(result.bias_by_group) == {"video", "in-person"}
+    video, live = result.bias_by_group["video"], result.bias_by_group["in-person"]
+    assert video["q1"].z < -2.5 and video["q1"].p_z < 0.01 and video["likability"].p_value < 0.01
+    assert live["q1"].z == 0 and live["q1"].p_z == 1.0
+    assert result.to_json()["bias_by_group"]["video"]["q5"]["p_z"] == video["q5"].p_z
