@@ -65,6 +65,8 @@ from gazebot.study.stats import (
 RESPONSE_COLUMNS = ("participant", "session", "condition", "level", "first", "second") + tuple(
     QUESTIONS
 )
+# Rows of the seed's Tables 6.1 and 6.2.
+TABLE_6_1_ORDER = ("face", "hand", "long-face-hand", "short-face-hand")
 #: Optional column: independent participant groups (e.g. ``video`` / ``in-person``).
 GROUP_COLUMN = "group"
 
@@ -150,8 +152,11 @@ def read_responses(path: str | Path) -> list[Response]:
 
 
 def behaviors_of(responses: list[Response]) -> list[str]:
-    """The behaviors compared, the seed's defaults first (in their order), then the others."""
+    """The behaviors compared, the seed's first (in the order of its tables), then the others.
+    A study of the 6.3 behaviors only is ordered as Tables 6.1/6.2: Face, Hand, L-FH, S-FH."""
     seen = {r.first for r in responses} | {r.second for r in responses}
+    if seen <= set(REACH_BEHAVIORS):
+        return [b for b in TABLE_6_1_ORDER if b in seen]
     order = dict.fromkeys((*DEFAULT_BEHAVIORS, "hand-face", "face-hand-face", *REACH_BEHAVIORS))
     known = [b for b in order if b in seen]
     return known + sorted(seen - set(known))

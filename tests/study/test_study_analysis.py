@@ -285,3 +285,19 @@ def test_bias_is_also_tested_per_group_as_the_seed_tests_each_study(tmp_path):
     assert video["q1"].z < -2.5 and video["q1"].p_z < 0.01 and video["likability"].p_value < 0.01
     assert live["q1"].z == 0 and live["q1"].p_z == 1.0
     assert result.to_json()["bias_by_group"]["video"]["q5"]["p_z"] == video["q5"].p_z
+
+
+def test_the_6_3_behaviors_are_reported_in_the_order_of_tables_6_1_and_6_2(tmp_path):
+    from gazebot.study.analysis import behaviors_of
+
+    path = tmp_path / "r.csv"
+    head = "participant,session,condition,level,first,second,q1,q2,q3,q4,q5\n"
+    pairs = [("short-face-hand", "hand"), ("face", "long-face-hand"), ("hand", "face")]
+    rows = [f"1,{k},,,{a},{b},1,2,1,2,1" for k, (a, b) in enumerate(pairs, start=1)]
+    path.write_text(head + "\n".join(rows) + "\n")
+    assert behaviors_of(read_responses(path)) == [
+        "face",
+        "hand",
+        "long-face-hand",
+        "short-face-hand",
+    ]
