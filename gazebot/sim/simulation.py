@@ -173,19 +173,11 @@ class HandoverSimulation:
         """The seed's reach controller on the arm, or None for the joint-space reach."""
         if ctrl.reach_controller is ReachControllerName.JOINT:
             return None
-        from gazebot.controllers import load_controllers_config, make_controller
+        from gazebot.controllers import make_controller
         from gazebot.controllers.arm_ik import ArmIK
+        from gazebot.sim.cartesian_reach import scene_controllers_config
 
-        cfg = load_controllers_config(ctrl.controllers)
-        update = {}
-        if self.config.direction is Direction.ROBOT_TO_HUMAN:
-            update["stl"] = {**cfg.stl.model_dump(), "role": "giver"}  # Table 4.3's giver rows
-        if ctrl.reach_time_s is not None:
-            update["reach_time_s"] = ctrl.reach_time_s
-        if ctrl.stall_time_s is not None:
-            update["stall_time_s"] = ctrl.stall_time_s
-        if update:
-            cfg = type(cfg).model_validate({**cfg.model_dump(), **update})
+        cfg = scene_controllers_config(ctrl, self.config.direction is Direction.ROBOT_TO_HUMAN)
         m = self.model
         ranges = np.array([m.jnt_range[m.joint(j).id] for j in self.robot.arm_joints])
         ik = ArmIK(
