@@ -338,3 +338,14 @@ def test_the_study_folders_consent_text_replaces_the_default(fresh):
     assert "<p>Approved text, part one.</p>" in page and "<p>Part &lt;two&gt;.</p>" in page
     assert "You are invited" not in page
     assert "You are invited" in client(fresh).get("/p/5").get_data(as_text=True)
+
+
+def test_serve_on_all_interfaces_prints_an_address_a_browser_can_open():
+    import socket
+
+    from gazebot.study.web.server import base_url
+
+    assert base_url("0.0.0.0", 8000) == f"http://{socket.gethostname()}:8000"
+    assert base_url("::", 80).startswith(f"http://{socket.gethostname()}")
+    assert base_url("127.0.0.1", 8000) == "http://127.0.0.1:8000"
+    assert base_url("::1", 8000) == "http://[::1]:8000"
