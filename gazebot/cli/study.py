@@ -206,6 +206,19 @@ def _check_behaviors(names: list[str]) -> None:
             ) from None
 
 
+def _check_robot(name: str | None) -> None:
+    """``--robot`` must name a robot config (or a robot YAML file): fail at plan time, not an
+    hour into rendering."""
+    if name is None:
+        return
+    from gazebot.kinematics.config import robot_config_path
+
+    try:
+        robot_config_path(name)
+    except FileNotFoundError as exc:
+        raise UsageError(f"--robot: {exc}") from None
+
+
 def _plan(args: argparse.Namespace) -> int:
     from gazebot.study.csvio import check_output_file
     from gazebot.study.plan import check_balance, make_plan, write_plan
@@ -218,6 +231,7 @@ def _plan(args: argparse.Namespace) -> int:
     )
     behaviors = [b.strip() for b in names.split(",") if b.strip()]
     _check_behaviors(behaviors)
+    _check_robot(args.robot)
     scenes = {}
     for item in args.scene:
         level, sep, scene = item.partition("=")
