@@ -175,7 +175,16 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
         assert "the robot's head movement" in d.find_element(By.ID, "instructions").text
         _submit(d)
         _at(d, "Practice session")
+        # Skipping to the end does not count: the video plays again, all of it, first.
+        _wait(lambda: d.execute_script("return document.getElementById('v1').readyState >= 1"))
+        d.execute_script("var v = document.getElementById('v1'); v.currentTime = v.duration;")
         _wait_for_questions(d)
+        played = d.execute_script(
+            "var v = document.getElementById('v1'), t = 0;"
+            "for (var i = 0; i < v.played.length; i++) t += v.played.end(i) - v.played.start(i);"
+            "return [t, v.duration];"
+        )
+        assert played[0] >= 0.9 * played[1], played
         _click_answers(d, {q: 1 for q in QUESTIONS}, "practice")
         _submit(d)
 
