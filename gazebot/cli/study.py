@@ -73,7 +73,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "eyes-only with one); the instructions name the head or the eyes to match",
     )
     p.add_argument("--seed", type=int, default=0, help="randomisation seed")
-    p.add_argument("--robot", default="sawyer")
+    p.add_argument(
+        "--robot",
+        default=None,
+        help="robot config (default: the seed's: jaco2, the Jaco-2 with its head, without a "
+        "condition (6.3); sawyer with one (6.4))",
+    )
     p.add_argument("--video-seed", type=int, default=0, help="seed of every rendered handover")
     p.add_argument(
         "--scene",
@@ -201,6 +206,19 @@ def _check_behaviors(names: list[str]) -> None:
             ) from None
 
 
+def _check_robot(name: str | None) -> None:
+    """``--robot`` must name a robot config (or a robot YAML file): fail at plan time, not an
+    hour into rendering."""
+    if name is None:
+        return
+    from gazebot.kinematics.config import robot_config_path
+
+    try:
+        robot_config_path(name)
+    except FileNotFoundError as exc:
+        raise UsageError(f"--robot: {exc}") from None
+
+
 def _plan(args: argparse.Namespace) -> int:
     from gazebot.study.csvio import check_output_file
     from gazebot.study.plan import check_balance, make_plan, write_plan
@@ -213,6 +231,7 @@ def _plan(args: argparse.Namespace) -> int:
     )
     behaviors = [b.strip() for b in names.split(",") if b.strip()]
     _check_behaviors(behaviors)
+    _check_robot(args.robot)
     scenes = {}
     for item in args.scene:
         level, sep, scene = item.partition("=")
@@ -240,6 +259,7 @@ def _plan(args: argparse.Namespace) -> int:
         "sessions_per_participant": len(plan) // args.participants,
         "behaviors": behaviors,
         "condition": args.condition or "",
+        "robot": plan[0].robot,
         "gaze_mode": plan[0].gaze_mode,
         "position_balanced": report.position_balanced,
         "carryover_balanced": report.carryover_balanced,
@@ -249,7 +269,8 @@ def _plan(args: argparse.Namespace) -> int:
     else:
         print(
             f"wrote {len(plan)} sessions ({len(plan) // args.participants} per participant) for "
-            f"{args.participants} participants to {args.out} (gaze mode {plan[0].gaze_mode}, "
+            f"{args.participants} participants to {args.out} (robot {plan[0].robot}, gaze mode "
+            f"{plan[0].gaze_mode}, "
             f"position balanced: {report.position_balanced}, "
             f"carry-over balanced: {report.carryover_balanced})"
         )
@@ -339,7 +360,12 @@ def _analyze(args: argparse.Namespace) -> int:
     for m, b in result.bias.items():
         print(f"first/second bias {m}: S={b.s:.1f} p={b.p_value:.2f}")
     for q, b in result.bias_per_question.items():
-        print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_value:.2f}")
+        # The seed quotes z with its normal p (6.4.4: "like: z = -0.68, p = 0.50").
+        print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_z:.2f}")
+    for g, tests in result.bias_by_group.items():
+        for k, b in tests.items():
+            p = b.p_z if k.startswith("q") else b.p_value
+            print(f"first/second bias, group {g}, {k}: S={b.s:.1f} z={b.z:.2f} p={p:.2f}")
     for c in result.comparisons:
         print(
             f"{c.measure} {c.behavior_i} vs {c.behavior_j} ({c.design}, n={c.n_a}/{c.n_b}): "

@@ -78,7 +78,9 @@ def current_step(
     if prog.instructions_at is None:
         return Step("instructions")
     done = set(prog.answered)
-    for k in [PRACTICE] + [s.session for s in study.sessions_of(participant)]:
+    # In person the experimenter enters the plan's sessions only: there is no practice to wait for.
+    practice = [] if prog.mode == "in-person" else [PRACTICE]
+    for k in practice + [s.session for s in study.sessions_of(participant)]:
         if k not in done:
             return Step("session", k)
     return Step("done")
