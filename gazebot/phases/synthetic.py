@@ -102,6 +102,9 @@ class SyntheticOptions:
             each frame sits half of it behind the contact point, along the giver-robot line.
         frozen_per_s: Rate of frozen stretches (the tracker repeats its last sample for 2-8
             samples with new times) per point.
+        robot_lead: When > 0, the robot sets off this long (s) *before* the giver (a
+            robot-initiated handover, seed 6.3: the receiver's hand moves first); 0: the robot
+            reacts to the giver 0.05-0.4 s after its onset.
     """
 
     rate: float = 100.0
@@ -115,6 +118,7 @@ class SyntheticOptions:
     robot_evidence: bool = False
     marker_offset: float = 0.0
     frozen_per_s: float = 0.0
+    robot_lead: float = 0.0
 
     def __post_init__(self) -> None:
         if not 1.0 <= self.rate <= 2000.0:
@@ -123,6 +127,8 @@ class SyntheticOptions:
             raise ValueError(f"irregular must be 0..0.9, got {self.irregular}")
         if self.handovers < 1 or self.speed <= 0:
             raise ValueError("handovers must be >= 1 and speed > 0")
+        if not 0.0 <= self.robot_lead <= 3.0:
+            raise ValueError(f"robot_lead must be 0..3 s, got {self.robot_lead}")
 
 
 @dataclass
@@ -169,7 +175,7 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
     lean = _Path(np.zeros(3))
     grip_events: list[tuple[float, float, float]] = []  # (t_close, t_release, t_open)
     truth: list[HandoverTruth] = []
-    t = u(0.4, 1.2)
+    t = u(0.4, 1.2) + opts.robot_lead
     for _ in range(opts.handovers):
         onset = t
         reach = float(np.clip(u(0.7, 1.25) / opts.speed, 0.4, 2.5))
@@ -179,6 +185,8 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
         # The robot reacts to the giver and aims at the handover pose with a small error;
         # its fingers meet the object half a size in front of the hand.
         lag = u(0.05, 0.4)
+        if opts.robot_lead > 0:
+            lag = -opts.robot_lead
         g_dur = u(0.8, 1.5)
         offset = np.array([-u(0.04, 0.15), u(-0.01, 0.01), u(-0.01, 0.01)])
         grip.move(onset + lag, g_dur, target + offset)

@@ -3,7 +3,8 @@
 The reach starts at the giver's motion onset before the transfer: the fastest motion in the
 window, from the last sample *seen* slower than ``reach_onset_speed``, back-dated from the last
 rest sample (speed under ``rest_speed``) with the minimum-jerk start ``t0 = t - 3 x / v`` (at
-most ``max_refine``); an onset hidden in a tracking gap is dated across the gap. A reach still
+most ``max_refine``); an onset hidden in a tracking gap is dated across the gap. A giver that
+never moved fast there leaves the receiver's onset (never the window's start). A reach still
 under way when the data end (no transfer yet) is one where the hands have closed by
 ``reach_confirm_distance`` while the giver's hand moves toward the receiver, or by
 ``min_approach`` after the giver's hand moved; and they are at their closest at the end.
@@ -20,10 +21,30 @@ from gazebot.phases.filtering import Signals
 
 
 def reach_start(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
-    """Start of the giver's reach before grid index ``hi`` (not before index ``lo``)."""
-    v = s.giver_speed[lo : hi + 1]
-    if hi <= lo or not np.nanmax(v, initial=0.0) >= c.reach_onset_speed:
+    """Start of the giver's reach before grid index ``hi`` (not before index ``lo``).
+
+    A giver whose hand never moved faster than ``reach_onset_speed`` there (it held the object
+    out already and the receiver came to take it) has no onset of its own: the receiver's
+    onset dates the reach then, and with neither hand moving it starts at ``hi``. Never the
+    window's start: that would date a reach seconds before anyone moved (a robot-initiated
+    handover closes the gap before the giver moves fast)."""
+    if hi <= lo:
         return float(s.t[lo])
+    for speed, pos in ((s.giver_speed, s.giver), (s.receiver_speed, s.receiver)):
+        onset = _onset(s, c, speed, pos, lo, hi)
+        if onset is not None:
+            return onset
+    return float(s.t[hi])
+
+
+def _onset(
+    s: Signals, c: PhaseConfig, speed: np.ndarray, pos: np.ndarray, lo: int, hi: int
+) -> float | None:
+    """Motion onset of one hand before ``hi`` (see the module docstring), ``None`` if that
+    hand never moved faster than ``reach_onset_speed`` in ``[lo, hi]``."""
+    v = speed[lo : hi + 1]
+    if not np.nanmax(v, initial=0.0) >= c.reach_onset_speed:
+        return None
     peak = int(np.nanargmax(v))
     head = v[: peak + 1]
     seen = np.isfinite(head)
@@ -35,13 +56,13 @@ def reach_start(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
         if slow.size == 0:
             return float(s.t[lo])  # already moving when the data start
         i_c = lo + int(slow[-1]) + 1
-    rest = np.flatnonzero(s.giver_speed[lo:i_c] < c.rest_speed)
+    rest = np.flatnonzero(speed[lo:i_c] < c.rest_speed)
     i_r = lo + int(rest[-1]) if rest.size else lo
-    x = float(np.linalg.norm(s.giver[i_c] - s.giver[i_r]))
-    speed = float(s.giver_speed[i_c])
-    back = 3.0 * x / speed if math.isfinite(x) and speed > 0 else 0.0
+    x = float(np.linalg.norm(pos[i_c] - pos[i_r]))
+    vc = float(speed[i_c])
+    back = 3.0 * x / vc if math.isfinite(x) and vc > 0 else 0.0
     floor = float(s.t[lo])
-    if i_c - i_r > 1 and not np.isfinite(s.giver_speed[i_r + 1 : i_c]).all():
+    if i_c - i_r > 1 and not np.isfinite(speed[i_r + 1 : i_c]).all():
         floor = max(floor, float(s.t[i_r]))
     return max(float(s.t[i_c]) - min(back, c.max_refine), floor)
 
