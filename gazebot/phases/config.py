@@ -77,6 +77,9 @@ class PhaseConfig(BaseModel):
         online_period: Online, the detector re-analyses the recent samples at most this often
             (s); between analyses it only stores samples.
         online_window: Online, how much history (s) the detector keeps and analyses.
+        online_refresh: Online, ``gazebot``: in a reach or retreat the full analysis runs at
+            least this often (s) for the end-of-phase prediction; otherwise only when a cheap
+            trigger on the recent samples says the next boundary may have passed.
         edge_guard: Online, a phase boundary closer than this to the newest sample is not yet
             reported (s): the smoothing has not seen what follows it.
         load_share_shared: Load share above which the object is shared (seed delta_1).
@@ -122,6 +125,7 @@ class PhaseConfig(BaseModel):
     frozen_speed: float = Field(0.05, ge=0)
     online_period: float = Field(0.02, ge=0)
     online_window: float = Field(5.0, gt=1)
+    online_refresh: float = Field(0.1, ge=0)
     edge_guard: float = Field(0.04, ge=0)
     load_share_shared: float = Field(0.1, ge=0, le=1)
     load_share_robot: float = Field(0.9, ge=0, le=1)

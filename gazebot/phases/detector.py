@@ -79,6 +79,7 @@ class DetectorStats:
     bad_time: int = 0
     held: int = 0
     analyses: int = 0
+    skipped: int = 0
 
 
 class PhaseDetector:
@@ -114,6 +115,15 @@ class PhaseDetector:
         self._prev_evidence = False
         self._robot_reports = False
         self._signals: Signals | None = None
+        # Cheap trigger (gazebot): the hands' mean position per online_period, so the full
+        # analysis runs only when the next boundary may have passed.
+        self._gate = isinstance(self.segmenter, GazebotSegmenter)
+        self._acc = np.zeros(6)
+        self._acc_n = np.zeros(2)
+        self._sum_t: deque[float] = deque()
+        self._sum_g: deque[np.ndarray] = deque()
+        self._sum_r: deque[np.ndarray] = deque()
+        self._last_full = -math.inf
         self._reach_missing_since = math.nan
         self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
@@ -213,8 +223,12 @@ class PhaseDetector:
             self._r.popleft()
         if g_ok:
             self._seen_g = t
+            self._acc[:3] += g
+            self._acc_n[0] += 1
         if r_ok:
             self._seen_r = t
+            self._acc[3:] += r
+            self._acc_n[1] += 1
         if not (g_ok and r_ok):
             st.held += 1
             if self.tracking:
@@ -240,9 +254,90 @@ class PhaseDetector:
             return
         if t - self._last_analysis >= c.online_period:
             self._last_analysis = t
-            self._analyse(t)
-        elif math.isfinite(self.expected_phase_end):
+            if not self._gate or self._may_advance(t):
+                self._last_full = t
+                self._analyse(t)
+                return
+            self.stats.skipped += 1
+            if self.phase is Phase.RETREAT and t - self.phase_start > c.max_retreat:
+                self._done(t, t, "timeout")
+        if math.isfinite(self.expected_phase_end):
             self.expected_phase_end = max(self.expected_phase_end, t)
+
+    def _may_advance(self, now: float) -> bool:
+        """Summarise the samples since the last period; True if the next boundary may have
+        passed (a necessary condition of its rule, on the per-period mean positions), or a
+        reach or retreat is due for its ``online_refresh``."""
+        c = self.config
+        n = self._acc_n
+        nan3 = np.full(3, np.nan)
+        self._sum_t.append(now)
+        self._sum_g.append(self._acc[:3] / n[0] if n[0] else nan3)
+        self._sum_r.append(self._acc[3:] / n[1] if n[1] else nan3)
+        self._acc[:] = 0.0
+        n[:] = 0.0
+        while self._sum_t[0] < now - c.online_window:
+            self._sum_t.popleft()
+            self._sum_g.popleft()
+            self._sum_r.popleft()
+        ph = self.phase
+        if len(self._sum_t) < 3 or not self.tracking:
+            return True
+        if ph in (Phase.REACH, Phase.RETREAT) and now - self._last_full >= c.online_refresh:
+            return True
+        ts = np.fromiter(self._sum_t, float, len(self._sum_t))
+        g = np.array(self._sum_g)
+        rel = np.array(self._sum_r) - g
+        d = np.linalg.norm(rel, axis=1)
+        if not math.isfinite(d[-1]):
+            return True
+        k = max(1, int(round(0.1 / max(c.online_period, 1e-3))))  # 0.1 s speed baseline
+        if ph in (Phase.IDLE, Phase.DONE):
+            # A reach (or a transfer) needs the hands closer than they were since the last
+            # phase began (2 cm, smoothed) and the giver's hand moving since they were farthest.
+            after = np.flatnonzero(ts >= self._floor - c.online_period)
+            if after.size <= k:
+                return False
+            da = d[after[0] :]
+            closed = float(np.nanmax(da)) - d[-1]
+            if not closed >= 0.5 * c.reach_confirm_distance:
+                return False
+            i_max = after[0] + int(np.nanargmax(da))
+            own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(float(d[-1]), 1e-9)
+            if closed < 0.8 * c.min_approach and not own >= 0.25 * c.reach_confirm_distance:
+                return False  # only the receiver came closer: no reach of the giver's yet
+            gm = g[max(i_max - k, 0) :]
+            if gm.shape[0] <= k:
+                return True
+            v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * c.online_period)
+            return bool(np.nanmax(v, initial=0.0) >= 0.5 * c.reach_onset_speed)
+        if ph is Phase.REACH:
+            # A transfer needs the approach to have stopped, an aborted reach the hands apart:
+            # either way the hands are no longer closing fast.
+            recent = d[ts >= now - (c.min_transfer + c.edge_guard + c.online_period)]
+            return float(np.nanmax(recent)) - d[-1] <= 2.0 * c.still_closing
+        since = ts >= self.phase_start
+        if ph is Phase.TRANSFER:
+            # A release moves the hands' relative position off the held pose.
+            held = rel[since]
+            held = held[np.isfinite(held).all(axis=1)]
+            if held.shape[0] < 2:
+                return True
+            # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
+            off = float(np.linalg.norm(np.nanmean(rel[-2:], axis=0) - held.mean(axis=0)))
+            return off >= 0.5 * c.release_distance
+        if ph is Phase.RETREAT:
+            if self._joined_late:
+                return True
+            # The retreat ends landing (slowing down), at rest or far away.
+            gs = g[since]
+            if gs.shape[0] <= k or not np.isfinite(gs[[0, -1]]).all():
+                return True
+            step = np.linalg.norm(gs[k:] - gs[:-k], axis=1)
+            if float(np.linalg.norm(gs[-1] - gs[0])) >= 0.8 * c.retreat_far_distance:
+                return True
+            return bool(step[-1] <= 0.5 * np.nanmax(step))
+        return True
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
         """Gripper / load-share evidence; True if it started a phase on this frame."""
@@ -273,9 +368,11 @@ class PhaseDetector:
         if n < 3:
             return
         traj = Trajectory(np.fromiter(self._t, float, n), np.array(self._g), np.array(self._r))
-        if self.phase in (Phase.TRANSFER, Phase.RETREAT) and math.isfinite(self.phase_start):
-            # After contact the rules need the hold and what follows, not the whole window.
-            keep = np.flatnonzero(traj.t >= self.phase_start - c.reach_duration)
+        if self.phase not in (Phase.IDLE, Phase.DONE) and math.isfinite(self.phase_start):
+            # After contact the rules need the hold and what follows, a reach its rest before
+            # and what follows, not the whole window (the cost grows with the samples).
+            back = c.reach_duration * (2.0 if self.phase is Phase.REACH else 1.0)
+            keep = np.flatnonzero(traj.t >= self.phase_start - back)
             if keep.size >= 3 and keep[0] > 0:
                 traj = traj.take(keep)
         if isinstance(self.segmenter, GazebotSegmenter):
