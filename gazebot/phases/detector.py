@@ -120,9 +120,9 @@ class PhaseDetector:
         self._gate = isinstance(self.segmenter, GazebotSegmenter)
         self._acc = np.zeros(6)
         self._acc_n = np.zeros(2)
-        self._sum_t: deque[float] = deque()
-        self._sum_g: deque[np.ndarray] = deque()
-        self._sum_r: deque[np.ndarray] = deque()
+        # rows [t, giver xyz, receiver xyz] in _sum[_s0:_s1] (grown and compacted in place)
+        self._sum = np.empty((64, 7))
+        self._s0 = self._s1 = 0
         self._last_full = -math.inf
         self._reach_missing_since = math.nan
         self._floor = -math.inf  # the next phase never starts before this
@@ -270,24 +270,31 @@ class PhaseDetector:
         reach or retreat is due for its ``online_refresh``."""
         c = self.config
         n = self._acc_n
-        nan3 = np.full(3, np.nan)
-        self._sum_t.append(now)
-        self._sum_g.append(self._acc[:3] / n[0] if n[0] else nan3)
-        self._sum_r.append(self._acc[3:] / n[1] if n[1] else nan3)
+        buf = self._sum
+        while self._s0 < self._s1 and buf[self._s0, 0] < now - c.online_window:
+            self._s0 += 1
+        if self._s1 == buf.shape[0]:
+            m = self._s1 - self._s0
+            if 2 * m > buf.shape[0]:
+                self._sum = np.empty((2 * buf.shape[0], 7))
+            self._sum[:m] = buf[self._s0 : self._s1]
+            buf, self._s0, self._s1 = self._sum, 0, m
+        row = buf[self._s1]
+        row[0] = now
+        row[1:4] = self._acc[:3] / n[0] if n[0] else np.nan
+        row[4:] = self._acc[3:] / n[1] if n[1] else np.nan
+        self._s1 += 1
         self._acc[:] = 0.0
         n[:] = 0.0
-        while self._sum_t[0] < now - c.online_window:
-            self._sum_t.popleft()
-            self._sum_g.popleft()
-            self._sum_r.popleft()
         ph = self.phase
-        if len(self._sum_t) < 3 or not self.tracking:
+        if self._s1 - self._s0 < 3 or not self.tracking:
             return True
         if ph in (Phase.REACH, Phase.RETREAT) and now - self._last_full >= c.online_refresh:
             return True
-        ts = np.fromiter(self._sum_t, float, len(self._sum_t))
-        g = np.array(self._sum_g)
-        rel = np.array(self._sum_r) - g
+        rows = buf[self._s0 : self._s1]
+        ts = rows[:, 0]
+        g = rows[:, 1:4]
+        rel = rows[:, 4:] - g
         d = np.linalg.norm(rel, axis=1)
         if not math.isfinite(d[-1]):
             return True
@@ -304,9 +311,14 @@ class PhaseDetector:
                 return False
             i_max = after[0] + int(np.nanargmax(da))
             own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(float(d[-1]), 1e-9)
-            if closed < 0.8 * c.min_approach and not own >= 0.25 * c.reach_confirm_distance:
+            deep = closed >= 0.8 * c.min_approach
+            if not deep and not own >= 0.25 * c.reach_confirm_distance:
                 return False  # only the receiver came closer: no reach of the giver's yet
-            gm = g[max(i_max - k, 0) :]
+            # The giver's hand moving fast: since the hands were farthest for a deep dip, else
+            # within the window the rule reads (smoothing, before the edge guard).
+            span = (c.smoothing + c.edge_guard + 0.1) / max(c.online_period, 1e-3)
+            recent = ts.shape[0] - 1 - int(span)
+            gm = g[max(i_max - k, 0 if deep else recent, 0) :]
             if gm.shape[0] <= k:
                 return True
             v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * c.online_period)

@@ -99,7 +99,9 @@ def resample(t: np.ndarray, p: np.ndarray, grid: np.ndarray, max_gap: float) -> 
     inside = (j > 0) & (j < tv.shape[0])
     gap = np.full(grid.shape[0], np.inf)
     gap[inside] = tv[j[inside]] - tv[j[inside] - 1]
-    exact = np.isin(grid, tv)
+    # grid points that are samples (both sorted: a searchsorted, not np.isin's sort)
+    k = np.minimum(np.searchsorted(tv, grid), tv.shape[0] - 1)
+    exact = tv[k] == grid
     out[(gap > max_gap + 1e-9) & ~exact] = np.nan
     return out
 
