@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
+from itertools import islice
 
 import numpy as np
 
@@ -55,6 +56,9 @@ _PHASE_OF_EVENT = {
     EventKind.HANDOVER_DONE: Phase.DONE,
 }
 _EVENT_OF_PHASE = {v: k for k, v in _PHASE_OF_EVENT.items()}
+# What one online period runs (gazebot's cheap trigger): the whole method, only the end
+# prediction, or nothing.
+_FULL, _REFRESH, _SKIP = "full", "refresh", "skip"
 # Back-dated boundaries are compared to the current phase's start with this slack (s): one
 # analysis may place a boundary a grid step or two off the previous one.
 _SLACK = 0.03
@@ -254,9 +258,10 @@ class PhaseDetector:
             return
         if t - self._last_analysis >= c.online_period:
             self._last_analysis = t
-            if not self._gate or self._may_advance(t):
+            mode = self._may_advance(t) if self._gate else _FULL
+            if mode is not _SKIP:
                 self._last_full = t
-                self._analyse(t)
+                self._analyse(t, predict_only=mode is _REFRESH)
                 return
             self.stats.skipped += 1
             if self.phase is Phase.RETREAT and t - self.phase_start > c.max_retreat:
@@ -264,10 +269,20 @@ class PhaseDetector:
         if math.isfinite(self.expected_phase_end):
             self.expected_phase_end = max(self.expected_phase_end, t)
 
-    def _may_advance(self, now: float) -> bool:
-        """Summarise the samples since the last period; True if the next boundary may have
-        passed (a necessary condition of its rule, on the per-period mean positions), or a
-        reach or retreat is due for its ``online_refresh``."""
+    def _may_advance(self, now: float) -> str:
+        """Summarise the samples since the last period; ``_FULL`` if the next boundary may
+        have passed (a necessary condition of its rule, on the per-period mean positions),
+        ``_REFRESH`` if not but a reach or retreat is due for its ``online_refresh``."""
+        full = self._boundary_possible(now)
+        if full:
+            return _FULL
+        if now - self._last_full < self.config.online_refresh:
+            return _SKIP
+        # A retreat's end (landing) is dated from the speed profile the analysis sees: run
+        # its rule; a reach only needs its end prediction.
+        return {Phase.REACH: _REFRESH, Phase.RETREAT: _FULL}.get(self.phase, _SKIP)
+
+    def _boundary_possible(self, now: float) -> bool:
         c = self.config
         n = self._acc_n
         buf = self._sum
@@ -288,8 +303,6 @@ class PhaseDetector:
         n[:] = 0.0
         ph = self.phase
         if self._s1 - self._s0 < 3 or not self.tracking:
-            return True
-        if ph in (Phase.REACH, Phase.RETREAT) and now - self._last_full >= c.online_refresh:
             return True
         rows = buf[self._s0 : self._s1]
         ts = rows[:, 0]
@@ -373,26 +386,34 @@ class PhaseDetector:
             return True
         return False
 
-    def _analyse(self, now: float) -> None:
+    def _analyse(self, now: float, predict_only: bool = False) -> None:
+        """Run the method on the samples kept (``predict_only``: only refresh the end-of-phase
+        prediction from the signals)."""
         c = self.config
         self.stats.analyses += 1
         n = len(self._t)
         if n < 3:
             return
-        traj = Trajectory(np.fromiter(self._t, float, n), np.array(self._g), np.array(self._r))
+        t = np.fromiter(self._t, float, n)
+        i0 = 0
         if self.phase not in (Phase.IDLE, Phase.DONE) and math.isfinite(self.phase_start):
             # After contact the rules need the hold and what follows, a reach its rest before
             # and what follows, not the whole window (the cost grows with the samples).
             back = c.reach_duration * (2.0 if self.phase is Phase.REACH else 1.0)
-            keep = np.flatnonzero(traj.t >= self.phase_start - back)
-            if keep.size >= 3 and keep[0] > 0:
-                traj = traj.take(keep)
+            i0 = int(np.searchsorted(t, self.phase_start - back))
+            if n - i0 < 3:
+                i0 = 0
+        traj = Trajectory(
+            t[i0:],
+            np.array(list(islice(self._g, i0, None))),
+            np.array(list(islice(self._r, i0, None))),
+        )
         if isinstance(self.segmenter, GazebotSegmenter):
             cut = self.segmenter.signals(traj, partial=True)
             # The last edge_guard of the smoothed speed sags (one-sided window): predictions
             # read the same trusted part as the rules.
             self._signals = cut
-            if cut is not None:
+            if cut is not None and not predict_only:
                 # Once the hands are in contact, the release and retreat-end rules run from the
                 # phase's own start; before, the whole method finds the next handover.
                 self._rules_after_contact(cut, now)
