@@ -15,11 +15,11 @@ from gazebot.types import EventKind
 @pytest.mark.parametrize(
     ("kind", "median", "p90", "share"),
     [
-        # Median / p90, share within 250 ms. Measured 284 / 392 ms, 40 %: 2 cm of closing with
+        # Median / p90, share within 250 ms. Measured 285 / 392 ms, 40 %: 2 cm of closing with
         # the giver's own share, past the smoothing's edge (40 ms).
-        (EventKind.REACH_STARTED, 0.3, 0.42, 0.35),
-        # Measured 264 / 376 ms, 33 % (1 cm of separation, or 4x the hold's jitter).
-        (EventKind.RETREAT_STARTED, 0.28, 0.4, 0.3),
+        (EventKind.REACH_STARTED, 0.29, 0.4, 0.38),
+        # Measured 264 / 376 ms, 35 % (1 cm of separation, or 4x the hold's jitter).
+        (EventKind.RETREAT_STARTED, 0.27, 0.38, 0.33),
         # Measured -21 / 43 ms, 100 % (the predicted landing).
         (EventKind.HANDOVER_DONE, 0.0, 0.06, 1.0),
     ],
