@@ -54,7 +54,34 @@ def register(sub: argparse._SubParsersAction) -> None:
         choices=["after-release", "after-grasp"],
         help="when the robot retreats (seed 6.3: after the release; 6.4.3: after grasping)",
     )
+    add_giver_motion_options(parser)
     parser.set_defaults(func=run_demo)
+
+
+def add_giver_motion_options(parser: argparse.ArgumentParser) -> None:
+    """``--giver-motion FILE`` and its point names: replay a recorded giver's hand and face."""
+    from gazebot.cli.phases import add_recording_options
+
+    parser.add_argument(
+        "--giver-motion",
+        default=None,
+        metavar="FILE",
+        help="replay a recorded giver (CSV, C3D, ROS bag, pose folder), retargeted so the "
+        "recorded hand meets the robot's handover location",
+    )
+    add_recording_options(parser)
+
+
+def giver_factory(args: argparse.Namespace):
+    """The recorded giver of ``--giver-motion`` (``None``: the simulated giver)."""
+    if getattr(args, "giver_motion", None) is None:
+        return None
+    from gazebot.sim.giver_replay import load_giver_motion
+
+    return load_giver_motion(
+        args.giver_motion, args.giver_hand, args.receiver_hand, args.giver_face,
+        args.unit, args.rate,
+    )
 
 
 def scene_with_overrides(args: argparse.Namespace):
@@ -183,4 +210,5 @@ def _record(args: argparse.Namespace, out: Path, monitor=None):
         width=args.width,
         height=args.height,
         progress=not args.no_progress,
+        giver_factory=giver_factory(args),
     )

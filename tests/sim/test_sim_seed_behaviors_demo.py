@@ -148,17 +148,22 @@ def test_short_face_hand_is_on_the_hand_within_50_ms_of_the_first_reach_start(ha
     targets, events, giver_start, _ = handover
     first_reach = min(_first(events, EventKind.ROBOT_REACH_STARTED), giver_start)
     timeline = targets["short-face-hand"]
+    # The hand is kept through the transfer and the retreat; the face comes back once the
+    # handover is done (the phase detector may see that before the recording ends).
+    retreat = _first(events, EventKind.ROBOT_RETREAT_STARTED)
     assert all(k == "face" for t, k in timeline if t < first_reach - 1e-9)
-    assert all(k == "hand" for t, k in timeline if t >= first_reach + SHIFT_TOL_S)
+    assert all(k == "hand" for t, k in timeline if first_reach + SHIFT_TOL_S <= t < retreat)
 
 
 def test_long_face_hand_turns_to_the_hand_when_the_robot_reach_ends(handover):
     targets, events, _, _ = handover
     reach_end = _first(events, EventKind.ROBOT_REACH_ENDED)
+    retreat = _first(events, EventKind.ROBOT_RETREAT_STARTED)
     timeline = targets["long-face-hand"]
-    # "as soon as the robot's reach phase ended" (6.3.2): not before, and not much after
+    # "as soon as the robot's reach phase ended" (6.3.2): not before, and not much after (the
+    # face comes back once the handover is done, which the detector may see before the end)
     assert all(k == "face" for t, k in timeline if t < reach_end - 1e-9)
-    assert all(k == "hand" for t, k in timeline if t >= reach_end + SHIFT_TOL_S)
+    assert all(k == "hand" for t, k in timeline if reach_end + SHIFT_TOL_S <= t < retreat)
 
 
 def _check_as_studied(targets, events) -> None:
