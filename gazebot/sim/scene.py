@@ -240,8 +240,8 @@ def _layout(
 # the arm (Sawyer) is watched from in front and to the robot's right; a head standing beside the
 # arm (Jaco-2) from straight beside the robot on the arm's side and above, because nearer the
 # front the Jaco's folded home pose hides the screen (measured over whole handovers).
-ON_ARM_VIEW = (-62.0, 12.0, 3.2)  # azimuth, elevation (deg), distance (m)
-BESIDE_VIEW = (-90.0, 20.0, 3.2)
+ON_ARM_VIEW = (-60.0, 12.0, 5.0)  # azimuth, elevation (deg), distance (m)
+BESIDE_VIEW = (-90.0, 20.0, 5.0)
 
 
 def observer_points(cfg: SceneConfig, layout: SceneLayout, giver: GiverBody, obj) -> np.ndarray:

@@ -182,7 +182,7 @@ class CameraConfig(_Strict):
     elevation_deg: float | None = Field(default=None, ge=-60.0, le=80.0)
     distance_m: float | None = Field(default=None, gt=0.5, le=10.0)
     fovy_deg: float | None = Field(default=None, gt=5, lt=150, description="None: fit the scene")
-    margin: float = Field(default=0.08, ge=0.0, le=0.4, description="frame kept free at edges")
+    margin: float = Field(default=0.05, ge=0.0, le=0.4, description="frame kept free at edges")
     inset: InsetConfig = Field(default_factory=InsetConfig)
 
 
@@ -249,3 +249,12 @@ def load_scene(scene: str | Path | SceneConfig = "default") -> SceneConfig:
             f"(known scenes: {', '.join(scene_names())})"
         )
     return load_model(SceneConfig, path)
+
+
+def with_inset(scene: str | Path | SceneConfig, enabled: bool) -> SceneConfig:
+    """``scene`` (name, YAML path or config) with the observer's screen close-up on or off."""
+    cfg = load_scene(scene)
+    camera = cfg.camera.model_copy(
+        update={"inset": cfg.camera.inset.model_copy(update={"enabled": bool(enabled)})}
+    )
+    return cfg.model_copy(update={"camera": camera})
