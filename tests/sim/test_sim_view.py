@@ -51,6 +51,7 @@ def test_every_scene_frames_the_giver_object_and_robot_head_clear_of_the_inset(r
         "hand at the handover location": lay.offer_hand,
         "object at rest": lay.rest_hand + lay.object_offset,
         "object at the handover location": lay.offer_hand + lay.object_offset,
+        "top of the object at rest": lay.rest_hand + lay.object_offset + [0, 0, obj.half_height],
         "gripper at the handover pose": lay.handover_location,
     }
     points |= {f"screen corner {i}": p for i, p in enumerate(lay.screen)}
@@ -77,7 +78,9 @@ def looking(request):
                 uv = _project(sim.model, sim.data, display_corners(sim.model, sim.data))
                 shots[label] = (tick.target, float(np.ptp(uv[:, 0])), sim.render(width=W, height=H))
 
-    record_handover(request.param, "face-hand-face", "default", None, progress=False, on_tick=on_tick)
+    record_handover(
+        request.param, "face-hand-face", "default", None, progress=False, on_tick=on_tick
+    )
     return request.param, shots
 
 
@@ -192,3 +195,15 @@ def test_a_bad_camera_section_names_the_file_and_the_field(tmp_path, camera, fie
     with pytest.raises(ConfigError, match=field) as err:
         load_scene(path)
     assert "bad.yaml" in str(err.value)
+
+
+def test_no_inset_option_of_the_demo_turns_the_close_up_off_and_keeps_the_other_options():
+    import argparse
+
+    from gazebot.cli.demo import scene_with_overrides
+
+    args = argparse.Namespace(scene="sitting", no_inset=True, controller="mce", retreat=None)
+    scene = scene_with_overrides(args)
+    assert not scene.camera.inset.enabled
+    assert scene.controller.reach_controller.value == "mce" and scene.posture.value == "sitting"
+    assert scene_with_overrides(argparse.Namespace(scene="sitting")) == "sitting"
