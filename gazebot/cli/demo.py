@@ -37,6 +37,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
     parser.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    parser.add_argument(
+        "--no-inset",
+        action="store_true",
+        help="no close-up of the robot's head screen in the video's corner (default: the scene's)",
+    )
     parser.add_argument("--json", action="store_true", help="print a JSON summary to stdout")
     parser.add_argument(
         "--controller",
@@ -85,8 +90,8 @@ def giver_factory(args: argparse.Namespace):
 
 
 def scene_with_overrides(args: argparse.Namespace):
-    """The scene named by ``--scene`` with the controller options applied (validated), or the
-    scene name itself when no option is given."""
+    """The scene named by ``--scene`` with the controller options and ``--no-inset`` applied
+    (validated), or the scene name itself when no option is given."""
     overrides = {
         key: value
         for key, value in (
@@ -97,12 +102,18 @@ def scene_with_overrides(args: argparse.Namespace):
         )
         if value is not None
     }
+    if getattr(args, "no_inset", False):
+        from gazebot.sim.scene_config import with_inset
+
+        base = with_inset(args.scene, False)
+    else:
+        base = args.scene
     if not overrides:
-        return args.scene
+        return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
     from gazebot.sim.scene_config import Direction, ReachControllerName, SceneConfig, load_scene
 
-    data = load_scene(args.scene).model_dump()
+    data = load_scene(base).model_dump()
     data["controller"].update(overrides)
     controller = ReachControllerName(data["controller"]["reach_controller"]).value
     timed = "reach_time_s" in overrides or "stall_time_s" in overrides

@@ -29,6 +29,11 @@ def register(kinds: argparse._SubParsersAction) -> None:
     parser.add_argument("--height", type=int, default=480, help="height, px, even (default: 480)")
     parser.add_argument("--fps", type=float, default=30.0, help="frames per second (default: 30)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    parser.add_argument(
+        "--no-inset",
+        action="store_true",
+        help="no close-up of the robot's head screen in the video's corner (default: the scene's)",
+    )
     from gazebot.cli.demo import add_giver_motion_options
 
     add_giver_motion_options(parser)
@@ -40,6 +45,7 @@ def run_render_video(args: argparse.Namespace) -> int:
     from gazebot.kinematics.config import with_gaze_mode
     from gazebot.sim.gl_check import OffscreenRenderingError
     from gazebot.sim.record import check_video_size, render_handover_video
+    from gazebot.sim.scene_config import with_inset
 
     if args.out.suffix.lower() != ".mp4":
         raise UsageError(f"--out must name an .mp4 file, got {args.out}")
@@ -51,7 +57,7 @@ def run_render_video(args: argparse.Namespace) -> int:
         path = render_handover_video(
             with_gaze_mode(args.robot, args.gaze_mode),
             args.behavior,
-            args.scene,
+            with_inset(args.scene, False) if args.no_inset else args.scene,
             args.out,
             seed=args.seed,
             width=args.width,

@@ -15,6 +15,8 @@ from gazebot.sim.robot import SimRobot
 from gazebot.sim.scene_config import Posture, SceneConfig
 
 OBSERVER = "observer"
+DISPLAY_GEOM = "display"  # the head screen box geom (its +x face shows the eyes)
+FRAME_ASPECT = 4 / 3  # the framing keeps the scene in a 4:3 frame (wider frames show more)
 MAX_RENDER = (1920, 1080)  # off-screen buffer: the largest video frame supported
 
 
@@ -28,6 +30,9 @@ class SceneLayout:
     object_offset: np.ndarray  # object center minus giver hand while the giver holds it
     shoulder: np.ndarray  # giver's right shoulder
     table_top: float | None  # height of the table top, None without a table
+    robot_points: np.ndarray  # (n, 3) the arm's bodies at the home and the handover pose
+    head: np.ndarray  # the robot's gaze site at the home pose
+    screen: np.ndarray  # (4, 3) corners of the head display at the home pose (may be empty)
 
 
 @dataclass
@@ -41,14 +46,47 @@ class Scene:
     object_mocap: int
 
 
-def _robot_fk(robot: SimRobot, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gripper and gaze site positions of the bare robot model at arm ``pose``."""
+def _robot_fk(
+    robot: SimRobot, pose: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Gripper and gaze site positions of the bare robot model at arm ``pose``, and the points
+    the observer must see: the arm's bodies and the corners of the head display."""
     model = mujoco.MjModel.from_xml_path(str(robot.mjcf))
     data = mujoco.MjData(model)
     for name, q in zip(robot.arm_joints, pose, strict=True):
         data.qpos[model.joint(name).qposadr[0]] = q
     mujoco.mj_kinematics(model, data)
-    return data.site(robot.gripper_site).xpos.copy(), data.site(robot.gaze_site).xpos.copy()
+    arm_roots = {int(model.jnt_bodyid[model.joint(j).id]) for j in robot.arm_joints}
+    points = [data.xpos[b] for b in range(1, model.nbody) if _below(model, b, arm_roots)]
+    return (
+        data.site(robot.gripper_site).xpos.copy(),
+        data.site(robot.gaze_site).xpos.copy(),
+        np.array(points),
+        display_corners(model, data),
+    )
+
+
+def _below(model: mujoco.MjModel, body: int, roots: set[int]) -> bool:
+    """Whether ``body`` is one of ``roots`` or hangs below one."""
+    while body > 0:
+        if body in roots:
+            return True
+        body = int(model.body_parentid[body])
+    return False
+
+
+def display_corners(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """World positions (4, 3) of the head display's screen corners (the ``display`` box geom's
+    +x face); none when the robot has no such geom."""
+    try:
+        g = model.geom(DISPLAY_GEOM).id
+    except KeyError:
+        return np.zeros((0, 3))
+    s = model.geom_size[g]
+    rot = data.geom_xmat[g].reshape(3, 3)
+    return np.array(
+        [data.geom_xpos[g] + rot @ [s[0], a * s[1], b * s[2]] for a in (-1, 1) for b in (1, -1)]
+    )
 
 
 def _look_at_quat(pos: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -164,7 +202,8 @@ def _layout(
 ) -> tuple[SceneLayout, np.ndarray]:
     """Where the giver stands and holds the object, from the robot's handover pose; also
     returns the robot's gaze site at that pose."""
-    handover, gaze = _robot_fk(robot, robot.handover)
+    handover, gaze, arm_out, _ = _robot_fk(robot, robot.handover)
+    _, home_gaze, arm_home, screen = _robot_fk(robot, robot.home)
     # The giver's hand is behind the object (on the giver's side, +x) at its center height.
     object_offset = np.array([-(obj.half_extent_x + 0.035), 0.0, 0.0])
     offer = handover - object_offset
@@ -188,28 +227,110 @@ def _layout(
         object_offset=object_offset,
         shoulder=shoulder,
         table_top=table_top,
+        robot_points=np.vstack([arm_home, arm_out]),
+        head=home_gaze,
+        screen=screen,
     )
     return layout, gaze
 
 
-def _camera(
-    cfg: SceneConfig, layout: SceneLayout, gaze: np.ndarray, face: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """The default observer view, looking at the middle of head, handover location and giver.
+# Default camera directions from the robot's head (deg). The head turns toward the giver, so the
+# camera stands on that side, in front of the robot: the screen faces it while the head looks at
+# the giver, and the giver is seen from the side (face in profile or three-quarter). A head on
+# the arm (Sawyer) is watched from in front and to the robot's right; a head standing beside the
+# arm (Jaco-2) from straight beside the robot on the arm's side and above, because nearer the
+# front the Jaco's folded home pose hides the screen (measured over whole handovers).
+ON_ARM_VIEW = (-60.0, 12.0, 5.0)  # azimuth, elevation (deg), distance (m)
+BESIDE_VIEW = (-90.0, 20.0, 5.0)
 
-    A head on the arm (Sawyer) is watched from the front right, the side the head turns to when
-    it looks at the giver. A head standing beside the arm (Jaco-2) is watched from the head's own
-    side and well in front of it: the arm, and the object it carries home, then stay behind the
-    display, and the display still faces the camera when the head turns to the handover location.
-    """
-    side = float(np.sign(gaze[1])) if abs(gaze[1]) > 0.15 else 0.0
-    look = np.array(cfg.camera.look_at_m) if cfg.camera.look_at_m else None
-    if look is None:
-        look = (gaze + layout.handover_location + face) / 3.0
-        look[2] -= 0.0 if side else 0.05
-    offset = np.array([1.7, side * 1.2, 0.7]) if side else np.array([0.7, -2.25, 0.2])
-    pos = np.array(cfg.camera.pos_m) if cfg.camera.pos_m else look + offset
-    return pos, look
+
+def observer_points(cfg: SceneConfig, layout: SceneLayout, giver: GiverBody, obj) -> np.ndarray:
+    """What the observer camera keeps in frame (robot base frame, m): the robot's head screen
+    and arm at home and at the handover pose, the giver's head and face, and the giver's hand
+    and the object at rest and at the handover location."""
+    r = giver.dims.head_radius
+    # The head turns: keep a box around its screen in frame, not only the screen at home.
+    screen = layout.screen
+    reach = 0.04 + float(np.max(np.linalg.norm(screen - layout.head, axis=1), initial=0.1))
+    box = layout.head + reach * np.array(
+        [[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-0.6, 0.6)]
+    )
+    pts = [
+        layout.robot_points,
+        box,
+        giver.head_center + [0.0, 0.0, 1.25 * r],
+        giver.face_point,
+        giver.head_center + [0.0, -r, 0.0],
+        giver.head_center + [0.0, r, 0.0],
+    ]
+    for hand in (layout.rest_hand, layout.offer_hand):
+        center = hand + layout.object_offset
+        pts += [hand, center + [0.0, 0.0, obj.half_height], center - [0.0, 0.0, obj.half_height]]
+    return np.vstack(pts)
+
+
+def _rotation(pos: np.ndarray, look: np.ndarray) -> np.ndarray:
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, _look_at_quat(pos, look))
+    return mat.reshape(3, 3)
+
+
+def _fit_fovy(points: np.ndarray, pos: np.ndarray, look: np.ndarray, margin: float) -> float:
+    """The vertical field of view (deg) of a 4:3 camera at ``pos`` aimed at ``look`` that shows
+    all ``points`` with ``margin`` of the half frame free."""
+    v = (points - pos) @ _rotation(pos, look)
+    depth = -v[:, 2]
+    if np.any(depth <= 0.05):
+        raise ValueError("the observer camera is too close to (or past) what it must show")
+    half = max(np.abs(v[:, 1] / depth).max(), np.abs(v[:, 0] / depth).max() / FRAME_ASPECT)
+    return float(2 * np.degrees(np.arctan(half / (1.0 - margin))))
+
+
+def frame_points(
+    points: np.ndarray, pos: np.ndarray, margin: float, fovy_deg: float | None = None
+) -> tuple[np.ndarray, float]:
+    """Aim a camera at ``pos`` so that ``points`` are centered in a 4:3 frame; returns the look-at
+    point and the vertical field of view (deg) that fits them with ``margin`` (a fraction of the
+    half frame) free at the edges, or ``fovy_deg`` when given."""
+    look = points.mean(axis=0)
+    dist = float(np.linalg.norm(look - pos))
+    for _ in range(8):  # re-center on the angular extent (converges in a few steps)
+        rot = _rotation(pos, look)
+        v = (points - pos) @ rot
+        depth = -v[:, 2]
+        tx, ty = v[:, 0] / depth, v[:, 1] / depth
+        ray = rot @ np.array([(tx.max() + tx.min()) / 2, (ty.max() + ty.min()) / 2, -1.0])
+        look = pos + dist * ray / np.linalg.norm(ray)
+    if fovy_deg is not None:
+        return look, float(fovy_deg)
+    return look, _fit_fovy(points, pos, look, margin)
+
+
+def observer_camera(
+    cfg: SceneConfig, layout: SceneLayout, points: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Position, look-at point and vertical field of view (deg) of the observer camera."""
+    cam = cfg.camera
+    head = layout.head
+    beside = abs(head[1]) > 0.15  # the head stands beside the arm, not on it
+    az, el, dist = BESIDE_VIEW if beside else ON_ARM_VIEW
+    if beside and head[1] < 0:  # a head on the robot's right turns left: mirror the view
+        az = -az
+    az = cam.azimuth_deg if cam.azimuth_deg is not None else az
+    el = cam.elevation_deg if cam.elevation_deg is not None else el
+    dist = cam.distance_m if cam.distance_m is not None else dist
+    if cam.pos_m is not None:
+        pos = np.array(cam.pos_m, float)
+    else:
+        a, e = np.radians(az), np.radians(el)
+        pos = head + dist * np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+    if cam.look_at_m is not None:
+        look = np.array(cam.look_at_m, float)
+        if cam.fovy_deg is not None:
+            return pos, look, float(cam.fovy_deg)
+        return pos, look, _fit_fovy(points, pos, look, cam.margin)
+    look, fovy = frame_points(points, pos, cam.margin, cam.fovy_deg)
+    return pos, look, fovy
 
 
 def build_scene(robot: SimRobot, cfg: SceneConfig) -> Scene:
@@ -234,12 +355,14 @@ def build_scene(robot: SimRobot, cfg: SceneConfig) -> Scene:
         _add_table(spec, x0, x1, layout.shoulder[1] - 0.15, layout.table_top)
     obj.add_to(spec)
 
-    pos, look = _camera(cfg, layout, gaze, giver.face_point)
+    pos, look, fovy = observer_camera(cfg, layout, observer_points(cfg, layout, giver, obj))
+    if float(np.linalg.norm(look - pos)) < 1e-6:
+        raise ValueError(f"scene {cfg.name!r}: camera.look_at_m is the camera's position")
     spec.worldbody.add_camera(
         name=OBSERVER,
         pos=pos.tolist(),
         quat=_look_at_quat(pos, look).tolist(),
-        fovy=cfg.camera.fovy_deg,
+        fovy=min(fovy, 120.0),
     )
     model = spec.compile()
     giver.bind(model)
@@ -252,4 +375,13 @@ def build_scene(robot: SimRobot, cfg: SceneConfig) -> Scene:
     )
 
 
-__all__ = ["OBSERVER", "Posture", "Scene", "SceneLayout", "build_scene"]
+__all__ = [
+    "DISPLAY_GEOM",
+    "OBSERVER",
+    "Posture",
+    "Scene",
+    "SceneLayout",
+    "build_scene",
+    "display_corners",
+    "observer_points",
+]

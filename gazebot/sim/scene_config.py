@@ -152,12 +152,38 @@ class TrackingNoiseConfig(_Strict):
     dropout_rate: float = Field(default=0.0, ge=0.0, lt=1.0)
 
 
+class InsetCorner(str, Enum):
+    TOP_LEFT = "top-left"
+    TOP_RIGHT = "top-right"
+    BOTTOM_LEFT = "bottom-left"
+    BOTTOM_RIGHT = "bottom-right"
+
+
+class InsetConfig(_Strict):
+    """A close-up of the robot's head screen (the display texture as the eyes are drawn) pasted
+    into a corner of the observer's frames, so the eyes read at any camera angle."""
+
+    enabled: bool = True
+    width_frac: float = Field(default=0.28, ge=0.1, le=0.5, description="of the frame width")
+    corner: InsetCorner = InsetCorner.BOTTOM_LEFT
+
+
 class CameraConfig(_Strict):
-    """Observer camera; ``None`` fields are derived from the robot and the giver."""
+    """Observer camera. By default it stands ``distance_m`` from the robot's head (its gaze site
+    at the home pose) in the direction ``azimuth_deg`` (about the vertical, from the robot's +x
+    toward the giver, positive to the robot's left) and ``elevation_deg`` (above the head), and
+    it aims and zooms so that the giver's face and hand, the object and the robot's head and arm
+    fill the frame. ``None``: derived from the robot (see ``gazebot.sim.scene``). ``pos_m`` /
+    ``look_at_m`` place it explicitly (robot base frame, m); ``fovy_deg`` fixes the zoom."""
 
     pos_m: tuple[float, float, float] | None = None
     look_at_m: tuple[float, float, float] | None = None
-    fovy_deg: float = Field(default=33.0, gt=5, lt=150)
+    azimuth_deg: float | None = Field(default=None, ge=-180.0, le=180.0)
+    elevation_deg: float | None = Field(default=None, ge=-60.0, le=80.0)
+    distance_m: float | None = Field(default=None, gt=0.5, le=10.0)
+    fovy_deg: float | None = Field(default=None, gt=5, lt=150, description="None: fit the scene")
+    margin: float = Field(default=0.05, ge=0.0, le=0.4, description="frame kept free at edges")
+    inset: InsetConfig = Field(default_factory=InsetConfig)
 
 
 class GiverMotionConfig(_Strict):
@@ -223,3 +249,12 @@ def load_scene(scene: str | Path | SceneConfig = "default") -> SceneConfig:
             f"(known scenes: {', '.join(scene_names())})"
         )
     return load_model(SceneConfig, path)
+
+
+def with_inset(scene: str | Path | SceneConfig, enabled: bool) -> SceneConfig:
+    """``scene`` (name, YAML path or config) with the observer's screen close-up on or off."""
+    cfg = load_scene(scene)
+    camera = cfg.camera.model_copy(
+        update={"inset": cfg.camera.inset.model_copy(update={"enabled": bool(enabled)})}
+    )
+    return cfg.model_copy(update={"camera": camera})

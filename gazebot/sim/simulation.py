@@ -30,6 +30,7 @@ from gazebot.sim.scene_config import (
     ControllerConfig,
     Direction,
     Initiator,
+    InsetConfig,
     ReachControllerName,
     RetreatTrigger,
     SceneConfig,
@@ -61,6 +62,33 @@ def _feedback_banner(frame: np.ndarray, text: str) -> np.ndarray:
         cv2.LINE_AA,
     )
     return out
+
+
+def inset_rect(
+    width: int, height: int, screen: tuple[int, int], inset: InsetConfig
+) -> tuple[int, int, int, int]:
+    """Where the screen close-up goes in a ``width`` x ``height`` frame: (x0, y0, x1, y1) px, the
+    screen's aspect kept (``screen`` = its texture's (width, height))."""
+    w = max(8, round(inset.width_frac * width))
+    h = max(4, round(w * screen[1] / screen[0]))
+    pad = max(2, round(width / 80))
+    x0 = pad if "left" in inset.corner.value else width - pad - w
+    y0 = pad if "top" in inset.corner.value else height - pad - h
+    return x0, y0, x0 + w, y0 + h
+
+
+def _paste_inset(frame: np.ndarray, screen: np.ndarray, rect: tuple[int, int, int, int]) -> None:
+    """Draw ``screen`` (the head display's texture, RGB) into ``rect`` of ``frame``, framed by a
+    thin light border so it reads as a picture-in-picture."""
+    import cv2
+
+    x0, y0, x1, y1 = rect
+    border = max(1, (x1 - x0) // 90)
+    frame[y0:y1, x0:x1] = (235, 235, 235)
+    inner = (x1 - x0 - 2 * border, y1 - y0 - 2 * border)
+    frame[y0 + border : y1 - border, x0 + border : x1 - border] = cv2.resize(
+        screen, inner, interpolation=cv2.INTER_AREA
+    )
 
 
 def nearest_equivalent(q: np.ndarray, goal: np.ndarray, ranges: np.ndarray) -> np.ndarray:
@@ -505,8 +533,18 @@ class HandoverSimulation:
         self._eyes_drawn = self._eyes
 
     # ----------------------------------------------------------------------------- rendering
-    def render(self, camera: str = OBSERVER, width: int = 640, height: int = 480) -> np.ndarray:
-        """An RGB frame ((height, width, 3) uint8) from ``camera`` (default: the observer)."""
+    def render(
+        self,
+        camera: str = OBSERVER,
+        width: int = 640,
+        height: int = 480,
+        inset: bool | None = None,
+    ) -> np.ndarray:
+        """An RGB frame ((height, width, 3) uint8) from ``camera`` (default: the observer).
+
+        The observer's frames carry a close-up of the head screen (the display texture as the
+        eyes are drawn) in a corner when ``inset`` is True, or when it is None and the scene's
+        ``camera.inset.enabled`` is (the default)."""
         self._draw_eyes()
         key = (int(width), int(height))
         renderer = self._renderers.get(key)
@@ -517,9 +555,20 @@ class HandoverSimulation:
             self.display.upload(renderer.context)
             renderer.texture_version[self.display.id] = self.display.version
         frame = renderer.render(self.data, camera)
-        if camera == OBSERVER and self.controller.infeasible_at is not None:
-            frame = _feedback_banner(frame, INFEASIBLE_MESSAGE)
+        if camera == OBSERVER:
+            cfg = self.config.camera.inset
+            if cfg.enabled if inset is None else inset:
+                frame = np.ascontiguousarray(frame)
+                _paste_inset(frame, self.display.read(), self.inset_rect(width, height))
+            if self.controller.infeasible_at is not None:
+                frame = _feedback_banner(frame, INFEASIBLE_MESSAGE)
         return frame
+
+    def inset_rect(self, width: int = 640, height: int = 480) -> tuple[int, int, int, int]:
+        """The screen close-up's place (x0, y0, x1, y1) px in an observer frame of that size."""
+        return inset_rect(
+            width, height, (self.display.width, self.display.height), self.config.camera.inset
+        )
 
     def close(self) -> None:
         """Free the GL contexts (also done when the object is garbage collected)."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gazebot.sim.scene import display_corners
 from gazebot.sim.simulation import HandoverSimulation
 
 W, H = 320, 240
@@ -27,8 +28,9 @@ def sim():
 
 
 def test_display_texture_changes_when_the_eyes_move(sim):
-    row, col = _pixel(sim, sim.data.site("gaze").xpos)
-    crop = (slice(row - 12, row + 13), slice(col - 15, col + 16))
+    # The screen's box in the image (its projected corners, a pixel of slack).
+    rows, cols = zip(*(_pixel(sim, p) for p in display_corners(sim.model, sim.data)), strict=True)
+    crop = (slice(min(rows) - 2, max(rows) + 3), slice(min(cols) - 2, max(cols) + 3))
     sim.apply_eyes(0.0, 0.0)
     center = sim.render(width=W, height=H)
     sim.apply_eyes(0.6, 0.0)
@@ -37,9 +39,12 @@ def test_display_texture_changes_when_the_eyes_move(sim):
     again = sim.render(width=W, height=H)
     diff = np.abs(center.astype(int) - left.astype(int)).sum(axis=2)
     assert diff[crop].sum() > 2000  # the pupils moved on the display
-    # ...and nothing else in the frame changed.
+    # ...and in the screen close-up, and nothing else in the frame changed.
+    x0, y0, x1, y1 = sim.inset_rect(W, H)
+    assert diff[y0:y1, x0:x1].sum() > 2000
     outside = diff.copy()
     outside[crop] = 0
+    outside[y0:y1, x0:x1] = 0
     assert outside.sum() == 0
     np.testing.assert_array_equal(center, again)
 
