@@ -127,8 +127,9 @@ def run() -> list[Result]:
             "us",
             f"{SEED} run online the same way",
             note=(
-                f"{len(frames)} samples at 100 Hz; re-analysis every online_period "
-                f"({PhaseConfig().online_period * 1e3:.0f} ms) over online_window"
+                f"{len(frames)} samples at 100 Hz; trigger every online_period "
+                f"({PhaseConfig().online_period * 1e3:.0f} ms), analysis over online_window "
+                "when it fires (the peer re-analyses every period)"
             ),
         )
     )
