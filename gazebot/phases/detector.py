@@ -3,7 +3,13 @@
 The detector keeps the last ``online_window`` seconds of samples and, at most every
 ``online_period``, runs the configured method (:mod:`gazebot.phases.methods`) on the samples
 seen so far (``partial``: a boundary the data do not show yet stays open, and the last
-``edge_guard`` is not trusted). Each phase start the analysis shows beyond the current phase is
+``edge_guard`` is not trusted). For ``gazebot`` that analysis costs milliseconds, so each period
+first checks a cheap trigger on the hands' mean positions per period: a necessary condition,
+loosened, of the rule that ends the current phase (idle: the hands closed with the giver's
+hand moving; reach: the hands stopped closing fast; transfer: the relative position left the
+held pose; retreat: the giver's hand slowing or far). Only when it fires does the method run;
+a reach or retreat still refreshes its end prediction every ``online_refresh``.
+Each phase start the analysis shows beyond the current phase is
 emitted once, in order (reach -> transfer -> retreat -> done), back-dated to where the
 analysis puts it (never before the current phase's start). So online and offline share every
 rule; the online latency is what the data need to show a boundary.
@@ -273,8 +279,8 @@ class PhaseDetector:
         """Summarise the samples since the last period; ``_FULL`` if the next boundary may
         have passed (a necessary condition of its rule, on the per-period mean positions),
         ``_REFRESH`` if not but a reach or retreat is due for its ``online_refresh``."""
-        full = self._boundary_possible(now)
-        if full:
+        self._summarise(now)
+        if self._boundary_possible(now):
             return _FULL
         if now - self._last_full < self.config.online_refresh:
             return _SKIP
@@ -282,7 +288,9 @@ class PhaseDetector:
         # its rule; a reach only needs its end prediction.
         return {Phase.REACH: _REFRESH, Phase.RETREAT: _FULL}.get(self.phase, _SKIP)
 
-    def _boundary_possible(self, now: float) -> bool:
+    def _summarise(self, now: float) -> None:
+        """Append the mean hand positions since the last period (NaN: none seen) and drop
+        rows older than ``online_window``."""
         c = self.config
         n = self._acc_n
         buf = self._sum
@@ -301,10 +309,15 @@ class PhaseDetector:
         self._s1 += 1
         self._acc[:] = 0.0
         n[:] = 0.0
+
+    def _boundary_possible(self, now: float) -> bool:
+        """A necessary condition of the rule that ends the current phase, on the per-period
+        means (loose: 0.5x its distances, so it fires before the rule can)."""
+        c = self.config
         ph = self.phase
         if self._s1 - self._s0 < 3 or not self.tracking:
             return True
-        rows = buf[self._s0 : self._s1]
+        rows = self._sum[self._s0 : self._s1]
         ts = rows[:, 0]
         g = rows[:, 1:4]
         rel = rows[:, 4:] - g
@@ -360,6 +373,8 @@ class PhaseDetector:
                 return True
             step = np.linalg.norm(gs[k:] - gs[:-k], axis=1)
             if float(np.linalg.norm(gs[-1] - gs[0])) >= 0.8 * c.retreat_far_distance:
+                return True
+            if not math.isfinite(float(step[-1])):
                 return True
             return bool(step[-1] <= 0.5 * np.nanmax(step))
         return True

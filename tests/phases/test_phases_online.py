@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from phase_truth import PHASE_KINDS, event_errors
 
-from gazebot.phases import PhaseConfig, PhaseDetector, run_online, segments_from_events
+from gazebot.phases import PhaseConfig, PhaseDetector, Trajectory, run_online, segments_from_events
 from gazebot.phases.synthetic import SyntheticOptions, generate, synthetic_set
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
 
@@ -339,3 +339,18 @@ def test_release_seen_only_after_a_restart_still_ends_the_handover_at_rest():
     kinds = [e.kind for e in events]
     assert kinds == [EventKind.RETREAT_STARTED, EventKind.HANDOVER_DONE]
     assert events[1].detected_at < 5.0
+
+
+def test_resting_hands_skip_the_analysis_and_a_handover_runs_it():
+    # The cheap trigger (engine.step cost): at rest almost every period skips the method;
+    # a handover runs it around its boundaries and still gives every event.
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 10.0, 1 / 120)
+    g = np.array([1.05, -0.2, 0.9]) + rng.normal(0.0, 0.002, (t.size, 3))
+    r = np.array([0.35, -0.3, 0.25]) + rng.normal(0.0, 0.0003, (t.size, 3))
+    rest = run_online(Trajectory(t, g, r))
+    assert rest.stats.analyses <= 0.05 * (rest.stats.analyses + rest.stats.skipped)
+    case = generate(3, SyntheticOptions(rate=120.0, posture="standing"))
+    res = run_online(case.trajectory)
+    assert [e.kind for e in _phase_events(res.events)] == list(PHASE_KINDS)
+    assert 0 < res.stats.analyses <= 0.4 * (res.stats.analyses + res.stats.skipped)
