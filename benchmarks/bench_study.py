@@ -1,9 +1,22 @@
-"""Bradley-Terry fit time: gazebot's Hunter MM (vectorised on the win matrix) against ``choix``
-measured in the same run on the same comparisons."""
+"""The study: Bradley-Terry fit time (gazebot's Hunter MM, vectorised on the win matrix, against
+``choix`` on the same comparisons), and the web study's answer submissions per second (``gazebot
+study serve`` on loopback: waitress + Flask + a committed SQLite transaction per answer) against a
+bare waitress app that only parses the same form, served and driven the same way; plus the page
+weight of a session page."""
 
 from __future__ import annotations
 
+import http.client
 import itertools
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.parse
+from pathlib import Path
 
 import numpy as np
 
@@ -25,6 +38,144 @@ def _comparisons(g: int, participants: int, seed: int = 0) -> list[tuple[int, in
         for i, j in itertools.permutations(range(g), 2):
             data.append((i, j) if rng.random() < s[i] / (s[i] + s[j]) else (j, i))
     return data
+
+
+# The peer: the same server (waitress, same threads) with an app that parses the answer form
+# and redirects, storing nothing: what HTTP and the server cost on their own.
+_BARE_SERVER = """
+import sys, urllib.parse
+from waitress import create_server
+def app(environ, start_response):
+    n = int(environ.get("CONTENT_LENGTH") or 0)
+    form = urllib.parse.parse_qs(environ["wsgi.input"].read(n).decode())
+    ok = all(form.get(q) in (["1"], ["2"]) for q in ("q1", "q2", "q3", "q4", "q5"))
+    start_response("303 See Other" if ok else "400 Bad Request",
+                   [("Location", "/p/1"), ("Content-Length", "0")])
+    return [b""]
+server = create_server(app, host="127.0.0.1", port=0, threads=4)
+print(f"serving at http://127.0.0.1:{server.effective_port}/p/N", flush=True)
+server.run()
+"""
+ANSWERS = urllib.parse.urlencode({"q1": 1, "q2": 2, "q3": 1, "q4": 2, "q5": 1, "comment": ""})
+BATCH = 120  # submissions per timed batch
+BATCHES = 5
+
+
+def _start(cmd: list[str]) -> tuple[subprocess.Popen, int]:
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env
+    )
+    for _ in range(20):
+        line = proc.stdout.readline()
+        m = re.search(r"at http://127\.0\.0\.1:(\d+)/p/N", line)
+        if m:
+            return proc, int(m.group(1))
+    proc.kill()
+    raise RuntimeError(f"server did not start: {line}")
+
+
+def _submit(port: int, paths: list[str], clients: int) -> float:
+    """Seconds to POST the answers to every path, over ``clients`` keep-alive connections."""
+    chunks = [paths[k::clients] for k in range(clients)]
+    headers = {"Content-Type": "application/x-www-form-urlencoded"}
+
+    def worker(chunk: list[str]) -> None:
+        con = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+        for path in chunk:
+            con.request("POST", path, ANSWERS, headers)
+            resp = con.getresponse()
+            resp.read()
+            if resp.status != 303:
+                raise RuntimeError(f"POST {path}: HTTP {resp.status}")
+        con.close()
+
+    threads = [threading.Thread(target=worker, args=(c,)) for c in chunks]
+    t0 = time.perf_counter()
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    return time.perf_counter() - t0
+
+
+def _web_results() -> list[Result]:
+    import functools
+    import statistics
+
+    from gazebot.study.folder import load_study
+    from gazebot.study.plan import make_plan
+    from gazebot.study.render import render_study
+    from gazebot.study.synthetic import render_synthetic_video
+
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp) / "study"
+        behaviors = ["face", "hand", "short-face-hand", "long-face-hand"]
+        clients_list = (1, 4)
+        need = BATCH * (BATCHES + 1) * len(clients_list)
+        participants = 12 * -(-need // 12 // 12)
+        plan = make_plan(behaviors, None, participants, seed=0)
+        fn = functools.partial(render_synthetic_video, duration=0.2)
+        render_study(plan, root, fn, 64, 48, 10, workers=1, card_seconds=0.1, progress=False)
+        study = load_study(root)
+        store = study.store()
+        for p in study.participants:  # everyone past consent and practice: only sessions left
+            store.give_consent(p)
+            store.read_instructions(p)
+            store.submit(p, 0, {f"q{k}": 1 for k in range(1, 6)})
+        sessions = [
+            f"/p/{s.participant}/session/{s.session}"
+            for s in sorted(study.plan, key=lambda s: (s.session, s.participant))
+        ]
+        ours, port = _start(
+            [sys.executable, "-m", "gazebot", "study", "serve", str(root), "--port", "0"]
+        )
+        bare, bare_port = _start([sys.executable, "-c", _BARE_SERVER])
+        try:
+            con = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+            con.request("GET", f"/p/{study.participants[-1]}")
+            page = con.getresponse().read()
+            con.close()
+            pos = 0
+            for clients in clients_list:
+                rates, peer_rates = [], []
+                for b in range(BATCHES + 1):  # the first batch warms up
+                    # Answers in plan order per participant: each request is the current step.
+                    batch = sessions[pos : pos + BATCH]
+                    pos += BATCH
+                    t_ours = _submit(port, batch, clients)
+                    t_peer = _submit(bare_port, batch, clients)
+                    if b:
+                        rates.append(BATCH / t_ours)
+                        peer_rates.append(BATCH / t_peer)
+                results.append(
+                    Result(
+                        f"answer submissions, {clients} keep-alive client(s), loopback",
+                        statistics.median(rates),
+                        statistics.median(peer_rates),
+                        "req/s",
+                        "bare waitress app parsing the same form",
+                        higher_is_better=True,
+                        note="each answer a committed SQLite transaction (WAL, synchronous=FULL)",
+                    )
+                )
+        finally:
+            for proc in (ours, bare):
+                proc.terminate()
+                proc.wait(timeout=10)
+        stored = len(store.answers())
+        if stored != pos:
+            raise RuntimeError(f"{pos} answers sent, {stored} stored")
+        results.append(
+            Result(
+                "session page weight (HTML, inline CSS and JS; videos extra)",
+                len(page) / 1024,
+                None,
+                "kB",
+            )
+        )
+    return results
 
 
 def run() -> list[Result]:
@@ -98,4 +249,4 @@ def run() -> list[Result]:
                 note=f"tol {TOL:g}, max |dP| {d_ilsr:.1e}",
             )
         )
-    return results
+    return results + _web_results()

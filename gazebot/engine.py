@@ -16,7 +16,7 @@ import numpy as np
 from gazebot.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
 from gazebot.config import ConfigError
 from gazebot.kinematics import GazeController, GazeShiftConfig, RobotConfig, RobotModel
-from gazebot.phases import PhaseConfig, PhaseDetector, load_phase_config
+from gazebot.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.types import (
     Event,
     EventKind,
@@ -74,7 +74,7 @@ class GazeEngine:
             )
         self.robot = robot
         self.behavior_spec = behavior
-        self.detector = PhaseDetector(phases or PhaseConfig())
+        self.detector = make_detector(phases or PhaseConfig())
         self.behavior = BehaviorMachine(behavior, seed=seed)
         self.gaze = GazeController(robot, shifts)
         self._memory = _PointMemory()
@@ -215,7 +215,7 @@ class GazeEngine:
 
     def reset(self, head: Mapping[str, float] | None = None) -> None:
         """Forget the current handover (e.g. after a restart) and optionally the head pose."""
-        self.detector = PhaseDetector(self.detector.config)
+        self.detector = make_detector(self.detector.config)
         self.behavior = BehaviorMachine(self.behavior_spec, seed=self.behavior.seed)
         self.gaze.reset(head)
         self._memory = _PointMemory()

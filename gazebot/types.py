@@ -71,6 +71,8 @@ class EventKind(str, Enum):
     ROBOT_GRASPED = "robot_grasped"
     ROBOT_RETREAT_STARTED = "robot_retreat_started"
     ROBOT_RETREAT_ENDED = "robot_retreat_ended"
+    ROBOT_REACH_INFEASIBLE = "robot_reach_infeasible"  # no reach meets the timing (seed 3.2)
+    ROBOT_RELEASED = "robot_released"  # robot-to-human: the robot let go of the object
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,10 @@
 """Gaze behaviors: what the robot looks at in each handover phase.
 
-- :mod:`~gazebot.behaviors.spec`: the YAML format (:class:`BehaviorSpec`, segments ``{phase, at,
-  target}``).
-- :mod:`~gazebot.behaviors.machine`: :class:`BehaviorMachine`, the state machine that runs a spec
-  online (phase events in, gaze target out).
+- :mod:`~gazebot.behaviors.segment`: a gaze segment ``{phase, at, target}`` and its ``at`` forms.
+- :mod:`~gazebot.behaviors.spec`: the YAML format (:class:`BehaviorSpec`).
+- :mod:`~gazebot.behaviors.machine`: :class:`BehaviorMachine`, the ``transitions`` state machine
+  whose states are the gaze decisions (phase events and timers in, gaze target out), and
+  :func:`~gazebot.behaviors.machine.diagram` (its Mermaid drawing).
 - :mod:`~gazebot.behaviors.registry`: :func:`load_behavior` and :func:`list_behaviors` (built-ins in
   ``configs/behaviors/`` plus user folders).
 - :mod:`~gazebot.behaviors.human`: the data-driven ``human-receiver`` timing model (read from

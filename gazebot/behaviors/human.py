@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from gazebot.behaviors.spec import AtFraction, Segment, check_target_name
+from gazebot.behaviors.segment import AtFraction, Segment, check_target_name
 
 PHASES = ("reach", "transfer", "retreat")
 

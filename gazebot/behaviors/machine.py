@@ -1,13 +1,28 @@
-"""The behavior state machine: handover phases driven by events, gaze sub-states by time.
+"""The behavior state machine: the ``transitions`` machine's states are the gaze decisions.
 
-States (``transitions`` hierarchical machine, ``BehaviorMachine.state``):
+One ``transitions`` hierarchical machine (:func:`machine_definition`) with two parallel regions
+under the root state ``behavior``:
 
-- top level, one per handover phase: ``idle``, ``reach``, ``transfer``, ``retreat``, ``done``;
-  phase events move between them;
-- inside each phase, a gaze sub-state: ``carry`` (the previous phase's gaze continues until the
-  phase's first segment starts), ``g0``, ``g1``, ... (segment *i* of the phase is active), ``lost``
-  (tracking lost); ``idle`` has ``before`` and ``done`` has ``after`` instead of segments. A state
-  reads e.g. ``reach_g1``.
+- ``handover``: one state per handover phase (``idle``, ``reach``, ``transfer``, ``retreat``,
+  ``done``), and inside each phase one state per gaze target, e.g. ``behavior_handover_reach_hand``.
+  The current gaze target *is* this state. Phase events (``reach_started``, ...) move between the
+  phases; the ``timer`` trigger shifts the gaze inside a phase when a segment's start time has
+  come (each transition's condition names the segment's ``at``); ``detector`` adopts the phase
+  detector's view when the events said otherwise. A phase entered within the same handover keeps
+  the gaze it had (reach -> transfer -> retreat carry the target: leaf-to-leaf transitions); a
+  new handover starts at the behavior's ``before`` target, ``done`` at its ``after`` target.
+- ``tracking``: ``ok``, ``hold`` (tracking lost: the gaze point is held for
+  ``tracking_lost.hold_s``) and ``lost`` (then the policy's target, the last known face, until
+  ``tracking_restored``). Phases and gaze shifts keep advancing meanwhile, so on restore the gaze
+  resumes where the behavior now is.
+
+:meth:`BehaviorMachine.state` reads e.g. ``reach_hand`` (``reach_hand_lost`` while tracking is
+lost). ``gazebot behaviors show NAME --diagram FILE`` draws the machine (:func:`diagram`).
+
+What the machine keeps beside its state are times, not decisions: the current phase's start and
+predicted end, the robot's events of this handover (anchors for ``{after: EVENT}``) and which
+segments of the phase have started. The ``timer`` trigger is fired only when a segment's start
+time has come (a tick with nothing due costs a few comparisons, not a ``transitions`` call).
 
 Rules for imperfect event streams (``handle`` never raises):
 
@@ -18,16 +33,14 @@ Rules for imperfect event streams (``handle`` never raises):
   ``retreat_started`` from idle/reach/transfer/done (a missed phase is skipped);
   ``handover_done`` from reach/transfer/retreat. A duplicate of the current phase's event is
   ignored (the first one's time stands).
+- **The handover's reach starts with the first reach, the robot's or the giver's.** A
+  ``robot_reach_started`` in idle/done starts the reach phase (the robot set off first, seed 6.3);
+  a later or earlier report of the other reach start of the same handover moves the reach start to
+  the earlier of the two. Other robot events never change the phase; the latest of each kind in
+  the current handover anchors ``{after: EVENT}`` segments and gives ``planned_duration``.
 - ``GazeContext.phase`` wins: when ``target(ctx)`` sees another phase than the events said, the
-  machine moves to ``ctx.phase`` (started at ``ctx.phase_start``): the detector's current view
-  beats a missed or late event.
-- Robot events never change the phase; the latest of each kind in the current handover anchors
-  ``{after: EVENT}`` segments and gives ``planned_duration``. A new handover keeps the robot
-  events from its start on, plus a ``robot_reach_started`` sent since the previous
-  ``handover_done`` (the robot may set off before the detector confirms the giver's reach).
-- ``tracking_lost``: hold the current gaze point for ``tracking_lost.hold_s``, then look at the
-  last known face position (the policy's target) until ``tracking_restored``; phases keep
-  advancing meanwhile, so on restore the gaze resumes where the behavior now is.
+  machine moves to ``ctx.phase`` (started at ``ctx.phase_start``), except back to idle or done
+  while the robot's reach has started the handover (the detector has not seen the giver move yet).
 
 "Halfway" (and any fraction of a phase) needs the phase's end online. The estimates:
 ``ctx.expected_phase_end`` (the phase detector's prediction from the giver's and the gripper's
@@ -36,8 +49,8 @@ motion), an ``expected_end`` in the phase event's info, and the robot's own moti
 ``phase_durations_s`` of the spec (the human mean phase lengths). A reach ends when both hands
 have arrived, so the latest estimate wins; a retreat ends when the giver's hand is back at rest
 (the detector's ``handover_done``, usually before the robot is home), so the first known
-estimate in the order above wins. The estimate is re-read every
-tick; a segment that has started stays started, so a revised estimate never moves the gaze back.
+estimate in the order above wins. The estimate is re-read every tick; a segment that has started
+stays started, so a revised estimate never moves the gaze back.
 
 Points: the returned point is ``ctx.points[kind]`` (the hand moves: it is read every call). When
 that point is missing (NaN or an unknown named point) the last finite position of that kind is
@@ -49,6 +62,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 from transitions.extensions import HierarchicalMachine
@@ -64,6 +79,7 @@ from gazebot.behaviors.spec import (
 )
 from gazebot.types import Event, EventKind, GazeContext, GazeTarget, Phase
 
+_ROOT, _HANDOVER, _TRACKING = "behavior", "behavior_handover", "behavior_tracking"
 _PHASE_ORDER = {Phase.IDLE: 0, Phase.REACH: 1, Phase.TRANSFER: 2, Phase.RETREAT: 3, Phase.DONE: 4}
 _PHASE_EVENTS = {
     EventKind.REACH_STARTED: Phase.REACH,
@@ -71,18 +87,28 @@ _PHASE_EVENTS = {
     EventKind.RETREAT_STARTED: Phase.RETREAT,
     EventKind.HANDOVER_DONE: Phase.DONE,
 }
+_EVENT_OF_PHASE = {phase: kind for kind, phase in _PHASE_EVENTS.items()}
 # Which phases each phase event may leave (see the module docstring).
 _EVENT_SOURCES = {
-    EventKind.REACH_STARTED: ("idle", "done", "transfer", "retreat"),
-    EventKind.TRANSFER_STARTED: ("idle", "reach", "done"),
-    EventKind.RETREAT_STARTED: ("idle", "reach", "transfer", "done"),
-    EventKind.HANDOVER_DONE: ("reach", "transfer", "retreat"),
+    EventKind.REACH_STARTED: (Phase.IDLE, Phase.DONE, Phase.TRANSFER, Phase.RETREAT),
+    EventKind.TRANSFER_STARTED: (Phase.IDLE, Phase.REACH, Phase.DONE),
+    EventKind.RETREAT_STARTED: (Phase.IDLE, Phase.REACH, Phase.TRANSFER, Phase.DONE),
+    EventKind.HANDOVER_DONE: (Phase.REACH, Phase.TRANSFER, Phase.RETREAT),
+}
+# Phase moves within one handover: the gaze carries over (all others start a new handover or
+# end it).
+_CARRY = {
+    (Phase.REACH, Phase.TRANSFER),
+    (Phase.REACH, Phase.RETREAT),
+    (Phase.TRANSFER, Phase.RETREAT),
 }
 # Robot motions whose planned duration estimates the end of a phase.
 _ROBOT_MOTION = {
     Phase.REACH: EventKind.ROBOT_REACH_STARTED,
     Phase.RETREAT: EventKind.ROBOT_RETREAT_STARTED,
 }
+_TRACKING_STATES = ("ok", "hold", "lost")
+_TRACKING_OK, _TRACKING_HOLD = f"{_TRACKING}_ok", f"{_TRACKING}_hold"
 
 
 def _finite(x: object) -> bool:
@@ -93,18 +119,189 @@ def _finite(x: object) -> bool:
         return False
 
 
-@dataclass
-class _Active:
-    """A segment of the current phase with its (latched) start time."""
+def _state_name(target: str) -> str:
+    # ``_`` separates nested state names in ``transitions``: ``handover_location`` is a target,
+    # not a state ``location`` inside ``handover``.
+    return target.replace("_", "-")
 
-    segment: Segment
-    started_at: float = math.nan  # NaN until it starts
+
+def _gaze_targets(spec: BehaviorSpec) -> list[str]:
+    """The targets the ``handover`` region can be in: ``before`` first, then sorted."""
+    names = {spec.before, spec.after, *(s.target for s in spec.segments)}
+    if spec.human is not None:
+        names |= spec.human.targets()
+    ordered = [spec.before, *sorted(names - {spec.before})]
+    states = [_state_name(n) for n in ordered]
+    if len(set(states)) != len(states):
+        raise ValueError(f"behavior '{spec.name}': targets differing only in '_' vs '-'")
+    return ordered
+
+
+def _describe(at: AtFraction | AtEvent, phase: Phase) -> str:
+    if isinstance(at, AtFraction):
+        return f"{at.fraction:g} of the {phase.value}"
+    return at.after.value + (f" + {at.delay:g} s" if at.delay else "")
+
+
+def _slots(spec: BehaviorSpec) -> dict[Phase, list[tuple[int, str, str]]]:
+    """Per phase, every ``(segment index, target, label)`` that can start in a handover
+    (``never`` segments cannot)."""
+    out: dict[Phase, list[tuple[int, str, str]]] = {p: [] for p in SEGMENT_PHASES}
+    if spec.human is not None:
+        for phase in SEGMENT_PHASES:
+            seen = set()
+            for pattern in spec.human.patterns:
+                for i, target in enumerate(getattr(pattern, phase.value)):
+                    if (i, target) not in seen:
+                        seen.add((i, target))
+                        out[phase].append((i, target, "start" if i == 0 else f"drawn shift {i}"))
+        return out
+    for phase in SEGMENT_PHASES:
+        segs = [s for s in spec.segments if s.phase == phase.value]
+        for i, seg in enumerate(segs):
+            at = spec.resolve(seg)
+            if not isinstance(at, AtNever):
+                out[phase].append((i, seg.target, _describe(at, phase)))
+    return out
+
+
+#: Builds a transition condition from its key and label: ``("segment", phase, index, target)``,
+#: ``("detector", phase)`` or ``("held",)``.
+ConditionFactory = Callable[[tuple, str], Callable[[], bool]]
+
+
+def _label_only(key: tuple, label: str) -> Callable[[], bool]:
+    """A condition that only carries its label (for drawing; never evaluated)."""
+
+    def condition() -> bool:
+        raise RuntimeError("a drawn machine is not run")
+
+    condition.__name__ = label
+    return condition
+
+
+def machine_definition(
+    spec: BehaviorSpec, condition: ConditionFactory = _label_only
+) -> dict[str, Any]:
+    """The states, transitions and initial state of ``spec``'s machine (``transitions``
+    keyword arguments); ``condition`` builds each transition condition (a callable whose
+    ``__name__`` is the label the diagram shows)."""
+    targets = _gaze_targets(spec)
+    before, after = _state_name(spec.before), _state_name(spec.after)
+    gaze = [_state_name(t) for t in targets]
+    phases = [
+        {"name": "idle", "children": [before], "initial": before},
+        *({"name": p.value, "children": gaze, "initial": before} for p in SEGMENT_PHASES),
+        {"name": "done", "children": [after], "initial": after},
+    ]
+    states = [
+        {
+            "name": _ROOT,
+            "parallel": [
+                {"name": "handover", "children": phases, "initial": "idle"},
+                {"name": "tracking", "children": list(_TRACKING_STATES), "initial": "ok"},
+            ],
+        }
+    ]
+
+    def leaf(phase: Phase, child: str | None = None) -> str:
+        return f"{_HANDOVER}_{phase.value}" + (f"_{child}" if child else "")
+
+    transitions: list[dict[str, Any]] = []
+    for kind, sources in _EVENT_SOURCES.items():
+        dest = _PHASE_EVENTS[kind]
+        for source in sources:
+            if (source, dest) in _CARRY:
+                transitions += [
+                    {"trigger": kind.value, "source": leaf(source, g), "dest": leaf(dest, g)}
+                    for g in gaze
+                ]
+            else:
+                transitions.append(
+                    {"trigger": kind.value, "source": leaf(source), "dest": leaf(dest)}
+                )
+    for source in (Phase.IDLE, Phase.DONE):
+        transitions.append(
+            {
+                "trigger": EventKind.ROBOT_REACH_STARTED.value,
+                "source": leaf(source),
+                "dest": leaf(Phase.REACH),
+            }
+        )
+    for phase, slots in _slots(spec).items():
+        for index, target, label in slots:
+            transitions.append(
+                {
+                    "trigger": "timer",
+                    "source": leaf(phase),
+                    "dest": leaf(phase, _state_name(target)),
+                    "conditions": [condition(("segment", phase, index, target), label)],
+                }
+            )
+    for phase in _PHASE_ORDER:
+        transitions.append(
+            {
+                "trigger": "detector",
+                "source": _HANDOVER,
+                "dest": leaf(phase),
+                "conditions": [condition(("detector", phase), f"detector in {phase.value}")],
+            }
+        )
+    hold = f"held {spec.tracking_lost.hold_s:g} s"
+    transitions += [
+        {
+            "trigger": EventKind.TRACKING_LOST.value,
+            "source": f"{_TRACKING}_ok",
+            "dest": f"{_TRACKING}_hold",
+        },
+        {
+            "trigger": "timer",
+            "source": f"{_TRACKING}_hold",
+            "dest": f"{_TRACKING}_lost",
+            "conditions": [condition(("held",), hold)],
+        },
+        {
+            "trigger": EventKind.TRACKING_RESTORED.value,
+            "source": [f"{_TRACKING}_hold", f"{_TRACKING}_lost"],
+            "dest": f"{_TRACKING}_ok",
+        },
+    ]
+    return {"states": states, "transitions": transitions, "initial": _ROOT}
+
+
+def diagram(spec: BehaviorSpec) -> str:
+    """The machine of ``spec`` as Mermaid ``stateDiagram-v2`` text, drawn by ``transitions``' own
+    diagram support (``HierarchicalGraphMachine`` with ``graph_engine="mermaid"``) from the same
+    :func:`machine_definition` the behavior runs on."""
+    from transitions.extensions import HierarchicalGraphMachine
+
+    class Drawn:
+        """A model for the drawing only (never triggered)."""
+
+    model = Drawn()
+    HierarchicalGraphMachine(
+        model=model,
+        **machine_definition(spec),
+        auto_transitions=False,
+        graph_engine="mermaid",
+        show_conditions=True,
+        title=f"gaze behavior {spec.name}",
+    )
+    return str(model.get_graph().draw(None))  # type: ignore[attr-defined]
 
 
 class _Model:
     """The object whose ``state`` the ``transitions`` machine drives."""
 
-    state: str
+    state: list[str]
+
+
+@dataclass
+class _Segment:
+    """A segment of the current phase: its slot and (latched) start time."""
+
+    segment: Segment
+    started_at: float = math.nan  # NaN until it starts
 
 
 class BehaviorMachine:
@@ -118,9 +315,55 @@ class BehaviorMachine:
 
     def __init__(self, spec: BehaviorSpec, seed: int = 0) -> None:
         self.spec = spec
+        targets = _gaze_targets(spec)
+        self._target_of = {_state_name(t): t for t in targets}
         self._model = _Model()
-        self._machine = self._build_machine()
+        self._firing = (Phase.IDLE, -1)  # the segment the next ``timer`` trigger may start
+        self._hold_over = False
+        self._detector_phase = Phase.IDLE
+        definition = machine_definition(spec, self._condition)
+        self._machine = HierarchicalMachine(
+            model=self._model,
+            **definition,
+            auto_transitions=False,
+            ignore_invalid_triggers=True,
+        )
+        # Leaf name -> (phase, gaze state) and tracking leaf -> name: parsing state names on
+        # every tick would cost more than the lookups.
+        self._leaf: dict[str, tuple[Phase, str]] = {}
+        for phase in _PHASE_ORDER:
+            for child in self._machine.get_state(f"{_HANDOVER}_{phase.value}").states:
+                self._leaf[f"{_HANDOVER}_{phase.value}_{child}"] = (phase, child)
+        self._tracking_leaf = {f"{_TRACKING}_{s}": s for s in _TRACKING_STATES}
         self.reset(seed)
+
+    def _condition(self, key: tuple, label: str) -> Callable[[], bool]:
+        """The runtime condition of a transition (see :data:`ConditionFactory`)."""
+        if key[0] == "segment":
+            _, phase, index, target = key
+
+            def due() -> bool:
+                # The segment the timer fires for, with this target (the drawn pattern's).
+                return (
+                    self._firing == (phase, index) and self._active[index].segment.target == target
+                )
+
+            condition = due
+        elif key[0] == "detector":
+            phase = key[1]
+
+            def seen() -> bool:
+                return self._detector_phase is phase
+
+            condition = seen
+        else:
+
+            def held() -> bool:
+                return self._hold_over
+
+            condition = held
+        condition.__name__ = label
+        return condition
 
     def reset(self, seed: int | None = None) -> None:
         """Forget everything (back to ``idle``), optionally with a new seed; cheaper than building
@@ -130,56 +373,23 @@ class BehaviorMachine:
         self.ignored = 0  # events ignored as stale, duplicated or not allowed from the phase
         self.pattern = ""  # name of the drawn pattern (data-driven behaviors)
         self._rng = np.random.default_rng(self.seed)
-        self._phase = Phase.IDLE
         self._phase_start = -math.inf
         self._phase_expected_end = math.nan  # from the phase event's info
         self._last_phase_t = -math.inf
         self._handover_t0 = -math.inf  # events at or after this belong to the current handover
+        self._robot_reach_t = math.nan  # the robot's reach start when it began this handover
         self._robot: dict[EventKind, Event] = {}
         self._plan: dict[Phase, list[Segment]] = self._draw_plan()
-        self._active: list[_Active] = []
-        self._current = -1  # index into _active; -1 = carry
-        self._carry = self.spec.before
-        self._lost_since: float | None = None
+        self._active: list[_Segment] = []
+        self._waiting = 0
+        self._latest = -math.inf  # start time of the segment the gaze state follows
+        self._lost_since = math.nan
         self._held: GazeTarget | None = None
         self._last_target: GazeTarget | None = None
         self._known: dict[str, np.ndarray] = {}
-        self._model.to_idle()
-        self._enter_segments(self._phase)
-
-    # ----------------------------------------------------------------- construction
-    def _n_children(self) -> int:
-        if self.spec.human is not None:
-            return self.spec.human.max_segments_per_phase()
-        counts = [sum(s.phase == p.value for s in self.spec.segments) for p in SEGMENT_PHASES]
-        return max(counts, default=0)
-
-    def _build_machine(self) -> HierarchicalMachine:
-        gaze = [f"g{i}" for i in range(self._n_children())]
-        states = [
-            {"name": "idle", "children": ["before", "lost"], "initial": "before"},
-            *(
-                {"name": p.value, "children": ["carry", *gaze, "lost"], "initial": "carry"}
-                for p in SEGMENT_PHASES
-            ),
-            {"name": "done", "children": ["after", "lost"], "initial": "after"},
-        ]
-        self._leaves = tuple(f"{st['name']}_{c}" for st in states for c in st["children"])
-        machine = HierarchicalMachine(
-            model=self._model,
-            states=states,
-            initial="idle",
-            ignore_invalid_triggers=True,
-            auto_transitions=True,
+        self._machine.set_state(
+            [f"{_HANDOVER}_idle_{_state_name(self.spec.before)}", f"{_TRACKING}_ok"]
         )
-        for kind, sources in _EVENT_SOURCES.items():
-            machine.add_transition(
-                kind.value,
-                list(sources),
-                _PHASE_EVENTS[kind].value,
-                conditions=[self._is_fresh],
-            )
-        return machine
 
     def _draw_plan(self) -> dict[Phase, list[Segment]]:
         """The segments of the next handover (drawn from the data model for ``human``)."""
@@ -190,25 +400,45 @@ class BehaviorMachine:
         return {p: [s for s in segments if s.phase == p.value] for p in SEGMENT_PHASES}
 
     # ----------------------------------------------------------------- public API
+    def _where(self) -> tuple[Phase, str, str]:
+        """(phase, gaze state, tracking state) read from the machine."""
+        handover, tracking = self._model.state
+        phase, gaze = self._leaf[handover]
+        return phase, gaze, self._tracking_leaf[tracking]
+
     @property
     def state(self) -> str:
-        """Current state, e.g. ``idle_before``, ``reach_g1``, ``retreat_lost``."""
-        return self._model.state
+        """Current state, e.g. ``idle_face``, ``reach_hand``, ``retreat_face_lost`` (the phase, the
+        gaze target's state and, while tracking is lost, ``hold`` or ``lost``)."""
+        phase, gaze, tracking = self._where()
+        return f"{phase.value}_{gaze}" + ("" if tracking == "ok" else f"_{tracking}")
 
     @property
     def states(self) -> list[str]:
-        """Every state :attr:`state` can take (leaf states, e.g. ``reach_g0``)."""
-        return list(self._leaves)
+        """Every value :attr:`state` can take."""
+        out = []
+        for phase, gaze in self._leaf.values():
+            out += [
+                f"{phase.value}_{gaze}",
+                f"{phase.value}_{gaze}_hold",
+                f"{phase.value}_{gaze}_lost",
+            ]
+        return out
 
     @property
     def phase(self) -> Phase:
-        """The handover phase the machine believes in."""
-        return self._phase
+        """The handover phase the machine is in."""
+        return self._leaf[self._model.state[0]][0]
+
+    @property
+    def gaze(self) -> str:
+        """The behavior's gaze target (the ``handover`` region's state), lost tracking aside."""
+        return self._target_of[self._leaf[self._model.state[0]][1]]
 
     @property
     def lost(self) -> bool:
         """True while tracking is lost."""
-        return self._lost_since is not None
+        return self._model.state[1] != _TRACKING_OK
 
     def handle(self, event: Event) -> None:
         """Apply one event (phase or robot); never raises (see the module docstring)."""
@@ -220,39 +450,30 @@ class BehaviorMachine:
         if kind in _PHASE_EVENTS:
             self._handle_phase(kind, t, event)
         elif kind is EventKind.TRACKING_LOST:
-            if self._lost_since is None:
+            if self._trigger(kind.value):
                 self._lost_since = t
                 self._held = self._last_target
-                self._to_sub("lost")
+                self._hold_over = False
             else:
                 self.ignored += 1  # duplicate: the first loss time stands
         elif kind is EventKind.TRACKING_RESTORED:
-            if self._lost_since is not None and t >= self._lost_since:
-                self._lost_since = None
-                self._held = None
-                self._to_sub(self._gaze_child())
-            else:
+            if not (self.lost and t >= self._lost_since and self._trigger(kind.value)):
                 self.ignored += 1
         else:
-            old = self._robot.get(kind)
-            if old is not None and old.t > t:
-                self.ignored += 1  # an older copy arriving late
-            else:
-                info = event.info if isinstance(getattr(event, "info", None), dict) else {}
-                self._robot[kind] = Event(kind, t, t, dict(info))
+            self._handle_robot(kind, t, event)
 
     def target(self, ctx: GazeContext) -> GazeTarget:
         """Where to look at ``ctx.t``: a target kind and its current point."""
         t = float(ctx.t) if _finite(ctx.t) else self._phase_start
         self._sync_phase(ctx, t)
+        self._run_timers(t, ctx.expected_phase_end)
+        handover, tracking = self._model.state
         lost_kind = self.spec.tracking_lost.target
-        if self._lost_since is not None:
-            hold_end = self._lost_since + self.spec.tracking_lost.hold_s
-            if t < hold_end and self._held is not None:
+        if tracking != _TRACKING_OK:
+            if tracking == _TRACKING_HOLD and self._held is not None:
                 return self._held
             return GazeTarget(lost_kind, self._point(lost_kind, ctx))
-        kind = self._gaze_kind(t, ctx.expected_phase_end)
-        self._to_sub(self._gaze_child())
+        kind = self._target_of[self._leaf[handover][1]]
         target = GazeTarget(kind, self._point(kind, ctx))
         if kind != lost_kind:
             self._point(lost_kind, ctx)  # keeps the last known face fresh for a tracking loss
@@ -274,23 +495,61 @@ class BehaviorMachine:
                 return float(value)
         return None
 
-    def _is_fresh(self, event: Event | None = None, t: float = math.nan) -> bool:
-        return t >= self._last_phase_t
+    def _trigger(self, name: str) -> bool:
+        return bool(self._model.trigger(name))
+
+    def _earlier_reach_start(self, t: float) -> bool:
+        """The other reach of the current handover started at ``t``: the reach starts with the
+        first (returns whether ``t`` belongs to this handover's reach)."""
+        if self.phase is not Phase.REACH or t < self._handover_t0:
+            return False
+        self._phase_start = min(self._phase_start, t)
+        return True
+
+    def _handle_robot(self, kind: EventKind, t: float, event: Event) -> None:
+        old = self._robot.get(kind)
+        if old is not None and old.t > t:
+            self.ignored += 1  # an older copy arriving late
+            return
+        info = event.info if isinstance(getattr(event, "info", None), dict) else {}
+        self._robot[kind] = Event(kind, t, t, dict(info))
+        if kind is not EventKind.ROBOT_REACH_STARTED:
+            return
+        if self.phase in (Phase.IDLE, Phase.DONE) and t >= self._last_phase_t:
+            # The robot set off first: the handover's reach starts now.
+            self._run_timers(t)
+            old_phase = self.phase
+            if self._trigger(kind.value):
+                self._last_phase_t = t
+                self._begin_phase(old_phase, Phase.REACH, t)
+                self._robot_reach_t = t
+        elif self._earlier_reach_start(t):
+            self._robot_reach_t = t
 
     def _handle_phase(self, kind: EventKind, t: float, event: Event) -> None:
-        before = (self._phase, self._carry_at(t))
-        if not self._model.trigger(kind.value, event=event, t=t):
+        phase = self.phase
+        if (
+            kind is EventKind.REACH_STARTED
+            and math.isfinite(self._robot_reach_t)
+            and self._earlier_reach_start(t)
+        ):
+            return  # the giver's reach of a handover the robot's reach started
+        if t < self._last_phase_t:
+            self.ignored += 1
+            return
+        self._run_timers(t)  # the gaze at the event's time is what carries on
+        if not self._trigger(kind.value):
             self.ignored += 1
             return
         self._last_phase_t = t
         info = getattr(event, "info", None) or {}
         expected = info.get("expected_end", math.nan) if isinstance(info, dict) else math.nan
-        self._begin_phase(_PHASE_EVENTS[kind], t, before, expected)
+        self._begin_phase(phase, _PHASE_EVENTS[kind], t, expected)
 
     def _begin_phase(
-        self, phase: Phase, t: float, before: tuple[Phase, str], expected: float = math.nan
+        self, old_phase: Phase, phase: Phase, t: float, expected: float = math.nan
     ) -> None:
-        old_phase, carry = before
+        """Bookkeeping after the machine entered ``phase`` at ``t`` (its state already moved)."""
         starts_new = (
             old_phase in (Phase.IDLE, Phase.DONE) or _PHASE_ORDER[phase] <= _PHASE_ORDER[old_phase]
         )
@@ -301,26 +560,18 @@ class BehaviorMachine:
             elif old_phase is not Phase.IDLE:
                 self._handover_t0 = t  # the previous handover_done was missed
             # Keep only what belongs to this handover: events since its start, and a robot reach
-            # that began between the previous handover's end and this start (the detector may
-            # confirm the giver's reach after the robot set off).
+            # that began between the previous handover's end and this start.
             self._robot = {
                 k: e
                 for k, e in self._robot.items()
                 if e.t >= t or (k is EventKind.ROBOT_REACH_STARTED and e.t >= self._handover_t0)
             }
+            self._robot_reach_t = math.nan
             self._plan = self._draw_plan()
-            carry = self.spec.before
-        self._phase = phase
         self._phase_start = t
         self._phase_expected_end = float(expected) if _finite(expected) else math.nan
-        self._carry = carry
-        self._enter_segments(phase)
-        if self._lost_since is not None:
-            self._to_sub("lost")
-
-    def _enter_segments(self, phase: Phase) -> None:
-        self._active = [_Active(s) for s in self._plan.get(phase, [])]
-        self._current = -1
+        self._active = [_Segment(s) for s in self._plan.get(phase, [])]
+        self._latest = -math.inf
         # Segments that may still start; "never" ones do not count.
         self._waiting = sum(
             not isinstance(self.spec.resolve(a.segment), AtNever) for a in self._active
@@ -334,106 +585,94 @@ class BehaviorMachine:
                 phase = Phase(phase)
             except ValueError:
                 return
+        current = self.phase
         start = float(ctx.phase_start) if _finite(ctx.phase_start) else t
-        if phase is not self._phase:
-            before = (self._phase, self._carry_at(start))
-            getattr(self._model, f"to_{phase.value}")()
-            self._last_phase_t = max(self._last_phase_t, start)
-            self._begin_phase(phase, start, before)
-        elif _finite(ctx.phase_start):
-            self._phase_start = float(ctx.phase_start)
+        if phase is current:
+            if _finite(ctx.phase_start):
+                if phase is Phase.REACH and math.isfinite(self._robot_reach_t):
+                    start = min(start, self._robot_reach_t)
+                self._phase_start = start
+            return
+        if (
+            phase in (Phase.IDLE, Phase.DONE)
+            and current is Phase.REACH
+            and math.isfinite(self._robot_reach_t)
+        ):
+            return  # the robot's reach started this handover; the giver has not moved yet
+        self._run_timers(start)
+        kind = _EVENT_OF_PHASE.get(phase)
+        if kind is None or not self._trigger(kind.value):
+            self._detector_phase = phase
+            self._trigger("detector")
+        self._last_phase_t = max(self._last_phase_t, start)
+        self._begin_phase(current, phase, start)
 
     # ----------------------------------------------------------------- gaze timing
-    def _expected_end(self, ctx_end: float) -> float:
+    def _expected_end(self, ctx_end: float, phase: Phase) -> float:
         start = self._phase_start
-        estimates = (ctx_end, self._phase_expected_end, self._robot_motion_end())
+        estimates = (ctx_end, self._phase_expected_end, self._robot_motion_end(phase))
         known = [end for end in estimates if _finite(end) and end > start]
         if not known:
-            return start + self.spec.phase_durations_s.of(self._phase)
-        if self._phase is Phase.REACH:
+            return start + self.spec.phase_durations_s.of(phase)
+        if phase is Phase.REACH:
             # A reach ends when both hands have arrived: the later arrival wins.
             return float(max(known))
         # A retreat ends when the giver's hand is back at rest (the detector's handover_done),
         # often well before the robot is home: its prediction comes first.
         return float(known[0])
 
-    def _robot_motion_end(self) -> float:
+    def _robot_motion_end(self, phase: Phase) -> float:
         """End of the robot's own reach/retreat (start + planned duration), NaN if unknown."""
-        motion = _ROBOT_MOTION.get(self._phase)
+        motion = _ROBOT_MOTION.get(phase)
         ev = self._robot.get(motion) if motion is not None else None
         if ev is None or ev.t < self._handover_t0:
             return math.nan
         planned = ev.info.get("planned_duration")
         return ev.t + float(planned) if _finite(planned) and planned > 0 else math.nan
 
-    def _anchor_time(self, at: AtEvent) -> float:
+    def _anchor_time(self, at: AtEvent, phase: Phase) -> float:
         """When the ``after`` event of the current handover happened (NaN if it did not yet)."""
-        if at.after is PHASE_START_EVENT.get(self._phase):
+        if at.after is PHASE_START_EVENT.get(phase):
             return self._phase_start
         ev = self._robot.get(at.after)
         if ev is None or ev.t < self._handover_t0:
             return math.nan
         return ev.t
 
-    def _update_active(self, t: float, ctx_end: float) -> None:
+    def _run_timers(self, t: float, ctx_end: float = math.nan) -> None:
+        """Fire the ``timer`` trigger for what is due at ``t``: the segment that started last
+        (its target becomes the gaze state) and the end of a tracking-loss hold."""
+        if self.lost and not self._hold_over:
+            if t >= self._lost_since + self.spec.tracking_lost.hold_s:
+                self._hold_over = True
+                self._trigger("timer")
         if self._waiting == 0:
             return  # every segment of the phase has started (or never will)
+        phase = self.phase
         end: float | None = None
-        changed = False
-        for item in self._active:
+        best, best_t = -1, self._latest
+        for i, item in enumerate(self._active):
             if math.isfinite(item.started_at):
                 continue
             at = self.spec.resolve(item.segment)
             if isinstance(at, AtFraction):
                 if end is None:
-                    end = self._expected_end(ctx_end)
+                    end = self._expected_end(ctx_end, phase)
                 start_t = self._phase_start + at.fraction * (end - self._phase_start)
             elif isinstance(at, AtEvent):
-                start_t = self._anchor_time(at) + at.delay
+                start_t = self._anchor_time(at, phase) + at.delay
             else:
                 continue  # never
             if start_t <= t:
                 item.started_at = max(start_t, self._phase_start)
                 self._waiting -= 1
-                changed = True
-        if not changed:
-            return
-        best, best_t = -1, -math.inf
-        for i, item in enumerate(self._active):
-            if item.started_at >= best_t:  # NaN compares False: not started
-                best, best_t = i, item.started_at
-        self._current = best
-
-    def _gaze_kind(self, t: float, ctx_end: float = math.nan) -> str:
-        if self._phase is Phase.IDLE:
-            return self.spec.before
-        if self._phase is Phase.DONE:
-            return self.spec.after
-        self._update_active(t, ctx_end)
-        if self._current < 0:
-            return self._carry
-        return self._active[self._current].segment.target
-
-    def _carry_at(self, t: float) -> str:
-        """The gaze kind of the current phase at time ``t`` (carried into the next phase)."""
-        return self._gaze_kind(t)
-
-    def _gaze_child(self) -> str:
-        if self._lost_since is not None:
-            return "lost"
-        if self._phase is Phase.IDLE:
-            return "before"
-        if self._phase is Phase.DONE:
-            return "after"
-        return "carry" if self._current < 0 else f"g{self._current}"
-
-    def _to_sub(self, child: str) -> None:
-        name = f"{self._phase.value}_{child}"
-        if self._model.state == name:
-            return
-        trigger: Callable[[], bool] | None = getattr(self._model, f"to_{name}", None)
-        if trigger is not None:
-            trigger()
+                if item.started_at >= best_t:  # the latest start wins; a tie: the later one
+                    best, best_t = i, item.started_at
+        if best >= 0:
+            self._latest = best_t
+            self._firing = (phase, best)
+            self._trigger("timer")
+            self._firing = (Phase.IDLE, -1)
 
     # ----------------------------------------------------------------- points
     def _point(self, kind: str, ctx: GazeContext) -> np.ndarray:
@@ -475,3 +714,13 @@ def _as3(p: object) -> np.ndarray | None:
         return np.asarray(p, dtype=float).reshape(-1)
     except (TypeError, ValueError):
         return None
+
+
+def write_diagram(spec: BehaviorSpec, path: Path) -> None:
+    """Write :func:`diagram` to ``path``; a ``.md`` file gets it in a fenced ``mermaid`` block
+    (rendered by GitHub and most Markdown viewers), any other file the bare Mermaid text."""
+    path = Path(path)
+    text = diagram(spec).strip() + "\n"
+    if path.suffix.lower() == ".md":
+        text = f"```mermaid\n{text}```\n"
+    path.write_text(text, encoding="utf-8")

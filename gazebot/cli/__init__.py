@@ -13,6 +13,7 @@ import sys
 from gazebot.cli.errors import UsageError
 from gazebot.config import ConfigError
 from gazebot.phases.trajectory import TrajectoryFormatError
+from gazebot.recordings import RecordingError
 
 # Command groups, in the order ``gazebot --help`` lists them.
 COMMAND_MODULES = (
@@ -23,6 +24,7 @@ COMMAND_MODULES = (
     "ik",
     "render",
     "sim",
+    "reach_plan",
     "run",
     "display",
     "study",
@@ -53,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
         # the interpreter's final flush does not complain again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except (ConfigError, TrajectoryFormatError, UsageError, OSError) as exc:
+    except (ConfigError, TrajectoryFormatError, RecordingError, UsageError, OSError) as exc:
         # Input errors only: a malformed file, a wrong option, a missing file, a directory where
         # a file was expected, permissions. Any other exception is a bug: it keeps its traceback.
         print(f"gazebot: error: {exc}", file=sys.stderr)

@@ -23,9 +23,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.set_defaults(func=_list)
 
-    p = cmds.add_parser("show", help="print a behavior's resolved definition")
+    p = cmds.add_parser("show", help="print a behavior's resolved definition (or its diagram)")
     p.add_argument("behavior", help="behavior name or YAML file")
     p.add_argument("--dir", action="append", type=Path, default=None, help="user behavior folder")
+    p.add_argument(
+        "--diagram",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write the behavior's state machine diagram as Mermaid text (FILE.md: in a fenced "
+        "mermaid block; any other name, e.g. FILE.mmd: the bare diagram)",
+    )
     p.set_defaults(func=_show)
 
 
@@ -48,5 +56,11 @@ def _show(args: argparse.Namespace) -> int:
     from gazebot.behaviors import load_behavior
 
     spec = load_behavior(args.behavior, args.dir)
+    if args.diagram is not None:
+        from gazebot.behaviors.machine import write_diagram
+
+        write_diagram(spec, args.diagram)
+        print(f"wrote {args.diagram} (state machine of {spec.name})")
+        return 0
     print(json.dumps(spec.model_dump(mode="json"), indent=2))
     return 0

@@ -26,13 +26,76 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="gaze behavior name or YAML (default: %(default)s)",
     )
     parser.add_argument("--scene", default="default", help="scene name or YAML (default: default)")
+    parser.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )
     parser.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
     parser.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
     parser.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     parser.add_argument("--json", action="store_true", help="print a JSON summary to stdout")
+    parser.add_argument(
+        "--controller",
+        choices=["joint", "pv", "mcj", "mce", "stl"],
+        help="the robot's reach controller (default: the scene's; seed chapters 3-4)",
+    )
+    parser.add_argument(
+        "--reach-time", type=float, help="'Reach before', s from the handover's start"
+    )
+    parser.add_argument(
+        "--stall-time", type=float, help="'Don't move until', s from the handover's start (mce)"
+    )
+    parser.add_argument(
+        "--retreat",
+        choices=["after-release", "after-grasp"],
+        help="when the robot retreats (seed 6.3: after the release; 6.4.3: after grasping)",
+    )
     parser.set_defaults(func=run_demo)
+
+
+def scene_with_overrides(args: argparse.Namespace):
+    """The scene named by ``--scene`` with the controller options applied (validated), or the
+    scene name itself when no option is given."""
+    overrides = {
+        key: value
+        for key, value in (
+            ("reach_controller", getattr(args, "controller", None)),
+            ("reach_time_s", getattr(args, "reach_time", None)),
+            ("stall_time_s", getattr(args, "stall_time", None)),
+            ("retreat", getattr(args, "retreat", None)),
+        )
+        if value is not None
+    }
+    if not overrides:
+        return args.scene
+    from pydantic import ValidationError
+
+    from gazebot.sim.scene_config import SceneConfig, load_scene
+
+    scene = load_scene(args.scene)
+    data = scene.model_dump()
+    data["controller"].update(overrides)
+    timed = "reach_time_s" in overrides or "stall_time_s" in overrides
+    if (
+        timed
+        and str(
+            getattr(
+                data["controller"]["reach_controller"],
+                "value",
+                data["controller"]["reach_controller"],
+            )
+        )
+        == "joint"
+    ):
+        raise UsageError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+    try:
+        return SceneConfig.model_validate(data)
+    except ValidationError as exc:
+        raise UsageError(f"invalid controller options: {exc}") from exc
 
 
 def run_demo(args: argparse.Namespace) -> int:
@@ -44,11 +107,21 @@ def run_demo(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    from gazebot.sim.stl_monitor import HandoverMonitor
+
+    monitor = HandoverMonitor()  # the seed's Table 4.2 specs over the run (4.2.1 robustness)
     try:
-        rec = _record(args, out)
+        rec = _record(args, out, monitor)
     except OffscreenRenderingError as exc:
         print(f"gazebot: error: {exc}", file=sys.stderr)
         return 2
+    from gazebot.controllers import INFEASIBLE_MESSAGE
+    from gazebot.types import EventKind
+
+    infeasible = [e for e in rec.robot_events if e.kind is EventKind.ROBOT_REACH_INFEASIBLE]
+    if infeasible:
+        # The seed's failure feedback (3.2), to the user before anything else.
+        print(INFEASIBLE_MESSAGE, file=sys.stderr if args.json else sys.stdout)
     csv_path = write_timeline_csv(rec.ticks, out / "timeline.csv")
     title = f"{Path(str(args.robot)).stem} - {Path(str(args.behavior)).stem} - {args.scene}"
     png_path = plot_timeline(rec.ticks, out / "timeline.png", title=title)
@@ -65,6 +138,9 @@ def run_demo(args: argparse.Namespace) -> int:
             for p, a, b in phase_spans(rec.ticks)
         ],
         "robot_events": [e.to_json() for e in rec.robot_events],
+        "reach_infeasible": bool(infeasible),
+        "reach_start_time_s": _last_reach_start_time(rec.ticks),
+        "stl_robustness": {k: round(v, 4) for k, v in monitor.robustness().items()},
         "wall_time_s": round(time.perf_counter() - t0, 2),
     }
     if args.json:
@@ -75,6 +151,8 @@ def run_demo(args: argparse.Namespace) -> int:
             f"handover {summary['duration_s']:.2f} s ({phases}), {rec.frames} frames, "
             f"{summary['wall_time_s']:.1f} s wall"
         )
+        rob = ", ".join(f"{k} {v:+.3f}" for k, v in summary["stl_robustness"].items())
+        print(f"STL robustness (Table 4.2, positive = met): {rob}")
         for path in (rec.video, csv_path, png_path):
             print(f"wrote {path}")
     if not rec.completed:
@@ -83,13 +161,23 @@ def run_demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _record(args: argparse.Namespace, out: Path):
+def _last_reach_start_time(ticks) -> float | None:
+    """The seed's reach-start time (giver's reach start - robot's, s) once both started."""
+    import math
+
+    value = ticks[-1].reach_start_time if ticks else math.nan
+    return None if math.isnan(value) else round(value, 4)
+
+
+def _record(args: argparse.Namespace, out: Path, monitor=None):
+    from gazebot.kinematics.config import with_gaze_mode
     from gazebot.sim.record import record_handover
 
     return record_handover(
-        robot=args.robot,
+        robot=with_gaze_mode(args.robot, args.gaze_mode),
         behavior=args.behavior,
-        scene=args.scene,
+        scene=scene_with_overrides(args),
+        on_tick=None if monitor is None else monitor.on_tick,
         out_path=out / "handover.mp4",
         seed=args.seed,
         width=args.width,

@@ -1,4 +1,5 @@
-"""``gazebot phases FILE.csv [--online] [--json] [--config FILE]``: segment a trajectory CSV."""
+"""``gazebot phases FILE [--method M] [--online] [--json] [--config FILE] [--giver-hand NAME]
+[--receiver-hand NAME] [--giver-face NAME] [--unit U] [--rate HZ]``: segment a recording."""
 
 from __future__ import annotations
 
@@ -14,24 +15,40 @@ if TYPE_CHECKING:
     from gazebot.phases import Segment
 
 
+def add_recording_options(p: argparse.ArgumentParser, prefix: str = "") -> None:
+    """The point-name, unit and rate options of a recording (shared with ``--giver-motion``)."""
+    p.add_argument(f"--{prefix}giver-hand", default=None, metavar="NAME",
+                   help="point/label/topic/frame of the giver's hand (default: giver_hand in CSV)")
+    p.add_argument(f"--{prefix}receiver-hand", default=None, metavar="NAME",
+                   help="point of the receiver's hand (default: receiver_hand in CSV)")
+    p.add_argument(f"--{prefix}giver-face", default=None, metavar="NAME",
+                   help="point of the giver's face (optional)")
+    p.add_argument(f"--{prefix}unit", default=None, choices=None, metavar="UNIT",
+                   help="length unit of CSV / pose-folder coordinates: m (default), cm or mm")
+    p.add_argument(f"--{prefix}rate", default=None, type=float, metavar="HZ",
+                   help="sampling rate of a pose folder (its files have no time column)")
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "phases",
-        help="split a hand-trajectory CSV into reach, transfer and retreat",
+        help="split a hand-motion recording into reach, transfer and retreat",
         description=(
-            "Segment a trajectory CSV (header t,giver_hand_x..z,receiver_hand_x..z"
-            "[,giver_face_x..z][,gripper_closed][,load_share]; s and m; empty cell = missing) "
-            "into handover phases. "
-            "Offline by default (whole recording, the seed's transfer rule); --online replays it "
-            "through the causal detector the engine runs."
+            "Segment a recording into handover phases. Formats: CSV (t + NAME_x,NAME_y,NAME_z "
+            "columns; s and m unless --unit; empty/NaN = missing), C3D (labels; its own unit), "
+            "ROS 1/2 bags (PoseStamped, PointStamped, TransformStamped topics, /tf child "
+            "frames), a folder of per-body pose CSVs (--rate). Offline by default (whole "
+            "recording); --online replays it through the causal detector the engine runs."
         ),
     )
-    p.add_argument("file", metavar="FILE.csv", help="trajectory CSV")
+    p.add_argument("file", metavar="FILE", help="recording: .csv, .c3d, .bag, ROS 2 bag, folder")
+    p.add_argument("--method", default=None, choices=("gazebot", "seed-7.2.5", "seed-4.4.3"),
+                   help="phase rules (default: method in the config, gazebot)")
     p.add_argument("--online", action="store_true", help="replay through the online detector")
     p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
-    p.add_argument(
-        "--config", default=None, help="phase thresholds YAML (default: configs/phases.yaml)"
-    )
+    p.add_argument("--config", default=None,
+                   help="phase settings YAML (default: configs/phases.yaml)")
+    add_recording_options(p)
     p.set_defaults(func=handle)
 
 
@@ -40,17 +57,15 @@ def _fmt(x: float | None) -> str:
 
 
 def handle(args: argparse.Namespace) -> int:
-    from gazebot.phases import load_phase_config, load_trajectory_csv, run_online, segment
+    from gazebot.phases import load_phase_config, run_online, segment
+    from gazebot.recordings import PointNames, load_recording
 
     config = load_phase_config(args.config)
-    try:
-        traj = load_trajectory_csv(args.file)
-    except UnicodeDecodeError as exc:
-        # The bare codec message names neither the file nor what to do about it.
-        raise UsageError(
-            f"{args.file}: not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset "
-            f"{exc.start}); save the CSV as UTF-8"
-        ) from None
+    if args.method is not None:
+        config = config.model_copy(update={"method": args.method})
+    names = PointNames(args.giver_hand, args.receiver_hand, args.giver_face)
+    rec = load_recording(args.file, names, unit=args.unit, rate=args.rate)
+    traj = rec.trajectory
     _, reordered, dropped = traj.cleaned()
     if reordered or dropped:
         print(
@@ -60,29 +75,36 @@ def handle(args: argparse.Namespace) -> int:
         )
     segments: list[Segment]
     if args.online:
-        result = run_online(traj, config)
-        segments = result.segments
+        segments = run_online(traj, config).segments
     else:
         segments = segment(traj, config)
     if args.json:
-        json.dump([s.to_json() for s in segments], sys.stdout, indent=1)
+        doc = {
+            "source": rec.source,
+            "format": rec.format,
+            "method": config.method,
+            "online": bool(args.online),
+            "units": {"time": "s", "length": "m", "file_length": rec.unit},
+            "rate_hz": None if math.isnan(rec.rate) else round(rec.rate, 3),
+            "names": dict(zip(("giver_hand", "receiver_hand", "giver_face"), rec.names, strict=True)),
+            "segments": [s.to_json() for s in segments],
+        }
+        json.dump(doc, sys.stdout, indent=1)
         sys.stdout.write("\n")
         return 0
-    if not segments:
-        print("no handover found")
-        return 0
+    print(f"# {rec.describe()}; method {config.method}{' (online)' if args.online else ''}")
     head = f"{'handover':>8}  {'phase':<9}{'start':>8}  {'end':>8}  {'duration':>8}"
     if args.online:
         head += f"  {'detected':>8}"
     print(head)
-    t_end = float(traj.t[-1]) if len(traj) else float("nan")
+    if not segments:
+        print("(no handover found)")
+        return 0
     for s in segments:
-        line = (
-            f"{s.handover:>8}  {s.phase.value:<9}{_fmt(s.start)}  {_fmt(s.end)}  {_fmt(s.duration)}"
-        )
+        line = f"{s.handover:>8}  {s.phase.value:<9}{_fmt(s.start)}  {_fmt(s.end)}  {_fmt(s.duration)}"
         if args.online:
             line += f"  {_fmt(s.detected_at)}"
-        if s.end >= t_end:
-            line += "  (to end of data)"  # the recording stops inside this phase
+        if s.open:
+            line += "  (to end of data)"
         print(line)
     return 0

@@ -17,6 +17,12 @@ def register(kinds: argparse._SubParsersAction) -> None:
     parser.add_argument("--robot", default="sawyer", help="sawyer | jaco2 | robot YAML")
     parser.add_argument("--behavior", required=True, help="gaze behavior name or YAML")
     parser.add_argument("--scene", default="default", help="scene name or YAML (default: default)")
+    parser.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )
     parser.add_argument("--out", type=Path, required=True, help="output FILE.mp4")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
     parser.add_argument("--width", type=int, default=640, help="width, px, even (default: 640)")
@@ -27,6 +33,7 @@ def register(kinds: argparse._SubParsersAction) -> None:
 
 
 def run_render_video(args: argparse.Namespace) -> int:
+    from gazebot.kinematics.config import with_gaze_mode
     from gazebot.sim.gl_check import OffscreenRenderingError
     from gazebot.sim.record import check_video_size, render_handover_video
 
@@ -38,7 +45,7 @@ def run_render_video(args: argparse.Namespace) -> int:
         raise UsageError(f"--width/--height/--fps: {exc}") from None
     try:
         path = render_handover_video(
-            args.robot,
+            with_gaze_mode(args.robot, args.gaze_mode),
             args.behavior,
             args.scene,
             args.out,

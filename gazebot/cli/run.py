@@ -20,6 +20,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
     p.add_argument("--behavior", default="face-hand-face", help="behavior name or YAML file")
+    p.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )
     p.add_argument("--phases", default=None, help="phase config YAML (default configs/phases.yaml)")
     p.add_argument("--seed", type=int, default=0, help="seed of behavior timings and blinks")
     p.add_argument("--duration", type=positive, default=None,
@@ -48,10 +54,12 @@ def handle(args: argparse.Namespace) -> int:
         resync=not args.no_resync,
         no_robot_warning=args.no_robot_warning,
     )
+    # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
+    from gazebot.kinematics.config import with_gaze_mode
     from gazebot.runtime import GazeLoop
 
-    # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
-    loop = GazeLoop.from_config(args.robot, args.behavior, args.phases, seed=args.seed)
+    robot = with_gaze_mode(args.robot, args.gaze_mode)
+    loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
     driver = ZenohRobotDriver.open(cfg, "engine")
     try:
         endpoints = f"listen {list(cfg.listen)}, connect {list(cfg.connect)}"

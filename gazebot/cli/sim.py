@@ -25,6 +25,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the giver and the tracking noise")
     p.add_argument("--with-engine", action="store_true", help="run a gaze engine in-process too")
     p.add_argument("--behavior", default="face-hand-face", help="behavior for --with-engine")
+    p.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )
     p.add_argument("--headless", action="store_true", help="no window")
     p.add_argument(
         "--eye-frames",
@@ -98,7 +104,10 @@ def handle(args: argparse.Namespace) -> int:
             from gazebot.runtime import GazeLoop
 
             driver = ZenohRobotDriver(endpoint.session, cfg.keys, "engine")
-            loop = GazeLoop.from_config(args.robot, args.behavior, seed=args.seed)
+            from gazebot.kinematics.config import with_gaze_mode
+
+            robot = with_gaze_mode(args.robot, args.gaze_mode)
+            loop = GazeLoop.from_config(robot, args.behavior, seed=args.seed)
             engine_node = EngineNode.with_eye_frames(loop, driver)
             thread = threading.Thread(target=engine_node.run, kwargs={"stop": stop},
                                       name="engine-node", daemon=True)

@@ -1,14 +1,22 @@
-"""``gazebot study plan|render|analyze|fit-wins``: run a pairwise video study end to end."""
+"""``gazebot study plan|render|serve|export|analyze|fit-wins``: run a pairwise video study end to
+end."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
 from gazebot.cli.errors import UsageError
-from gazebot.study.conditions import CONDITION_LEVELS, DEFAULT_BEHAVIORS
+from gazebot.study.conditions import (
+    CONDITION_LEVELS,
+    DEFAULT_BEHAVIORS,
+    GAZE_MODES,
+    REACH_BEHAVIORS,
+    default_behaviors,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -19,20 +27,30 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = study.add_parser("plan", help="write a counterbalanced session plan (CSV)")
     p.add_argument(
         "--behaviors",
-        default=",".join(DEFAULT_BEHAVIORS),
-        help="comma-separated behavior names (default: the seed's three)",
+        default=None,
+        help="comma-separated behavior names (default: the seed's: "
+        f"{','.join(REACH_BEHAVIORS)} without a condition (6.3), "
+        f"{','.join(DEFAULT_BEHAVIORS)} with one (6.4))",
     )
     p.add_argument(
         "--condition",
-        required=True,
+        default=None,
         choices=list(CONDITION_LEVELS),
-        help="; ".join(f"{c}: {a} / {b}" for c, (a, b) in CONDITION_LEVELS.items()),
+        help="none: every ordered pair once (6.3); else both levels of it (6.4): "
+        + "; ".join(f"{c}: {a} / {b}" for c, (a, b) in CONDITION_LEVELS.items()),
     )
     p.add_argument(
         "--participants",
         type=int,
         required=True,
-        help="a multiple of the block size 2*g*(g-1) (12 for three behaviors)",
+        help="a multiple of the block size: g*(g-1) without a condition, 2*g*(g-1) with one",
+    )
+    p.add_argument(
+        "--gaze-mode",
+        choices=list(GAZE_MODES),
+        default=None,
+        help="how the robot shows its gaze (default: the seed's: head-only without a condition, "
+        "eyes-only with one); the instructions name the head or the eyes to match",
     )
     p.add_argument("--seed", type=int, default=0, help="randomisation seed")
     p.add_argument("--robot", default="sawyer")
@@ -42,9 +60,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="append",
         default=[],
         metavar="LEVEL=SCENE",
-        help="render a level in another scene (default: the shipped scene of the level)",
+        help="render a level in another scene (default: the shipped scene of the level); "
+        "without a condition just SCENE (default: robot-initiated)",
     )
-    p.add_argument("--out", required=True, type=Path, help="plan CSV file to write")
+    p.add_argument(
+        "--out", type=Path, default=Path("plan.csv"), help="plan CSV file (default: plan.csv)"
+    )
     p.add_argument("--json", action="store_true", help="print the balance summary as JSON")
     p.set_defaults(func=_plan)
 
@@ -70,6 +91,31 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--no-progress", action="store_true")
     r.set_defaults(func=_render)
 
+    sv = study.add_parser("serve", help="run a rendered study in the browser (answers in SQLite)")
+    sv.add_argument("dir", type=Path, help="a folder written by `gazebot study render`")
+    sv.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    sv.add_argument("--port", type=int, default=8000, help="port (0: any free port)")
+    sv.add_argument("--threads", type=int, default=4, help="server worker threads")
+    sv.add_argument(
+        "--admin-token", default=None, help="token for /admin from other hosts (default: random)"
+    )
+    sv.add_argument(
+        "--token-only",
+        action="store_true",
+        help="ask for the token on /admin from this machine too (behind a local reverse proxy)",
+    )
+    sv.set_defaults(func=_serve)
+
+    ex = study.add_parser("export", help="write the answers of a served study as a responses CSV")
+    ex.add_argument("dir", type=Path)
+    ex.add_argument("--out", required=True, type=Path, help="CSV file for `gazebot study analyze`")
+    ex.add_argument(
+        "--include-practice",
+        action="store_true",
+        help="also the practice session (session 0; for inspection, not for analyze)",
+    )
+    ex.set_defaults(func=_export)
+
     a = study.add_parser("analyze", help="Bradley-Terry analysis of a responses CSV")
     a.add_argument("responses", type=Path)
     a.add_argument("--json", action="store_true")
@@ -91,6 +137,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         default="participant",
         help="one value per participant (default) or per session (like the seed) in the bias test",
     )
+    a.add_argument(
+        "--sides",
+        choices=["one", "two"],
+        default="one",
+        help="p-values of the proportion difference tests: one-sided in the observed direction "
+        "(default, as the seed's Tables B.7-B.12) or two-sided",
+    )
     a.set_defaults(func=_analyze)
 
     f = study.add_parser("fit-wins", help="Bradley-Terry fit of a win-count matrix CSV")
@@ -99,7 +152,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--participants",
         type=float,
         required=True,
-        help="n: every pair compared n times (cell(i,j) + cell(j,i) = n)",
+        help="n: every pair compared n times (cell(i,j) + cell(j,i) = n); a pair with another "
+        "total is fitted with its own total, with a warning",
     )
     f.add_argument("--json", action="store_true")
     f.set_defaults(func=_fit_wins)
@@ -132,16 +186,31 @@ def _plan(args: argparse.Namespace) -> int:
     from gazebot.study.plan import check_balance, make_plan, write_plan
 
     check_output_file(args.out, "plan")
-    behaviors = [b.strip() for b in args.behaviors.split(",") if b.strip()]
+    names = (
+        args.behaviors
+        if args.behaviors is not None
+        else ",".join(default_behaviors(args.condition))
+    )
+    behaviors = [b.strip() for b in names.split(",") if b.strip()]
     _check_behaviors(behaviors)
     scenes = {}
     for item in args.scene:
         level, sep, scene = item.partition("=")
+        if not sep and not args.condition and level:
+            scenes[""] = level  # no condition: the single scenario's scene
+            continue
         if not sep or not level or not scene:
             raise UsageError(f"--scene expects LEVEL=SCENE, got {item!r}")
         scenes[level] = scene
     plan = make_plan(
-        behaviors, args.condition, args.participants, args.seed, args.robot, scenes, args.video_seed
+        behaviors,
+        args.condition,
+        args.participants,
+        args.seed,
+        args.robot,
+        scenes,
+        args.video_seed,
+        args.gaze_mode,
     )
     write_plan(plan, args.out)
     report = check_balance(plan)
@@ -149,6 +218,9 @@ def _plan(args: argparse.Namespace) -> int:
         "out": str(args.out),
         "participants": args.participants,
         "sessions_per_participant": len(plan) // args.participants,
+        "behaviors": behaviors,
+        "condition": args.condition or "",
+        "gaze_mode": plan[0].gaze_mode,
         "position_balanced": report.position_balanced,
         "carryover_balanced": report.carryover_balanced,
     }
@@ -156,8 +228,9 @@ def _plan(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
     else:
         print(
-            f"wrote {len(plan)} sessions for {args.participants} participants to {args.out} "
-            f"(position balanced: {report.position_balanced}, "
+            f"wrote {len(plan)} sessions ({len(plan) // args.participants} per participant) for "
+            f"{args.participants} participants to {args.out} (gaze mode {plan[0].gaze_mode}, "
+            f"position balanced: {report.position_balanced}, "
             f"carry-over balanced: {report.carryover_balanced})"
         )
     return 0
@@ -221,6 +294,7 @@ def _analyze(args: argparse.Namespace) -> int:
         margin=args.margin,
         behaviors=order,
         bias_unit=args.bias_unit,
+        sides=args.sides,
     )
     if args.plot is not None:
         from gazebot.study.plots import plot_preferences
@@ -244,11 +318,13 @@ def _analyze(args: argparse.Namespace) -> int:
             )
     for m, b in result.bias.items():
         print(f"first/second bias {m}: S={b.s:.1f} p={b.p_value:.2f}")
+    for q, b in result.bias_per_question.items():
+        print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_value:.2f}")
     for c in result.comparisons:
         print(
             f"{c.measure} {c.behavior_i} vs {c.behavior_j} ({c.design}, n={c.n_a}/{c.n_b}): "
             f"{c.sample_a} {c.proportion_a:.2f} vs {c.sample_b} {c.proportion_b:.2f}, "
-            f"z={c.difference.z:.2f} p={c.difference.p_value:.2f}, "
+            f"z={c.difference.z:.2f} p={c.difference.p_value:.2f} ({args.sides}-sided), "
             f"equivalence p={c.equivalence.p_value:.2f}"
         )
     return 0
@@ -259,7 +335,7 @@ def _fit_wins(args: argparse.Namespace) -> int:
 
     from gazebot.study.analysis import read_win_matrix
     from gazebot.study.bradley_terry import fit_bradley_terry
-    from gazebot.study.stats import bradley_terry_chi2
+    from gazebot.study.stats import bradley_terry_chi2, likelihood_ratio_chi2
 
     n = _finite(args.participants, "--participants")
     names, w = read_win_matrix(args.wins)
@@ -270,20 +346,27 @@ def _fit_wins(args: argparse.Namespace) -> int:
         for i, j in zip(*iu, strict=True)
         if abs(totals[i, j] - n) > 1e-6 * max(1.0, n)
     ]
-    if bad:
-        i, j, t = bad[0]
-        raise UsageError(
-            f"{args.wins}: cells ({i}, {j}) + ({j}, {i}) = {t:g}, expected "
-            f"--participants {n:g} (every participant compares every pair once)"
-        )
     fit = fit_bradley_terry(w, names)
-    chi = bradley_terry_chi2(fit.wins, fit.p, n)
+    if bad:
+        # A published table may have a pair not every participant answered (the seed's Table
+        # B.3: 23 of 24). The MM fit uses each pair's own total already; the chi-square of
+        # eq. 6.2 assumes n per pair, so the likelihood-ratio form (equal to it for n) is used.
+        for i, j, t in bad:
+            print(
+                f"gazebot: warning: {args.wins}: cells ({i}, {j}) + ({j}, {i}) = {t:g}, not "
+                f"--participants {n:g}; using that pair's own total",
+                file=sys.stderr,
+            )
+        chi = likelihood_ratio_chi2(w, fit.p)
+    else:
+        chi = bradley_terry_chi2(fit.wins, fit.p, n)
     out = {
         "conditions": names,
         "p": [float(v) for v in fit.p],
         "chi2": chi.chi2,
         "df": chi.df,
         "p_value": chi.p_value,
+        "pair_totals_differ": [[i, j, t] for i, j, t in bad],
     }
     if args.json:
         print(json.dumps(out))
@@ -291,4 +374,30 @@ def _fit_wins(args: argparse.Namespace) -> int:
         for c, v, a in zip(names, fit.p, fit.wins, strict=True):
             print(f"{c}: a_i={a:g} P_i={v:.2f}")
         print(f"chi2={chi.chi2:.3f} df={chi.df} p={chi.p_value:.3g}")
+    return 0
+
+
+def _serve(args: argparse.Namespace) -> int:
+    from gazebot.study.web.server import serve
+
+    if not 0 <= args.port <= 65535:
+        raise ValueError(f"--port must be in 0..65535, got {args.port}")
+    if args.threads < 1:
+        raise ValueError(f"--threads must be >= 1, got {args.threads}")
+    serve(
+        str(args.dir),
+        args.host,
+        args.port,
+        args.threads,
+        args.admin_token,
+        local_admin=not args.token_only,
+    )
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from gazebot.study.export import export_responses
+
+    out, n = export_responses(args.dir, args.out, args.include_practice)
+    print(f"wrote {n} answered sessions to {out}")
     return 0

@@ -4,7 +4,13 @@ Entry points: :meth:`RobotModel.load`, :func:`solve_ik` (one look-at solve) and
 :class:`GazeController` (timed neck + eye commands for a stream of targets).
 """
 
-from gazebot.kinematics.config import RobotConfig, load_robot_config
+from gazebot.kinematics.config import (
+    GAZE_MODES,
+    GazeMode,
+    RobotConfig,
+    load_robot_config,
+    with_gaze_mode,
+)
 from gazebot.kinematics.controller import GazeController, HeadEyeState
 from gazebot.kinematics.eyes import DisplayEyes, eye_angles, eye_direction
 from gazebot.kinematics.look_at import IKConfig, LookAtSolution, solve_ik
@@ -12,6 +18,8 @@ from gazebot.kinematics.robot import GazePose, RobotModel
 from gazebot.kinematics.shifts import GazeShiftConfig, MinJerkTrajectory, min_jerk
 
 __all__ = [
+    "GAZE_MODES",
+    "GazeMode",
     "DisplayEyes",
     "GazeController",
     "GazePose",
@@ -27,4 +35,5 @@ __all__ = [
     "load_robot_config",
     "min_jerk",
     "solve_ik",
+    "with_gaze_mode",
 ]

@@ -9,6 +9,7 @@ repeated here: the MJCF is their single source.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -16,6 +17,12 @@ from gazebot.config import ConfigError, configs_dir, load_model
 from gazebot.kinematics.shifts import GazeShiftConfig
 
 REQUIRED_POINTS = ("face", "handover_location", "rest")
+
+#: How the robot points its gaze: ``head-and-eyes`` (the neck turns and the display's eyes take
+#: the rest), ``head-only`` (the display shows fixed eyes; seed 6.3: "a static image of two eyes")
+#: or ``eyes-only`` (the neck holds still; seed 6.4: "robot eye gazes instead of head gazes").
+GazeMode = Literal["head-and-eyes", "head-only", "eyes-only"]
+GAZE_MODES: tuple[str, ...] = ("head-and-eyes", "head-only", "eyes-only")
 
 
 class DisplayConfig(BaseModel):
@@ -44,7 +51,8 @@ class EyeConfig(BaseModel):
     @classmethod
     def _range(cls, value: tuple[float, float]) -> tuple[float, float]:
         lo, hi = value
-        if not (-89.0 <= lo <= 0.0 <= hi <= 89.0 and lo < hi):
+        # [0, 0] is allowed: eyes that cannot move (e.g. a static image of two eyes).
+        if not -89.0 <= lo <= 0.0 <= hi <= 89.0:
             raise ValueError("[min, max] degrees with -89 <= min <= 0 <= max <= 89")
         return value
 
@@ -64,14 +72,15 @@ class RobotConfig(BaseModel):
     gripper_actuator: str = "gripper"
     eye_style: str = Field(min_length=1)
     display: DisplayConfig
-    head_joints: list[str] = Field(min_length=1)
-    head_velocity_limits_deg_s: dict[str, float]
+    head_joints: list[str] = Field(default_factory=list)  # none: a fixed head (eyes only)
+    head_velocity_limits_deg_s: dict[str, float] = Field(default_factory=dict)
     head_rest_deg: dict[str, float] = Field(default_factory=dict)
     arm_joints: list[str] = Field(min_length=1)
     arm_home_deg: dict[str, float]
     arm_handover_deg: dict[str, float]
     eyes: EyeConfig
     shifts: GazeShiftConfig = Field(default_factory=GazeShiftConfig)
+    gaze_mode: GazeMode = "head-and-eyes"
     points: dict[str, Point]
 
     @model_validator(mode="after")
@@ -123,6 +132,27 @@ def load_robot_config(name_or_yaml: str | Path) -> tuple[RobotConfig, Path]:
     """
     path = robot_config_path(name_or_yaml)
     return load_model(RobotConfig, path), path
+
+
+def with_gaze_mode(robot: str | Path | RobotConfig, mode: str | None) -> str | Path | RobotConfig:
+    """``robot`` (name, YAML path or config) with its ``gaze_mode`` replaced; ``None`` returns
+    ``robot`` unchanged. The result is a :class:`RobotConfig` whose MJCF path is absolute, so it
+    loads like the original (the CLI's ``--gaze-mode``).
+
+    Raises:
+        ValueError: ``mode`` is not one of :data:`GAZE_MODES`.
+    """
+    if mode is None:
+        return robot
+    if mode not in GAZE_MODES:
+        raise ValueError(f"gaze mode one of {', '.join(GAZE_MODES)}, not {mode!r}")
+    if isinstance(robot, RobotConfig):
+        config, path = robot, None
+    else:
+        config, path = load_robot_config(robot)
+    data = config.model_dump()
+    data.update(gaze_mode=mode, mjcf=str(resolve_mjcf(config, path).resolve()))
+    return RobotConfig.model_validate(data)
 
 
 def resolve_mjcf(config: RobotConfig, yaml_path: Path | None) -> Path:

@@ -268,13 +268,16 @@ def solve_ik_raw(
     stepped = False  # the looser tracking stop applies only after a step
     # Only the pose is needed to test convergence; the Jacobian is computed for the steps (a
     # warm start on a slowly moving target converges in one step: one Jacobian, two poses).
-    # ``current``: robot.data holds the kinematics of ``qs`` (else the Jacobian recomputes them).
-    current = frame is None
     if frame is None:
         frame = robot.gaze_frame_lists(qs)
         rows = None
+    # A head that holds still (eyes-only gaze mode, or no head joints) takes no step: the eyes do
+    # all the pointing from where it is.
+    max_iterations = cfg.max_iterations if n and robot.head_moves else 0
+    if not max_iterations:
+        converged = stalled = True
     # Plain-Python floats on purpose: with n <= 4 joints numpy's per-call overhead would dominate.
-    for iterations in range(1, cfg.max_iterations + 1):  # noqa: B007 (reported afterwards)
+    for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported afterwards)
         (r00, _, _, px), (r10, _, _, py), (r20, _, _, pz) = frame
         dx, dy, dz = tx - px, ty - py, tz - pz
         dist = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -288,7 +291,7 @@ def solve_ik_raw(
         if stepped and cos >= cos_loose:
             break
         if rows is None:
-            rows = robot.gaze_jacobian_rows(None if current else qs)
+            rows = robot.gaze_jacobian_rows(qs)
         e0, e1, r0, r1 = _pointing_error(frame, (px, py, pz), rows, target)
         if not nudged and e0 * e0 + e1 * e1 > 2.0:
             g2 = sum((a * e0 + b * e1) ** 2 for a, b in zip(r0, r1, strict=True))
@@ -301,7 +304,7 @@ def solve_ik_raw(
                         nudged = True
                         break
                 if nudged:
-                    frame, rows, current = robot.gaze_frame_lists(qs), None, True
+                    frame, rows = robot.gaze_frame_lists(qs), None
                     continue
         # The active set below only matters when some joint is at a limit.
         at_limit = False
@@ -390,10 +393,13 @@ def solve_ik_raw(
             break
         qs = q_new
         stepped = True
-        frame, rows, current = robot.gaze_frame_lists(qs), None, True
+        frame, rows = robot.gaze_frame_lists(qs), None
 
     (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = frame
     dx, dy, dz = tx - px, ty - py, tz - pz
+    if not max_iterations and math.sqrt(dx * dx + dy * dy + dz * dz) < cfg.min_distance:
+        nan = math.nan
+        return RawSolution(qs, False, (nan, nan, nan), nan, 0, False, False, False)
     local = (
         r00 * dx + r10 * dy + r20 * dz,
         r01 * dx + r11 * dy + r21 * dz,
@@ -402,7 +408,7 @@ def solve_ik_raw(
     residual = angle_between((1.0, 0.0, 0.0), local)
     reached = residual <= tol
     if jacobian and rows is None:
-        rows = robot.gaze_jacobian_rows(None if current else qs)
+        rows = robot.gaze_jacobian_rows(qs)
     return RawSolution(
         qs,
         True,
@@ -472,6 +478,9 @@ def solve_ik(
     message = ""
     if clamped:
         message = f"head joint limit reached ({', '.join(limited)}); the eyes take the rest"
+    elif not reached and not robot.head_moves:
+        why = "no head joints" if not robot.head_joints else f"gaze mode {robot.gaze_mode}"
+        message = f"the head holds still ({why}); the eyes take the rest"
     elif not reached and stalled:
         message = "the head cannot turn closer (missing degrees of freedom); the eyes take the rest"
     elif not converged:

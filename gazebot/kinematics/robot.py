@@ -56,7 +56,11 @@ class RobotModel:
         head_bounds: ``(lower, upper, rest)`` as lists of floats (read-only arrays above).
         eye_yaw_range, eye_pitch_range: Eye ranges (rad) as ``(min, max)``.
         eye_velocity_limit: Eye speed limit (rad/s).
-        eyes: The display eyes (range and speed) as a :class:`DisplayEyes`.
+        eyes: The display eyes (range and speed) as a :class:`DisplayEyes`; in ``head-only``
+            mode their range is zero (fixed eyes).
+        gaze_mode: ``head-and-eyes``, ``head-only`` or ``eyes-only`` (from the YAML).
+        head_moves: Whether the look-at solver may turn the head (``False`` in ``eyes-only``
+            mode or without head joints: the head holds still).
         gaze_frame_id: Pinocchio frame id of the ``gaze`` site.
         points: Default points (face, handover_location, rest, ...) as (3,) arrays.
         arm_joints: Arm joint names; ``arm_home``/``arm_handover``: poses (rad) by joint.
@@ -112,8 +116,17 @@ class RobotModel:
         for arr in (self.lower, self.upper, self.rest):
             arr.flags.writeable = False
         self.head_bounds = (self.lower.tolist(), self.upper.tolist(), self.rest.tolist())
-        self.eye_yaw_range = tuple(math.radians(v) for v in config.eyes.yaw_range_deg)
-        self.eye_pitch_range = tuple(math.radians(v) for v in config.eyes.pitch_range_deg)
+        self.gaze_mode = config.gaze_mode
+        self.head_moves = bool(self.head_joints) and self.gaze_mode != "eyes-only"
+        fixed_eyes = self.gaze_mode == "head-only"
+        self.eye_yaw_range = (
+            (0.0, 0.0) if fixed_eyes else tuple(math.radians(v) for v in config.eyes.yaw_range_deg)
+        )
+        self.eye_pitch_range = (
+            (0.0, 0.0)
+            if fixed_eyes
+            else tuple(math.radians(v) for v in config.eyes.pitch_range_deg)
+        )
         self.eye_velocity_limit = math.radians(config.eyes.velocity_limit_deg_s)
         self.eyes = DisplayEyes(self.eye_yaw_range, self.eye_pitch_range, self.eye_velocity_limit)
         self.points = {k: np.asarray(v, dtype=float) for k, v in config.points.items()}
@@ -130,6 +143,8 @@ class RobotModel:
         contiguous = self.head_idx.tolist() == list(range(first, first + len(self.head_idx)))
         self._head_sel = slice(first, first + len(self.head_idx)) if contiguous else self.head_idx
         self._arm_revision = 0
+        # (head vector, arm revision) whose forward kinematics :attr:`data` holds, or None.
+        self._kinematics_of: tuple[tuple[float, ...], int] | None = None
 
     @classmethod
     def load(cls, name_or_yaml: str | Path | RobotConfig = "sawyer") -> RobotModel:
@@ -223,6 +238,7 @@ class RobotModel:
     # --- kinematics ---------------------------------------------------------------------------
     def gaze_pose(self, q_head: np.ndarray) -> GazePose:
         """Pose of the gaze frame for head vector ``q_head``."""
+        self._kinematics_of = None
         pin.forwardKinematics(self.model, self.data, self.configuration(q_head))
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
         return GazePose(M.translation.copy(), M.rotation.copy())
@@ -232,25 +248,30 @@ class RobotModel:
         R_i2, p_i]`` (rotation columns = x, y, z; origin ``p``).
 
         The hot paths (look-at solver, gaze controller) use lists: with 3-vectors and <= 4 joints,
-        numpy's per-call overhead would dominate. Also leaves :attr:`data` at this configuration
-        for :meth:`gaze_jacobian_rows`.
+        numpy's per-call overhead would dominate.
         """
         q = self._q_work
         q[self._head_sel] = q_head
         pin.forwardKinematics(self.model, self.data, q)
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
+        self._kinematics_of = (tuple(q_head), self._arm_revision)
         return M.homogeneous[:3].tolist()
 
-    def gaze_jacobian_rows(self, q_head: Sequence[float] | None = None) -> list[list[float]]:
+    def gaze_jacobian_rows(self, q_head: Sequence[float]) -> list[list[float]]:
         """The 6 rows (linear, angular; LOCAL_WORLD_ALIGNED) of the gaze frame Jacobian over the
-        head joints at ``q_head``; ``None``: at the configuration of the last
-        :meth:`gaze_frame_lists` call (reuses its forward kinematics)."""
-        if q_head is None:
+        head joints at ``q_head``.
+
+        When :attr:`data` already holds the forward kinematics of ``q_head`` (the last call was
+        :meth:`gaze_frame_lists` at the same head vector and arm pose) they are reused; any other
+        call order recomputes them, so results never depend on which call came before.
+        """
+        if self._kinematics_of == (tuple(q_head), self._arm_revision):
             pin.computeJointJacobians(self.model, self.data)
         else:
             q = self._q_work
             q[self._head_sel] = q_head
             pin.computeJointJacobians(self.model, self.data, q)
+            self._kinematics_of = (tuple(q_head), self._arm_revision)
         J = pin.getFrameJacobian(self.model, self.data, self.gaze_frame_id, pin.LOCAL_WORLD_ALIGNED)
         return J[:, self._head_sel].tolist()
 
@@ -258,6 +279,7 @@ class RobotModel:
         """Gaze pose and its frame Jacobian (6 x n_head) in LOCAL_WORLD_ALIGNED: linear velocity
         of the gaze origin then angular velocity, both in base-frame axes."""
         q = self.configuration(q_head)
+        self._kinematics_of = None
         # computeJointJacobians runs the forward kinematics too (data.oMi), so the frame placement
         # and its Jacobian come from the same configuration.
         pin.computeJointJacobians(self.model, self.data, q)

@@ -26,6 +26,7 @@ class Segment:
         end: Phase end (s); the next phase of the same handover starts here.
         handover: Index of the handover in the recording (0 for the first).
         detected_at: Online only: when the phase start was detected (s); ``None`` offline.
+        open: The data end inside this phase: its end is the last sample, not an observed end.
     """
 
     phase: Phase
@@ -33,6 +34,7 @@ class Segment:
     end: float
     handover: int = 0
     detected_at: float | None = None
+    open: bool = False
 
     @property
     def duration(self) -> float:
@@ -77,5 +79,5 @@ def segments_from_events(events: Iterable[Event], t_end: float) -> list[Segment]
             open_phase = (_START_KIND[ev.kind], ev.t, ev.detected_at)
     if open_phase is not None and math.isfinite(t_end):
         phase, start, det = open_phase
-        out.append(Segment(phase, start, max(start, t_end), max(handover, 0), det))
+        out.append(Segment(phase, start, max(start, t_end), max(handover, 0), det, open=True))
     return out

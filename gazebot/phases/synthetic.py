@@ -97,6 +97,11 @@ class SyntheticOptions:
         speed: Giver speed factor (>1 fast, <1 slow); durations scale with ``1 / speed``.
         handovers: Number of consecutive handovers in the recording.
         robot_evidence: Whether the recording has the gripper state and load share.
+        marker_offset: Distance (m) between the tracked hand frames at contact, as on real
+            motion capture (markers on the back of the hand or the wrist, an object between):
+            each frame sits half of it behind the contact point, along the giver-robot line.
+        frozen_per_s: Rate of frozen stretches (the tracker repeats its last sample for 2-8
+            samples with new times) per point.
     """
 
     rate: float = 100.0
@@ -108,6 +113,8 @@ class SyntheticOptions:
     speed: float = 1.0
     handovers: int = 1
     robot_evidence: bool = False
+    marker_offset: float = 0.0
+    frozen_per_s: float = 0.0
 
     def __post_init__(self) -> None:
         if not 1.0 <= self.rate <= 2000.0:
@@ -208,6 +215,17 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
     gh = hand.at(ts) + sway + rng.normal(0.0, opts.noise, (n, 3))
     rh = grip.at(ts) + rng.normal(0.0, opts.gripper_noise, (n, 3))
     gf = face + lean.at(ts) + 0.5 * sway + rng.normal(0.0, opts.noise, (n, 3))
+    if opts.marker_offset > 0:
+        half = np.array([0.5 * opts.marker_offset, 0.0, 0.0])
+        gh = gh + half  # the giver stands at +x, the robot at -x
+        rh = rh - half
+    if opts.frozen_per_s > 0:
+        for arr in (gh, rh):
+            for t0 in rng.uniform(0, t_end, rng.poisson(opts.frozen_per_s * t_end)):
+                i = int(np.searchsorted(ts, t0))
+                k = int(rng.integers(2, 9))
+                if 0 < i < n - k:
+                    arr[i : i + k] = arr[i - 1]
     if opts.dropouts_per_s > 0:
         for arr in (gh, gf, rh):
             k = rng.poisson(opts.dropouts_per_s * t_end * (0.3 if arr is rh else 1.0))

@@ -32,8 +32,10 @@ class RobotDisplay:
 
 def _half_range(range_deg: tuple[float, float]) -> float:
     """``[lo, hi]`` degrees -> the largest magnitude in rad (the renderer's eye travel is
-    symmetric; the config guarantees lo <= 0 <= hi and |lo|, |hi| <= 89)."""
-    return math.radians(max(abs(range_deg[0]), abs(range_deg[1])))
+    symmetric; the config guarantees lo <= 0 <= hi and |lo|, |hi| <= 89). Eyes without range
+    (``[0, 0]``: they never move) keep the default scale, which then only draws them centred."""
+    half = math.radians(max(abs(range_deg[0]), abs(range_deg[1])))
+    return half if half > 0.0 else RobotDisplay.yaw_range
 
 
 def robot_display(robot: str | Path | RobotConfig) -> RobotDisplay:

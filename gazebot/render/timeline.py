@@ -31,6 +31,7 @@ class TickRecord:
     face: np.ndarray  # giver face (simulation truth)
     head_measured: dict[str, float] = field(default_factory=dict)
     events: tuple[str, ...] = ()
+    reach_start_time: float = math.nan  # giver's reach start - robot's (s), once both started
 
 
 def _xyz(prefix: str, p: np.ndarray) -> dict[str, float]:
@@ -48,7 +49,7 @@ def write_timeline_csv(ticks: Sequence[TickRecord], path: str | Path) -> Path:
     joints = list(ticks[0].head)
     fields = ["t", "phase", "target", *joints, "eye_yaw", "eye_pitch"]
     fields += [f"{p}_{a}" for p in ("target", "hand", "face") for a in "xyz"]
-    fields += [f"{j}_measured" for j in joints] + ["events"]
+    fields += [f"{j}_measured" for j in joints] + ["events", "reach_start_time"]
     with path.open("w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields)
         writer.writeheader()
@@ -60,6 +61,7 @@ def write_timeline_csv(ticks: Sequence[TickRecord], path: str | Path) -> Path:
                 row.update({key: f"{v:.5f}" for key, v in _xyz(name, p).items()})
             row.update({f"{j}_measured": f"{k.head_measured.get(j, math.nan):.6f}" for j in joints})
             row["events"] = ";".join(k.events)
+            row["reach_start_time"] = f"{k.reach_start_time:.4f}"
             writer.writerow(row)
     return path
 

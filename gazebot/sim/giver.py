@@ -5,7 +5,7 @@ durations (``GiverConfig``), so every seed gives a slightly different, human-lik
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 
 import numpy as np
@@ -50,9 +50,13 @@ class SimulatedGiver:
         rest: Hand position holding the object before and after the handover.
         offer: Hand position when offering the object at the handover location.
         plan: Timing of this handover.
+        cued: Wait for :meth:`respond_at` instead of starting at ``plan.start_t``
+            (robot-initiated handovers).
     """
 
-    def __init__(self, rest: np.ndarray, offer: np.ndarray, plan: GiverPlan) -> None:
+    def __init__(
+        self, rest: np.ndarray, offer: np.ndarray, plan: GiverPlan, cued: bool = False
+    ) -> None:
         self.rest = np.asarray(rest, float)
         self.offer = np.asarray(offer, float)
         self.plan = plan
@@ -61,6 +65,20 @@ class SimulatedGiver:
         self._share_end = np.inf
         self.hand = self.rest.copy()
         self.released_at: float | None = None
+        self.reach_started_at: float | None = None
+        self._cued = cued
+
+    def respond_at(self, t: float) -> None:
+        """Start the reach at ``t`` (s) if it has not started: the giver answering a
+        robot-initiated handover (a ``cued`` giver waits for this call)."""
+        if self.state is GiverState.IDLE:
+            self.plan = replace(self.plan, start_t=float(t))
+            self._cued = False
+
+    def let_go(self, t: float) -> None:
+        """End the transfer now (the robot pulls the object away right after grasping it)."""
+        if self.state is GiverState.SHARE:
+            self._share_end = min(self._share_end, float(t))
 
     @property
     def holds_object(self) -> bool:
@@ -70,9 +88,10 @@ class SimulatedGiver:
     def update(self, t: float, robot_grasped: bool) -> None:
         """Advance to time ``t`` (s); ``robot_grasped`` is whether the robot holds the object."""
         p = self.plan
-        if self.state is GiverState.IDLE and t >= p.start_t:
+        if self.state is GiverState.IDLE and not self._cued and t >= p.start_t:
             self._segment = MinJerkSegment(self.rest, self.offer, p.start_t, p.reach_s)
             self.state = GiverState.REACH
+            self.reach_started_at = p.start_t
         if self.state is GiverState.REACH and self._segment is not None and self._segment.done(t):
             self.state = GiverState.OFFER
         if self.state is GiverState.OFFER and robot_grasped:

@@ -152,6 +152,9 @@ def record_handover(
                             face=sim.scene.giver.face_point.copy(),
                             head_measured={j: state[j] for j in cmd.head if j in state},
                             events=tuple(e.kind.value for e in cmd.events),
+                            reach_start_time=(
+                                math.nan if sim.reach_start_time is None else sim.reach_start_time
+                            ),
                         )
                     )
                 if on_tick is not None and ticks:

@@ -73,11 +73,68 @@ class GiverConfig(_Strict):
     reach: DurationModel = Field(default_factory=_reach)
     transfer: DurationModel = Field(default_factory=_transfer)
     retreat: DurationModel = Field(default_factory=_retreat)
+    reaction_time_s: float = Field(
+        default=0.3,
+        ge=0.0,
+        le=3.0,
+        description="robot-initiated scenes: the giver starts this long after the robot's reach",
+    )
+
+
+class ReachControllerName(str, Enum):
+    """How the robot reaches: ``joint`` (a joint-space minimum-jerk move to the predefined
+    handover pose, the gaze studies' robot) or one of the seed's controllers (chapters 3-4)."""
+
+    JOINT = "joint"
+    PV = "pv"
+    MCJ = "mcj"
+    MCE = "mce"
+    STL = "stl"
+
+
+class RetreatTrigger(str, Enum):
+    """When the robot retreats home: after the giver releases the object (seed 6.3: "after the
+    human released the object and started to retreat") or right after grasping it (6.4.3: "The
+    robot retreated to its home position after grasping the object")."""
+
+    AFTER_RELEASE = "after-release"
+    AFTER_GRASP = "after-grasp"
+
+
+class Initiator(str, Enum):
+    """Who starts the handover: the giver (the robot reacts to the giver's reach) or the robot
+    (seed 6.3: the robot starts its reach, the giver responds after a reaction time)."""
+
+    GIVER = "giver"
+    ROBOT = "robot"
+
+
+class Direction(str, Enum):
+    """Who gives: the human (human-to-robot, the gaze studies) or the robot (robot-to-human, the
+    seed's chapter 3 task: the simulated person takes the object from the robot)."""
+
+    HUMAN_TO_ROBOT = "human-to-robot"
+    ROBOT_TO_HUMAN = "robot-to-human"
 
 
 class ControllerConfig(_Strict):
-    """The robot's handover controller (seed 6.3.2/6.4.3): reach a predefined handover pose once
-    the giver starts, grasp when the object is close, retreat home after the giver lets go."""
+    """The robot's handover controller (seed 6.3.2/6.4.3): reach once the handover starts, grasp
+    when the object is close, retreat home after the giver lets go (or after grasping)."""
+
+    reach_controller: ReachControllerName = ReachControllerName.JOINT
+    reach_time_s: float | None = Field(
+        default=None, gt=0, description="'Reach before' from the handover's start (None: YAML)"
+    )
+    stall_time_s: float | None = Field(
+        default=None, ge=0, description="'Don't move until' (mce; None: configs/controllers.yaml)"
+    )
+    controllers: str | None = Field(
+        default=None, description="controllers YAML (None: configs/controllers.yaml)"
+    )
+    retreat: RetreatTrigger = RetreatTrigger.AFTER_RELEASE
+    robot_start_s: float = Field(
+        default=1.0, ge=0.0, description="robot-initiated scenes: when the robot starts its reach"
+    )
 
     reach_min_duration_s: float = Field(default=1.6, gt=0)
     retreat_min_duration_s: float = Field(default=1.6, gt=0)
@@ -111,6 +168,8 @@ class SceneConfig(_Strict):
     posture: Posture = Posture.STANDING
     object: ObjectKind = ObjectKind.SMALL_BOX
     table: bool | None = Field(default=None, description="None: a table when sitting")
+    initiator: Initiator = Initiator.GIVER
+    direction: Direction = Direction.HUMAN_TO_ROBOT
     giver: GiverConfig = Field(default_factory=GiverConfig)
     controller: ControllerConfig = Field(default_factory=ControllerConfig)
     tracking: TrackingNoiseConfig = Field(default_factory=TrackingNoiseConfig)

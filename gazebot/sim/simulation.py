@@ -16,16 +16,51 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from gazebot.controllers.base import INFEASIBLE_MESSAGE
 from gazebot.kinematics.config import RobotConfig
+from gazebot.sim.cartesian_reach import CartesianReach
 from gazebot.sim.controller import ControllerState, HandoverController, Sensed
 from gazebot.sim.display import DisplayTexture
 from gazebot.sim.giver import GiverPlan, GiverState, SimulatedGiver
 from gazebot.sim.offscreen import OffscreenRenderer
+from gazebot.sim.receiver import ReceiverState, SimulatedReceiver
 from gazebot.sim.robot import SimRobot, load_sim_robot
 from gazebot.sim.scene import OBSERVER, Scene, build_scene
-from gazebot.sim.scene_config import SceneConfig, TrackingNoiseConfig, load_scene
+from gazebot.sim.scene_config import (
+    ControllerConfig,
+    Direction,
+    Initiator,
+    ReachControllerName,
+    RetreatTrigger,
+    SceneConfig,
+    TrackingNoiseConfig,
+    load_scene,
+)
 from gazebot.sim.tracking import TrackingNoise
-from gazebot.types import Event, TrackingFrame
+from gazebot.types import Event, EventKind, TrackingFrame
+
+
+def _feedback_banner(frame: np.ndarray, text: str) -> np.ndarray:
+    """``frame`` with the robot's failure feedback (seed 3.2) in a banner along the top."""
+    import cv2
+
+    out = np.ascontiguousarray(frame).copy()
+    h, w = out.shape[:2]
+    scale = max(0.35, w / 1400.0)
+    (tw, th), base = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)
+    bar = th + base + 12
+    out[:bar] = (out[:bar] * 0.35 + np.array([150, 20, 20]) * 0.65).astype(np.uint8)
+    cv2.putText(
+        out,
+        text,
+        (max(4, (w - tw) // 2), th + 6),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        scale,
+        (255, 255, 255),
+        1,
+        cv2.LINE_AA,
+    )
+    return out
 
 
 def nearest_equivalent(q: np.ndarray, goal: np.ndarray, ranges: np.ndarray) -> np.ndarray:
@@ -94,8 +129,28 @@ class HandoverSimulation:
 
         rng = np.random.default_rng([self.seed, 0])
         plan = GiverPlan.draw(self.config.giver, rng)
-        self.giver = SimulatedGiver(self.layout.rest_hand, self.layout.offer_hand, plan)
-        self.controller = HandoverController(self.home, self.robot.handover, self.config.controller)
+        self.robot_initiated = self.config.initiator is Initiator.ROBOT
+        self.robot_to_human = self.config.direction is Direction.ROBOT_TO_HUMAN
+        # A robot-initiated giver waits for the robot's reach (respond_at) plus a reaction time.
+        # ``giver`` is the simulated person: in a robot-to-human scene, the one who takes it.
+        human = SimulatedReceiver if self.robot_to_human else SimulatedGiver
+        self.giver = human(
+            self.layout.rest_hand, self.layout.offer_hand, plan, cued=self.robot_initiated
+        )
+        ctrl = self.config.controller
+        self.controller = HandoverController(
+            self.home,
+            self.robot.handover,
+            ctrl,
+            reach=self._cartesian_reach(ctrl),
+            start_at=ctrl.robot_start_s if self.robot_initiated else None,
+            target=np.asarray(self.robot.config.points["handover_location"], float)
+            if "handover_location" in self.robot.config.points
+            else None,
+            giver=self.robot_to_human,
+        )
+        if self.robot_to_human:
+            self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, 1.0)
         self._noise = TrackingNoise(
             tracking_noise or self.config.tracking, np.random.default_rng([self.seed, 1])
         )
@@ -106,12 +161,46 @@ class HandoverSimulation:
         self._renderers: dict[tuple[int, int], OffscreenRenderer] = {}
         self._events: list[Event] = []
         self._object_rel: tuple[np.ndarray, np.ndarray] | None = None  # object in gripper frame
+        self._object_in_hand: np.ndarray | None = None  # robot-to-human: object minus hand
         self._arm_external = False
         self._t = 0.0
+        mujoco.mj_kinematics(m, self.data)  # the gripper's pose, for an object it starts holding
         self._place_kinematic()
         mujoco.mj_forward(m, self.data)
 
     # ----------------------------------------------------------------------------- helpers
+    def _cartesian_reach(self, ctrl: ControllerConfig) -> CartesianReach | None:
+        """The seed's reach controller on the arm, or None for the joint-space reach."""
+        if ctrl.reach_controller is ReachControllerName.JOINT:
+            return None
+        from gazebot.controllers import load_controllers_config, make_controller
+        from gazebot.controllers.arm_ik import ArmIK
+
+        cfg = load_controllers_config(ctrl.controllers)
+        update = {}
+        if self.config.direction is Direction.ROBOT_TO_HUMAN:
+            update["stl"] = {**cfg.stl.model_dump(), "role": "giver"}  # Table 4.3's giver rows
+        if ctrl.reach_time_s is not None:
+            update["reach_time_s"] = ctrl.reach_time_s
+        if ctrl.stall_time_s is not None:
+            update["stall_time_s"] = ctrl.stall_time_s
+        if update:
+            cfg = type(cfg).model_validate({**cfg.model_dump(), **update})
+        m = self.model
+        ranges = np.array([m.jnt_range[m.joint(j).id] for j in self.robot.arm_joints])
+        ik = ArmIK(
+            self.robot.mjcf,
+            self.robot.arm_joints,
+            self.robot.gripper_site,
+            max_joint_speed=np.deg2rad(ctrl.max_joint_speed_deg),
+            lower=np.maximum(ranges[:, 0], self._arm_lo),
+            upper=np.minimum(ranges[:, 1], self._arm_hi),
+        )
+        # The STL handover zone is centred on the robot's base: the first arm joint's body.
+        mujoco.mj_kinematics(m, self.data)
+        base = self.data.xpos[m.jnt_bodyid[m.joint(self.robot.arm_joints[0]).id]].copy()
+        return CartesianReach(make_controller(ctrl.reach_controller.value, cfg), ik, base)
+
     def _actuator(self, name: str) -> int:
         act = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
         if act < 0:
@@ -144,6 +233,9 @@ class HandoverSimulation:
         hand = self.giver.hand
         self.scene.giver.pose_arm(self.data, hand)
         mocap = self.scene.object_mocap
+        if self.robot_to_human:
+            self._place_object_robot_giver(hand)
+            return
         if self.giver.holds_object or not self.controller.grasped:
             self.data.mocap_pos[mocap] = hand + self.layout.object_offset
             self.data.mocap_quat[mocap] = [1.0, 0.0, 0.0, 0.0]
@@ -166,6 +258,30 @@ class HandoverSimulation:
         mujoco.mju_mulQuat(quat, g_quat, rel_quat)
         self.data.mocap_quat[mocap] = quat
 
+    def _place_object_robot_giver(self, hand: np.ndarray) -> None:
+        """Robot-to-human: the object rides in the gripper until the robot lets go, then in the
+        person's hand (keeping where it was in the hand when taken)."""
+        mocap = self.scene.object_mocap
+        if not self.controller.grasped:
+            if self._object_in_hand is None:
+                self._object_in_hand = self.data.mocap_pos[mocap] - hand
+            self.data.mocap_pos[mocap] = hand + self._object_in_hand
+            return
+        g_pos, g_quat = self._gripper_pose()
+        if self._object_rel is None:  # the start: the object sits in the gripper, upright
+            inv = np.zeros(4)
+            mujoco.mju_negQuat(inv, g_quat)
+            rel_quat = np.zeros(4)
+            mujoco.mju_mulQuat(rel_quat, inv, np.array([1.0, 0.0, 0.0, 0.0]))
+            self._object_rel = (np.zeros(3), rel_quat)
+        rel_pos, rel_quat = self._object_rel
+        world = np.zeros(3)
+        mujoco.mju_rotVecQuat(world, rel_pos, g_quat)
+        self.data.mocap_pos[mocap] = g_pos + world
+        quat = np.zeros(4)
+        mujoco.mju_mulQuat(quat, g_quat, rel_quat)
+        self.data.mocap_quat[mocap] = quat
+
     # ----------------------------------------------------------------------------- state
     @property
     def t(self) -> float:
@@ -175,7 +291,8 @@ class HandoverSimulation:
     @property
     def done(self) -> bool:
         """True once the robot is back home with the object and the giver has retreated."""
-        return self.controller.state is ControllerState.DONE and self.giver.state is GiverState.DONE
+        human_done = self.giver.state in (GiverState.DONE, ReceiverState.DONE)
+        return self.controller.state is ControllerState.DONE and human_done
 
     @property
     def head_joints(self) -> tuple[str, ...]:
@@ -186,18 +303,18 @@ class HandoverSimulation:
         if not (math.isfinite(dt) and dt > 0.0):
             raise ValueError(f"step dt must be a positive number of seconds, got {dt}")
         t = self._t + dt
-        self.giver.update(t, self.controller.grasped)
         obj = self.data.mocap_pos[self.scene.object_mocap]
         gripper = self.data.site_xpos[self._gripper_site]
-        sensed = Sensed(
-            giver_hand=self.giver.hand.copy(),
-            object_gap=float(np.linalg.norm(obj - gripper)),
-            hand_object_gap=float(
-                np.linalg.norm(self.giver.hand + self.layout.object_offset - obj)
-            ),
-        )
+        if self.robot_to_human:
+            sensed = self._sense_robot_giver(t, obj)
+        else:
+            self.giver.update(t, self.controller.grasped)
+            sensed = self._sense_robot_receiver(obj, gripper)
         cmd = self.controller.update(t, self.data.qpos[self._arm_qpos], sensed)
-        self._events.extend(self.controller.pop_events())
+        events = self.controller.pop_events()
+        for e in events:
+            self._on_robot_event(e)
+        self._events.extend(events)
         if not self._arm_external:
             self.data.ctrl[self._arm_act] = np.clip(cmd.arm, self._arm_lo, self._arm_hi)
         self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, cmd.gripper)
@@ -208,11 +325,72 @@ class HandoverSimulation:
         self._place_kinematic()
         mujoco.mj_kinematics(self.model, self.data)
 
+    def _sense_robot_giver(self, t: float, obj: np.ndarray) -> Sensed:
+        """Robot-to-human: the person takes the object once it is within grasp, the robot lets
+        go once the person's hand is at it; ``object_pos`` is where the object goes (in the
+        hand), ``object_gap`` how far it still is."""
+        into_hand = self.giver.hand + self.layout.object_offset
+        gap = float(np.linalg.norm(obj - into_hand))
+        released = not self.controller.grasped
+        self.giver.update(t, gap <= self.config.controller.grasp_distance_m, released)
+        into_hand = self.giver.hand + self.layout.object_offset
+        return Sensed(
+            giver_hand=self.giver.hand.copy(),
+            object_gap=float(np.linalg.norm(obj - into_hand)),
+            hand_object_gap=0.0,
+            object_pos=into_hand,
+        )
+
+    def _sense_robot_receiver(self, obj: np.ndarray, gripper: np.ndarray) -> Sensed:
+        return Sensed(
+            giver_hand=self.giver.hand.copy(),
+            object_gap=float(np.linalg.norm(obj - gripper)),
+            hand_object_gap=float(
+                np.linalg.norm(self.giver.hand + self.layout.object_offset - obj)
+            ),
+            object_pos=obj.copy(),
+        )
+
+    def _on_robot_event(self, event: Event) -> None:
+        """The giver's side of the robot's events (methods a replayed giver may lack)."""
+        if event.kind is EventKind.ROBOT_REACH_STARTED and self.robot_initiated:
+            respond = getattr(self.giver, "respond_at", None)
+            if respond is not None:
+                respond(event.t + self.config.giver.reaction_time_s)
+        if (
+            event.kind is EventKind.ROBOT_RETREAT_STARTED
+            and self.config.controller.retreat is RetreatTrigger.AFTER_GRASP
+        ):
+            let_go = getattr(self.giver, "let_go", None)
+            if let_go is not None:
+                let_go(event.t)
+
+    @property
+    def reach_start_time(self) -> float | None:
+        """The seed's reach-start time (6.4: "the difference between the start of the human
+        hand's reaching motion and the start of the robot arm's reaching motion"): the giver's
+        reach start minus the robot's (s; positive when the robot started first), None until
+        both have started."""
+        giver = getattr(self.giver, "reach_started_at", None)
+        robot = self.controller.reach_started_at
+        if giver is None or robot is None:
+            return None
+        return float(giver - robot)
+
     def tracking(self) -> TrackingFrame:
-        """What a motion-capture system would report now (robot base frame, m)."""
+        """What a motion-capture system would report now (robot base frame, m): the person's
+        hand and face, the gripper, and the object's taker's grip and load share (the robot's in
+        a human-to-robot scene, the person's in a robot-to-human one)."""
         noise = self._noise.apply
         grasped = self.controller.grasped
-        if not grasped:
+        if self.robot_to_human:
+            # The person is in the giver_* fields (the robot looks at their face and hand), and
+            # the grip and load share are the taker's (the person's), so the phase detector sees
+            # the usual sequence: reach, transfer while both hold, retreat once the robot let go.
+            takes = self.giver.holds_object
+            share = 0.0 if not takes else (0.5 if grasped else 1.0)
+            grasped = takes
+        elif not grasped:
             share = 0.0
         elif self.giver.holds_object:
             share = 0.5
@@ -324,7 +502,10 @@ class HandoverSimulation:
             renderer.make_current()
             self.display.upload(renderer.context)
             renderer.texture_version[self.display.id] = self.display.version
-        return renderer.render(self.data, camera)
+        frame = renderer.render(self.data, camera)
+        if camera == OBSERVER and self.controller.infeasible_at is not None:
+            frame = _feedback_banner(frame, INFEASIBLE_MESSAGE)
+        return frame
 
     def close(self) -> None:
         """Free the GL contexts (also done when the object is garbage collected)."""

@@ -47,8 +47,8 @@ from pathlib import Path
 import numpy as np
 
 from gazebot.study.bradley_terry import BradleyTerryFit, fit_bradley_terry
+from gazebot.study.conditions import DEFAULT_BEHAVIORS, REACH_BEHAVIORS
 from gazebot.study.csvio import open_text
-from gazebot.study.plan import DEFAULT_BEHAVIORS
 from gazebot.study.questionnaire import MEASURES, QUESTIONS
 from gazebot.study.stats import (
     BiasTest,
@@ -152,7 +152,8 @@ def read_responses(path: str | Path) -> list[Response]:
 def behaviors_of(responses: list[Response]) -> list[str]:
     """The behaviors compared, the seed's defaults first (in their order), then the others."""
     seen = {r.first for r in responses} | {r.second for r in responses}
-    known = [b for b in DEFAULT_BEHAVIORS if b in seen]
+    order = dict.fromkeys((*DEFAULT_BEHAVIORS, "hand-face", "face-hand-face", *REACH_BEHAVIORS))
+    known = [b for b in order if b in seen]
     return known + sorted(seen - set(known))
 
 
@@ -250,7 +251,9 @@ class StudyAnalysis:
     levels: list[str]
     per_level: dict[str, dict[str, MeasureResult]] = field(default_factory=dict)
     bias: dict[str, BiasTest] = field(default_factory=dict)
+    bias_per_question: dict[str, BiasTest] = field(default_factory=dict)
     comparisons: list[LevelComparison] = field(default_factory=list)
+    sides: str = "one"
 
     def to_json(self) -> dict:
         """A JSON-ready dict."""
@@ -273,9 +276,14 @@ class StudyAnalysis:
                 for level, measures in self.per_level.items()
             },
             "bias": {
-                m: {"W": b.statistic, "S": b.s, "n": b.n, "p_value": b.p_value}
+                m: {"W": b.statistic, "S": b.s, "z": b.z, "n": b.n, "p_value": b.p_value}
                 for m, b in self.bias.items()
             },
+            "bias_per_question": {
+                q: {"W": b.statistic, "S": b.s, "z": b.z, "n": b.n, "p_value": b.p_value}
+                for q, b in self.bias_per_question.items()
+            },
+            "sides": self.sides,
             "level_comparisons": [
                 {
                     "measure": c.measure,
@@ -319,13 +327,19 @@ def analyze(
     margin: float = 0.1,
     behaviors: list[str] | None = None,
     bias_unit: str = "participant",
+    sides: str = "one",
 ) -> StudyAnalysis:
     """Bradley-Terry P_i with the likelihood-ratio chi-square (= eqs 6.1-6.2 for a complete
     design) per sample (level, or ``group:level``) and measure, the first/second bias test per
     measure (see :func:`position_differences` for ``bias_unit``), and the between-sample
     difference and equivalence tests (margin ``margin``) per pair of behaviors: matched or
     unmatched as the module doc explains. ``behaviors`` fixes the order of the conditions
-    (default: :func:`behaviors_of`)."""
+    (default: :func:`behaviors_of`). The bias test is run per measure and per question (the seed
+    reports it per measure in 6.3 and per question in 6.4). ``sides``: p-values of the difference
+    tests, ``"one"`` (one-sided in the observed direction, as the seed's Tables B.7-B.12) or
+    ``"two"``."""
+    if sides not in ("one", "two"):
+        raise ValueError(f"sides must be 'one' or 'two', got {sides!r}")
     if not (isinstance(margin, int | float) and math.isfinite(margin) and 0 < margin < 1):
         raise ValueError(f"equivalence margin must be a finite proportion in (0, 1), got {margin}")
     found = behaviors_of(responses)
@@ -335,7 +349,7 @@ def analyze(
         raise ValueError(f"responses compare behaviors {found}, not {list(behaviors)}")
     behaviors = list(behaviors)
     samples = list(dict.fromkeys(r.sample for r in responses))
-    result = StudyAnalysis(behaviors=behaviors, levels=samples)
+    result = StudyAnalysis(behaviors=behaviors, levels=samples, sides=sides)
     for sample in samples:
         rows = [r for r in responses if r.sample == sample]
         result.per_level[sample] = {}
@@ -352,8 +366,11 @@ def analyze(
     for measure, questions in MEASURES.items():
         diffs = position_differences(responses, questions, bias_unit)
         result.bias[measure] = position_bias_test(diffs)
+    for q in QUESTIONS:
+        diffs = position_differences(responses, (q,), bias_unit)
+        result.bias_per_question[q] = position_bias_test(diffs)
     for a, b in comparable_samples(responses):
-        result.comparisons += _compare(a, b, behaviors, margin)
+        result.comparisons += _compare(a, b, behaviors, margin, sides)
     return result
 
 
@@ -377,7 +394,11 @@ def comparable_samples(
 
 
 def _compare(
-    rows_a: list[Response], rows_b: list[Response], behaviors: list[str], margin: float
+    rows_a: list[Response],
+    rows_b: list[Response],
+    behaviors: list[str],
+    margin: float,
+    sides: str = "one",
 ) -> list[LevelComparison]:
     """Matched tests if the samples share participants (on the shared ones), else unmatched."""
     ra, rb = rows_a[0], rows_b[0]
@@ -395,7 +416,7 @@ def _compare(
                 if xa.size == 0:
                     continue
                 design = "matched"
-                difference = matched_proportion_difference(xa, xb)
+                difference = matched_proportion_difference(xa, xb, sides)
                 equivalence = matched_equivalence(xa, xb, margin)
             else:
                 xa = np.array([v[i, j] for v in pa.values() if np.isfinite(v[i, j])])
@@ -404,7 +425,7 @@ def _compare(
                     continue
                 design = "unmatched"
                 counts = (float(xa.sum()), xa.size, float(xb.sum()), xb.size)
-                difference = unmatched_proportion_difference(*counts)
+                difference = unmatched_proportion_difference(*counts, sides=sides)
                 equivalence = unmatched_equivalence(*counts, margin=margin)
             out.append(
                 LevelComparison(

@@ -18,7 +18,8 @@ be picklable (a module-level function or a ``functools.partial`` of one) to run 
 
 @dataclass(frozen=True)
 class VideoSpec:
-    """One handover video."""
+    """One handover video. ``inputs``: a digest of the behavior's, scene's and robot's content
+    (:func:`inputs_digest`), so an edited YAML gets a new video although its name is the same."""
 
     robot: str
     behavior: str
@@ -27,6 +28,8 @@ class VideoSpec:
     width: int
     height: int
     fps: int
+    gaze_mode: str = "head-and-eyes"
+    inputs: str = ""
 
     def content_hash(self, code_version: str) -> str:
         """Hash of everything that determines the video's pixels."""
@@ -38,6 +41,45 @@ class VideoSpec:
             f"{self.robot}_{self.behavior}_{self.scene}_s{self.seed}_"
             f"{self.content_hash(code_version)}.mp4"
         )
+
+
+def behavior_content(behavior: str) -> str:
+    """The resolved content of behavior ``behavior`` (a name in the built-in or user folders, or
+    a YAML path) as canonical JSON, ``extends:`` chains included; ``""`` if it cannot be loaded
+    (the renderer reports that error itself)."""
+    from gazebot.behaviors import load_behavior
+
+    try:
+        spec = load_behavior(behavior)
+    except (FileNotFoundError, ValueError):
+        return ""
+    return json.dumps(spec.model_dump(mode="json"), sort_keys=True)
+
+
+def _config_bytes(kind: str, name: str) -> bytes:
+    """The bytes of config ``configs/<kind>/<name>.yaml`` or of the file ``name``; empty if
+    neither exists."""
+    from gazebot.config import configs_dir
+
+    candidates = [Path(name)] if name.endswith((".yaml", ".yml")) else []
+    try:
+        candidates.append(configs_dir() / kind / f"{name}.yaml")
+    except FileNotFoundError:
+        pass
+    for path in candidates:
+        if path.is_file():
+            return path.read_bytes()
+    return b""
+
+
+def inputs_digest(robot: str, behavior: str, scene: str) -> str:
+    """A digest of what the names ``robot``, ``behavior`` and ``scene`` stand for today: the
+    behavior's resolved content and the scene's and robot's files."""
+    h = hashlib.sha256()
+    h.update(behavior_content(behavior).encode())
+    h.update(b"\0" + _config_bytes("scenes", scene))
+    h.update(b"\0" + _config_bytes("robots", robot))
+    return h.hexdigest()[:16]
 
 
 def _files_digest(paths: Iterable[Path], root: Path) -> str:

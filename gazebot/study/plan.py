@@ -1,8 +1,12 @@
-"""Counterbalanced session plans for the video study (seed section 6.4.4, Tables 6.3/6.4).
+"""Counterbalanced session plans for the video study (seed sections 6.3.2 and 6.4.4).
 
-Every participant sees each ordered pairing of the gaze behaviors (Table 6.4: 6 for 3 behaviors)
-once for each of the two levels of one condition (Table 6.3), i.e. ``k = 2 g (g - 1)`` sessions
-(12 for the seed's 3 behaviors).
+Two designs, as the seed ran them:
+
+- **no condition** (6.3, reach phase): every participant sees each ordered pairing of the ``g``
+  behaviors once, ``k = g (g - 1)`` sessions ("The 12 sessions consisted of the six possible
+  pairings of the four gaze patterns and their reverse order");
+- **one condition** (6.4, Tables 6.3/6.4): each ordered pairing once for each of the two levels
+  of the condition, ``k = 2 g (g - 1)`` sessions (12 for the seed's 3 behaviors).
 
 Balance property. The session orders come from a Williams design: a ``k x k`` Latin square whose
 rows are participants and columns session positions, in which
@@ -29,12 +33,19 @@ from pathlib import Path
 
 import numpy as np
 
-from gazebot.study.conditions import CONDITION_LEVELS, DEFAULT_BEHAVIORS, DEFAULT_SCENES
+from gazebot.study.conditions import (
+    CONDITION_LEVELS,
+    DEFAULT_BEHAVIORS,
+    DEFAULT_SCENES,
+    GAZE_MODES,
+    default_gaze_mode,
+)
 from gazebot.study.csvio import check_output_file, open_text
 
 __all__ = [
     "CONDITION_LEVELS",
     "DEFAULT_BEHAVIORS",
+    "GAZE_MODES",
     "DEFAULT_SCENES",
     "PLAN_COLUMNS",
     "BalanceReport",
@@ -52,7 +63,8 @@ __all__ = [
 class Session:
     """One row of a plan: ``participant`` (1-based) watches, in session ``session`` (1-based
     position), the handover with behavior ``first`` then ``second``, both in ``scene`` (the level
-    ``level`` of ``condition``), on ``robot``, rendered with ``video_seed``."""
+    ``level`` of ``condition``; both empty in a design without a condition), on ``robot`` showing
+    its gaze as ``gaze_mode``, rendered with ``video_seed``."""
 
     participant: int
     session: int
@@ -63,6 +75,7 @@ class Session:
     first: str
     second: str
     video_seed: int
+    gaze_mode: str = "head-and-eyes"
 
     @property
     def key(self) -> tuple[str, str, str]:
@@ -103,23 +116,31 @@ def williams_square(k: int) -> np.ndarray:
 
 def make_plan(
     behaviors: list[str] | tuple[str, ...] = DEFAULT_BEHAVIORS,
-    condition: str = "object-size",
+    condition: str | None = "object-size",
     participants: int = 24,
     seed: int = 0,
     robot: str = "sawyer",
     scenes: dict[str, str] | None = None,
     video_seed: int = 0,
+    gaze_mode: str | None = None,
 ) -> list[Session]:
     """A counterbalanced plan (see the module doc): ``participants`` must be a positive multiple
-    of the block size ``2 g (g - 1)``. ``scenes`` maps a level to a scene name (overrides
-    :data:`DEFAULT_SCENES`). Raises ``ValueError`` for an unknown condition or an invalid
-    participant count."""
-    if condition not in CONDITION_LEVELS:
+    of the block size (``g (g - 1)`` without a condition, ``2 g (g - 1)`` with one). ``condition``
+    ``None`` or ``""``: the 6.3 design (one scenario, level ``""``). ``scenes`` maps a level to a
+    scene name (overrides :data:`DEFAULT_SCENES`); ``gaze_mode`` defaults to the seed's for the
+    design (:func:`~gazebot.study.conditions.default_gaze_mode`). Raises ``ValueError`` for an
+    unknown condition or gaze mode or an invalid participant count."""
+    condition = condition or ""
+    if condition and condition not in CONDITION_LEVELS:
         raise ValueError(
-            f"unknown condition {condition!r}; expected one of {sorted(CONDITION_LEVELS)}"
+            f"unknown condition {condition!r}; expected one of {sorted(CONDITION_LEVELS)} "
+            "(or none for the seed's 6.3 design)"
         )
+    gaze_mode = gaze_mode or default_gaze_mode(condition)
+    if gaze_mode not in GAZE_MODES:
+        raise ValueError(f"unknown gaze mode {gaze_mode!r}; expected one of {list(GAZE_MODES)}")
     pairings = ordered_pairings(behaviors)
-    levels = CONDITION_LEVELS[condition]
+    levels = CONDITION_LEVELS[condition] if condition else ("",)
     items = [(level, first, second) for level in levels for first, second in pairings]
     k = len(items)
     if participants <= 0 or participants % k:
@@ -149,6 +170,7 @@ def make_plan(
                         first=first,
                         second=second,
                         video_seed=int(video_seed),
+                        gaze_mode=gaze_mode,
                     )
                 )
     return plan
@@ -215,13 +237,18 @@ def write_plan(plan: list[Session], path: str | Path) -> Path:
 
 def read_plan(path: str | Path) -> list[Session]:
     """Read a plan CSV written by :func:`write_plan`; a missing column or a malformed value raises
-    ``ValueError`` naming the file, row and column."""
+    ``ValueError`` naming the file, row and column. ``condition`` and ``level`` may be empty (a
+    design without a condition); a plan without a ``gaze_mode`` column (older gazebot) is
+    ``head-and-eyes``."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"plan file not found: {path}")
     with open_text(path) as fh:
         reader = csv.DictReader(fh)
-        missing = [c for c in PLAN_COLUMNS if c not in (reader.fieldnames or [])]
+        optional = {"gaze_mode"}
+        missing = [
+            c for c in PLAN_COLUMNS if c not in (reader.fieldnames or []) and c not in optional
+        ]
         if missing:
             raise ValueError(f"{path}: missing column(s) {missing}; expected {list(PLAN_COLUMNS)}")
         plan = []
@@ -229,7 +256,14 @@ def read_plan(path: str | Path) -> list[Session]:
             values: dict[str, object] = {}
             for col in PLAN_COLUMNS:
                 raw = (row.get(col) or "").strip()
-                if not raw:
+                if col == "gaze_mode":
+                    raw = raw or "head-and-eyes"
+                    if raw not in GAZE_MODES:
+                        raise ValueError(
+                            f"{path}: line {line}: column 'gaze_mode' expected one of "
+                            f"{list(GAZE_MODES)}, got {raw!r}"
+                        )
+                if not raw and col not in ("condition", "level"):
                     raise ValueError(f"{path}: line {line}: column '{col}' is empty")
                 if col in ("participant", "session", "video_seed"):
                     try:

@@ -10,13 +10,20 @@
    ``DIR/participants/PNN/session-MM.mp4`` link to it (hard link, copy if linking fails).
 3. ``DIR/questionnaire.csv`` is the researcher's response sheet (the responses-CSV layout of
    :mod:`gazebot.study.analysis` with blank answers), ``DIR/questionnaire.md`` the questions, and
-   ``DIR/participants/PNN/index.html`` a blind per-participant page with the videos in order and
-   the five questions.
+   ``DIR/participants/PNN/index.html`` a blind offline page with the videos in order and the five
+   questions.
+4. ``DIR/plan.csv`` is the plan and ``DIR/manifest.json`` maps every participant's session (and
+   the practice session) to its two handover videos: what ``gazebot study serve`` shows.
+
+The practice session shows the plan's first ordered pairing in reverse order (a pair every
+participant also sees as a study session): the seed names a practice session but not its content.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
+import inspect
 import json
 import multiprocessing
 import os
@@ -26,12 +33,19 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from gazebot.study.cache import RenderFn, VideoSpec, code_version
+from gazebot.study.cache import RenderFn, VideoSpec, code_version, inputs_digest
 from gazebot.study.pair_video import make_pair_video
-from gazebot.study.plan import Session
+from gazebot.study.plan import Session, write_plan
 from gazebot.study.questionnaire import write_participant_page, write_questionnaire
 
-__all__ = ["RenderReport", "VideoSpec", "code_version", "default_renderer", "render_study"]
+__all__ = [
+    "RenderReport",
+    "VideoSpec",
+    "code_version",
+    "default_renderer",
+    "render_handover_in_gaze_mode",
+    "render_study",
+]
 
 
 @dataclass(frozen=True)
@@ -49,22 +63,63 @@ class RenderReport:
     questionnaire_md: Path
 
 
-def default_renderer() -> RenderFn:
-    """The SIM package's MuJoCo renderer (imported lazily: it pulls in MuJoCo)."""
+def render_handover_in_gaze_mode(
+    robot: str,
+    behavior: str,
+    scene: str,
+    out_path: str | Path,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+    fps: int = 30,
+    progress: bool = True,
+    gaze_mode: str = "head-and-eyes",
+) -> Path:
+    """The SIM package's MuJoCo handover renderer on ``robot`` with its gaze mode set to the
+    plan's (the robot config's ``gaze_mode``, as ``--gaze-mode`` sets it on the other commands)."""
+    from gazebot.sim.record import render_handover_video
+
     try:
-        from gazebot.sim.record import render_handover_video
+        from gazebot.kinematics.config import with_gaze_mode
+    except ImportError:  # a gazebot without gaze modes: only the robot's own mode exists
+        if gaze_mode != "head-and-eyes":
+            raise ValueError(f"this gazebot cannot render gaze mode {gaze_mode!r}") from None
+        robot_arg = robot
+    else:
+        robot_arg = with_gaze_mode(robot, gaze_mode)
+    return render_handover_video(
+        robot_arg,
+        behavior,
+        scene,
+        out_path,
+        seed=seed,
+        width=width,
+        height=height,
+        fps=fps,
+        progress=progress,
+    )
+
+
+def default_renderer() -> RenderFn:
+    """The MuJoCo renderer in the plan's gaze mode (:func:`render_handover_in_gaze_mode`); MuJoCo
+    is imported in the workers, when a video is rendered."""
+    try:
+        import gazebot.sim.record  # noqa: F401 - fail here, not in a worker
     except ImportError as exc:
         raise ValueError(
             f"the MuJoCo handover renderer is not available ({exc}); "
             "use --renderer synthetic for a dry run"
         ) from exc
-    return render_handover_video
+    return render_handover_in_gaze_mode
 
 
-def _render_video_job(render_fn: RenderFn, spec: VideoSpec, out_path: Path) -> Path:
+def _render_video_job(
+    render_fn: RenderFn, spec: VideoSpec, out_path: Path, pass_mode: bool = True
+) -> Path:
     """Worker: render into a temporary name, then rename, so the cache never holds a partial
-    file."""
+    file. ``pass_mode``: give the renderer the spec's ``gaze_mode``."""
     tmp = out_path.with_name(out_path.stem + f".part{os.getpid()}.mp4")
+    extra = {"gaze_mode": spec.gaze_mode} if pass_mode else {}
     try:
         render_fn(
             spec.robot,
@@ -76,6 +131,7 @@ def _render_video_job(render_fn: RenderFn, spec: VideoSpec, out_path: Path) -> P
             height=spec.height,
             fps=spec.fps,
             progress=False,
+            **extra,
         )
         if not tmp.is_file() or tmp.stat().st_size == 0:
             raise RuntimeError(f"renderer wrote no video for {spec}")
@@ -115,6 +171,16 @@ def _run_jobs(jobs: list[tuple[Callable, tuple]], workers: int, progress: bool, 
             bar.close()
 
 
+def accepts_gaze_mode(render_fn: RenderFn) -> bool:
+    """Whether ``render_fn`` takes a ``gaze_mode`` keyword (or ``**kwargs``)."""
+    fn = render_fn.func if isinstance(render_fn, functools.partial) else render_fn
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == "gaze_mode" or p.kind is p.VAR_KEYWORD for p in params)
+
+
 def _link(src: Path, dst: Path) -> None:
     dst.unlink(missing_ok=True)
     try:
@@ -152,6 +218,13 @@ def render_study(
     if card_seconds <= 0:
         raise ValueError(f"card_seconds must be positive, got {card_seconds}")
     render_fn = render_fn or default_renderer()
+    modes = sorted({s.gaze_mode for s in plan} - {"head-and-eyes"})
+    pass_mode = accepts_gaze_mode(render_fn)
+    if modes and not pass_mode:
+        raise ValueError(
+            f"the plan asks for gaze mode {modes[0]!r}, but the renderer "
+            f"{getattr(render_fn, '__name__', render_fn)!r} takes no gaze_mode"
+        )
     workers = workers or os.cpu_count() or 1
     version = code_version_str or code_version(render_fn)
     out_dir = Path(out_dir)
@@ -159,14 +232,21 @@ def render_study(
     for d in (video_dir, pair_dir):
         d.mkdir(parents=True, exist_ok=True)
 
+    digests: dict[tuple[str, str, str], str] = {}
+
     def spec(s: Session, behavior: str) -> VideoSpec:
-        return VideoSpec(s.robot, behavior, s.scene, s.video_seed, width, height, fps)
+        key = (s.robot, behavior, s.scene)
+        if key not in digests:
+            digests[key] = inputs_digest(*key)
+        return VideoSpec(
+            s.robot, behavior, s.scene, s.video_seed, width, height, fps, s.gaze_mode, digests[key]
+        )
 
     specs = list(dict.fromkeys(spec(s, b) for s in plan for b in (s.first, s.second)))
     videos = {sp: video_dir / sp.file_name(version) for sp in specs}
     todo = [sp for sp in specs if not videos[sp].is_file()]
     _run_jobs(
-        [(_render_video_job, (render_fn, sp, videos[sp])) for sp in todo],
+        [(_render_video_job, (render_fn, sp, videos[sp], pass_mode)) for sp in todo],
         workers,
         progress,
         "handover videos",
@@ -201,18 +281,37 @@ def render_study(
         sessions.setdefault(s.participant, []).append(dst)
 
     csv_path, md_path = write_questionnaire(plan, out_dir)
+    gaze_mode = plan[0].gaze_mode
     for participant, files in sessions.items():
-        write_participant_page(participant, files, out_dir / "participants" / f"P{participant:02d}")
+        write_participant_page(
+            participant, files, out_dir / "participants" / f"P{participant:02d}", gaze_mode
+        )
+    write_plan(plan, out_dir / "plan.csv")
+
+    def rel(p: Path) -> str:
+        return p.relative_to(out_dir).as_posix()
+
+    def entry(s: Session) -> dict:
+        a, b = pair_of[s]
+        return {"first": rel(videos[a]), "second": rel(videos[b]), "pair": rel(pairs[(a, b)])}
+
+    first = min(plan, key=lambda s: (s.participant, s.session))
+    reverse = (first.second, first.first, first.level)
+    practice = next((s for s in plan if (s.first, s.second, s.level) == reverse), first)
     manifest = {
         "code_version": version,
-        "videos": {str(p.relative_to(out_dir)): asdict(sp) for sp, p in videos.items()},
-        "pairs": {
-            str(p.relative_to(out_dir)): [
-                str(videos[a].relative_to(out_dir)),
-                str(videos[b].relative_to(out_dir)),
-            ]
-            for (a, b), p in pairs.items()
+        "gaze_mode": gaze_mode,
+        "practice": entry(practice),
+        "participants": {
+            str(p): {
+                str(s.session): entry(s)
+                for s in sorted(plan, key=lambda s: s.session)
+                if s.participant == p
+            }
+            for p in sorted({s.participant for s in plan})
         },
+        "videos": {rel(p): asdict(sp) for sp, p in videos.items()},
+        "pairs": {rel(p): [rel(videos[a]), rel(videos[b])] for (a, b), p in pairs.items()},
     }
     (out_dir / "manifest.json").write_text(json.dumps(manifest, indent=2), encoding="utf-8")
     return RenderReport(videos, todo, pairs, sessions, csv_path, md_path)

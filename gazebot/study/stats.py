@@ -77,13 +77,16 @@ class BiasTest:
 
     ``statistic``: scipy's W (sum of ranks of the positive differences); ``s``: the centred
     statistic ``W - m (m + 1) / 4`` (m = nonzero differences) that SAS reports as S and the seed
-    quotes; ``n``: number of nonzero differences; ``p_value``: two-sided.
+    quotes in 6.3; ``z``: S over its standard deviation under H0 (with the tie correction), the
+    normal-approximation score the seed quotes per question in 6.4; ``n``: number of nonzero
+    differences; ``p_value``: two-sided.
     """
 
     statistic: float
     s: float
     n: int
     p_value: float
+    z: float = 0.0
 
 
 def position_bias_test(differences: np.ndarray) -> BiasTest:
@@ -98,13 +101,15 @@ def position_bias_test(differences: np.ndarray) -> BiasTest:
     nz = d[d != 0]
     m = nz.size
     if m == 0:
-        return BiasTest(statistic=0.0, s=0.0, n=0, p_value=1.0)
+        return BiasTest(statistic=0.0, s=0.0, n=0, p_value=1.0, z=0.0)
     ranks = sps.rankdata(np.abs(nz))
     w_plus = float(ranks[nz > 0].sum())
     res = sps.wilcoxon(nz, zero_method="wilcox", alternative="two-sided")
-    return BiasTest(
-        statistic=w_plus, s=w_plus - m * (m + 1) / 4.0, n=int(m), p_value=float(res.pvalue)
-    )
+    s = w_plus - m * (m + 1) / 4.0
+    _, tie_counts = np.unique(np.abs(nz), return_counts=True)
+    var = m * (m + 1) * (2 * m + 1) / 24.0 - float(np.sum(tie_counts**3 - tie_counts)) / 48.0
+    z = s / math.sqrt(var) if var > 0 else 0.0
+    return BiasTest(statistic=w_plus, s=s, n=int(m), p_value=float(res.pvalue), z=float(z))
 
 
 @dataclass(frozen=True)
@@ -120,13 +125,22 @@ class ProportionTest:
     margin: float | None = None
 
 
-def _z_test(diff: float, se: float) -> ProportionTest:
+SIDES = ("one", "two")
+
+
+def _z_test(diff: float, se: float, sides: str = "two") -> ProportionTest:
+    """z = diff / se; ``sides="two"``: p = 2 P(Z > |z|); ``"one"``: p = P(Z > |z|), one-sided in
+    the direction observed (the seed's Tables B.7-B.12 report the preferred condition in bold
+    with such a p)."""
+    if sides not in SIDES:
+        raise ValueError(f"sides must be 'one' or 'two', got {sides!r}")
     if se <= 0:
         # No variability: identical answers in both samples (diff 0) cannot show a difference.
         z = 0.0 if diff == 0 else math.copysign(math.inf, diff)
-        return ProportionTest(diff, 0.0, z, 1.0 if diff == 0 else 0.0)
+        return ProportionTest(diff, 0.0, z, (1.0 if sides == "two" else 0.5) if diff == 0 else 0.0)
     z = diff / se
-    return ProportionTest(diff, se, z, float(2 * sps.norm.sf(abs(z))))
+    tail = float(sps.norm.sf(abs(z)))
+    return ProportionTest(diff, se, z, 2 * tail if sides == "two" else tail)
 
 
 def _tost(diff: float, se: float, margin: float) -> ProportionTest:
@@ -156,12 +170,15 @@ def _paired(x_a: np.ndarray, x_b: np.ndarray) -> tuple[float, float]:
     return diff, math.sqrt(max(var, 0.0))
 
 
-def matched_proportion_difference(x_a: np.ndarray, x_b: np.ndarray) -> ProportionTest:
+def matched_proportion_difference(
+    x_a: np.ndarray, x_b: np.ndarray, sides: str = "two"
+) -> ProportionTest:
     """Equations 6.3-6.4: do the same participants prefer condition i over j equally often in
     levels a and b? ``x_a[k]``, ``x_b[k]``: participant k's preference for i over j (1 = i, 0 =
     j; fractions allowed when answers were averaged). With 0/1 answers ``p_b``/``p_c`` are the
-    shares preferring i only in a / only in b and ``var = (p_b + p_c - (p_b - p_c)^2) / n``."""
-    return _z_test(*_paired(x_a, x_b))
+    shares preferring i only in a / only in b and ``var = (p_b + p_c - (p_b - p_c)^2) / n``.
+    ``sides``: ``"two"`` or ``"one"`` (see :func:`_z_test`)."""
+    return _z_test(*_paired(x_a, x_b), sides)
 
 
 def matched_equivalence(x_a: np.ndarray, x_b: np.ndarray, margin: float = 0.1) -> ProportionTest:
@@ -177,7 +194,9 @@ def _check_count(x: float, n: int, name: str) -> None:
         raise ValueError(f"{name}: count {x} outside [0, {n}]")
 
 
-def unmatched_proportion_difference(x_b: float, n_b: int, x_c: float, n_c: int) -> ProportionTest:
+def unmatched_proportion_difference(
+    x_b: float, n_b: int, x_c: float, n_c: int, sides: str = "two"
+) -> ProportionTest:
     """Equations 6.5-6.6: two groups, ``x_b`` of ``n_b`` and ``x_c`` of ``n_c`` participants
     prefer condition i over j. Pooled ``p_d = (x_b + x_c) / (n_b + n_c)`` and
     ``var = p_d (1 - p_d) (1/n_b + 1/n_c)`` (the seed prints ``1/n_b - 1/n_c``, a typo: it would
@@ -187,7 +206,7 @@ def unmatched_proportion_difference(x_b: float, n_b: int, x_c: float, n_c: int) 
     p_b, p_c = x_b / n_b, x_c / n_c
     p_d = (x_b + x_c) / (n_b + n_c)
     se = math.sqrt(p_d * (1 - p_d) * (1 / n_b + 1 / n_c))
-    return _z_test(p_b - p_c, se)
+    return _z_test(p_b - p_c, se, sides)
 
 
 def unmatched_equivalence(

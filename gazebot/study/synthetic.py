@@ -25,6 +25,7 @@ def render_synthetic_video(
     fps: int = 30,
     progress: bool = True,
     duration: float = 1.0,
+    gaze_mode: str = "head-and-eyes",
 ) -> Path:
     """Write a ``duration``-second clip (deterministic for its arguments) and return its path."""
     import cv2
@@ -33,7 +34,7 @@ def render_synthetic_video(
 
     if width % 2 or height % 2 or width < 16 or height < 16:
         raise ValueError(f"width and height must be even and >= 16, got {width}x{height}")
-    digest = hashlib.sha256(f"{robot}|{behavior}|{scene}|{seed}".encode()).digest()
+    digest = hashlib.sha256(f"{robot}|{behavior}|{scene}|{seed}|{gaze_mode}".encode()).digest()
     color = np.frombuffer(digest[:3], dtype=np.uint8)
     frames = max(1, round(duration * fps))
     base = np.empty((height, width, 3), np.uint8)

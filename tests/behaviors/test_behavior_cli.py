@@ -42,3 +42,34 @@ def test_show_prints_the_resolved_variant(capsys):
 def test_show_unknown_behavior_raises_for_the_dispatcher():
     with pytest.raises(FileNotFoundError):
         run(["behaviors", "show", "nope"])
+
+
+def test_show_diagram_writes_the_machine_with_its_phase_and_gaze_states(tmp_path, capsys):
+    out = tmp_path / "fhf.md"
+    assert run(["behaviors", "show", "face-hand-face", "--diagram", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert text.startswith("```mermaid\n") and "stateDiagram-v2" in text
+    for phase in ("idle", "reach", "transfer", "retreat", "done"):
+        assert f'state "{phase}" as behavior_handover_{phase}' in text
+    for gaze in ("reach_face", "reach_hand", "transfer_hand", "retreat_face"):
+        assert f"as behavior_handover_{gaze}" in text
+    # The gaze shifts are the machine's transitions, labelled with the segment's timing.
+    assert (
+        "behavior_handover_reach --> behavior_handover_reach_hand: timer [0.5 of the reach]" in text
+    )
+    assert (
+        "behavior_handover_reach_hand --> behavior_handover_transfer_hand: transfer_started" in text
+    )
+
+
+def test_the_diagram_is_the_machine_the_behavior_runs_on():
+    from gazebot.behaviors import BehaviorMachine, load_behavior
+    from gazebot.behaviors.machine import diagram
+
+    spec = load_behavior("hand-face-as-studied")
+    m = BehaviorMachine(spec)
+    text = diagram(spec)
+    for state in m.states:
+        phase, gaze = state.split("_")[:2]
+        assert f"as behavior_handover_{phase}_{gaze}" in text
+    assert "timer [robot_retreat_started]" in text

@@ -48,3 +48,26 @@ def test_fitting_code_lives_in_annotations_not_behaviors():
 
     assert not hasattr(human, "fit_human_model")
     assert callable(fit.fit_human_model) and callable(fit.human_behavior_document)
+
+
+def test_behaviors_modules_import_each_other_without_a_cycle():
+    """Every import inside the package (function-level ones too) goes one way."""
+    folder = Path(gazebot.behaviors.__file__).parent
+    graph: dict[str, set[str]] = {}
+    for path in folder.glob("*.py"):
+        deps = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+                "gazebot.behaviors."
+            ):
+                deps.add(node.module.rsplit(".", 1)[1])
+        graph[path.stem] = deps - {path.stem}
+
+    def reaches(start: str, goal: str, seen: set[str]) -> bool:
+        for dep in graph.get(start, ()):
+            if dep == goal or (dep not in seen and reaches(dep, goal, seen | {dep})):
+                return True
+        return False
+
+    assert "spec" in graph["human"] or "segment" in graph["human"]  # the graph is read
+    assert [m for m in graph if m != "__init__" and reaches(m, m, set())] == []

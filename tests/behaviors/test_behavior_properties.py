@@ -125,13 +125,13 @@ def test_a_missing_transfer_is_skipped_and_the_reach_gaze_carries_on():
     assert m.target(GazeContext(0.8, Phase.REACH, 0.0, 1.0, points(0.8))).kind == "hand"
     m.handle(Event(EventKind.RETREAT_STARTED, 1.0, 1.0))
     assert m.target(GazeContext(1.1, Phase.RETREAT, 1.0, 2.0, points(1.1))).kind == "hand"
-    assert m.state == "retreat_carry"
+    assert m.state == "retreat_hand"
 
 
 def test_the_context_phase_wins_over_missing_events():
-    m = BehaviorMachine(SPECS["face-hand-face-as-studied"])
+    m = BehaviorMachine(SPECS["face-hand-face"])
     assert m.target(GazeContext(2.1, Phase.TRANSFER, 2.0, math.nan, points(2.1))).kind == "hand"
-    assert m.state == "transfer_g0"
+    assert m.state == "transfer_hand"
 
 
 def test_a_new_reach_after_a_missed_handover_done_starts_a_new_handover():
@@ -148,7 +148,8 @@ def test_garbage_events_are_ignored():
     m.handle(Event("not-a-kind", 1.0, 1.0))  # type: ignore[arg-type]
     m.handle(Event(EventKind.REACH_STARTED, math.nan, math.nan))
     m.handle(Event(EventKind.ROBOT_REACH_STARTED, 1.0, 1.0, "oops"))  # type: ignore[arg-type]
-    assert m.ignored == 2 and m.state == "idle_before"
+    # The malformed info is dropped; the robot's reach itself still starts the handover's reach.
+    assert m.ignored == 2 and m.state == "reach_hand"
 
 
 def test_unknown_named_target_falls_back_to_the_last_known_point(tmp_path):

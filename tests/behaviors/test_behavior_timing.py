@@ -53,10 +53,9 @@ def test_face_looks_at_the_face_before_during_and_after():
     assert set(run_standard(machine("face")).values()) == {"face"}
 
 
-def test_hand_looks_at_the_hand_in_every_phase_and_face_outside_the_handover():
-    got = run_standard(machine("hand"))
-    assert got.pop("idle") == "face" and got.pop("done") == "face"
-    assert set(got.values()) == {"hand"}
+def test_hand_looks_at_the_hand_continuously_before_during_and_after_the_handover():
+    # Seed 6.3.2: "Continuously look at the giver's hand" -- the whole video, not the face outside.
+    assert set(run_standard(machine("hand")).values()) == {"hand"}
 
 
 def test_short_face_hand_shifts_to_the_hand_when_the_reach_starts():
@@ -82,9 +81,20 @@ def test_long_face_hand_shifts_to_the_hand_when_the_robot_reach_ends():
     assert got["transfer@2.0"] == "hand"
 
 
-def test_long_face_hand_without_robot_events_shifts_at_the_transfer():
+def test_long_face_hand_without_robot_events_keeps_the_face_until_the_retreat():
+    # No robot_reach_ended: the face until the retreat, when the robot has surely arrived.
     got = run_standard(machine("long-face-hand"), robot=False)
-    assert got["reach@1.99"] == "face" and got["transfer@2.0"] == "hand"
+    assert got["reach@1.99"] == "face" and got["transfer@2.49"] == "face"
+    assert got["retreat@2.5"] == "hand"
+
+
+def test_long_face_hand_waits_for_the_robot_even_when_the_transfer_is_seen_first():
+    m = machine("long-face-hand")
+    m.handle(ev("reach_started", 1.0))
+    m.handle(ev("transfer_started", 1.8))
+    assert kind(m, 1.9, T, 1.8) == "face"
+    m.handle(ev("robot_reach_ended", 1.95))
+    assert kind(m, 1.95, T, 1.8) == "hand"
 
 
 def test_face_hand_face_shifts_halfway_through_reach_and_retreat():
@@ -149,9 +159,12 @@ def test_face_hand_face_keeps_the_hand_when_the_estimate_grows_later():
 
 
 def test_face_hand_face_as_studied_is_face_in_reach_hand_in_transfer_face_in_retreat():
+    # The phases as the seed's robot sensed them: the transfer from its grasp (2.05 s), the
+    # retreat from its own retreat (2.5 s).
     got = run_standard(machine("face-hand-face-as-studied"))
     assert {got[f"reach@{t}"] for t in (1.0, 1.3, 1.51, 1.99)} == {"face"}
-    assert {got[f"transfer@{t}"] for t in (2.0, 2.2, 2.49)} == {"hand"}
+    assert got["transfer@2.0"] == "face"  # the detector's transfer, before the robot grasped
+    assert {got[f"transfer@{t}"] for t in (2.2, 2.49)} == {"hand"}
     assert {got[f"retreat@{t}"] for t in (2.5, 2.8, 3.01, 3.4)} == {"face"}
 
 
@@ -241,10 +254,10 @@ def test_tracking_lost_holds_the_gaze_then_looks_at_the_last_face():
     later = m.target(ctx(0.5 + hold + 0.01, R, 0.0, face=nan, hand=nan))
     assert later.kind == "face"
     np.testing.assert_allclose(later.point, FACE)  # the last known face position
-    assert m.state == "reach_lost"
+    assert m.state == "reach_hand_lost"
     m.handle(ev("tracking_restored", 1.5))
     assert m.target(ctx(1.6, R, 0.0)).kind == "hand"
-    assert m.state == "reach_g0"
+    assert m.state == "reach_hand"
 
 
 def test_human_receiver_is_reproducible_for_a_seed():
@@ -302,3 +315,33 @@ def test_face_hand_face_retreat_halfway_follows_the_giver_not_the_slower_robot()
     m.handle(ev("robot_retreat_started", 2.6, planned_duration=2.4))
     assert kind(m, 2.99, E, 2.5, 3.5) == "hand"
     assert kind(m, 3.0, E, 2.5, 3.5) == "face"  # halfway of the giver's 2.5-3.5 s retreat
+
+
+def test_the_robots_reach_starts_the_reach_before_the_detector_sees_the_giver():
+    # Seed 6.3: the robot starts its reach and the giver responds; the detector still says idle
+    # (first handover) or done (the next one) until the giver moves.
+    m = machine("short-face-hand")
+    assert kind(m, 0.5, Phase.IDLE, 0.0) == "face"
+    m.handle(ev("robot_reach_started", 1.0, planned_duration=1.2))
+    assert kind(m, 1.0, Phase.IDLE, 0.0) == "hand" and m.phase is R
+    m.handle(ev("reach_started", 1.4))  # the giver's reach: the handover's reach began at 1.0
+    assert kind(m, 1.5, R, 1.4) == "hand"
+    for kind_, t in (("transfer_started", 2.3), ("retreat_started", 3.0), ("handover_done", 4.0)):
+        m.handle(ev(kind_, t))
+    assert kind(m, 5.0, D, 4.0) == "face"
+    m.handle(ev("robot_reach_started", 10.0, planned_duration=1.2))
+    assert kind(m, 10.01, D, 4.0) == "hand" and m.phase is R
+
+
+def test_the_reach_start_is_the_earlier_of_the_robots_and_the_givers():
+    m = machine("face-hand-face")
+    m.handle(ev("robot_reach_started", 1.0, planned_duration=1.0))  # robot arrives at 2.0 s
+    m.handle(ev("reach_started", 1.4))
+    # Halfway through the 1.0-2.0 s reach (not 1.4-2.0 s): 1.5 s.
+    assert kind(m, 1.49, R, 1.4, 1.9) == "face"
+    assert kind(m, 1.5, R, 1.4, 1.9) == "hand"
+    m = machine("face-hand-face")
+    m.handle(ev("reach_started", 1.0))
+    m.handle(ev("robot_reach_started", 0.8, planned_duration=1.2))  # reported late, started first
+    assert kind(m, 1.39, R, 1.0, 1.5) == "face"
+    assert kind(m, 1.4, R, 1.0, 1.5) == "hand"  # halfway through 0.8-2.0 s

@@ -248,3 +248,27 @@ def test_joint_space_move_from_home_to_handover_is_short_and_collision_free(robo
             (mj.geom(c.geom1).name, mj.geom(c.geom2).name) for c in data.contact[: data.ncon]
         }
         assert not touching, f"at {s:.2f} of the move: {touching}"
+
+
+def test_kinematics_calls_give_the_same_result_in_any_order():
+    """The model's Pinocchio data is shared scratch space: no call may depend on the one before."""
+    robot = RobotModel.load("sawyer")
+    qa = (robot.rest + 0.3 * (robot.upper - robot.rest)).tolist()
+    qb = (robot.rest + 0.3 * (robot.lower - robot.rest)).tolist()
+    fresh = RobotModel.load("sawyer")
+    want_a = fresh.gaze_jacobian_rows(qa)
+    want_b = fresh.gaze_jacobian_rows(qb)
+    robot.gaze_frame_lists(qb)  # data now holds qb's kinematics
+    np.testing.assert_allclose(robot.gaze_jacobian_rows(qa), want_a, atol=1e-12)
+    robot.gaze_frame_lists(qa)
+    robot.gaze_pose(np.array(qb))
+    np.testing.assert_allclose(robot.gaze_jacobian_rows(qa), want_a, atol=1e-12)
+    robot.gaze_frame_lists(qb)
+    np.testing.assert_allclose(robot.gaze_jacobian_rows(qb), want_b, atol=1e-12)
+    # A moved arm carrying the head is a different configuration too.
+    robot.gaze_frame_lists(qa)
+    assert robot.set_arm({robot.passive_joints[0]: 0.7})
+    fresh.set_arm({robot.passive_joints[0]: 0.7})
+    np.testing.assert_allclose(
+        robot.gaze_jacobian_rows(qa), fresh.gaze_jacobian_rows(qa), atol=1e-12
+    )

@@ -44,7 +44,8 @@ def test_yaml_override_is_loaded(tmp_path):
         ("transfer_speeed_max: 0.1\n", "transfer_speeed_max"),
         ("transfer_speed_max: 0.3\n", "<root>"),  # above the exit speed: no hysteresis
         ("load_share_robot: 1.5\n", "load_share_robot"),
-        ("settle_speed: 0.2\n", "<root>"),
+        ("rest_speed: 0.2\n", "<root>"),  # a resting hand faster than a reach onset
+        ("method: seed-9\n", "method"),
     ],
 )
 def test_bad_yaml_names_the_field(tmp_path, text, field):
@@ -54,6 +55,26 @@ def test_bad_yaml_names_the_field(tmp_path, text, field):
         load_phase_config(f)
     assert exc.value.field == field
     assert str(f) in str(exc.value)
+
+
+def test_shipped_yaml_sets_every_field_with_a_unit_and_a_reason():
+    lines = default_phase_config_path().read_text().splitlines()
+    for name in PhaseConfig.model_fields:
+        row = next((ln for ln in lines if ln.startswith(f"{name}:")), None)
+        assert row is not None, f"{name} missing from configs/phases.yaml"
+        if name == "method":
+            continue
+        comment = row.split("#", 1)[1].strip() if "#" in row else ""
+        unit = comment.split(",")[0].split()[0] if comment else ""
+        assert unit in {"m", "s", "m/s", "Hz", "1", "N"}, f"{name}: no unit in {comment!r}"
+        assert len(comment) > 12, f"{name}: no reason given"
+
+
+@pytest.mark.parametrize("method", ["gazebot", "seed-7.2.5", "seed-4.4.3"])
+def test_method_is_selectable_in_yaml(tmp_path, method):
+    f = tmp_path / "m.yaml"
+    f.write_text(f"method: {method}\n")
+    assert load_phase_config(f).method == method
 
 
 def test_missing_file_is_a_config_error(tmp_path):

@@ -236,3 +236,16 @@ def test_levels_of_different_conditions_are_not_compared(tmp_path):
     result = analyze(read_responses(write_responses(rows, tmp_path / "r.csv")), behaviors=BEHAVIORS)
     pairs = {(c.level_a, c.level_b, c.design) for c in result.comparisons}
     assert pairs == {("small-box", "large-box", "matched"), ("sitting", "standing", "matched")}
+
+
+def test_bias_is_tested_per_question_as_in_6_4_and_sides_default_to_one(two_level_csv):
+    responses = read_responses(two_level_csv)
+    one = analyze(responses, behaviors=BEHAVIORS)
+    two = analyze(responses, behaviors=BEHAVIORS, sides="two")
+    assert list(one.bias_per_question) == ["q1", "q2", "q3", "q4", "q5"]
+    assert one.sides == "one" and one.to_json()["bias_per_question"]["q5"]["z"] == (
+        one.bias_per_question["q5"].z
+    )
+    for c1, c2 in zip(one.comparisons, two.comparisons, strict=True):
+        assert c1.difference.z == c2.difference.z
+        assert c1.difference.p_value == pytest.approx(c2.difference.p_value / 2)

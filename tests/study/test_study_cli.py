@@ -36,16 +36,35 @@ def test_fit_wins_json_reproduces_table_6_2(tmp_path, capsys, measure):
     path = _write_table(tmp_path / "w.csv", names, TABLE_6_2[measure]["wins"])
     assert run(["study", "fit-wins", str(path), "--participants", "24", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert set(doc) == {"conditions", "p", "chi2", "df", "p_value"}
+    assert set(doc) == {"conditions", "p", "chi2", "df", "p_value", "pair_totals_differ"}
+    assert doc["pair_totals_differ"] == []
     assert doc["conditions"] == names and doc["df"] == 3
     assert [round(p, 2) for p in doc["p"]] == TABLE_6_2[measure]["P"]
     assert round(doc["p_value"], 2) == TABLE_6_2[measure]["p_value"]
 
 
-def test_fit_wins_rejects_totals_that_do_not_match_participants(tmp_path):
-    path = _write_table(tmp_path / "w.csv", ["a", "b"], [[0, 10], [10, 0]])
-    with pytest.raises(ValueError, match="expected --participants 24"):
-        run(["study", "fit-wins", str(path), "--participants", "24"])
+def test_fit_wins_with_a_pair_answered_23_of_24_warns_and_uses_its_own_total(tmp_path, capsys):
+    """Like the seed's Table B.3, where one pair was answered by 23 of 24 participants."""
+    import numpy as np
+
+    from gazebot.study.bradley_terry import fit_bradley_terry
+    from gazebot.study.stats import likelihood_ratio_chi2
+
+    names = ["Face", "Hand", "L-FH", "S-FH"]
+    wins = np.array(TABLE_6_2["likability"]["wins"], dtype=float)
+    wins[0, 1] -= 1  # Face vs Hand: 14 + 9 = 23 answers
+    path = _write_table(tmp_path / "w.csv", names, wins.tolist())
+    assert run(["study", "fit-wins", str(path), "--participants", "24", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "(Face, Hand) + (Hand, Face) = 23, not --participants 24" in captured.err
+    doc = json.loads(captured.out)
+    assert doc["pair_totals_differ"] == [["Face", "Hand", 23.0]]
+    fit = fit_bradley_terry(wins, names)
+    np.testing.assert_allclose(doc["p"], fit.p)
+    assert doc["chi2"] == pytest.approx(likelihood_ratio_chi2(wins, fit.p).chi2)
+    # One win fewer for Face lowers its P_i below the complete table's, and only a little.
+    full = fit_bradley_terry(np.array(TABLE_6_2["likability"]["wins"]), names)
+    assert full.p[0] - 0.02 < doc["p"][0] < full.p[0]
 
 
 def test_plan_command_writes_balanced_plan(tmp_path, capsys):
@@ -160,3 +179,33 @@ def test_render_command_rejects_unknown_scene_before_rendering(tmp_path):
     with pytest.raises(ValueError, match="unknown scene 'no-such-scene'"):
         run(["study", "render", str(plan), "--out", str(tmp_path / "out"), "--no-progress"])
     assert not (tmp_path / "out").exists()
+
+
+def test_plan_of_the_seed_6_3_design_needs_no_condition_and_no_out(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    argv = "study plan --behaviors face,hand,short-face-hand,long-face-hand --participants 24"
+    assert run([*argv.split(), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["sessions_per_participant"] == 12 and doc["condition"] == ""
+    assert doc["gaze_mode"] == "head-only"
+    with (tmp_path / "plan.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 24 * 12
+    for p in range(1, 25):
+        pairs = [(r["first"], r["second"]) for r in rows if r["participant"] == str(p)]
+        assert len(pairs) == len(set(pairs)) == 12  # each ordered pair once
+
+
+def test_plan_with_a_condition_defaults_to_the_as_studied_behaviors(tmp_path, capsys):
+    argv = ["study", "plan", "--condition", "posture", "--participants", "12"]
+    assert run([*argv, "--out", str(tmp_path / "p.csv"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["behaviors"] == ["hand-face-as-studied", "face-hand-face-as-studied", "hand"]
+    assert doc["gaze_mode"] == "eyes-only"
+
+
+def test_serve_and_export_on_a_folder_that_is_not_a_rendered_study_say_so(tmp_path):
+    with pytest.raises(ValueError, match="is not a rendered study"):
+        run(["study", "export", str(tmp_path), "--out", str(tmp_path / "r.csv")])
+    with pytest.raises(ValueError, match="is not a rendered study"):
+        run(["study", "serve", str(tmp_path), "--port", "0"])

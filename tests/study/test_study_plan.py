@@ -10,6 +10,7 @@ import pytest
 
 from gazebot.study.plan import (
     CONDITION_LEVELS,
+    DEFAULT_BEHAVIORS,
     check_balance,
     make_plan,
     ordered_pairings,
@@ -53,8 +54,32 @@ def test_plan_of_24_gives_each_participant_all_12_sessions_once(condition):
         assert {s.level for s in rows} == levels
         for level in levels:
             assert sorted((s.first, s.second) for s in rows if s.level == level) == sorted(
-                ordered_pairings(["hand-face", "face-hand-face", "hand"])
+                ordered_pairings(list(DEFAULT_BEHAVIORS))
             )
+    assert {s.gaze_mode for s in plan} == {"eyes-only"}  # 6.4: "robot eye gazes"
+
+
+def test_seed_6_3_design_plans_every_ordered_pair_of_four_behaviors_once():
+    """6.3.2: "The 12 sessions consisted of the six possible pairings of the four gaze patterns
+    and their reverse order", no condition, 24 participants."""
+    behaviors = ["face", "hand", "short-face-hand", "long-face-hand"]
+    plan = make_plan(behaviors, condition=None, participants=24, seed=3)
+    assert len(plan) == 24 * 12
+    for p in range(1, 25):
+        rows = sorted((s for s in plan if s.participant == p), key=lambda s: s.session)
+        assert [s.session for s in rows] == list(range(1, 13))
+        assert sorted((s.first, s.second) for s in rows) == sorted(
+            itertools.permutations(behaviors, 2)
+        )
+        assert {(s.condition, s.level, s.scene) for s in rows} == {("", "", "robot-initiated")}
+    assert {s.gaze_mode for s in plan} == {"head-only"}  # 6.3.2: static eyes on a moving head
+    report = check_balance(plan)
+    assert report.position_balanced and report.carryover_balanced
+
+
+def test_plan_without_condition_round_trips_through_csv_with_empty_level(tmp_path):
+    plan = make_plan(["face", "hand"], condition=None, participants=4, gaze_mode="eyes-only")
+    assert read_plan(write_plan(plan, tmp_path / "p.csv")) == plan
 
 
 def test_each_session_appears_once_per_position_in_every_block_of_12():

@@ -111,9 +111,8 @@ def test_every_participant_gets_session_files_in_plan_order(rendered):
     for s in plan[:24]:
         f = out / "participants" / f"P{s.participant:02d}" / f"session-{s.session:02d}.mp4"
         assert f.is_file()
-        a, b = (
-            VideoSpec(s.robot, x, s.scene, s.video_seed, W, H, FPS) for x in (s.first, s.second)
-        )
+        specs = {(v.behavior, v.scene): v for v in report.videos}
+        a, b = (specs[(x, s.scene)] for x in (s.first, s.second))
         assert (
             os.path.samefile(f, report.pairs[(a, b)])
             or f.read_bytes() == report.pairs[(a, b)].read_bytes()
@@ -148,14 +147,19 @@ def test_invalid_resolution_is_rejected(tmp_path):
 
 @pytest.mark.slow
 def test_real_renderer_at_tiny_resolution_renders_distinct_videos(tmp_path):
-    from gazebot.sim.record import render_handover_video
+    from gazebot.study.render import default_renderer
 
-    plan = make_plan(behaviors=["hand", "face-hand-face"], condition="posture", participants=4)
+    plan = make_plan(
+        behaviors=["hand", "face-hand-face"],
+        condition="posture",
+        participants=4,
+        gaze_mode="head-and-eyes",
+    )
     plan = [s for s in plan if s.participant == 1][:1]  # one session: 2 videos, 2 workers
     report = render_study(
         plan,
         tmp_path,
-        render_handover_video,
+        default_renderer(),
         64,
         48,
         10,
@@ -168,3 +172,60 @@ def test_real_renderer_at_tiny_resolution_renders_distinct_videos(tmp_path):
     assert all(len(c) > 5 and c[0].shape == (48, 64, 3) for c in clips)
     pair = _frames(next(iter(report.pairs.values())))
     assert len(pair) == 2 * 2 + len(clips[0]) + len(clips[1])  # 0.2 s cards at 10 fps
+
+
+def test_manifest_maps_every_session_and_the_practice_to_its_two_videos(rendered):
+    import json
+
+    from gazebot.study.folder import load_study
+    from gazebot.study.plan import read_plan
+
+    plan, report, out, _ = rendered
+    assert read_plan(out / "plan.csv") == plan
+    study = load_study(out)
+    specs = {p: v for v, p in report.videos.items()}
+    for s in plan:
+        first, second = (study.video_path(s.participant, s.session, k) for k in (1, 2))
+        assert (specs[first].behavior, specs[second].behavior) == (s.first, s.second)
+        assert specs[first].scene == s.scene
+    practice = [specs[study.video_path(1, 0, k)] for k in (1, 2)]
+    assert practice[0].behavior != practice[1].behavior
+    assert json.loads((out / "manifest.json").read_text())["gaze_mode"] == "eyes-only"
+
+
+def test_eyes_only_instructions_name_the_eyes_and_head_only_the_head(tmp_path):
+    from gazebot.study.questionnaire import instructions
+
+    assert "the robot's eyes in the video" in instructions("eyes-only")
+    assert "head" not in instructions("eyes-only")
+    assert "the robot's head movement in the video" in instructions("head-only")
+    assert "eyes" not in instructions("head-only")
+
+
+def test_edited_user_behavior_yaml_renders_a_new_video(tmp_path, monkeypatch):
+    """The cache keys on the behavior's content, not its name."""
+    folder = tmp_path / "behaviors"
+    folder.mkdir()
+    monkeypatch.setenv("GAZEBOT_BEHAVIORS_PATH", str(folder))
+    mine = folder / "mine.yaml"
+    mine.write_text("extends: face-hand-face\ndescription: first version\n")
+    plan = make_plan(["mine", "hand"], condition=None, participants=2, gaze_mode="head-only")
+    fn = functools.partial(render_synthetic_video, duration=0.2)
+    first = render_study(plan, tmp_path / "out", fn, W, H, FPS, workers=1, progress=False)
+    assert len(first.rendered) == 2
+    again = render_study(plan, tmp_path / "out", fn, W, H, FPS, workers=1, progress=False)
+    assert again.rendered == []
+    mine.write_text("extends: face-hand-face\ndescription: edited\n")
+    edited = render_study(plan, tmp_path / "out", fn, W, H, FPS, workers=1, progress=False)
+    assert [v.behavior for v in edited.rendered] == ["mine"]
+
+
+def test_plan_gaze_mode_needs_a_renderer_that_takes_it(tmp_path):
+    def old_renderer(
+        robot, behavior, scene, out_path, seed=0, width=640, height=480, fps=30, progress=True
+    ):
+        raise AssertionError("must not be called")
+
+    plan = make_plan(["face", "hand"], condition=None, participants=2, gaze_mode="eyes-only")
+    with pytest.raises(ValueError, match="gaze mode 'eyes-only'.*takes no gaze_mode"):
+        render_study(plan, tmp_path, old_renderer, W, H, FPS, workers=1, progress=False)

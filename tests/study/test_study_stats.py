@@ -108,3 +108,29 @@ def test_centred_s_matches_seed_reporting_for_per_session_answers():
     res = position_bias_test(np.array([1.0] * 155 + [-1.0] * 157))
     assert res.s == pytest.approx(-156.5)
     assert res.p_value > 0.85
+
+
+def test_bias_z_is_the_tie_corrected_normal_score_scipy_reports():
+    from scipy import stats as sps
+
+    d = np.array([0.5, -0.2, 0.5, 1, -1, 0.3, 0.5, -0.5, 0.2, 0.1, 0.0])
+    res = sps.wilcoxon(d, method="approx", zero_method="wilcox", correction=False)
+    b = position_bias_test(d)
+    assert abs(b.z) == pytest.approx(abs(res.zstatistic), rel=1e-12)
+    assert b.z > 0 and b.s > 0  # more "1st" than "2nd": positive S and z
+
+
+def test_one_sided_p_is_half_the_two_sided_p_in_the_observed_direction():
+    rng = np.random.default_rng(3)
+    a = (rng.random(24) < 0.7).astype(float)
+    b = (rng.random(24) < 0.4).astype(float)
+    two = matched_proportion_difference(a, b, sides="two")
+    one = matched_proportion_difference(a, b, sides="one")
+    assert one.z == two.z and one.p_value == pytest.approx(two.p_value / 2)
+    flipped = matched_proportion_difference(b, a, sides="one")
+    assert flipped.p_value == pytest.approx(one.p_value) and flipped.z == -one.z
+    u_two = unmatched_proportion_difference(15, 24, 9, 24, sides="two")
+    u_one = unmatched_proportion_difference(15, 24, 9, 24, sides="one")
+    assert u_one.p_value == pytest.approx(u_two.p_value / 2)
+    with pytest.raises(ValueError, match="sides"):
+        matched_proportion_difference(a, b, sides="both")

@@ -1,0 +1,360 @@
+"""Online (causal) phase detection, one tracking frame at a time.
+
+The detector keeps the last ``online_window`` seconds of samples and, at most every
+``online_period``, runs the configured method (:mod:`gazebot.phases.methods`) on the samples
+seen so far (``partial``: a boundary the data do not show yet stays open, and the last
+``edge_guard`` is not trusted). Each phase start the analysis shows beyond the current phase is
+emitted once, in order (reach -> transfer -> retreat -> done), back-dated to where the
+analysis puts it (never before the current phase's start). So online and offline share every
+rule; the online latency is what the data need to show a boundary.
+
+Robot evidence (seed section 4.3) comes first: a rising edge of "gripper closed" or of a load
+share above ``load_share_shared`` starts the transfer at once (and reports the reach if it was
+missed); a load share above ``load_share_robot`` starts the retreat. Once frames carry that
+evidence, hand motion alone no longer starts a transfer (hands resting close together while the
+robot has not grasped are a giver waiting).
+
+A reach the analysis no longer shows for ``online_period`` + ``max_refine`` (the hands parted
+before any transfer) ends as ``handover_done`` with ``source = "aborted"``; a retreat longer
+than ``max_retreat`` ends with ``source = "timeout"``.
+
+Bad samples: a frame with a non-finite time, or a time not after the last accepted one
+(duplicate or out of order), is ignored and counted (``stats``). Missing points (NaN) and
+frozen repeats are bridged for up to ``max_gap_hold``; after that ``tracking_lost`` fires
+(``t`` = last valid sample, ``info["missing"]`` names the points) and phase detection pauses
+until both hands are seen again (``tracking_restored``).
+
+One :meth:`PhaseDetector.update` call returns at most one event; the rest are queued and
+returned by the next calls, oldest first (:meth:`PhaseDetector.update_all` returns all).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import Signals, compute_signals
+from gazebot.phases.methods import GazebotSegmenter, make_segmenter
+from gazebot.phases.prediction import predict_end
+from gazebot.phases.segment import Segment, segments_from_events
+from gazebot.phases.trajectory import Trajectory
+from gazebot.types import Event, EventKind, Phase, TrackingFrame
+
+_PHASE_OF_EVENT = {
+    EventKind.REACH_STARTED: Phase.REACH,
+    EventKind.TRANSFER_STARTED: Phase.TRANSFER,
+    EventKind.RETREAT_STARTED: Phase.RETREAT,
+    EventKind.HANDOVER_DONE: Phase.DONE,
+}
+_EVENT_OF_PHASE = {v: k for k, v in _PHASE_OF_EVENT.items()}
+# Back-dated boundaries are compared to the current phase's start with this slack (s): one
+# analysis may place a boundary a grid step or two off the previous one.
+_SLACK = 0.03
+
+
+def _point(p: object) -> np.ndarray:
+    """A point as a float 3-vector (NaNs if it is not a numeric 3-vector)."""
+    try:
+        v = np.asarray(p, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        return np.full(3, np.nan)
+    return v if v.shape == (3,) else np.full(3, np.nan)
+
+
+@dataclass
+class DetectorStats:
+    """Counts of samples the detector ignored or bridged, and analyses it ran."""
+
+    samples: int = 0
+    out_of_order: int = 0
+    duplicates: int = 0
+    bad_time: int = 0
+    held: int = 0
+    analyses: int = 0
+
+
+class PhaseDetector:
+    """Causal handover phase detector running ``config.method`` (see the module docstring).
+
+    Attributes:
+        config: The settings.
+        phase: Current phase (``idle`` -> ``reach`` -> ``transfer`` -> ``retreat`` -> ``done``,
+            then ``reach`` again for a following handover).
+        phase_start: Estimated start of the current phase (s; NaN in ``idle``).
+        expected_phase_end: Predicted end of the current phase (s; NaN when unknown).
+        handover: Index of the current (or last) handover, -1 before the first.
+        tracking: False between ``tracking_lost`` and ``tracking_restored``.
+        stats: Counts of ignored and bridged samples.
+    """
+
+    def __init__(self, config: PhaseConfig | None = None) -> None:
+        self.config = config if config is not None else PhaseConfig()
+        self.segmenter = make_segmenter(self.config)
+        self.phase = Phase.IDLE
+        self.phase_start = math.nan
+        self.expected_phase_end = math.nan
+        self.handover = -1
+        self.tracking = True
+        self.stats = DetectorStats()
+        self._queue: deque[Event] = deque()
+        self._t: deque[float] = deque()
+        self._g: deque[np.ndarray] = deque()
+        self._r: deque[np.ndarray] = deque()
+        self._last_t = -math.inf
+        self._last_analysis = -math.inf
+        self._seen_g = self._seen_r = math.nan  # last valid sample of each hand
+        self._prev_evidence = False
+        self._robot_reports = False
+        self._signals: Signals | None = None
+        self._reach_missing_since = math.nan
+        self._floor = -math.inf  # the next phase never starts before this
+
+    # ----------------------------------------------------------------- public API
+    @property
+    def pending(self) -> int:
+        """Number of queued events the next calls will return."""
+        return len(self._queue)
+
+    def update(self, frame: TrackingFrame) -> Event | None:
+        """Feed one frame; return the oldest new (or queued) event, else ``None``."""
+        self._step(frame)
+        return self._queue.popleft() if self._queue else None
+
+    def update_all(self, frame: TrackingFrame) -> list[Event]:
+        """Feed one frame; return every new and queued event, oldest first."""
+        self._step(frame)
+        out = list(self._queue)
+        self._queue.clear()
+        return out
+
+    def resync(self, event: Event) -> None:
+        """Adopt a phase known from elsewhere (e.g. published before an engine restart).
+
+        Phase events set the phase and its start to ``event.t``; ``robot_grasped`` counts as a
+        transfer start when the detector is idle, done or in a reach. Tracking and other robot
+        events are ignored. No event is emitted, and queued events are dropped. A new handover
+        is counted when a reach (or a transfer without a reach) follows ``idle``, ``done`` or
+        ``retreat``.
+        """
+        kind = event.kind
+        if kind is EventKind.ROBOT_GRASPED:
+            if self.phase not in (Phase.IDLE, Phase.REACH, Phase.DONE):
+                return
+            phase = Phase.TRANSFER
+        else:
+            phase = _PHASE_OF_EVENT.get(kind)
+            if phase is None:
+                return
+        between = self.phase in (Phase.IDLE, Phase.DONE, Phase.RETREAT)
+        if between and phase in (Phase.REACH, Phase.TRANSFER):
+            self.handover += 1
+        self._enter(phase, event.t)
+        self._queue.clear()
+
+    # ----------------------------------------------------------------- internals
+    def _enter(self, phase: Phase, t0: float) -> None:
+        self.phase = phase
+        self.phase_start = t0
+        self._floor = t0
+        self._reach_missing_since = math.nan
+        self.expected_phase_end = predict_end(phase, t0, self._signals, t0, self.config)
+
+    def _start(self, phase: Phase, t0: float, now: float, source: str) -> None:
+        t0 = min(t0, now)
+        if math.isfinite(self.phase_start):
+            t0 = max(t0, self.phase_start)  # phases never go back in time
+        if phase is Phase.REACH or (
+            phase is Phase.TRANSFER and self.phase in (Phase.IDLE, Phase.DONE)
+        ):
+            self.handover += 1
+        info = {"handover": max(self.handover, 0), "source": source}
+        self._queue.append(Event(_EVENT_OF_PHASE[phase], t0, now, info))
+        self._enter(phase, t0)
+
+    def _step(self, frame: TrackingFrame) -> None:
+        st = self.stats
+        try:
+            t = float(frame.t)
+        except (TypeError, ValueError):
+            t = math.nan
+        if not math.isfinite(t):
+            st.bad_time += 1
+            return
+        if t <= self._last_t:
+            if t == self._last_t:
+                st.duplicates += 1
+            else:
+                st.out_of_order += 1
+            return
+        self._last_t = t
+        st.samples += 1
+        c = self.config
+        g, r = _point(frame.giver_hand), _point(frame.receiver_hand)
+        g_ok, r_ok = bool(np.isfinite(g).all()), bool(np.isfinite(r).all())
+        self._t.append(t)
+        self._g.append(g)
+        self._r.append(r)
+        while self._t and self._t[0] < t - c.online_window:
+            self._t.popleft()
+            self._g.popleft()
+            self._r.popleft()
+        if g_ok:
+            self._seen_g = t
+        if r_ok:
+            self._seen_r = t
+        if not (g_ok and r_ok):
+            st.held += 1
+            if self.tracking:
+                first = self._t[0]
+                last_g = self._seen_g if self._seen_g == self._seen_g else first
+                last_r = self._seen_r if self._seen_r == self._seen_r else first
+                last = min(last_g, last_r)
+                if t - last > c.max_gap_hold:
+                    self.tracking = False
+                    missing = [n for n, ok in (("giver_hand", g_ok), ("receiver_hand", r_ok)) if not ok]
+                    info = {"handover": max(self.handover, 0), "missing": missing}
+                    self._queue.append(Event(EventKind.TRACKING_LOST, last, t, info))
+            if not self.tracking:
+                return
+        elif not self.tracking:
+            self.tracking = True
+            info = {"handover": max(self.handover, 0)}
+            self._queue.append(Event(EventKind.TRACKING_RESTORED, t, t, info))
+
+        if self._robot_evidence(frame, t):
+            return
+        if t - self._last_analysis >= c.online_period:
+            self._last_analysis = t
+            self._analyse(t)
+        elif math.isfinite(self.expected_phase_end):
+            self.expected_phase_end = max(self.expected_phase_end, t)
+
+    def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
+        """Gripper / load-share evidence; True if it started a phase on this frame."""
+        c = self.config
+        grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
+        load = frame.load_share
+        load_ok = load is not None and math.isfinite(load)
+        if frame.gripper_closed is not None or load_ok:
+            self._robot_reports = True
+        evidence = grip or (load_ok and load > c.load_share_shared)  # type: ignore[operator]
+        rising = evidence and not self._prev_evidence
+        self._prev_evidence = evidence
+        source = "gripper" if grip else "load_share"
+        if rising and self.phase in (Phase.IDLE, Phase.DONE, Phase.REACH):
+            if self.phase is not Phase.REACH:
+                self._start(Phase.REACH, t, t, source)
+            self._start(Phase.TRANSFER, t, t, source)
+            return True
+        if self.phase is Phase.TRANSFER and load_ok and load > c.load_share_robot:  # type: ignore[operator]
+            self._start(Phase.RETREAT, t, t, "load_share")
+            return True
+        return False
+
+    def _analyse(self, now: float) -> None:
+        c = self.config
+        self.stats.analyses += 1
+        n = len(self._t)
+        if n < 3:
+            return
+        traj = Trajectory(np.fromiter(self._t, float, n), np.array(self._g), np.array(self._r))
+        s = compute_signals(traj, c)
+        self._signals = s
+        if isinstance(self.segmenter, GazebotSegmenter):
+            cut = self.segmenter.signals(traj, partial=True)
+            segs = [] if cut is None else self.segmenter.segment_signals(cut, now, partial=True)
+        else:
+            segs = self.segmenter.segment_sorted(traj, partial=True)
+        self._advance(segs, now)
+        self.expected_phase_end = predict_end(self.phase, self.phase_start, s, now, c)
+
+    def _find(self, segs: list[Segment], phase: Phase, after: float) -> Segment | None:
+        for seg in segs:
+            if seg.phase is phase and seg.start >= after - _SLACK:
+                return seg
+        return None
+
+    def _advance(self, segs: list[Segment], now: float) -> None:
+        c = self.config
+        for _ in range(4):  # at most one full handover per analysis
+            ph = self.phase
+            if ph in (Phase.IDLE, Phase.DONE):
+                reach = self._find(segs, Phase.REACH, self._floor)
+                if reach is not None:
+                    self._start(Phase.REACH, reach.start, now, "motion")
+                    continue
+                if not self._robot_reports:
+                    tr = self._find(segs, Phase.TRANSFER, self._floor)
+                    if tr is not None:
+                        self._start(Phase.REACH, tr.start, now, "motion")
+                        continue
+                return
+            if ph is Phase.REACH:
+                tr = None if self._robot_reports else self._find(segs, Phase.TRANSFER, self._floor)
+                if tr is not None:
+                    self._start(Phase.TRANSFER, tr.start, now, "motion")
+                    continue
+                alive = any(
+                    sg.phase in (Phase.REACH, Phase.TRANSFER) and sg.end >= self._floor - _SLACK
+                    for sg in segs
+                )
+                if alive:
+                    self._reach_missing_since = math.nan
+                elif self._reach_missing_since != self._reach_missing_since:
+                    self._reach_missing_since = now
+                elif now - self._reach_missing_since > c.online_period + c.max_refine:
+                    self._done(now, now, "aborted")
+                return
+            if ph is Phase.TRANSFER:
+                ret = self._find(segs, Phase.RETREAT, self._floor)
+                if ret is not None:
+                    self._start(Phase.RETREAT, ret.start, now, "motion")
+                    continue
+                return
+            # Retreat: done when its end is seen, or a next reach began.
+            ret = self._find(segs, Phase.RETREAT, self._floor)
+            nxt = self._find(segs, Phase.REACH, self._floor + _SLACK * 2)
+            if ret is not None and not ret.open:
+                self._done(ret.end, now, "motion")
+                continue
+            if nxt is not None:
+                self._done(nxt.start, now, "next_reach")
+                continue
+            if now - self.phase_start > c.max_retreat:
+                self._done(now, now, "timeout")
+            return
+
+    def _done(self, t0: float, now: float, source: str) -> None:
+        t0 = max(min(t0, now), self.phase_start)
+        info = {"handover": max(self.handover, 0), "source": source}
+        self._queue.append(Event(EventKind.HANDOVER_DONE, t0, now, info))
+        self._enter(Phase.DONE, t0)
+
+
+@dataclass
+class OnlineResult:
+    """What :func:`run_online` saw: every event, the resulting segments and the sample counts."""
+
+    events: list[Event]
+    segments: list[Segment]
+    stats: DetectorStats
+
+
+def run_online(trajectory: Trajectory, config: PhaseConfig | None = None) -> OnlineResult:
+    """Replay a recording through a fresh :class:`PhaseDetector`, sample by sample, in the
+    stored order (out-of-order samples are ignored as they would be live)."""
+    det = PhaseDetector(config)
+    events: list[Event] = []
+    for frame in trajectory.iter_frames():
+        events.extend(det.update_all(frame))
+    t_end = float(np.nanmax(trajectory.t)) if len(trajectory) else math.nan
+    return OnlineResult(events, segments_from_events(events, t_end), det.stats)
+
+
+def make_detector(config: PhaseConfig | None = None) -> PhaseDetector:
+    """The online detector of ``config.method`` (the engine's entry point)."""
+    return PhaseDetector(config)

@@ -1,0 +1,124 @@
+"""``gazebot``: the robust default method, composed of the rules in :mod:`gazebot.phases.rules`.
+
+Per handover (a dip of the hands' distance): the transfer starts where the approach stopped
+(:mod:`~gazebot.phases.rules.transfer`), ends at the back-dated release
+(:mod:`~gazebot.phases.rules.release`); the reach starts at the giver's motion onset before it
+(:mod:`~gazebot.phases.rules.reach`) and the retreat ends at rest, far away, at the next reach
+or at the data end (:mod:`~gazebot.phases.rules.retreat`). A recording cut short ends in the
+phase under way (``open``), with nothing invented after its last sample.
+
+The robot's gripper and load-share columns are not used here; the online detector uses them
+(they arrive before the motion shows).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gazebot.phases.filtering import Signals, compute_signals
+from gazebot.phases.methods.base import Segmenter
+from gazebot.phases.rules.reach import reach_start, trailing_reach
+from gazebot.phases.rules.release import transfer_end
+from gazebot.phases.rules.retreat import far_after, rest_after
+from gazebot.phases.rules.transfer import find_cores
+from gazebot.phases.segment import Segment
+from gazebot.phases.trajectory import Trajectory
+from gazebot.types import Phase
+
+
+class GazebotSegmenter(Segmenter):
+    """The robust default method (see the module docstring)."""
+
+    name = "gazebot"
+
+    def signals(self, trajectory: Trajectory, partial: bool = False) -> Signals | None:
+        """The smoothed signals (cut ``edge_guard`` before the last sample when ``partial``)."""
+        if len(trajectory) < 3:
+            return None
+        s = compute_signals(trajectory, self.config)
+        if partial and self.config.edge_guard > 0:
+            keep = s.t <= float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
+            if np.count_nonzero(keep) < 3:
+                return None
+            s = Signals(*(getattr(s, f)[keep] for f in s.__dataclass_fields__))
+        return s
+
+    def segment_sorted(self, trajectory: Trajectory, partial: bool = False) -> list[Segment]:
+        s = self.signals(trajectory, partial)
+        if s is None:
+            return []
+        return self.segment_signals(s, float(trajectory.t[-1]), partial)
+
+    def segment_signals(self, s: Signals, t_last: float, partial: bool = False) -> list[Segment]:
+        """Segments from precomputed signals (``t_last``: the last sample's time)."""
+        c = self.config
+        grid_end = float(s.t[-1])
+        if partial:
+            t_last = grid_end
+
+        def at_end(x: float) -> float:
+            return t_last if x >= grid_end - 1e-9 else x
+
+        cores = find_cores(s, c)
+        out: list[Segment] = []
+        prev_end_idx = 0
+        n = s.t.shape[0]
+        trailing_ok = True
+        for k, core in enumerate(cores):
+            t_start = core.t_start
+            if not math.isfinite(t_start):
+                if partial:
+                    # The approach has not settled yet: still a reach.
+                    onset = reach_start(s, c, prev_end_idx, core.start)
+                    start = max(onset, out[-1].end) if out else onset
+                    out.append(Segment(Phase.REACH, min(start, t_last), t_last, k, open=True))
+                    trailing_ok = False
+                    break
+                t_start = float(s.t[core.start])
+            t_start = min(t_start, t_last)
+            i_start = int(np.searchsorted(s.t, t_start))
+            onset = reach_start(s, c, prev_end_idx, max(i_start - 1, prev_end_idx))
+            if out:
+                onset = max(onset, out[-1].end)
+            out.append(Segment(Phase.REACH, min(onset, t_start), t_start, k))
+            t_end, open_end = transfer_end(s, c, core)
+            if open_end:
+                out.append(Segment(Phase.TRANSFER, t_start, t_last, k, open=True))
+                trailing_ok = False
+                break
+            if t_end - t_start < c.min_transfer and not partial:
+                # A refinement that collapses a short transfer (fast giver, sparse samples):
+                # the seed rule's own run stands.
+                t_start, t_end = float(s.t[core.start]), float(s.t[core.end])
+                out[-1] = Segment(Phase.REACH, out[-1].start, t_start, k)
+            i_end = min(int(np.searchsorted(s.t, t_end)), n - 1)
+            nxt = cores[k + 1].start if k + 1 < len(cores) else n - 1
+            t_rest, seen = rest_after(s, c, i_end, max(nxt, i_end))
+            t_far = far_after(s, c, i_end)
+            if k + 1 < len(cores):
+                seen = True  # the next handover ends this one at the latest
+            retreat_end = min(t_rest, t_far)
+            seen = seen or math.isfinite(t_far)
+            retreat_end = at_end(max(retreat_end, t_end))
+            out.append(Segment(Phase.TRANSFER, t_start, t_end, k))
+            out.append(Segment(Phase.RETREAT, t_end, retreat_end, k, open=not seen))
+            prev_end_idx = int(np.searchsorted(s.t, retreat_end))
+        if trailing_ok and (not out or out[-1].phase is Phase.RETREAT):
+            onset = trailing_reach(s, c, min(prev_end_idx, n - 1))
+            if onset is not None:
+                start = max(onset, out[-1].end) if out else onset
+                k = out[-1].handover + 1 if out else 0
+                out.append(Segment(Phase.REACH, min(start, t_last), t_last, k, open=True))
+        # The next reach may begin before the retreat looked finished: clip the retreat.
+        for i in range(len(out) - 1):
+            ret, nxt_reach = out[i], out[i + 1]
+            if ret.phase is Phase.RETREAT and ret.end > nxt_reach.start:
+                fixed = max(nxt_reach.start, ret.start)
+                out[i] = Segment(Phase.RETREAT, ret.start, fixed, ret.handover)
+                if nxt_reach.start < fixed:
+                    out[i + 1] = Segment(
+                        Phase.REACH, fixed, nxt_reach.end, nxt_reach.handover, open=nxt_reach.open
+                    )
+        return out

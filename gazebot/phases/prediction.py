@@ -1,0 +1,54 @@
+"""End-of-phase prediction (``expected_phase_end``).
+
+Reach and retreat follow roughly symmetric bell-shaped (minimum-jerk) speed profiles: once a
+hand's speed has fallen below ``peak_passed_fraction`` of its peak, the motion ends about as
+long after the peak as the peak came after the onset (``onset + 2 (t_peak - onset)``); before
+that, ``onset + reach_duration`` (``retreat_duration``). A reach ends at contact, so it is the
+later of the giver's and the receiver's predicted arrivals (the receiver's onset is where its
+own speed first exceeded ``reach_onset_speed``). A transfer is predicted to last
+``transfer_duration``. Never earlier than now; NaN in ``idle`` and ``done``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import Signals
+from gazebot.types import Phase
+
+
+def _mirrored(t: np.ndarray, v: np.ndarray, onset: float, nominal: float, c: PhaseConfig) -> float:
+    ok = np.isfinite(v)
+    if not ok.any():
+        return onset + nominal
+    i = int(np.nanargmax(v))
+    peak = float(v[i])
+    last = float(v[np.flatnonzero(ok)[-1]])
+    if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
+        return onset + 2.0 * max(float(t[i]) - onset, 0.0)
+    return onset + nominal
+
+
+def predict_end(phase: Phase, start: float, s: Signals | None, now: float, c: PhaseConfig) -> float:
+    """Predicted end of ``phase`` that started at ``start`` (s), from the signals so far."""
+    if phase is Phase.TRANSFER:
+        return max(start + c.transfer_duration, now)
+    if phase not in (Phase.REACH, Phase.RETREAT) or not math.isfinite(start):
+        return math.nan
+    nominal = c.reach_duration if phase is Phase.REACH else c.retreat_duration
+    if s is None or s.t.shape[0] == 0:
+        return max(start + nominal, now)
+    i0 = int(np.searchsorted(s.t, start))
+    pred = _mirrored(s.t[i0:], s.giver_speed[i0:], start, nominal, c)
+    if phase is Phase.REACH:
+        j0 = int(np.searchsorted(s.t, start - nominal))
+        rv = s.receiver_speed[j0:]
+        moving = np.flatnonzero(rv >= c.reach_onset_speed)
+        if moving.size:
+            r_on = float(s.t[j0 + int(moving[0])])
+            k0 = j0 + int(moving[0])
+            pred = max(pred, _mirrored(s.t[k0:], s.receiver_speed[k0:], r_on, nominal, c))
+    return max(pred, now)

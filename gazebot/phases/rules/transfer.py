@@ -1,0 +1,218 @@
+"""Reach -> transfer: the handovers in a recording and when each transfer starts.
+
+A handover is a dip of the hands' distance at least ``min_approach`` deep (the recording's ends
+count as high ground) that closes at least ``approach_fraction`` of the distance the hands
+started from (a pause of a slow approach is no handover). Its minimum is the seed's "minimum distance" (section 7.2.5), whatever it
+is: on real motion capture the hand frames sit on the back of the hand or at the wrist and the
+object has size, so they never come closer than 0.3-0.5 m; no absolute contact distance is
+assumed. Within the dip, the seed's rule (within ``transfer_distance_margin`` of the minimum,
+relative speed under ``transfer_speed_max``) gives the transfer's core; runs split by short
+blips under ``transfer_exit_speed`` or by tracking gaps merge. The giver's hand must have moved
+(``reach_onset_speed``) before the core: a receiver (robot) returning home near a resting
+giver makes a dip too; the receiver may move more than the giver.
+
+The seed's 15 cm/s is crossed on the tail of the approach, before contact. The transfer starts
+where the approach has stopped: the relative speed falls below ``settle_fraction`` of the
+approach's own peak relative speed (scale-free: fast and slow approaches alike), or below
+``settle_floor_factor`` times the hold's speed floor (marker noise and both hands carrying the
+object keep the relative speed of a real hold at 3-7 cm/s).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import Signals
+
+
+@dataclass(frozen=True)
+class TransferCore:
+    """One handover's transfer core on the analysis grid.
+
+    Attributes:
+        lo: First grid index of the handover's dip.
+        start: First grid index of the seed-rule core.
+        end: Last grid index of the core.
+        hi: Last grid index of the dip.
+        t_start: Transfer start (s), or NaN when the approach has not yet settled in the data.
+    """
+
+    lo: int
+    start: int
+    end: int
+    hi: int
+    t_start: float
+
+
+def runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Inclusive index ranges of the True runs of ``mask``."""
+    if mask.size == 0:
+        return []
+    padded = np.concatenate([[False], mask, [False]])
+    edges = np.flatnonzero(padded[1:] != padded[:-1])
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
+    """Dips of ``d`` at least ``depth`` deep on both sides, as ``(left, minimum, right)`` index
+    triples (left/right: the highest points between neighbouring dips). The recording's ends
+    count as high ground, so a recording that starts or ends mid-handover keeps its dip.
+    NaN samples are skipped."""
+    out: list[tuple[int, int, int]] = []
+    idx = np.flatnonzero(np.isfinite(d))
+    if idx.size == 0:
+        return out
+    left = int(idx[0])
+    going_down = True
+    lo_v, lo_i = math.inf, -1
+    hi_v, hi_i = -math.inf, -1
+    for i, v in zip(idx.tolist(), d[idx].tolist(), strict=True):
+        if going_down:
+            if v < lo_v:
+                lo_v, lo_i = v, i
+            elif v >= lo_v + depth:
+                going_down = False
+                hi_v, hi_i = v, i
+        else:
+            if v > hi_v:
+                hi_v, hi_i = v, i
+            elif v <= hi_v - depth:
+                out.append((left, lo_i, hi_i))
+                left = hi_i
+                going_down = True
+                lo_v, lo_i = v, i
+    if going_down:
+        if lo_i >= 0:
+            out.append((left, lo_i, int(idx[-1])))
+    else:
+        out.append((left, lo_i, hi_i if hi_i >= 0 else int(idx[-1])))
+    return out
+
+
+def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
+    """Every handover's transfer core, in time order (see the module docstring)."""
+    d = s.distance
+    n = d.shape[0]
+    if n < 3 or not np.isfinite(d).any():
+        return []
+    out: list[TransferCore] = []
+    rs = np.where(np.isfinite(s.rel_speed), s.rel_speed, np.inf)
+    unknown = ~np.isfinite(s.rel_speed)
+    min_len = max(1, int(round(c.min_transfer * c.analysis_rate)))
+    for lo, p, hi in dips(d, c.min_approach):
+        near = np.zeros(n, dtype=bool)
+        near[lo : hi + 1] = d[lo : hi + 1] <= d[p] + c.transfer_distance_margin
+        rule_runs = runs(near & (rs < c.transfer_speed_max))
+        if not rule_runs:
+            continue
+        soft = near & (rs < c.transfer_exit_speed)
+        merged: list[list[int]] = [list(rule_runs[0])]
+        for a, b in rule_runs[1:]:
+            gap = slice(merged[-1][1] + 1, a)
+            # A short blip under the exit speed, or a tracking gap with nothing but such
+            # samples, does not end a transfer.
+            ok = soft[gap] | unknown[gap]
+            if ok.all() and np.count_nonzero(~unknown[gap]) < min_len:
+                merged[-1][1] = b
+            else:
+                merged.append([a, b])
+        core = next((m for m in merged if m[0] <= p <= m[1]), None)
+        if core is None:
+            core = max(merged, key=lambda m: m[1] - m[0])
+        a, b = core
+        if b - a + 1 < min_len:
+            continue
+        top = float(np.nanmax(d[lo : p + 1]))
+        if top - d[p] < c.approach_fraction * top:
+            continue  # the hands paused while still far apart (relative to where they started)
+        if not np.nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed:
+            continue  # only the receiver moved: not a handover
+        if out and a <= out[-1].end:
+            continue  # the same transfer seen from a neighbouring dip
+        out.append(TransferCore(lo, a, b, hi, transfer_start(s, c, lo, a, b)))
+    return out
+
+
+def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
+    """The relative speed floor of the hold ``[a, b]`` (m/s): marker noise and both hands
+    carrying the object, the ``hold_floor_quantile`` of its relative speed."""
+    hold = s.rel_speed[a : b + 1]
+    hold = hold[np.isfinite(hold)]
+    return float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
+
+
+def settle_speed(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
+    """The relative speed below which the approach of the core ``[a, b]`` has stopped (m/s)."""
+    peak = float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
+    floor = c.settle_floor_factor * hold_floor(s, c, a, b)
+    return min(max(c.settle_fraction * peak, floor), c.transfer_speed_max)
+
+
+def _crossing(s: Signals, i: int, level: float) -> float:
+    """Time the relative speed fell through ``level`` between grid points ``i - 1`` and ``i``."""
+    if i > 0 and np.isfinite(s.rel_speed[i - 1]):
+        v0, v1 = float(s.rel_speed[i - 1]), float(s.rel_speed[i])
+        if v0 > level >= v1 and v0 > v1:
+            return float(s.t[i - 1]) + (v0 - level) / (v0 - v1) * s.dt
+    return float(s.t[i])
+
+
+def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
+    """When the approach into the core ``[a, b]`` stopped (s); NaN if not yet seen to settle.
+
+    The relative speed's crossing of the settle speed ``v_s``; when that lies above the hold's
+    floor ``v_f`` (``settle_floor_factor`` x floor: a clean approach), the approach's tail,
+    parabolic near its end (``v ~ (t_stop - t)^2``), is extrapolated from the crossings of
+    the seed's ``transfer_speed_max`` (t_a) and ``v_s`` (t_s) to where it meets ``v_f``:
+    ``t_s + stop_extrapolation (t_s - t_a) (sqrt(v_s) - sqrt(v_f)) / (sqrt(v_a) - sqrt(v_s))``
+    (at most ``max_refine``). Only the tail seen before the first tracking gap counts. An
+    approach that stopped inside a tracking gap is dated from the last sample seen before it
+    (:func:`stop_in_gap_before`).
+    """
+    v_settle = settle_speed(s, c, lo, a, b)
+    hidden = stop_in_gap_before(s, a, v_settle)
+    if hidden is not None:
+        return hidden
+    seg = s.rel_speed[a : b + 1]
+    gaps = np.flatnonzero(~np.isfinite(seg))
+    seen = seg[: int(gaps[0])] if gaps.size else seg
+    below = np.flatnonzero(seen < v_settle)
+    if below.size == 0:
+        if gaps.size:
+            return float(s.t[a + int(np.argmin(seen))]) if seen.size else float(s.t[a])
+        return math.nan
+    i = a + int(below[0])
+    t_s = _crossing(s, i, v_settle)
+    t_a = _crossing(s, a, c.transfer_speed_max)
+    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
+    v_a = c.transfer_speed_max
+    if v_f < v_settle < v_a and t_s > t_a:
+        ext = (t_s - t_a) * (math.sqrt(v_settle) - math.sqrt(v_f))
+        ext /= math.sqrt(v_a) - math.sqrt(v_settle)
+        t_s += min(c.stop_extrapolation * ext, c.max_refine)
+    return t_s
+
+
+def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
+    """The approach's stop when it hides in a tracking gap ending at grid index ``a``.
+
+    ``None`` if ``a`` follows a seen sample, or the hands have not settled at ``a``. Else, from
+    the last sample seen before the gap, approaching at speed ``v`` with ``x`` left to go, the
+    minimum-jerk tail (``x ~ (t_stop - t)^3``) stops ``3 x / v`` later; at the latest when the
+    gap ends."""
+    if a == 0 or np.isfinite(s.rel_speed[a - 1]) or not s.rel_speed[a] < v_settle:
+        return None
+    seen = np.flatnonzero(np.isfinite(s.rel_speed[:a]))
+    t_a = float(s.t[a])
+    if seen.size == 0:
+        return None
+    i = int(seen[-1])
+    x = float(np.linalg.norm(s.rel[a] - s.rel[i]))
+    v = float(s.rel_speed[i])
+    if not (math.isfinite(x) and v > 1e-6):
+        return t_a
+    return min(float(s.t[i]) + 3.0 * x / v, t_a)

@@ -1,0 +1,65 @@
+"""Recording readers: the formats labs record, into a :class:`~gazebot.phases.Trajectory` in SI.
+
+:func:`load_recording` picks the reader from the file: ``.csv`` (:mod:`.csv_table`), ``.c3d``
+(:mod:`.c3d_file`), ROS 1 ``.bag`` / ROS 2 bag folders, ``.db3`` and ``.mcap`` (:mod:`.rosbag`),
+and folders of per-body pose CSVs (:mod:`.pose_folder`). Point names choose the giver's hand,
+the receiver's hand and (optionally) the giver's face; a name the file lacks is an error that
+lists the names it has.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from gazebot.recordings.base import PointNames, Recording, RecordingError, median_rate
+from gazebot.recordings.c3d_file import read_c3d
+from gazebot.recordings.csv_table import read_csv
+from gazebot.recordings.pose_folder import read_pose_folder
+from gazebot.recordings.rosbag import read_bag
+
+
+def load_recording(path: str | Path, names: PointNames | None = None, unit: str | None = None,
+                   rate: float | None = None) -> Recording:
+    """Read any supported recording (see the module docstring).
+
+    Args:
+        path: The file (or bag / pose folder).
+        names: Point names; ``None`` fields use the format's defaults.
+        unit: Length unit of CSV and pose-folder coordinates (m, cm, mm; default m). C3D files
+            and bags carry their own.
+        rate: Sampling rate of a pose folder (Hz).
+
+    Raises:
+        RecordingError: Missing or unreadable file, unknown format or unit, a wrong name.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise RecordingError(path, "no such file")
+    suffix = path.suffix.lower()
+    if path.is_dir():
+        if (path / "metadata.yaml").is_file() or any(path.glob("*.db3")) or any(path.glob("*.mcap")):
+            return read_bag(path, names)
+        return read_pose_folder(path, names, rate, unit or "m")
+    if suffix == ".csv":
+        return read_csv(path, names, unit or "m")
+    if suffix == ".c3d":
+        if unit is not None:
+            raise RecordingError(path, "a C3D file states its own unit (POINT:UNITS): drop --unit")
+        return read_c3d(path, names)
+    if suffix in (".bag", ".db3", ".mcap"):
+        return read_bag(path, names)
+    raise RecordingError(path, f"unknown format {suffix or '(no extension)'}: expected .csv, "
+                         ".c3d, .bag, a ROS 2 bag folder or a folder of pose CSVs")
+
+
+__all__ = [
+    "PointNames",
+    "Recording",
+    "RecordingError",
+    "load_recording",
+    "median_rate",
+    "read_bag",
+    "read_c3d",
+    "read_csv",
+    "read_pose_folder",
+]

@@ -1,0 +1,136 @@
+"""STL robustness of the seed's handover specifications (Table 4.2) over a simulated run: the
+reach ("within t_1 seconds after the handover signal e"), the transfer (grasp within t_2 of the
+object reaching the gripper; a giver robot releases within t_8 of sharing it) and the retreat (at
+the drop-off within t_3 of holding the object; a giver robot home within t_9 of the person
+holding it). Positive robustness: the run met the spec.
+
+In the simulation "near" is the grasp distance (the controller grasps or releases there, seed
+3.3.4), taken as an l1 bound (``sqrt(3)`` times the Euclidean grasp distance); the drop-off of a
+receiving robot is its home gripper position (it retreats home with the object)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gazebot.controllers.config import ControllersConfig, Role
+from gazebot.controllers.stl_logic import (
+    Always,
+    And,
+    Eventually,
+    Formula,
+    Not,
+    Predicate,
+    Signal,
+    implies,
+    near,
+    object_states,
+)
+
+
+@dataclass
+class HandoverMonitor:
+    """Collects one sample per control tick (pass :meth:`on_tick` as ``record_handover``'s
+    ``on_tick``, or call :meth:`sample`) and evaluates the specs at the end."""
+
+    config: ControllersConfig | None = None  # None: the simulated robot's own
+    rows: dict[str, list] = field(default_factory=lambda: {k: [] for k in _KEYS})
+    start_t: float | None = None
+    role: Role = Role.RECEIVER
+    eps: float = 0.05 * math.sqrt(3)
+    home: np.ndarray | None = None
+    dt: float | None = None
+    _last_t: float | None = None
+
+    def on_tick(self, sim, _tick=None) -> None:
+        self.sample(sim)
+
+    def sample(self, sim) -> None:
+        """Record the simulation's state now."""
+        ctrl = sim.controller
+        if self.config is None:
+            self.config = robot_timing(sim)
+        self.role = Role.GIVER if getattr(sim, "robot_to_human", False) else Role.RECEIVER
+        self.eps = math.sqrt(3) * sim.config.controller.grasp_distance_m
+        gripper = sim.data.site_xpos[sim._gripper_site].copy()
+        if self.home is None:
+            self.home = gripper.copy()
+        if self.start_t is None and ctrl.handover_start is not None:
+            self.start_t = float(ctrl.handover_start)
+        if self._last_t is not None and self.dt is None:
+            self.dt = sim.t - self._last_t
+        self._last_t = sim.t
+        grasped = ctrl.grasped
+        person = sim.giver.holds_object
+        alpha = 0.0 if not grasped else (0.5 if person else 1.0)
+        obj = sim.data.mocap_pos[sim.scene.object_mocap].copy()
+        row = {
+            "t": sim.t,
+            "p_r": gripper,
+            "p_h": sim.giver.hand + sim.layout.object_offset,  # where the object sits in the hand
+            "p_o": obj,
+            "alpha": alpha,
+            "g_r": 1.0 - float(ctrl._gripper),
+            "p_d": self.home,
+            "p_home": self.home,
+        }
+        for k in _KEYS:
+            self.rows[k].append(row[k])
+
+    def signal(self) -> Signal:
+        values = {k: np.asarray(v, float) for k, v in self.rows.items() if k != "t"}
+        t = np.asarray(self.rows["t"], float)
+        e = np.zeros(len(t))
+        if self.start_t is not None and len(t):
+            e[int(np.argmin(np.abs(t - self.start_t)))] = 1.0
+        values["e"] = e
+        return Signal(dt=self.dt or 1.0, values=values)
+
+    def specs(self) -> dict[str, Formula]:
+        """Table 4.2's specs for the robot's role, with this run's tolerances."""
+        assert self.config is not None, "sample a run first"
+        stl = self.config.stl.model_copy(update={"eps_p_m": self.eps})
+        o = object_states(stl, self.eps)
+        e = Predicate("e", lambda s: s["e"] - 0.5)
+        reach = Always(
+            implies(e, Eventually(near("p_h", "p_r", self.eps), 0, self.config.reach_time_s))
+        )
+        closed = Predicate("g_r=0", lambda s: 0.1 - np.abs(s["g_r"]))
+        opened = Predicate("g_r=1", lambda s: 0.1 - np.abs(s["g_r"] - 1.0))
+        t_tr, t_re = stl.transfer_time_s, stl.retreat_time_s
+        if self.role is Role.RECEIVER:
+            at_obj = near("p_o", "p_r", self.eps)
+            transfer = Always(implies(And(at_obj, Not(o["o_r"])), Eventually(closed, 0, t_tr)))
+            retreat = Always(implies(o["o_r"], Eventually(near("p_r", "p_d", self.eps), 0, t_re)))
+        else:
+            transfer = Always(implies(o["o_s"], Eventually(opened, 0, t_tr)))
+            gone = Predicate("alpha<=d1", lambda s: stl.delta_1 - s["alpha"])
+            retreat = Always(implies(gone, Eventually(near("p_r", "p_home", self.eps), 0, t_re)))
+        return {"reach": reach, "transfer": transfer, "retreat": retreat}
+
+    def robustness(self) -> dict[str, float]:
+        """Each spec's robustness over the run (positive: met)."""
+        if len(self.rows["t"]) < 2:
+            raise ValueError("no run recorded")
+        sig = self.signal()
+        return {name: float(f.robustness(sig)) for name, f in self.specs().items()}
+
+
+def robot_timing(sim) -> ControllersConfig:
+    """The timing the simulated robot works to: its reach controller's, else the controllers
+    YAML with the scene's reach time."""
+    reach = sim.controller.reach
+    if reach is not None:
+        return reach.controller.config
+    from gazebot.controllers import load_controllers_config
+
+    ctrl = sim.config.controller
+    cfg = load_controllers_config(ctrl.controllers)
+    if ctrl.reach_time_s is not None:
+        cfg = cfg.model_copy(update={"reach_time_s": ctrl.reach_time_s})
+    return cfg
+
+
+_KEYS = ("t", "p_r", "p_h", "p_o", "alpha", "g_r", "p_d", "p_home")

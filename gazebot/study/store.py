@@ -1,0 +1,263 @@
+"""The answers of a study run in the browser: one SQLite file, ``DIR/responses.sqlite``.
+
+Every write is one transaction committed before the HTTP response goes out, in WAL mode with
+``synchronous=FULL``: an answer the participant saw accepted survives a killed server (and a
+power cut). A participant's place in the study is derived from what is stored (consent given,
+instructions read, the sessions answered), never kept in the server's memory, so a reload, a
+closed tab or a restarted server resumes exactly there.
+
+Tables:
+
+- ``participants(participant, mode, consent_at, instructions_at, finished_at)``: ``mode`` is
+  ``video`` (the participant answers in the browser) or ``in-person`` (the experimenter enters
+  the answers after each live pair); set by the first step taken.
+- ``answers(participant, session, q1..q5, comment, mode, shown_at, submitted_at)``: one row per
+  answered session, session 0 being the practice; the primary key (participant, session) makes a
+  double submit record once (the first one wins).
+- ``views(participant, session, shown_at)``: when a session page was first shown, for the time
+  spent per session.
+
+Times are UTC seconds since the epoch (floats).
+"""
+
+from __future__ import annotations
+
+import sqlite3
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+QUESTION_KEYS = ("q1", "q2", "q3", "q4", "q5")
+MODES = ("video", "in-person")
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS participants (
+    participant INTEGER PRIMARY KEY,
+    mode TEXT NOT NULL CHECK (mode IN ('video', 'in-person')),
+    consent_at REAL,
+    instructions_at REAL,
+    finished_at REAL
+);
+CREATE TABLE IF NOT EXISTS answers (
+    participant INTEGER NOT NULL,
+    session INTEGER NOT NULL,
+    q1 INTEGER NOT NULL CHECK (q1 IN (1, 2)),
+    q2 INTEGER NOT NULL CHECK (q2 IN (1, 2)),
+    q3 INTEGER NOT NULL CHECK (q3 IN (1, 2)),
+    q4 INTEGER NOT NULL CHECK (q4 IN (1, 2)),
+    q5 INTEGER NOT NULL CHECK (q5 IN (1, 2)),
+    comment TEXT NOT NULL DEFAULT '',
+    mode TEXT NOT NULL,
+    shown_at REAL,
+    submitted_at REAL NOT NULL,
+    PRIMARY KEY (participant, session)
+);
+CREATE TABLE IF NOT EXISTS views (
+    participant INTEGER NOT NULL,
+    session INTEGER NOT NULL,
+    shown_at REAL NOT NULL,
+    PRIMARY KEY (participant, session)
+);
+"""
+
+
+@dataclass(frozen=True)
+class Answer:
+    """One answered session (session 0: the practice)."""
+
+    participant: int
+    session: int
+    answers: dict[str, int]
+    comment: str
+    mode: str
+    shown_at: float | None
+    submitted_at: float
+
+    @property
+    def seconds(self) -> float | None:
+        """Time from first showing the session to submitting it (None if never shown)."""
+        return None if self.shown_at is None else self.submitted_at - self.shown_at
+
+
+@dataclass(frozen=True)
+class Progress:
+    """Where a participant is: the steps done and the answered sessions."""
+
+    participant: int
+    mode: str | None
+    consent_at: float | None
+    instructions_at: float | None
+    finished_at: float | None
+    answered: tuple[int, ...]
+    last_activity: float | None
+
+
+class ResponseStore:
+    """The study's SQLite file. Each method opens its own connection (cheap, and safe from any
+    server thread) and commits before returning."""
+
+    def __init__(self, path: str | Path, timeout_s: float = 10.0) -> None:
+        self.path = Path(path)
+        self.timeout_s = timeout_s
+        # Writers of this process take turns here: SQLite's own busy handler would put a
+        # waiting writer to sleep for milliseconds; other processes still meet its lock.
+        self._write_lock = threading.Lock()
+        with self._connect() as con:
+            con.execute("PRAGMA journal_mode=WAL")
+            con.executescript(_SCHEMA)
+
+    @contextmanager
+    def _connect(self) -> Iterator[sqlite3.Connection]:
+        con = sqlite3.connect(self.path, timeout=self.timeout_s, isolation_level=None)
+        try:
+            con.execute("PRAGMA synchronous=FULL")
+            con.execute("PRAGMA foreign_keys=ON")
+            yield con
+        finally:
+            con.close()
+
+    @contextmanager
+    def _transaction(self) -> Iterator[sqlite3.Connection]:
+        with self._write_lock, self._connect() as con:
+            con.execute("BEGIN IMMEDIATE")
+            try:
+                yield con
+            except BaseException:
+                con.execute("ROLLBACK")
+                raise
+            con.execute("COMMIT")
+
+    def _ensure(self, con: sqlite3.Connection, participant: int, mode: str) -> str:
+        """Create the participant's row in ``mode`` if new; return the stored mode."""
+        if mode not in MODES:
+            raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
+        con.execute(
+            "INSERT INTO participants (participant, mode) VALUES (?, ?) "
+            "ON CONFLICT (participant) DO NOTHING",
+            (participant, mode),
+        )
+        return con.execute(
+            "SELECT mode FROM participants WHERE participant = ?", (participant,)
+        ).fetchone()[0]
+
+    def give_consent(self, participant: int, mode: str = "video", now: float | None = None) -> None:
+        """Record consent (the first time only)."""
+        with self._transaction() as con:
+            self._ensure(con, participant, mode)
+            con.execute(
+                "UPDATE participants SET consent_at = ? "
+                "WHERE participant = ? AND consent_at IS NULL",
+                (now or time.time(), participant),
+            )
+
+    def read_instructions(self, participant: int, now: float | None = None) -> None:
+        """Record that the instructions were read (the first time only; needs consent)."""
+        with self._transaction() as con:
+            con.execute(
+                "UPDATE participants SET instructions_at = ? "
+                "WHERE participant = ? AND instructions_at IS NULL AND consent_at IS NOT NULL",
+                (now or time.time(), participant),
+            )
+
+    def mark_shown(self, participant: int, session: int, now: float | None = None) -> None:
+        """Remember when a session page was first shown."""
+        with self._transaction() as con:
+            con.execute(
+                "INSERT INTO views (participant, session, shown_at) VALUES (?, ?, ?) "
+                "ON CONFLICT DO NOTHING",
+                (participant, session, now or time.time()),
+            )
+
+    def submit(
+        self,
+        participant: int,
+        session: int,
+        answers: dict[str, int],
+        comment: str = "",
+        mode: str = "video",
+        last_session: int | None = None,
+        now: float | None = None,
+    ) -> bool:
+        """Store one session's answers; ``True`` if stored now, ``False`` if that session was
+        already answered (a double submit: the first answers stay). ``last_session``: the plan's
+        last session, whose answer marks the participant finished. A participant answering in
+        another mode than their first step raises ``ValueError``."""
+        values = [int(answers[q]) for q in QUESTION_KEYS]
+        if any(v not in (1, 2) for v in values):
+            raise ValueError(f"answers must be 1 or 2, got {answers}")
+        now = now or time.time()
+        with self._transaction() as con:
+            stored_mode = self._ensure(con, participant, mode)
+            if stored_mode != mode:
+                raise ValueError(f"participant {participant} takes part {stored_mode}, not {mode}")
+            shown = con.execute(
+                "SELECT shown_at FROM views WHERE participant = ? AND session = ?",
+                (participant, session),
+            ).fetchone()
+            cur = con.execute(
+                "INSERT INTO answers (participant, session, q1, q2, q3, q4, q5, comment, mode, "
+                "shown_at, submitted_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) "
+                "ON CONFLICT (participant, session) DO NOTHING",
+                (participant, session, *values, comment, mode, shown[0] if shown else None, now),
+            )
+            stored = cur.rowcount == 1
+            if stored and last_session is not None and session == last_session:
+                con.execute(
+                    "UPDATE participants SET finished_at = ? WHERE participant = ?",
+                    (now, participant),
+                )
+        return stored
+
+    def progress(self, participant: int) -> Progress:
+        """The participant's stored progress (all empty for one who has not started)."""
+        with self._connect() as con:
+            row = con.execute(
+                "SELECT mode, consent_at, instructions_at, finished_at FROM participants "
+                "WHERE participant = ?",
+                (participant,),
+            ).fetchone()
+            sessions = con.execute(
+                "SELECT session, submitted_at FROM answers WHERE participant = ? ORDER BY session",
+                (participant,),
+            ).fetchall()
+        mode, consent, instr, finished = row if row else (None, None, None, None)
+        times = [t for t in (consent, instr, *(t for _, t in sessions)) if t is not None]
+        return Progress(
+            participant=participant,
+            mode=mode,
+            consent_at=consent,
+            instructions_at=instr,
+            finished_at=finished,
+            answered=tuple(s for s, _ in sessions),
+            last_activity=max(times) if times else None,
+        )
+
+    def all_progress(self) -> list[Progress]:
+        """Progress of every participant who has started, by participant number."""
+        with self._connect() as con:
+            ids = [r[0] for r in con.execute("SELECT participant FROM participants ORDER BY 1")]
+        return [self.progress(p) for p in ids]
+
+    def answers(self, include_practice: bool = False) -> list[Answer]:
+        """Every stored answer by (participant, session)."""
+        with self._connect() as con:
+            rows = con.execute(
+                "SELECT participant, session, q1, q2, q3, q4, q5, comment, mode, shown_at, "
+                "submitted_at FROM answers WHERE session >= ? ORDER BY participant, session",
+                (0 if include_practice else 1,),
+            ).fetchall()
+        return [
+            Answer(
+                participant=r[0],
+                session=r[1],
+                answers=dict(zip(QUESTION_KEYS, r[2:7], strict=True)),
+                comment=r[7],
+                mode=r[8],
+                shown_at=r[9],
+                submitted_at=r[10],
+            )
+            for r in rows
+        ]

@@ -1,0 +1,387 @@
+"""The study's web pages (Flask): one step per page for a participant, an experimenter's view.
+
+Participant ``N`` opens ``/p/N`` and is shown the step they are at, derived from the stored
+answers (:mod:`gazebot.study.store`): consent, instructions, the practice session, then the plan's
+sessions in order, then a closing page. Every form posts to its step and is answered with a
+redirect back to ``/p/N`` (post/redirect/get), so a reload never resubmits and a double submit of
+a session stores it once.
+
+A session page plays the first handover video, then the second (each with the caption naming the
+head or the eyes, as the seed's captions did); the five questions are enabled once both have
+played to the end, and all five are required (the comment is optional, as the seed's question 6
+says).
+
+The experimenter's pages under ``/admin`` (from the loopback interface, or anywhere with the
+token printed at start) show every participant's progress and let the experimenter enter an
+in-person participant's answers after each live pair, the plan telling which behavior comes
+first.
+"""
+
+from __future__ import annotations
+
+import hmac
+import ipaddress
+import secrets
+import time
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from functools import wraps
+
+from flask import (
+    Flask,
+    abort,
+    make_response,
+    redirect,
+    render_template,
+    request,
+    send_file,
+    url_for,
+)
+
+from gazebot.study.folder import PRACTICE, StudyFolder, load_study
+from gazebot.study.plan import Session
+from gazebot.study.questionnaire import (
+    COMMENT_QUESTION,
+    attention_caption,
+    instructions,
+    questions,
+)
+from gazebot.study.store import Progress, ResponseStore
+
+ADMIN_COOKIE = "gazebot_admin"
+MAX_COMMENT = 4000  # characters kept of a comment
+
+
+@dataclass(frozen=True)
+class Step:
+    """Where a participant is: ``kind`` is ``consent``, ``instructions``, ``session`` (with
+    ``session``: 0 for the practice, else the plan's session number) or ``done``."""
+
+    kind: str
+    session: int | None = None
+
+
+def current_step(
+    study: StudyFolder, store: ResponseStore, participant: int, prog: Progress | None = None
+) -> Step:
+    """The participant's next step, from the stored progress only (``prog``: already read)."""
+    prog = prog or store.progress(participant)
+    if prog.consent_at is None:
+        return Step("consent")
+    if prog.instructions_at is None:
+        return Step("instructions")
+    done = set(prog.answered)
+    for k in [PRACTICE] + [s.session for s in study.sessions_of(participant)]:
+        if k not in done:
+            return Step("session", k)
+    return Step("done")
+
+
+def _utc(t: float | None) -> str:
+    if t is None:
+        return ""
+    return datetime.fromtimestamp(t, timezone.utc).strftime("%Y-%m-%d %H:%M:%S")
+
+
+def _is_loopback(addr: str | None) -> bool:
+    try:
+        return addr is not None and ipaddress.ip_address(addr).is_loopback
+    except ValueError:
+        return False
+
+
+def _step_label(prog: Progress, step: Step) -> str:
+    """What the experimenter's table says a participant is at."""
+    if prog.finished_at is not None:
+        return "finished"
+    if prog.mode is None:
+        return "not started"
+    if step.kind == "session":
+        return "practice" if step.session == PRACTICE else f"session {step.session}"
+    return step.kind
+
+
+def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool = True) -> Flask:
+    """The Flask app of the rendered study in ``study_dir`` (answers in
+    ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` (default: a
+    random one, in ``app.config["ADMIN_TOKEN"]``); ``local_admin``: also open it without the token
+    to requests from the loopback interface (turn off behind a reverse proxy on the same
+    machine, where every request comes from there)."""
+    study = load_study(study_dir)
+    store = study.store()
+    app = Flask(__name__)
+    app.config["ADMIN_TOKEN"] = admin_token or secrets.token_urlsafe(16)
+    app.config["STUDY"] = study
+    app.config["STORE"] = store
+    n_sessions = {p: len(study.sessions_of(p)) for p in study.participants}
+    last_session = {p: max(s.session for s in study.sessions_of(p)) for p in study.participants}
+
+    def page(template: str, status: int = 200, **kw: object):
+        resp = make_response(render_template(template, **kw), status)
+        resp.headers["Cache-Control"] = "no-store"  # a step page must never come from a cache
+        return resp
+
+    def participant_or_404(participant: int) -> None:
+        if participant not in n_sessions:
+            abort(404, description=f"Participant {participant} is not in this study's plan.")
+
+    def in_person_page(participant: int):
+        return page(
+            "message.html",
+            409,
+            title="Taking part in person",
+            message=(
+                f"Participant {participant} takes part in person: the experimenter enters the "
+                "answers. Please ask the experimenter."
+            ),
+        )
+
+    def session_page(participant: int, k: int, errors: list[str] | None = None, values=None):
+        sessions = study.sessions_of(participant)
+        store.mark_shown(participant, k)
+        return page(
+            "session.html",
+            400 if errors else 200,
+            participant=participant,
+            session=k,
+            practice=k == PRACTICE,
+            position=0 if k == PRACTICE else [s.session for s in sessions].index(k) + 1,
+            total=len(sessions),
+            caption=attention_caption(study.gaze_mode),
+            questions=questions("video"),
+            comment_question=COMMENT_QUESTION,
+            errors=errors or [],
+            values=values or {},
+        )
+
+    @app.get("/")
+    def index():
+        pid = request.args.get("participant", "").strip()
+        if pid:
+            if not pid.isdigit():
+                return page(
+                    "index.html", 400, error=f"{pid!r} is not a participant number.", value=pid
+                )
+            return redirect(url_for("participant_page", participant=int(pid)), 303)
+        return page("index.html", error=None, value="")
+
+    @app.get("/healthz")
+    def healthz():
+        return {"ok": True, "participants": len(n_sessions)}
+
+    @app.get("/p/<int:participant>")
+    def participant_page(participant: int):
+        participant_or_404(participant)
+        prog = store.progress(participant)
+        if prog.mode == "in-person":
+            return in_person_page(participant)
+        step = current_step(study, store, participant, prog)
+        if step.kind == "consent":
+            return page("consent.html", participant=participant)
+        if step.kind == "instructions":
+            return page(
+                "instructions.html",
+                participant=participant,
+                text=instructions(study.gaze_mode),
+                total=n_sessions[participant],
+            )
+        if step.kind == "done":
+            return page(
+                "message.html",
+                title="Thank you",
+                message=(
+                    f"You have completed all {n_sessions[participant]} sessions; your answers "
+                    "are saved. You can close this page."
+                ),
+            )
+        return session_page(participant, step.session)
+
+    @app.post("/p/<int:participant>/consent")
+    def consent(participant: int):
+        participant_or_404(participant)
+        if request.form.get("consent") != "yes":
+            return page("consent.html", 400, participant=participant, error="Please tick the box.")
+        if store.progress(participant).mode == "in-person":
+            return in_person_page(participant)
+        store.give_consent(participant, "video")
+        return redirect(url_for("participant_page", participant=participant), 303)
+
+    @app.post("/p/<int:participant>/instructions")
+    def instructions_read(participant: int):
+        participant_or_404(participant)
+        store.read_instructions(participant)
+        return redirect(url_for("participant_page", participant=participant), 303)
+
+    def parse_answers(mode: str) -> tuple[dict[str, int], str, list[str]]:
+        answers, errors = {}, []
+        for k, (q, text) in enumerate(questions(mode).items(), start=1):
+            raw = request.form.get(q, "")
+            if raw in ("1", "2"):
+                answers[q] = int(raw)
+            else:
+                errors.append(f"Question {k} ({text}) needs an answer: 1st or 2nd.")
+        comment = request.form.get("comment", "").strip()[:MAX_COMMENT]
+        return answers, comment, errors
+
+    @app.post("/p/<int:participant>/session/<int:k>")
+    def submit(participant: int, k: int):
+        participant_or_404(participant)
+        prog = store.progress(participant)
+        if prog.mode == "in-person":
+            return in_person_page(participant)
+        if k in prog.answered:  # a double submit or a resent form: already stored, go on
+            return redirect(url_for("participant_page", participant=participant), 303)
+        step = current_step(study, store, participant, prog)
+        if step.kind != "session" or step.session != k:
+            return page(
+                "message.html",
+                409,
+                title="Not this session yet",
+                message="This is not your current step.",
+                link=url_for("participant_page", participant=participant),
+            )
+        answers, comment, errors = parse_answers("video")
+        if errors:
+            return session_page(participant, k, errors, dict(request.form))
+        store.submit(participant, k, answers, comment, "video", last_session[participant])
+        return redirect(url_for("participant_page", participant=participant), 303)
+
+    @app.get("/p/<int:participant>/video/<int:k>/<int:which>.mp4")
+    def video(participant: int, k: int, which: int):
+        participant_or_404(participant)
+        try:
+            path = study.video_path(participant, k, which)
+        except KeyError:
+            abort(404, description="No such video.")
+        # conditional=True: Range requests (206 Partial Content), ETag and Last-Modified.
+        resp = send_file(path, mimetype="video/mp4", conditional=True, max_age=3600)
+        resp.headers["Accept-Ranges"] = "bytes"
+        # The file name holds the behavior's name: the study is blind.
+        resp.headers.pop("Content-Disposition", None)
+        return resp
+
+    # ---- experimenter ----
+
+    def admin_only(view):
+        @wraps(view)
+        def wrapped(*args, **kwargs):
+            token = request.args.get("token") or request.cookies.get(ADMIN_COOKIE) or ""
+            good = hmac.compare_digest(token.encode(), app.config["ADMIN_TOKEN"].encode())
+            if not (good or (local_admin and _is_loopback(request.remote_addr))):
+                abort(403, description="The experimenter's pages need the token printed at start.")
+            resp = make_response(view(*args, **kwargs))
+            if good and request.args.get("token"):
+                resp.set_cookie(ADMIN_COOKIE, token, httponly=True, samesite="Strict")
+            return resp
+
+        return wrapped
+
+    @app.get("/admin")
+    @admin_only
+    def admin():
+        rows = []
+        for p in study.participants:
+            prog = store.progress(p)
+            rows.append(
+                {
+                    "participant": p,
+                    "mode": prog.mode or "",
+                    "answered": len([k for k in prog.answered if k != PRACTICE]),
+                    "total": n_sessions[p],
+                    "step": _step_label(prog, current_step(study, store, p, prog)),
+                    "last": _utc(prog.last_activity),
+                }
+            )
+        return page(
+            "admin.html",
+            rows=rows,
+            started=sum(r["mode"] != "" for r in rows),
+            finished=sum(r["step"] == "finished" for r in rows),
+            gaze_mode=study.gaze_mode,
+        )
+
+    def next_in_person(participant: int) -> Session | None:
+        done = set(store.progress(participant).answered)
+        return next((s for s in study.sessions_of(participant) if s.session not in done), None)
+
+    def in_person_form(participant: int, errors=None, values=None, status: int = 200):
+        prog = store.progress(participant)
+        nxt = next_in_person(participant)
+        if nxt is not None and prog.mode != "video":
+            store.mark_shown(participant, nxt.session)  # the time of the live pair starts
+        return page(
+            "in_person.html",
+            status,
+            participant=participant,
+            mode=prog.mode,
+            session=nxt,
+            answered=len(prog.answered),
+            total=n_sessions[participant],
+            questions=questions("in-person"),
+            comment_question=COMMENT_QUESTION,
+            errors=errors or [],
+            values=values or {},
+        )
+
+    @app.get("/admin/in-person/<int:participant>")
+    @admin_only
+    def in_person(participant: int):
+        participant_or_404(participant)
+        return in_person_form(participant)
+
+    @app.post("/admin/in-person/<int:participant>")
+    @admin_only
+    def in_person_submit(participant: int):
+        participant_or_404(participant)
+        prog = store.progress(participant)
+        if prog.mode == "video":
+            return in_person_form(participant, ["This participant answers online."], status=409)
+        k = request.form.get("session", "")
+        if k.isdigit() and int(k) in prog.answered:
+            return redirect(url_for("in_person", participant=participant), 303)
+        nxt = next_in_person(participant)
+        if nxt is None or not k.isdigit() or int(k) != nxt.session:
+            return redirect(url_for("in_person", participant=participant), 303)
+        answers, comment, errors = parse_answers("in-person")
+        if errors:
+            return in_person_form(participant, errors, dict(request.form), status=400)
+        now = time.time()
+        if prog.mode is None:
+            store.give_consent(participant, "in-person", now)
+            store.read_instructions(participant, now)
+        store.submit(
+            participant, nxt.session, answers, comment, "in-person", last_session[participant]
+        )
+        return redirect(url_for("in_person", participant=participant), 303)
+
+    @app.errorhandler(404)
+    def not_found(err):
+        desc = getattr(err, "description", "")
+        known = isinstance(desc, str) and desc.startswith(("Participant", "No such"))
+        return page(
+            "message.html",
+            404,
+            title="Not found",
+            message=desc if known else "There is no such page: check the link you were given.",
+            link=url_for("index"),
+        )
+
+    @app.errorhandler(403)
+    def forbidden(err):
+        return page("message.html", 403, title="Forbidden", message=err.description)
+
+    @app.errorhandler(405)
+    def not_allowed(err):
+        return page("message.html", 405, title="Not allowed", message="Use the study's pages.")
+
+    @app.errorhandler(500)
+    def server_error(err):
+        return page(
+            "message.html",
+            500,
+            title="Something went wrong",
+            message="The server could not handle this request; your saved answers are safe. "
+            "Please reload the page.",
+        )
+
+    return app

@@ -1,0 +1,104 @@
+"""STL robustness (seed 4.2.1) and the handover specs (Tables 4.1-4.3) on met and missed runs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gazebot.controllers import load_controllers_config, make_controller
+from gazebot.controllers.config import Role
+from gazebot.controllers.rollout import run_reach
+from gazebot.controllers.stl_logic import (
+    Always,
+    Eventually,
+    Predicate,
+    Signal,
+    reach_spec,
+    retreat_spec,
+    transfer_spec,
+)
+
+
+def _signal_from_run(run, dt, holds=False):
+    n = len(run.times)
+    return Signal(
+        dt=dt,
+        values={
+            "p_r": run.positions,
+            "p_h": run.hands,
+            "p_o": run.hands,
+            "alpha": np.full(n, 1.0 if holds else 0.0),
+            "zone_center": np.zeros((n, 3)),
+        },
+    )
+
+
+def test_eventually_and_always_robustness_by_hand():
+    s = Signal(dt=0.5, values={"v": np.array([-1.0, 0.5, 2.0, -0.5])})
+    pos = Predicate("v>0", lambda s: s["v"])
+    assert Eventually(pos, 0, 0.5).rho(s).tolist() == [0.5, 2.0, 2.0, -0.5]
+    assert Always(pos, 0, 0.5).rho(s).tolist() == [-1.0, 0.5, -0.5, -0.5]
+    assert Always(pos).robustness(s) == -1.0
+    assert Eventually(pos).robustness(s) == 2.0
+
+
+@pytest.mark.parametrize("reach_time,meets", [(2.0, True), (3.0, True)])
+def test_reach_spec_robustness_positive_on_a_run_that_meets_it(reach_time, meets):
+    cfg = load_controllers_config().model_copy(update={"reach_time_s": reach_time})
+    run = run_reach(make_controller("stl", cfg), np.zeros(3), np.array([1.5, 0, 0]), reach_time + 1)
+    rho = reach_spec(cfg.stl, reach_time).robustness(_signal_from_run(run, cfg.dt_s))
+    assert (rho > 0) == meets
+
+
+def test_reach_spec_robustness_negative_on_a_run_that_misses_it():
+    cfg = load_controllers_config().model_copy(update={"reach_time_s": 1.0})
+    run = run_reach(make_controller("stl", cfg), np.zeros(3), np.array([1.5, 0, 0]), 2.0)
+    rho = reach_spec(cfg.stl, 1.0).robustness(_signal_from_run(run, cfg.dt_s))
+    assert rho < 0
+    # a slow PV reach meets a generous spec and misses a tight one (PV has no timing of its own)
+    pv = run_reach(make_controller("pv", cfg), np.zeros(3), np.array([0.5, 0, 0]), 4.0)
+    sig = _signal_from_run(pv, cfg.dt_s)
+    assert reach_spec(cfg.stl, 3.5).robustness(sig) > 0
+    assert reach_spec(cfg.stl, 0.6).robustness(sig) < 0
+
+
+def test_giver_reach_spec_only_triggers_while_the_robot_holds_the_object():
+    cfg = load_controllers_config()
+    run = run_reach(make_controller("pv", cfg), np.zeros(3), np.array([1.5, 0, 0]), 0.6)
+    spec = reach_spec(cfg.stl, 0.4, role=Role.GIVER)
+    assert spec.robustness(_signal_from_run(run, cfg.dt_s, holds=False)) > 0  # vacuous
+    assert spec.robustness(_signal_from_run(run, cfg.dt_s, holds=True)) < 0
+
+
+def test_transfer_and_retreat_specs_sign():
+    cfg = load_controllers_config().stl
+    n, dt = 11, 0.1
+    alpha = np.r_[np.zeros(3), np.full(8, 1.0)]  # the robot holds the object from sample 3
+    p_r = np.zeros((n, 3))
+    p_r[7:] = [0.3, 0.0, 0.0]  # at the drop-off 0.4 s after taking the object
+    sig = Signal(
+        dt,
+        {
+            "alpha": alpha,
+            "p_r": p_r,
+            "p_d": np.tile([0.3, 0, 0], (n, 1)),
+            "p_o": np.zeros((n, 3)),
+            "p_h": np.zeros((n, 3)),
+        },
+    )
+    assert retreat_spec(cfg, 0.5, Role.RECEIVER).robustness(sig) > 0
+    assert retreat_spec(cfg, 0.3, Role.RECEIVER).robustness(sig) < 0
+    # giver: the object shared (0.5 load share) from sample 2; gripper open (1) from sample 5
+    g = np.r_[np.zeros(5), np.ones(6)]
+    sig = Signal(
+        dt,
+        {
+            "alpha": np.r_[np.ones(2), np.full(9, 0.5)],
+            "g_r": g,
+            "p_o": np.zeros((n, 3)),
+            "p_h": np.zeros((n, 3)),
+            "p_r": np.zeros((n, 3)),
+        },
+    )
+    assert transfer_spec(cfg, 0.3, Role.GIVER).robustness(sig) > 0
+    assert transfer_spec(cfg, 0.2, Role.GIVER).robustness(sig) < 0

@@ -1,0 +1,137 @@
+"""Phase detection on real motion capture (the KTH sample) and on generated recordings shaped
+like it: marker-offset hand frames, noise, frozen samples, dropouts, 30-240 Hz."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gazebot.phases import PhaseConfig, run_online, segment
+from gazebot.phases.synthetic import SyntheticOptions, generate
+from gazebot.recordings import PointNames, load_recording
+from gazebot.types import EventKind, Phase
+from tests.phases.kth import RATE, force_truth, kth_dir
+from tests.phases.seed725_reference import seed_transfers
+
+KTH = kth_dir()
+needs_kth = pytest.mark.skipif(
+    KTH is None, reason="KTH sample absent (fetch KTH-RPL/handovers_dataset, set GAZEBOT_KTH_DATA)"
+)
+
+
+def _kth():
+    names = PointNames("giver_RHand", "taker_RHand", "giver_head")
+    return load_recording(KTH, names, rate=RATE).trajectory  # type: ignore[arg-type]
+
+
+def _phases(segs):
+    return [s.phase for s in segs]
+
+
+@needs_kth
+def test_default_config_finds_the_kth_handover_within_100ms_of_the_force_truth():
+    t0, t1 = force_truth(KTH)  # type: ignore[arg-type]
+    segs = segment(_kth(), PhaseConfig())
+    assert _phases(segs) == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT]
+    tr = segs[1]
+    assert abs(tr.start - t0) <= 0.100 and abs(tr.end - t1) <= 0.100
+
+
+@needs_kth
+def test_default_beats_the_published_rule_at_the_kth_transfer_start():
+    t0, t1 = force_truth(KTH)  # type: ignore[arg-type]
+    ours = [s for s in segment(_kth(), PhaseConfig()) if s.phase is Phase.TRANSFER][0]
+    seed = [s for s in segment(_kth(), PhaseConfig(method="seed-7.2.5")) if s.phase is Phase.TRANSFER][0]
+    assert abs(ours.start - t0) < abs(seed.start - t0)
+    assert abs(ours.end - t1) <= max(abs(seed.end - t1), 0.05)
+
+
+@needs_kth
+def test_online_detects_the_kth_transfer_within_250ms_as_reach_transfer_retreat():
+    t0, _ = force_truth(KTH)  # type: ignore[arg-type]
+    res = run_online(_kth(), PhaseConfig())
+    kinds = [e.kind for e in res.events]
+    assert kinds == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED,
+                     EventKind.RETREAT_STARTED, EventKind.HANDOVER_DONE]
+    transfer = res.events[1]
+    assert transfer.detected_at - t0 <= 0.250
+
+
+def test_marker_offset_noisy_frozen_recordings_give_every_handover():
+    errors = []
+    for seed in range(6):
+        rate = (30.0, 60.0, 120.0, 240.0, 45.0, 100.0)[seed]
+        opts = SyntheticOptions(rate=rate, noise=0.0015, marker_offset=0.3 + 0.04 * seed,
+                                frozen_per_s=1.0, dropouts_per_s=0.5, irregular=0.2,
+                                handovers=1 + seed % 2)
+        sh = generate(100 + seed, opts)
+        d = np.linalg.norm(sh.trajectory.receiver_hand - sh.trajectory.giver_hand, axis=1)
+        assert np.nanmin(d) > 0.25  # hand frames never come close, as on real mocap
+        segs = segment(sh.trajectory, PhaseConfig())
+        assert _phases(segs) == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT] * len(sh.truth)
+        for h, tr in zip(sh.truth, [s for s in segs if s.phase is Phase.TRANSFER], strict=True):
+            errors += [tr.start - h.transfer_start, tr.end - h.transfer_end]
+    # Truth here is the kinematic stop of a minimum-jerk approach: the rule (3 % of the peak
+    # speed) lands a few tens of ms before it.
+    assert float(np.median(np.abs(errors))) <= 0.06
+    assert float(np.max(np.abs(errors))) <= 0.15
+
+
+def test_frozen_samples_count_as_missing_not_as_a_stop():
+    opts = SyntheticOptions(rate=120.0, noise=0.002, marker_offset=0.4)
+    sh = generate(7, opts)
+    traj = sh.trajectory
+    h = sh.truth[0]
+    # Freeze the giver's hand for 60 ms in mid-reach (the tracker repeats its last sample).
+    mid = 0.5 * (h.reach_start + h.transfer_start)
+    i = int(np.searchsorted(traj.t, mid))
+    traj.giver_hand[i : i + 7] = traj.giver_hand[i - 1]
+    segs = segment(traj, PhaseConfig())
+    assert _phases(segs) == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT]
+    assert abs(segs[1].start - h.transfer_start) <= 0.100
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_seed_725_method_matches_an_independent_implementation_within_two_samples(seed):
+    opts = SyntheticOptions(rate=(30.0, 60.0, 120.0, 240.0)[seed % 4], noise=0.002,
+                            marker_offset=0.35 * (seed % 2), handovers=1 + seed % 3,
+                            dropouts_per_s=0.3 * (seed % 2))
+    traj = generate(300 + seed, opts).trajectory
+    ref = seed_transfers(traj.t, traj.giver_hand, traj.receiver_hand)
+    ours = [s for s in segment(traj, PhaseConfig(method="seed-7.2.5")) if s.phase is Phase.TRANSFER]
+    assert len(ref) >= 1 and len(ours) == len(ref)
+    dt = 1.0 / opts.rate
+    for (a, b), s in zip(ref, ours, strict=True):
+        assert abs(s.start - a) <= 2 * dt + 1e-9 and abs(s.end - b) <= 2 * dt + 1e-9
+
+
+@needs_kth
+def test_seed_725_method_matches_the_independent_implementation_on_kth():
+    traj = _kth()
+    ref = seed_transfers(traj.t, traj.giver_hand, traj.receiver_hand)
+    ours = [s for s in segment(traj, PhaseConfig(method="seed-7.2.5")) if s.phase is Phase.TRANSFER]
+    assert len(ours) == len(ref) == 1
+    assert abs(ours[0].start - ref[0][0]) <= 2 / RATE and abs(ours[0].end - ref[0][1]) <= 2 / RATE
+
+
+def test_seed_443_splits_one_giving_motion_with_the_published_fractions():
+    sh = generate(5, SyntheticOptions(rate=100.0, noise=0.0005))
+    segs = segment(sh.trajectory, PhaseConfig(method="seed-4.4.3"))
+    assert _phases(segs) == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT]
+    traj = sh.trajectory
+    dist = np.linalg.norm(traj.giver_hand - traj.giver_hand[0], axis=1)
+    i = int(np.searchsorted(traj.t, segs[0].start))
+    # The reach begins at the first sample farther than 0.41 d_max from the start.
+    assert dist[i] > 0.41 * dist.max() and dist[i - 1] <= 0.41 * dist.max()
+
+
+def test_no_handover_gives_no_segments_with_every_method():
+    t = np.arange(0, 5, 0.01)
+    g = np.tile([1.0, 0.0, 1.0], (t.size, 1)) + np.random.default_rng(0).normal(0, 0.001, (t.size, 3))
+    r = np.tile([0.3, 0.0, 1.0], (t.size, 1))
+    from gazebot.phases import Trajectory
+
+    traj = Trajectory(t, g, r)
+    for m in ("gazebot", "seed-7.2.5", "seed-4.4.3"):
+        assert segment(traj, PhaseConfig(method=m)) == [] or m == "seed-4.4.3"
+    assert segment(traj, PhaseConfig()) == []

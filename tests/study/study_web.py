@@ -1,0 +1,122 @@
+"""Helpers for the web-study tests: a tiny rendered study (short synthetic clips, no MuJoCo) and
+the study server as a real subprocess that a test can SIGKILL and restart."""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.parse
+import urllib.request
+from pathlib import Path
+
+from gazebot.study.plan import make_plan
+from gazebot.study.render import render_study
+from gazebot.study.synthetic import render_synthetic_video
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def render_tiny_study(out: Path, behaviors=("face", "hand", "short-face-hand"), participants=6):
+    """A rendered 6.3-style study (no condition): g (g - 1) sessions per participant, each
+    handover a 0.4 s synthetic clip at 64x48."""
+    plan = make_plan(list(behaviors), condition=None, participants=participants, seed=1)
+    fn = functools.partial(render_synthetic_video, duration=0.4)
+    render_study(plan, out, fn, 64, 48, 10, workers=1, card_seconds=0.1, progress=False)
+    return plan
+
+
+class StudyServer:
+    """``python -m gazebot study serve DIR --port 0`` in a subprocess; ``base`` is its URL once
+    it listens. ``kill()`` sends SIGKILL (no shutdown code runs)."""
+
+    def __init__(self, study_dir: Path, token: str = "test-token", port: int = 0) -> None:
+        self.study_dir = study_dir
+        self.token = token
+        self.port = port
+        self.proc: subprocess.Popen | None = None
+        self.base = ""
+
+    def start(self, timeout_s: float = 30.0) -> StudyServer:
+        """Start the server (on the port of the last start, if any) and wait until it listens."""
+        env = {**os.environ, "PYTHONPATH": str(REPO), "PYTHONUNBUFFERED": "1"}
+        self.proc = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "gazebot",
+                "study",
+                "serve",
+                str(self.study_dir),
+                "--port",
+                str(self.port),
+                "--admin-token",
+                self.token,
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env=env,
+        )
+        deadline = time.monotonic() + timeout_s
+        lines = []
+        assert self.proc.stdout is not None
+        while time.monotonic() < deadline:
+            line = self.proc.stdout.readline()
+            if not line:
+                break
+            lines.append(line)
+            m = re.search(r"at (http://\S+)/p/N", line)
+            if m:
+                self.base = m.group(1)
+                self.port = int(self.base.rsplit(":", 1)[1])
+                self.proc.stdout.readline()  # the experimenter line
+                return self
+        self.stop()
+        raise RuntimeError("study server did not start:\n" + "".join(lines))
+
+    def kill(self) -> None:
+        """SIGKILL, as a crash or the OOM killer would."""
+        if self.proc and self.proc.poll() is None:
+            os.kill(self.proc.pid, signal.SIGKILL)
+            self.proc.wait(timeout=10)
+
+    def stop(self) -> None:
+        if self.proc and self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.kill()
+        if self.proc and self.proc.stdout:
+            self.proc.stdout.close()
+
+    def __enter__(self) -> StudyServer:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+class _NoRedirect(urllib.request.HTTPRedirectHandler):
+    def redirect_request(self, *args, **kwargs):  # noqa: ANN002, ANN003
+        return None
+
+
+_opener = urllib.request.build_opener(_NoRedirect)
+
+
+def http(method: str, url: str, data: dict | None = None, headers: dict | None = None):
+    """(status, headers, body) of one request; redirects are not followed."""
+    body = urllib.parse.urlencode(data).encode() if data is not None else None
+    req = urllib.request.Request(url, data=body, method=method, headers=headers or {})
+    try:
+        with _opener.open(req, timeout=30) as resp:
+            return resp.status, dict(resp.headers), resp.read()
+    except urllib.error.HTTPError as err:
+        return err.code, dict(err.headers), err.read()

@@ -1,0 +1,221 @@
+"""A whole participant in headless Chromium: consent, instructions, practice and every session,
+with a SIGKILL and restart of the server in the middle of a session, a reload and a new tab; the
+exported answers must equal what was clicked, nothing lost and nothing doubled."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from study_web import REPO, StudyServer, http, render_tiny_study
+
+from gazebot.study.folder import load_study
+
+pytestmark = pytest.mark.browser
+
+QUESTIONS = ("q1", "q2", "q3", "q4", "q5")
+
+
+def _chromium() -> tuple[str, str]:
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    driver = shutil.which("chromedriver")
+    if not (browser and driver):
+        pytest.skip(
+            "no Chromium here: the browser tests need Debian's `chromium` and `chromium-driver` "
+            "(`make test` installs them when run as root on Debian)"
+        )
+    return browser, driver
+
+
+@pytest.fixture
+def driver(tmp_path):
+    webdriver = pytest.importorskip("selenium.webdriver")
+    from selenium.webdriver.chrome.service import Service
+
+    browser, chromedriver = _chromium()
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = browser
+    for arg in (
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        f"--user-data-dir={tmp_path / 'chromium-profile'}",
+        "--autoplay-policy=no-user-gesture-required",
+        "--window-size=900,1400",
+    ):
+        opts.add_argument(arg)
+    # An explicit driver path: Selenium Manager would otherwise try to download one.
+    d = webdriver.Chrome(service=Service(executable_path=chromedriver), options=opts)
+    d.set_page_load_timeout(60)
+    yield d
+    d.quit()
+
+
+def _wait(predicate, timeout_s: float = 60.0, what: str = "condition"):
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def _heading(d) -> str:
+    """The page's heading, "" while a page is loading (no h1 yet, or the old one going)."""
+    from selenium.common.exceptions import NoSuchElementException, StaleElementReferenceException
+    from selenium.webdriver.common.by import By
+
+    try:
+        return d.find_element(By.TAG_NAME, "h1").text
+    except (NoSuchElementException, StaleElementReferenceException):
+        return ""
+
+
+def _at(d, heading: str) -> None:
+    """Wait for the page with ``heading`` (fails with the heading seen instead)."""
+    try:
+        _wait(lambda: _heading(d) == heading, timeout_s=30, what=heading)
+    except AssertionError:
+        raise AssertionError(f"expected page {heading!r}, at {_heading(d)!r}") from None
+
+
+def _wait_for_questions(d) -> None:
+    """Both videos play to the end, then the questions are enabled."""
+    from selenium.webdriver.common.by import By
+
+    _wait(
+        lambda: d.find_element(By.ID, "questions").get_attribute("disabled") is None,
+        what="both videos to play and the questions to appear",
+    )
+    ended = d.execute_script(
+        "return [document.getElementById('v1').ended, document.getElementById('v2').ended]"
+    )
+    assert ended == [True, True]
+    # One video at a time: the first is put away when the second plays.
+    assert not d.find_element(By.ID, "v1").is_displayed()
+    assert d.find_element(By.ID, "v2").is_displayed()
+
+
+def _click_answers(d, answers: dict[str, int], comment: str) -> None:
+    from selenium.webdriver.common.by import By
+
+    for q, v in answers.items():
+        d.find_element(By.ID, f"{q}-{v}").click()
+    box = d.find_element(By.ID, "comment")
+    box.clear()
+    box.send_keys(comment)
+
+
+def _submit(d) -> None:
+    from selenium.webdriver.common.by import By
+
+    old = d.find_element(By.TAG_NAME, "h1")
+    d.find_element(By.ID, "next").click()
+    _wait(lambda: _stale(old), what="the next page")
+
+
+def _stale(element) -> bool:
+    from selenium.common.exceptions import StaleElementReferenceException
+
+    try:
+        element.is_enabled()
+    except StaleElementReferenceException:
+        return True
+    return False
+
+
+def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(driver, tmp_path):
+    from selenium.webdriver.common.by import By
+
+    study_dir = tmp_path / "study"
+    render_tiny_study(study_dir)
+    study = load_study(study_dir)
+    sessions = study.sessions_of(1)
+    rng = np.random.default_rng(14)
+    clicked: dict[int, dict[str, int]] = {}
+    server = StudyServer(study_dir).start()
+    try:
+        d = driver
+        d.get(f"{server.base}/p/1")
+        _at(d, "Consent")
+        d.find_element(By.ID, "consent").click()
+        _submit(d)
+        _at(d, "Instructions")
+        assert "the robot's head movement" in d.find_element(By.ID, "instructions").text
+        _submit(d)
+        _at(d, "Practice session")
+        _wait_for_questions(d)
+        _click_answers(d, {q: 1 for q in QUESTIONS}, "practice")
+        _submit(d)
+
+        kill_at = sessions[len(sessions) // 2].session
+        for s in sessions:
+            _at(d, f"Session {s.session} of {len(sessions)}")
+            _wait_for_questions(d)
+            answers = {q: int(rng.integers(1, 3)) for q in QUESTIONS}
+            clicked[s.session] = answers
+            _click_answers(d, answers, f"comment {s.session}")
+            if s.session == kill_at:
+                # Mid-session: answers clicked but not submitted. Kill the server hard, then
+                # restart it on the same port and reload: the page resumes at this session.
+                server.kill()
+                server.start()
+                d.refresh()
+                _at(d, f"Session {s.session} of {len(sessions)}")
+                # A closed tab: a new one opens the same session.
+                old = d.current_window_handle
+                d.switch_to.new_window("tab")
+                d.get(f"{server.base}/p/1")
+                _at(d, f"Session {s.session} of {len(sessions)}")
+                d.close()
+                d.switch_to.window(old)
+                _wait_for_questions(d)
+                _click_answers(d, answers, f"comment {s.session}")
+            # Two clicks in a row on the submit button: the page sends one form.
+            d.execute_script(
+                "var b = document.getElementById('next'); b.click(); b.click();"
+            )
+            _wait(
+                lambda s=s: _heading(d) not in ("", f"Session {s.session} of {len(sessions)}"),
+                what="the next page after a double click",
+            )
+        _at(d, "Thank you")
+        # A resent form after the end (browser back + resubmit) changes nothing.
+        last = sessions[-1].session
+        status, _, _ = http("POST", f"{server.base}/p/1/session/{last}", {"q1": "2"})
+        assert status == 303
+        d.get(f"{server.base}/p/1")
+        assert "completed all" in d.find_element(By.ID, "message").text
+        d.get(f"{server.base}/p/77")
+        assert "Participant 77 is not in this study's plan." in d.page_source
+    finally:
+        server.stop()
+
+    out = tmp_path / "responses.csv"
+    cli = [sys.executable, "-m", "gazebot", "study"]
+    env = {"PYTHONPATH": str(REPO), "PATH": "/usr/bin:/bin"}
+    subprocess.run([*cli, "export", str(study_dir), "--out", str(out)], check=True, env=env)
+    with out.open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert [int(r["session"]) for r in rows] == [s.session for s in sessions]  # once each
+    for r, s in zip(rows, sessions, strict=True):
+        assert {q: int(r[q]) for q in QUESTIONS} == clicked[s.session]
+        assert r["comments"] == f"comment {s.session}"
+        assert (r["first"], r["second"]) == (s.first, s.second)
+        assert float(r["seconds"]) > 0.5  # at least both clips were watched
+    analyzed = subprocess.run(
+        [*cli, "analyze", str(out), "--json"], check=True, env=env, capture_output=True, text=True
+    )
+    assert json.loads(analyzed.stdout)["per_level"][""]["likability"]["participants"] == 1

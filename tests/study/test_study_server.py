@@ -1,0 +1,292 @@
+"""``gazebot study serve``: the participant's steps, stored answers, resume, double submits,
+clear pages for bad ids, video range requests, the experimenter's pages, and ``study export``
+feeding ``study analyze`` (through Flask's test client; the browser tests drive a real one)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import sqlite3
+
+import numpy as np
+import pytest
+from study_responses import BEHAVIORS, responses_from_tables
+from study_seed_tables import TABLE_6_1
+from study_web import render_tiny_study
+
+from gazebot.study.analysis import analyze, read_responses
+from gazebot.study.export import export_responses
+from gazebot.study.folder import load_study
+from gazebot.study.web.app import create_app
+
+ANSWERS = {"q1": "1", "q2": "2", "q3": "1", "q4": "1", "q5": "2"}
+
+
+@pytest.fixture(scope="module")
+def study_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("web") / "study"
+    render_tiny_study(out)
+    return out
+
+
+@pytest.fixture
+def fresh(study_dir, tmp_path):
+    """A copy-free fresh start: the rendered folder with its answers file removed."""
+    for suffix in ("", "-wal", "-shm"):
+        (study_dir / f"responses.sqlite{suffix}").unlink(missing_ok=True)
+    return study_dir
+
+
+def client(study_dir, remote="127.0.0.1"):
+    app = create_app(str(study_dir), admin_token="tok")
+    c = app.test_client()
+    c.environ_base["REMOTE_ADDR"] = remote
+    return c
+
+
+def start(c, pid=1):
+    assert c.post(f"/p/{pid}/consent", data={"consent": "yes"}).status_code == 303
+    assert c.post(f"/p/{pid}/instructions").status_code == 303
+
+
+def test_participant_steps_in_order_consent_instructions_practice_sessions_done(fresh):
+    c = client(fresh)
+    page = c.get("/p/1")
+    assert page.status_code == 200 and b"Consent" in page.data
+    assert c.post("/p/1/consent", data={}).status_code == 400  # the box must be ticked
+    assert c.post("/p/1/consent", data={"consent": "yes"}).headers["Location"].endswith("/p/1")
+    page = c.get("/p/1").get_data(as_text=True)
+    assert "Instructions" in page and "robot&#39;s head movement" in page  # the plan's head-only
+    c.post("/p/1/instructions")
+    assert "Practice session" in c.get("/p/1").get_data(as_text=True)
+    assert c.post("/p/1/session/0", data=ANSWERS).status_code == 303
+    n = len(load_study(fresh).sessions_of(1))
+    for k in range(1, n + 1):
+        page = c.get("/p/1").get_data(as_text=True)
+        assert f"Session {k} of {n}" in page
+        assert f'action="/p/1/session/{k}"' in page
+        assert c.post(f"/p/1/session/{k}", data={**ANSWERS, "comment": f"c{k}"}).status_code == 303
+    page = c.get("/p/1")
+    assert page.status_code == 200 and b"You have completed all 6 sessions" in page.data
+
+
+def test_session_page_shows_the_seed_questions_and_no_behavior_names(fresh):
+    c = client(fresh)
+    start(c)
+    page = c.get("/p/1").get_data(as_text=True)
+    assert "Which handover did you like better? (1st or 2nd)" in page
+    assert "wanted the giver to give the object? (1st or 2nd)" in page
+    assert "Any other comments (optional)" in page
+    for name in ("face", "hand", "short-face-hand", "sawyer", ".mp4\">"):
+        assert f"{name}_" not in page and f"/{name}" not in page
+    assert page.count("<video") == 2 and "disabled" in page  # questions wait for both videos
+
+
+def test_missing_answer_is_refused_with_the_question_named_and_nothing_stored(fresh):
+    c = client(fresh)
+    start(c)
+    resp = c.post("/p/1/session/0", data={k: v for k, v in ANSWERS.items() if k != "q3"})
+    assert resp.status_code == 400
+    assert b"Question 3 (Which handover seemed more natural? (1st or 2nd)) needs" in resp.data
+    assert b'value="1" id="q1-1" required checked' in resp.data  # the given answers are kept
+    assert load_study(fresh).store().progress(1).answered == ()
+
+
+def test_double_submit_records_once_and_first_answers_win(fresh):
+    c = client(fresh)
+    start(c)
+    c.post("/p/1/session/0", data=ANSWERS)
+    first = c.post("/p/1/session/1", data=ANSWERS)
+    again = c.post("/p/1/session/1", data={**ANSWERS, "q1": "2"})
+    assert first.status_code == again.status_code == 303
+    rows = load_study(fresh).store().answers()
+    assert [(a.session, a.answers["q1"]) for a in rows] == [(1, 1)]
+    assert "Session 2 of 6" in c.get("/p/1").get_data(as_text=True)
+
+
+def test_a_future_session_cannot_be_answered_out_of_order(fresh):
+    c = client(fresh)
+    start(c)
+    resp = c.post("/p/1/session/3", data=ANSWERS)
+    assert resp.status_code == 409 and b"not your current step" in resp.data
+    assert load_study(fresh).store().progress(1).answered == ()
+
+
+def test_a_new_app_on_the_same_folder_resumes_where_the_participant_was(fresh):
+    c = client(fresh)
+    start(c)
+    for k in (0, 1, 2):
+        c.post(f"/p/1/session/{k}", data=ANSWERS)
+    resumed = client(fresh)  # a restarted server: nothing kept in memory
+    assert "Session 3 of 6" in resumed.get("/p/1").get_data(as_text=True)
+
+
+@pytest.mark.parametrize("path", ["/p/99", "/p/0", "/p/abc", "/p/-1", "/nowhere"])
+def test_unknown_participant_or_page_gets_a_clear_page_not_a_traceback(fresh, path):
+    resp = client(fresh).get(path)
+    assert resp.status_code == 404
+    text = resp.get_data(as_text=True)
+    assert "Traceback" not in text
+    if path in ("/p/99", "/p/0"):
+        assert f"Participant {path[3:]} is not in this study&#39;s plan." in text
+    else:
+        assert "no such page" in text
+
+
+def test_index_sends_a_participant_number_to_their_page(fresh):
+    c = client(fresh)
+    assert c.get("/?participant=2").headers["Location"].endswith("/p/2")
+    assert c.get("/?participant=x1").status_code == 400
+
+
+def test_videos_are_served_with_range_requests_and_without_their_file_name(fresh):
+    c = client(fresh)
+    full = c.get("/p/1/video/1/1.mp4")
+    assert full.status_code == 200 and full.headers["Accept-Ranges"] == "bytes"
+    part = c.get("/p/1/video/1/1.mp4", headers={"Range": "bytes=10-49"})
+    assert part.status_code == 206
+    assert part.headers["Content-Range"] == f"bytes 10-49/{len(full.data)}"
+    assert part.data == full.data[10:50]
+    assert "Content-Disposition" not in part.headers  # the file name names the behavior
+    assert full.data == load_study(fresh).video_path(1, 1, 1).read_bytes()
+    assert c.get("/p/1/video/1/3.mp4").status_code == 404
+    assert c.get("/p/1/video/99/1.mp4").status_code == 404
+
+
+def test_admin_needs_loopback_or_the_token(fresh):
+    assert client(fresh, remote="192.0.2.7").get("/admin").status_code == 403
+    remote = client(fresh, remote="192.0.2.7")
+    assert remote.get("/admin?token=tok").status_code == 200
+    assert remote.get("/admin").status_code == 200  # the token is kept in a cookie
+    assert client(fresh, remote="192.0.2.7").get("/admin?token=bad").status_code == 403
+    assert client(fresh).get("/admin").status_code == 200
+
+
+def test_admin_shows_each_participants_progress(fresh):
+    c = client(fresh)
+    start(c, 2)
+    c.post("/p/2/session/0", data=ANSWERS)
+    c.post("/p/2/session/1", data=ANSWERS)
+    page = c.get("/admin").get_data(as_text=True)
+    assert "1 of 6 participants started, 0 finished" in page
+    assert "<td>2</td><td>video</td><td>1 / 6</td><td>session 2</td>" in page
+
+
+def test_in_person_mode_enters_answers_in_plan_order_with_the_in_person_question_5(fresh):
+    study = load_study(fresh)
+    c = client(fresh)
+    sessions = study.sessions_of(3)
+    for s in sessions:
+        page = c.get("/admin/in-person/3").get_data(as_text=True)
+        order = f"Handover 1: <strong>{s.first}</strong>, then handover 2: <strong>{s.second}"
+        assert order in page
+        assert "the robot wanted you to give the object? (1st or 2nd)" in page
+        resp = c.post("/admin/in-person/3", data={**ANSWERS, "session": str(s.session)})
+        assert resp.status_code == 303
+    assert "All sessions entered." in c.get("/admin/in-person/3").get_data(as_text=True)
+    # The participant's own page says the experimenter enters the answers.
+    assert client(fresh).get("/p/3").status_code == 409
+    answers = study.store().answers()
+    assert [a.session for a in answers] == [s.session for s in sessions]
+    assert {a.mode for a in answers} == {"in-person"}
+    assert study.store().progress(3).finished_at is not None
+
+
+def test_in_person_entry_for_an_online_participant_is_refused(fresh):
+    c = client(fresh)
+    start(c, 4)
+    resp = c.post("/admin/in-person/4", data={**ANSWERS, "session": "1"})
+    assert resp.status_code == 409 and b"answers online" in resp.data
+
+
+def test_export_writes_what_analyze_reads_with_timestamps_and_time_per_session(fresh, tmp_path):
+    c = client(fresh)
+    for pid in (1, 2):
+        start(c, pid)
+        for k in range(0, 7):
+            c.get(f"/p/{pid}")  # the session page is shown: its time starts
+            c.post(f"/p/{pid}/session/{k}", data={**ANSWERS, "q2": str(1 + (k + pid) % 2)})
+    out, n = export_responses(fresh, tmp_path / "responses.csv")
+    assert n == 12  # the practice is left out
+    with out.open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert rows[0]["shown_at"] <= rows[0]["submitted_at"] and rows[0]["submitted_at"].endswith(
+        "+00:00"
+    )
+    assert all(float(r["seconds"]) >= 0 for r in rows)
+    assert {r["gaze_mode"] for r in rows} == {"head-only"} and {r["group"] for r in rows} == {""}
+    plan = {(s.participant, s.session): s for s in load_study(fresh).plan}
+    for r in rows:
+        s = plan[(int(r["participant"]), int(r["session"]))]
+        assert (r["first"], r["second"]) == (s.first, s.second)
+        assert r["q2"] == str(1 + (int(r["session"]) + int(r["participant"])) % 2)
+    result = analyze(read_responses(out))
+    assert result.per_level[""]["likability"].participants == 2
+
+
+def test_export_of_a_study_without_answers_says_so(fresh, tmp_path):
+    with pytest.raises(ValueError, match="no answers yet"):
+        export_responses(fresh, tmp_path / "r.csv")
+
+
+def test_store_commits_each_answer_in_wal_mode(fresh):
+    c = client(fresh)
+    start(c)
+    c.post("/p/1/session/0", data=ANSWERS)
+    con = sqlite3.connect(fresh / "responses.sqlite")
+    assert con.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
+    assert con.execute("SELECT count(*) FROM answers").fetchone()[0] == 1
+    con.close()
+
+
+def test_table_6_1_reproduced_through_the_served_6_3_study(tmp_path):
+    """The seed's 6.3 video study as run: four behaviors, no condition, 24 participants, 12
+    sessions each; the answers behind Table 6.1 entered through the web pages, exported and
+    analyzed give the table's P_i."""
+    out = tmp_path / "study"
+    render_tiny_study(out, behaviors=BEHAVIORS, participants=24)
+    table_rows = responses_from_tables({"": TABLE_6_1})
+    answer_of = {(r["participant"], r["first"], r["second"]): r for r in table_rows}
+    study = load_study(out)
+    c = client(out)
+    for pid in study.participants:
+        start(c, pid)
+        c.post(f"/p/{pid}/session/0", data=ANSWERS)
+        for s in study.sessions_of(pid):
+            r = answer_of[(pid, s.first, s.second)]
+            data = {q: str(r[q]) for q in ANSWERS}
+            assert c.post(f"/p/{pid}/session/{s.session}", data=data).status_code == 303
+    csv_path, n = export_responses(out, tmp_path / "responses.csv")
+    assert n == 24 * 12
+    result = analyze(read_responses(csv_path), behaviors=BEHAVIORS)
+    for measure, data in TABLE_6_1.items():
+        r = result.per_level[""][measure]
+        np.testing.assert_allclose(r.wins, data["wins"])
+        assert np.round(r.fit.p, 2).tolist() == pytest.approx(data["P"], abs=1e-9)
+        assert r.chi2.p_value < 1e-4  # "all of the chi2 values are large (p < 0.0001)"
+    json.dumps(result.to_json())
+
+
+def test_token_only_admin_refuses_loopback_without_the_token(fresh):
+    app = create_app(str(fresh), admin_token="tok", local_admin=False)
+    c = app.test_client()
+    c.environ_base["REMOTE_ADDR"] = "127.0.0.1"
+    assert c.get("/admin").status_code == 403
+    assert c.get("/admin?token=tok").status_code == 200
+
+
+def test_export_names_the_mode_as_group_when_a_study_has_both(fresh, tmp_path):
+    c = client(fresh)
+    start(c, 1)
+    c.post("/p/1/session/0", data=ANSWERS)
+    c.post("/p/1/session/1", data=ANSWERS)
+    first = load_study(fresh).sessions_of(3)[0]
+    c.get("/admin/in-person/3")  # the experimenter's page for the live pair
+    c.post("/admin/in-person/3", data={**ANSWERS, "session": str(first.session)})
+    out, n = export_responses(fresh, tmp_path / "r.csv")
+    with out.open() as fh:
+        rows = {r["participant"]: r for r in csv.DictReader(fh)}
+    assert n == 2
+    assert (rows["1"]["group"], rows["1"]["mode"]) == ("video", "video")
+    assert rows["3"]["group"] == "in-person" and float(rows["3"]["seconds"]) >= 0
+    assert {r.group for r in read_responses(out)} == {"video", "in-person"}
