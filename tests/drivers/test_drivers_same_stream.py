@@ -20,12 +20,13 @@ def recorded_handover():
     ticks = []
     with HandoverSimulation("sawyer", "default", seed=2) as sim:
         done_at = None
-        while sim.t < 12.0:
+        while sim.t < 15.0:
             sim.step(1 / 120)
             ticks.append((sim.tracking(), sim.robot_events(), dict(sim.joint_state())))
             if done_at is None and sim.done:
                 done_at = sim.t
-            if done_at is not None and sim.t > done_at + 0.5:
+            # the phase detector confirms the end from the tracking about 2 s later
+            if done_at is not None and sim.t > done_at + 3.0:
                 break
     assert done_at is not None, "the recorded handover did not finish"
     return ticks

@@ -23,7 +23,9 @@ def run_handover(seed: int):
         node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face", seed=seed)),
                           driver)
         node.start()
-        while not sim.done and sim.t < 15:
+        # until the engine has seen the whole handover (it confirms the end from the tracking
+        # a little after the simulation's own end)
+        while not any(m.kind == "handover_done" for m in driver.events) and sim.t < 20:
             node.tick()
         pan = float(sim.data.qpos[sim.model.joint("head_pan").qposadr[0]])
         return sim.done, sent, driver, pan
