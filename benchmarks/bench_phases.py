@@ -1,81 +1,27 @@
-"""Phase detection speed against a plain NumPy implementation of the seed's rule.
+"""Phase detection: accuracy on real motion capture, and speed, each method against the seed's
+rule (``seed-7.2.5``, dissertation section 7.2.5) measured in the same run.
 
-Offline: segments per second over a synthetic set (100-120 Hz, ~8 s recordings). Online: median
-cost of one ``PhaseDetector.update`` per sample. The peer in both is the seed's rule (section
-7.2.5: hands within 20 cm of their minimum distance and relative speed below 15 cm/s) written
-the straightforward NumPy way; its accuracy on the same set is given in the notes.
+- KTH sample (github KTH-RPL/handovers_dataset, one_saved_handover_New/handover_sample; found
+  through GAZEBOT_KTH_DATA or /work/data/kth, skipped when absent): every method's transfer
+  start and end against the force truth (both grips loaded / the giver's grip lets go), and
+  the online detection latency of the transfer.
+- Offline throughput: recordings segmented per second over a synthetic set (100 Hz, ~8 s).
+- Online cost: median time of one ``PhaseDetector.update`` per sample.
 """
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
 
 from benchmarks.common import Result
-from gazebot.phases import PhaseConfig, PhaseDetector, Segment, Trajectory, segment
-from gazebot.phases.synthetic import SyntheticHandover, synthetic_set
-from gazebot.types import Phase, TrackingFrame
+from benchmarks.kth_data import RATE, force_truth, kth_dir
+from gazebot.phases import METHODS, PhaseConfig, PhaseDetector, Trajectory, run_online, segment
+from gazebot.phases.synthetic import synthetic_set
+from gazebot.types import EventKind, Phase
 
-MARGIN = 0.20  # m, seed
-SPEED = 0.15  # m/s, seed
-
-
-def seed_rule_segments(traj: Trajectory) -> list[Segment]:
-    """The seed's rule on a whole recording, plainly: one transfer = the longest run where the
-    distance is within 20 cm of its minimum and the relative speed below 15 cm/s."""
-    ok = np.isfinite(traj.giver_hand).all(axis=1) & np.isfinite(traj.receiver_hand).all(axis=1)
-    t = traj.t[ok]
-    rel = traj.receiver_hand[ok] - traj.giver_hand[ok]
-    d = np.linalg.norm(rel, axis=1)
-    v = np.linalg.norm(np.gradient(rel, t, axis=0), axis=1)
-    mask = (d <= d.min() + MARGIN) & (v < SPEED)
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
-    starts, ends = edges[::2], edges[1::2] - 1
-    if starts.size == 0:
-        return []
-    k = int(np.argmax(ends - starts))
-    a, b = t[starts[k]], t[ends[k]]
-    return [
-        Segment(Phase.REACH, t[0], a),
-        Segment(Phase.TRANSFER, a, b),
-        Segment(Phase.RETREAT, b, t[-1]),
-    ]
-
-
-class SeedRuleOnline:
-    """The seed's rule sample by sample with NumPy: running minimum distance, finite-difference
-    relative speed."""
-
-    def __init__(self) -> None:
-        self.prev_q: np.ndarray | None = None
-        self.prev_t = -math.inf
-        self.d_min = math.inf
-        self.in_transfer = False
-
-    def update(self, frame: TrackingFrame) -> bool:
-        q = frame.receiver_hand - frame.giver_hand
-        if not np.all(np.isfinite(q)) or frame.t <= self.prev_t:
-            return self.in_transfer
-        d = float(np.linalg.norm(q))
-        self.d_min = min(self.d_min, d)
-        if self.prev_q is not None:
-            v = float(np.linalg.norm((q - self.prev_q) / (frame.t - self.prev_t)))
-            self.in_transfer = d <= self.d_min + MARGIN and v < SPEED
-        self.prev_q, self.prev_t = q, frame.t
-        return self.in_transfer
-
-
-def _transfer_errors(cases: list[SyntheticHandover], fn) -> tuple[float, float]:
-    """Median |error| (s) of the first transfer's start and end over single-handover cases."""
-    es, ee = [], []
-    for c in cases:
-        tr = [s for s in fn(c.trajectory) if s.phase is Phase.TRANSFER]
-        if tr:
-            es.append(abs(tr[0].start - c.truth[0].transfer_start))
-            ee.append(abs(tr[0].end - c.truth[0].transfer_end))
-    return float(np.median(es)), float(np.median(ee))
+SEED = "seed-7.2.5"
 
 
 def _interleaved(a, b, repeat: int) -> tuple[float, float]:
@@ -92,62 +38,98 @@ def _interleaved(a, b, repeat: int) -> tuple[float, float]:
     return float(np.median(ta)), float(np.median(tb))
 
 
-def run() -> list[Result]:
-    cases = synthetic_set(12, seed=7, rate=100.0, handovers=1)
-    config = PhaseConfig()
-    trajs = [c.trajectory for c in cases]
+def _kth_trajectory() -> tuple[Trajectory, float, float] | None:
+    from gazebot.recordings import PointNames, load_recording
 
-    def ours_offline() -> int:
-        return sum(len(segment(tr, config)) for tr in trajs)
+    folder = kth_dir()
+    if folder is None:
+        return None
+    names = PointNames("giver_RHand", "taker_RHand", "giver_head")
+    traj = load_recording(folder, names, rate=RATE).trajectory
+    t0, t1 = force_truth(folder)
+    return traj, t0, t1
 
-    def peer_offline() -> int:
-        return sum(len(seed_rule_segments(tr)) for tr in trajs)
 
-    n_ours, n_peer = ours_offline(), peer_offline()
-    # Interleaved runs: on a shared machine both see the same load.
-    t_ours, t_peer = _interleaved(ours_offline, peer_offline, repeat=9)
-    (os_, oe), (ps, pe) = (
-        _transfer_errors(cases, lambda tr: segment(tr, config)),
-        _transfer_errors(cases, seed_rule_segments),
-    )
-    results = [
-        Result(
-            "offline segmentation",
-            n_ours / t_ours,
-            n_peer / t_peer,
-            "segments/s",
-            "NumPy seed rule",
-            higher_is_better=True,
-            note=(
-                f"median |err| transfer start/end: ours {os_ * 1e3:.0f}/{oe * 1e3:.0f} ms, "
-                f"seed rule {ps * 1e3:.0f}/{pe * 1e3:.0f} ms"
-            ),
+def _kth_results() -> list[Result]:
+    found = _kth_trajectory()
+    if found is None:
+        return [Result("KTH sample", float("nan"), None, "", note="absent: set GAZEBOT_KTH_DATA")]
+    traj, t0, t1 = found
+    out = []
+    errs = {}
+    for m in METHODS:
+        c = PhaseConfig(method=m)
+        tr = [s for s in segment(traj, c) if s.phase is Phase.TRANSFER]
+        ev = [e for e in run_online(traj, c).events if e.kind is EventKind.TRANSFER_STARTED]
+        es = (tr[0].start - t0) * 1e3 if tr else float("nan")
+        ee = (tr[0].end - t1) * 1e3 if tr else float("nan")
+        lat = (ev[0].detected_at - t0) * 1e3 if ev else float("nan")
+        errs[m] = (es, ee, lat)
+    ps, pe, pl = errs[SEED]
+    for m, (es, ee, lat) in errs.items():
+        out.append(
+            Result(
+                f"KTH transfer start error, {m}",
+                abs(es),
+                abs(ps),
+                "ms",
+                SEED,
+                note=(
+                    f"signed start {es:+.0f} ms, end {ee:+.0f} ms; online detected {lat:+.0f} ms "
+                    f"after the force truth (truth {t0:.3f}-{t1:.3f} s, 120 Hz)"
+                ),
+            )
         )
-    ]
+    return out
 
+
+def run() -> list[Result]:
+    results = _kth_results()
+    cases = synthetic_set(12, seed=7, rate=100.0, handovers=1)
+    trajs = [c.trajectory for c in cases]
+    seed_cfg = PhaseConfig(method=SEED)
+    for m in METHODS:
+        if m == SEED:
+            continue
+        cfg = PhaseConfig(method=m)
+        t_ours, t_peer = _interleaved(
+            lambda cfg=cfg: [segment(tr, cfg) for tr in trajs],
+            lambda: [segment(tr, seed_cfg) for tr in trajs],
+            repeat=7,
+        )
+        results.append(
+            Result(
+                f"offline segmentation, {m}",
+                len(trajs) / t_ours,
+                len(trajs) / t_peer,
+                "recordings/s",
+                SEED,
+                higher_is_better=True,
+                note="12 synthetic recordings, 100 Hz, ~8 s each",
+            )
+        )
     frames = cases[0].trajectory.frames()
 
-    def one_pass(make):
+    def one_pass(cfg):
         def run_pass() -> None:
-            det = make()
+            det = PhaseDetector(cfg)
             for f in frames:
                 det.update(f)
 
         return run_pass
 
-    ours, peer = _interleaved(
-        one_pass(lambda: PhaseDetector(config)), one_pass(SeedRuleOnline), repeat=15
-    )
-    ours /= len(frames)
-    peer /= len(frames)
+    ours, peer = _interleaved(one_pass(PhaseConfig()), one_pass(seed_cfg), repeat=5)
     results.append(
         Result(
-            "online update per sample",
-            ours * 1e6,
-            peer * 1e6,
+            "online update per sample, gazebot",
+            ours / len(frames) * 1e6,
+            peer / len(frames) * 1e6,
             "us",
-            "NumPy seed rule per sample",
-            note=f"{len(frames)} samples at 100 Hz; engine budget 1000 us",
+            f"{SEED} run online the same way",
+            note=(
+                f"{len(frames)} samples at 100 Hz; re-analysis every online_period "
+                f"({PhaseConfig().online_period * 1e3:.0f} ms) over online_window"
+            ),
         )
     )
     return results

@@ -1,8 +1,9 @@
 """The study: Bradley-Terry fit time (gazebot's Hunter MM, vectorised on the win matrix, against
 ``choix`` on the same comparisons), and the web study's answer submissions per second (``gazebot
 study serve`` on loopback: waitress + Flask + a committed SQLite transaction per answer) against a
-bare waitress app that only parses the same form, served and driven the same way; plus the page
-weight of a session page."""
+bare waitress app that parses the same form and commits it to SQLite with the same durability
+(and, as a floor, one that stores nothing), served and driven the same way; plus the page weight
+of a session page."""
 
 from __future__ import annotations
 
@@ -40,15 +41,44 @@ def _comparisons(g: int, participants: int, seed: int = 0) -> list[tuple[int, in
     return data
 
 
-# The peer: the same server (waitress, same threads) with an app that parses the answer form
-# and redirects, storing nothing: what HTTP and the server cost on their own.
+# The peers: the same server (waitress, same threads) with an app that parses the answer form
+# and redirects. The fair peer also stores each answer as gazebot does, durably: one committed
+# SQLite transaction per answer (WAL, synchronous=FULL, a connection per request, the primary
+# key keeping a resend once), but without Flask and without reading the participant's place.
+# With no database argument it stores nothing: the floor of HTTP and the server alone.
 _BARE_SERVER = """
-import sys, urllib.parse
+import sqlite3, sys, threading, urllib.parse
 from waitress import create_server
+DB = sys.argv[1] if len(sys.argv) > 1 else None
+LOCK = threading.Lock()
+def connect():
+    con = sqlite3.connect(DB, timeout=10, isolation_level=None)
+    con.execute("PRAGMA synchronous=FULL")
+    return con
+if DB:
+    con = connect()
+    con.execute("PRAGMA journal_mode=WAL")
+    con.execute("CREATE TABLE IF NOT EXISTS answers (participant INTEGER, session INTEGER, "
+                "q1, q2, q3, q4, q5, comment, submitted_at REAL DEFAULT (julianday('now')), "
+                "PRIMARY KEY (participant, session))")
+    con.close()
 def app(environ, start_response):
     n = int(environ.get("CONTENT_LENGTH") or 0)
-    form = urllib.parse.parse_qs(environ["wsgi.input"].read(n).decode())
+    form = urllib.parse.parse_qs(environ["wsgi.input"].read(n).decode(), keep_blank_values=True)
     ok = all(form.get(q) in (["1"], ["2"]) for q in ("q1", "q2", "q3", "q4", "q5"))
+    if ok and DB:
+        _, _, pid, _, k = environ["PATH_INFO"].split("/")
+        with LOCK:
+            con = connect()
+            try:
+                con.execute("BEGIN IMMEDIATE")
+                con.execute("INSERT INTO answers (participant, session, q1, q2, q3, q4, q5, "
+                            "comment) VALUES (?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT DO NOTHING",
+                            (int(pid), int(k), *(int(form[q][0]) for q in
+                             ("q1", "q2", "q3", "q4", "q5")), form["comment"][0]))
+                con.execute("COMMIT")
+            finally:
+                con.close()
     start_response("303 See Other" if ok else "400 Bad Request",
                    [("Location", "/p/1"), ("Content-Length", "0")])
     return [b""]
@@ -131,6 +161,8 @@ def _web_results() -> list[Result]:
         ours, port = _start(
             [sys.executable, "-m", "gazebot", "study", "serve", str(root), "--port", "0"]
         )
+        peer_db = Path(tmp) / "peer.sqlite"
+        durable, durable_port = _start([sys.executable, "-c", _BARE_SERVER, str(peer_db)])
         bare, bare_port = _start([sys.executable, "-c", _BARE_SERVER])
         try:
             con = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
@@ -139,34 +171,41 @@ def _web_results() -> list[Result]:
             con.close()
             pos = 0
             for clients in clients_list:
-                rates, peer_rates = [], []
+                rates, peer_rates, floor_rates = [], [], []
                 for b in range(BATCHES + 1):  # the first batch warms up
                     # Answers in plan order per participant: each request is the current step.
                     batch = sessions[pos : pos + BATCH]
                     pos += BATCH
                     t_ours = _submit(port, batch, clients)
-                    t_peer = _submit(bare_port, batch, clients)
+                    t_peer = _submit(durable_port, batch, clients)
+                    t_floor = _submit(bare_port, batch, clients)
                     if b:
                         rates.append(BATCH / t_ours)
                         peer_rates.append(BATCH / t_peer)
+                        floor_rates.append(BATCH / t_floor)
                 results.append(
                     Result(
                         f"answer submissions, {clients} keep-alive client(s), loopback",
                         statistics.median(rates),
                         statistics.median(peer_rates),
                         "req/s",
-                        "bare waitress app parsing the same form",
+                        "bare waitress app committing the same answer to SQLite, same pragmas",
                         higher_is_better=True,
-                        note="each answer a committed SQLite transaction (WAL, synchronous=FULL)",
+                        note="each answer a committed SQLite transaction (WAL, synchronous=FULL); "
+                        f"storing nothing: {statistics.median(floor_rates):.0f} req/s",
                     )
                 )
         finally:
-            for proc in (ours, bare):
+            for proc in (ours, durable, bare):
                 proc.terminate()
                 proc.wait(timeout=10)
         stored = len(store.answers())
-        if stored != pos:
-            raise RuntimeError(f"{pos} answers sent, {stored} stored")
+        import sqlite3
+
+        with sqlite3.connect(peer_db) as con:
+            peer_stored = con.execute("SELECT COUNT(*) FROM answers").fetchone()[0]
+        if stored != pos or peer_stored != pos:
+            raise RuntimeError(f"{pos} answers sent, {stored} stored, {peer_stored} by the peer")
         results.append(
             Result(
                 "session page weight (HTML, inline CSS and JS; videos extra)",

@@ -1,10 +1,13 @@
 """Embed the gaze engine in a robot stack: feed it tracking frames, send its commands on.
 
-Here the "robot stack" is a loop over a recorded trajectory CSV (the format `gazebot phases`
-reads); a real stack calls `engine.step` from its tracking callback instead and forwards
-`cmd.head` to the neck controller and `cmd.eye_yaw` / `cmd.eye_pitch` to the face display.
+Here the "robot stack" is a loop over a recording (any format `gazebot phases` reads: CSV,
+C3D, ROS bag, a folder of pose CSVs); a real stack calls `engine.step` from its tracking
+callback instead and forwards `cmd.head` to the neck controller and `cmd.eye_yaw` /
+`cmd.eye_pitch` to the face display.
 
     python examples/embed_engine.py recording.csv --robot jaco2 --behavior hand-face
+    python examples/embed_engine.py handover_sample --rate 120 \
+        --giver-hand giver_RHand --receiver-hand taker_RHand --giver-face giver_head
     python examples/embed_engine.py            # a synthetic handover, generated on the fly
 """
 
@@ -14,22 +17,32 @@ import argparse
 import math
 
 from gazebot import Event, EventKind, GazeEngine
-from gazebot.phases import load_trajectory_csv
+from gazebot.phases import load_phase_config
 from gazebot.phases.synthetic import SyntheticOptions, generate
+from gazebot.recordings import PointNames, load_recording
 
 
 def main(argv: list[str] | None = None) -> list[str]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("csv", nargs="?", help="trajectory CSV (default: a synthetic handover)")
+    parser.add_argument("csv", nargs="?", help="recording (default: a synthetic handover)")
     parser.add_argument("--robot", default="sawyer")
     parser.add_argument("--behavior", default="face-hand-face")
+    parser.add_argument("--method", default=None, help="phase method (default: gazebot)")
+    parser.add_argument("--giver-hand", default=None)
+    parser.add_argument("--receiver-hand", default=None)
+    parser.add_argument("--giver-face", default=None)
+    parser.add_argument("--rate", type=float, default=None, help="pose-folder rate (Hz)")
     args = parser.parse_args(argv)
 
     if args.csv:
-        trajectory = load_trajectory_csv(args.csv)
+        names = PointNames(args.giver_hand, args.receiver_hand, args.giver_face)
+        trajectory = load_recording(args.csv, names, rate=args.rate).trajectory
     else:
         trajectory = generate(seed=1, options=SyntheticOptions(rate=120.0)).trajectory
-    engine = GazeEngine.from_config(robot=args.robot, behavior=args.behavior)
+    phases = load_phase_config()
+    if args.method:
+        phases = phases.model_copy(update={"method": args.method})
+    engine = GazeEngine.from_config(robot=args.robot, behavior=args.behavior, phases=phases)
 
     lines = []
     last_target = None

@@ -114,12 +114,12 @@ def test_out_of_order_frames_do_not_move_time_backwards(engine):
 
 def test_resync_after_restart_resumes_the_handover_phase(engine):
     frames = handover_frames()
-    commands = run(engine, frames[:260])  # into the transfer (t ~ 2.17 s)
+    commands = run(engine, frames[:290])  # into the transfer (t ~ 2.42 s)
     assert commands[-1].phase == Phase.TRANSFER
     published = [e for c in commands for e in c.events]
     fresh = GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
     fresh.resync(published)
-    cmd = fresh.step(frames[260])
+    cmd = fresh.step(frames[290])
     assert cmd.phase == Phase.TRANSFER
     assert cmd.target == "hand"
 

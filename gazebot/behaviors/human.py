@@ -95,9 +95,6 @@ class HumanGazeModel(_Strict):
                     raise ValueError(f"patterns: {p.name} needs a shift {key} in 'shifts'")
         return self
 
-    def max_segments_per_phase(self) -> int:
-        return max((len(getattr(p, ph)) for p in self.patterns for ph in PHASES), default=1)
-
     def targets(self) -> set[str]:
         return {t for p in self.patterns for ph in PHASES for t in getattr(p, ph)}
 

@@ -118,7 +118,3 @@ class Segment(_Strict):
     @classmethod
     def _check_target(cls, value: str) -> str:
         return check_target_name(value)
-
-    @property
-    def phase_enum(self) -> Phase:
-        return Phase(self.phase)

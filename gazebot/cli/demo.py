@@ -54,7 +54,34 @@ def register(sub: argparse._SubParsersAction) -> None:
         choices=["after-release", "after-grasp"],
         help="when the robot retreats (seed 6.3: after the release; 6.4.3: after grasping)",
     )
+    add_giver_motion_options(parser)
     parser.set_defaults(func=run_demo)
+
+
+def add_giver_motion_options(parser: argparse.ArgumentParser) -> None:
+    """``--giver-motion FILE`` and its point names: replay a recorded giver's hand and face."""
+    from gazebot.cli.phases import add_recording_options
+
+    parser.add_argument(
+        "--giver-motion",
+        default=None,
+        metavar="FILE",
+        help="replay a recorded giver (CSV, C3D, ROS bag, pose folder), retargeted so the "
+        "recorded hand meets the robot's handover location",
+    )
+    add_recording_options(parser)
+
+
+def giver_factory(args: argparse.Namespace):
+    """The recorded giver of ``--giver-motion`` (``None``: the simulated giver)."""
+    if getattr(args, "giver_motion", None) is None:
+        return None
+    from gazebot.sim.giver_replay import load_giver_motion
+
+    return load_giver_motion(
+        args.giver_motion, args.giver_hand, args.receiver_hand, args.giver_face,
+        args.unit, args.rate,
+    )
 
 
 def scene_with_overrides(args: argparse.Namespace):
@@ -72,36 +99,36 @@ def scene_with_overrides(args: argparse.Namespace):
     }
     if not overrides:
         return args.scene
-    from pydantic import ValidationError
+    from gazebot.sim.cartesian_reach import scene_controllers_config
+    from gazebot.sim.scene_config import Direction, ReachControllerName, SceneConfig, load_scene
 
-    from gazebot.sim.scene_config import SceneConfig, load_scene
-
-    scene = load_scene(args.scene)
-    data = scene.model_dump()
+    data = load_scene(args.scene).model_dump()
     data["controller"].update(overrides)
+    controller = ReachControllerName(data["controller"]["reach_controller"]).value
     timed = "reach_time_s" in overrides or "stall_time_s" in overrides
-    if (
-        timed
-        and str(
-            getattr(
-                data["controller"]["reach_controller"],
-                "value",
-                data["controller"]["reach_controller"],
-            )
-        )
-        == "joint"
-    ):
+    if timed and controller == "joint":
         raise UsageError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+    if "stall_time_s" in overrides and controller != "mce":
+        raise UsageError("--stall-time ('Don't move until') is the mce controller's")
     try:
-        return SceneConfig.model_validate(data)
-    except ValidationError as exc:
+        scene = SceneConfig.model_validate(data)
+        if scene.controller.reach_controller is not ReachControllerName.JOINT:
+            # The reach and stall times against the controllers YAML, as the simulation will.
+            scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
+    except ValueError as exc:  # pydantic's ValidationError is one; it names the field
         raise UsageError(f"invalid controller options: {exc}") from exc
+    return scene
 
 
 def run_demo(args: argparse.Namespace) -> int:
+    from gazebot.kinematics.config import GAZE_MODES
     from gazebot.render.timeline import phase_spans, plot_timeline, write_timeline_csv
     from gazebot.sim.gl_check import OffscreenRenderingError
 
+    if args.gaze_mode is not None and args.gaze_mode not in GAZE_MODES:
+        raise UsageError(
+            f"--gaze-mode must be one of {', '.join(GAZE_MODES)}, not {args.gaze_mode!r}"
+        )
     out: Path = args.out
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out} exists and is not a folder")
@@ -182,4 +209,5 @@ def _record(args: argparse.Namespace, out: Path, monitor=None):
         width=args.width,
         height=args.height,
         progress=not args.no_progress,
+        giver_factory=giver_factory(args),
     )

@@ -9,24 +9,44 @@ import math
 import sys
 from typing import TYPE_CHECKING
 
-from gazebot.cli.errors import UsageError
-
 if TYPE_CHECKING:
     from gazebot.phases import Segment
 
 
 def add_recording_options(p: argparse.ArgumentParser, prefix: str = "") -> None:
     """The point-name, unit and rate options of a recording (shared with ``--giver-motion``)."""
-    p.add_argument(f"--{prefix}giver-hand", default=None, metavar="NAME",
-                   help="point/label/topic/frame of the giver's hand (default: giver_hand in CSV)")
-    p.add_argument(f"--{prefix}receiver-hand", default=None, metavar="NAME",
-                   help="point of the receiver's hand (default: receiver_hand in CSV)")
-    p.add_argument(f"--{prefix}giver-face", default=None, metavar="NAME",
-                   help="point of the giver's face (optional)")
-    p.add_argument(f"--{prefix}unit", default=None, choices=None, metavar="UNIT",
-                   help="length unit of CSV / pose-folder coordinates: m (default), cm or mm")
-    p.add_argument(f"--{prefix}rate", default=None, type=float, metavar="HZ",
-                   help="sampling rate of a pose folder (its files have no time column)")
+    p.add_argument(
+        f"--{prefix}giver-hand",
+        default=None,
+        metavar="NAME",
+        help="point/label/topic/frame of the giver's hand (default: giver_hand in CSV)",
+    )
+    p.add_argument(
+        f"--{prefix}receiver-hand",
+        default=None,
+        metavar="NAME",
+        help="point of the receiver's hand (default: receiver_hand in CSV)",
+    )
+    p.add_argument(
+        f"--{prefix}giver-face",
+        default=None,
+        metavar="NAME",
+        help="point of the giver's face (optional)",
+    )
+    p.add_argument(
+        f"--{prefix}unit",
+        default=None,
+        choices=None,
+        metavar="UNIT",
+        help="length unit of CSV / pose-folder coordinates: m (default), cm or mm",
+    )
+    p.add_argument(
+        f"--{prefix}rate",
+        default=None,
+        type=float,
+        metavar="HZ",
+        help="sampling rate of a pose folder (its files have no time column)",
+    )
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -42,12 +62,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
     )
     p.add_argument("file", metavar="FILE", help="recording: .csv, .c3d, .bag, ROS 2 bag, folder")
-    p.add_argument("--method", default=None, choices=("gazebot", "seed-7.2.5", "seed-4.4.3"),
-                   help="phase rules (default: method in the config, gazebot)")
+    p.add_argument(
+        "--method",
+        default=None,
+        choices=("gazebot", "seed-7.2.5", "seed-4.4.3"),
+        help="phase rules (default: method in the config, gazebot)",
+    )
     p.add_argument("--online", action="store_true", help="replay through the online detector")
     p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
-    p.add_argument("--config", default=None,
-                   help="phase settings YAML (default: configs/phases.yaml)")
+    p.add_argument(
+        "--config", default=None, help="phase settings YAML (default: configs/phases.yaml)"
+    )
     add_recording_options(p)
     p.set_defaults(func=handle)
 
@@ -86,7 +111,9 @@ def handle(args: argparse.Namespace) -> int:
             "online": bool(args.online),
             "units": {"time": "s", "length": "m", "file_length": rec.unit},
             "rate_hz": None if math.isnan(rec.rate) else round(rec.rate, 3),
-            "names": dict(zip(("giver_hand", "receiver_hand", "giver_face"), rec.names, strict=True)),
+            "names": dict(
+                zip(("giver_hand", "receiver_hand", "giver_face"), rec.names, strict=True)
+            ),
             "segments": [s.to_json() for s in segments],
         }
         json.dump(doc, sys.stdout, indent=1)
@@ -101,7 +128,9 @@ def handle(args: argparse.Namespace) -> int:
         print("(no handover found)")
         return 0
     for s in segments:
-        line = f"{s.handover:>8}  {s.phase.value:<9}{_fmt(s.start)}  {_fmt(s.end)}  {_fmt(s.duration)}"
+        line = (
+            f"{s.handover:>8}  {s.phase.value:<9}{_fmt(s.start)}  {_fmt(s.end)}  {_fmt(s.duration)}"
+        )
         if args.online:
             line += f"  {_fmt(s.detected_at)}"
         if s.open:

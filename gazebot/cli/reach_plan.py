@@ -12,6 +12,9 @@ from pathlib import Path
 
 from gazebot.cli.errors import UsageError
 
+# A reach longer than this is no reach; the bound also keeps a typo from planning for hours.
+MAX_DURATION_S = 120.0
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     from gazebot.controllers import CONTROLLER_NAMES
@@ -100,22 +103,41 @@ def run_reach_plan(args: argparse.Namespace) -> int:
     from gazebot.controllers.rollout import run_reach
 
     cfg = controllers_config_from_args(args)
+    if args.stall_time is not None and args.controller != "mce":
+        raise UsageError(
+            "--stall-time ('Don't move until') is the mce controller's; use --controller mce"
+        )
+    points = {
+        "--start": args.start,
+        "--hand": args.hand,
+        "--hand-velocity": args.hand_velocity,
+        "--target": args.target,
+    }
+    for name, v in points.items():
+        if v is not None and not np.all(np.isfinite(v)):
+            raise UsageError(f"{name} must be finite, got {list(v)}")
     start = np.array(args.start, float)
     hand0 = np.array(args.hand, float)
-    for name, v in (("--start", start), ("--hand", hand0)):
-        if not np.all(np.isfinite(v)):
-            raise UsageError(f"{name} must be finite, got {v.tolist()}")
     hand = hand0
     if args.hand_velocity is not None:
         vel = np.array(args.hand_velocity, float)
         hand = lambda t: hand0 + vel * t  # noqa: E731
+    target = None if args.target is None else np.array(args.target, float)
+    if args.controller == "stl" and not cfg.stl.strategy.towards_human and target is None:
+        raise UsageError(
+            f"--strategy {cfg.stl.strategy.value} needs --target X Y Z (the handover location)"
+        )
     controller = make_controller(args.controller, cfg)
     duration = args.duration if args.duration is not None else cfg.reach_time_s + 1.0
-    if not duration > 0:
-        raise UsageError(f"--duration must be positive, got {duration}")
-    target = None if args.target is None else np.array(args.target, float)
+    if not 0 < duration <= MAX_DURATION_S:
+        raise UsageError(f"--duration must be in (0, {MAX_DURATION_S:g}] s, got {duration}")
     run = run_reach(controller, start, hand, duration, target=target)
     tol = cfg.stl.eps_p_m if args.controller == "stl" else cfg.mcj.eps_x_m
+    # What the controller goes to: the --target, unless an stl strategy goes towards the hand.
+    to_target = target is not None and not (
+        args.controller == "stl" and cfg.stl.strategy.towards_human
+    )
+    goal = target if to_target else None
     result = {
         "controller": args.controller,
         "feasible": run.feasible,
@@ -125,8 +147,9 @@ def run_reach_plan(args: argparse.Namespace) -> int:
         else round(float(run.times[np.argmin(run.feasible_steps)]), 4),
         "reach_time_s": None if args.controller == "pv" else cfg.reach_time_s,
         "stall_time_s": cfg.stall_time_s if args.controller == "mce" else None,
-        "reached_at_s": run.reached_at(tol + 1e-6),
-        "final_gap_m": round(float(run.gap()[-1]), 5),
+        "goal": "target" if to_target else "hand",
+        "reached_at_s": run.reached_at(tol + 1e-6, goal),
+        "final_gap_m": round(float(run.gap(goal)[-1]), 5),
         "path": [
             [round(float(t), 4), *np.round(p, 5).tolist()]
             for t, p in zip(run.times, run.positions, strict=True)

@@ -29,10 +29,14 @@ def register(kinds: argparse._SubParsersAction) -> None:
     parser.add_argument("--height", type=int, default=480, help="height, px, even (default: 480)")
     parser.add_argument("--fps", type=float, default=30.0, help="frames per second (default: 30)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    from gazebot.cli.demo import add_giver_motion_options
+
+    add_giver_motion_options(parser)
     parser.set_defaults(func=run_render_video)
 
 
 def run_render_video(args: argparse.Namespace) -> int:
+    from gazebot.cli.demo import giver_factory
     from gazebot.sim.gl_check import OffscreenRenderingError
     from gazebot.sim.record import check_video_size, render_handover_video
 
@@ -53,6 +57,7 @@ def run_render_video(args: argparse.Namespace) -> int:
             height=args.height,
             fps=args.fps,
             progress=not args.no_progress,
+            giver_factory=giver_factory(args),
         )
     except OffscreenRenderingError as exc:
         print(f"gazebot: error: {exc}", file=sys.stderr)

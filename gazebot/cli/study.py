@@ -4,12 +4,15 @@ end."""
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from gazebot.cli.errors import UsageError
+from gazebot.config import ConfigError
 from gazebot.study.conditions import (
     CONDITION_LEVELS,
     DEFAULT_BEHAVIORS,
@@ -17,6 +20,23 @@ from gazebot.study.conditions import (
     REACH_BEHAVIORS,
     default_behaviors,
 )
+
+
+def _input_errors(command: Callable[[argparse.Namespace], int]) -> Callable:
+    """The study package raises ``ValueError`` (naming file, line and field) for bad input files
+    and options: report those as the command line's input errors (:class:`UsageError`), not as
+    bugs."""
+
+    @functools.wraps(command)
+    def run(args: argparse.Namespace) -> int:
+        try:
+            return command(args)
+        except (ConfigError, UsageError):
+            raise
+        except ValueError as exc:
+            raise UsageError(str(exc)) from exc
+
+    return run
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -53,7 +73,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "eyes-only with one); the instructions name the head or the eyes to match",
     )
     p.add_argument("--seed", type=int, default=0, help="randomisation seed")
-    p.add_argument("--robot", default="sawyer")
+    p.add_argument(
+        "--robot",
+        default=None,
+        help="robot config (default: the seed's: jaco2, the Jaco-2 with its head, without a "
+        "condition (6.3); sawyer with one (6.4))",
+    )
     p.add_argument("--video-seed", type=int, default=0, help="seed of every rendered handover")
     p.add_argument(
         "--scene",
@@ -67,7 +92,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--out", type=Path, default=Path("plan.csv"), help="plan CSV file (default: plan.csv)"
     )
     p.add_argument("--json", action="store_true", help="print the balance summary as JSON")
-    p.set_defaults(func=_plan)
+    p.set_defaults(func=_input_errors(_plan))
 
     r = study.add_parser("render", help="render a plan's videos, pair videos and questionnaires")
     r.add_argument("plan", type=Path)
@@ -89,7 +114,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="pin the cache key's code version (default: a hash of gazebot's sources and configs)",
     )
     r.add_argument("--no-progress", action="store_true")
-    r.set_defaults(func=_render)
+    r.set_defaults(func=_input_errors(_render))
 
     sv = study.add_parser("serve", help="run a rendered study in the browser (answers in SQLite)")
     sv.add_argument("dir", type=Path, help="a folder written by `gazebot study render`")
@@ -104,7 +129,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="ask for the token on /admin from this machine too (behind a local reverse proxy)",
     )
-    sv.set_defaults(func=_serve)
+    sv.set_defaults(func=_input_errors(_serve))
 
     ex = study.add_parser("export", help="write the answers of a served study as a responses CSV")
     ex.add_argument("dir", type=Path)
@@ -114,7 +139,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also the practice session (session 0; for inspection, not for analyze)",
     )
-    ex.set_defaults(func=_export)
+    ex.set_defaults(func=_input_errors(_export))
 
     a = study.add_parser("analyze", help="Bradley-Terry analysis of a responses CSV")
     a.add_argument("responses", type=Path)
@@ -144,7 +169,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="p-values of the proportion difference tests: one-sided in the observed direction "
         "(default, as the seed's Tables B.7-B.12) or two-sided",
     )
-    a.set_defaults(func=_analyze)
+    a.set_defaults(func=_input_errors(_analyze))
 
     f = study.add_parser("fit-wins", help="Bradley-Terry fit of a win-count matrix CSV")
     f.add_argument("wins", type=Path)
@@ -156,11 +181,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "total is fitted with its own total, with a warning",
     )
     f.add_argument("--json", action="store_true")
-    f.set_defaults(func=_fit_wins)
+    f.set_defaults(func=_input_errors(_fit_wins))
 
 
 def _finite(value: float, option: str, low: float = 0.0, high: float = math.inf) -> float:
-    """``value`` if finite and in (low, high); ``ValueError`` naming ``option`` otherwise."""
+    """``value`` if finite and in (low, high); ``UsageError`` naming ``option`` otherwise."""
     if not (math.isfinite(value) and low < value < high):
         bound = f"in ({low:g}, {high:g})" if math.isfinite(high) else f"> {low:g}"
         raise UsageError(f"{option} must be a finite number {bound}, got {value}")
@@ -181,6 +206,19 @@ def _check_behaviors(names: list[str]) -> None:
             ) from None
 
 
+def _check_robot(name: str | None) -> None:
+    """``--robot`` must name a robot config (or a robot YAML file): fail at plan time, not an
+    hour into rendering."""
+    if name is None:
+        return
+    from gazebot.kinematics.config import robot_config_path
+
+    try:
+        robot_config_path(name)
+    except FileNotFoundError as exc:
+        raise UsageError(f"--robot: {exc}") from None
+
+
 def _plan(args: argparse.Namespace) -> int:
     from gazebot.study.csvio import check_output_file
     from gazebot.study.plan import check_balance, make_plan, write_plan
@@ -193,6 +231,7 @@ def _plan(args: argparse.Namespace) -> int:
     )
     behaviors = [b.strip() for b in names.split(",") if b.strip()]
     _check_behaviors(behaviors)
+    _check_robot(args.robot)
     scenes = {}
     for item in args.scene:
         level, sep, scene = item.partition("=")
@@ -220,6 +259,7 @@ def _plan(args: argparse.Namespace) -> int:
         "sessions_per_participant": len(plan) // args.participants,
         "behaviors": behaviors,
         "condition": args.condition or "",
+        "robot": plan[0].robot,
         "gaze_mode": plan[0].gaze_mode,
         "position_balanced": report.position_balanced,
         "carryover_balanced": report.carryover_balanced,
@@ -229,7 +269,8 @@ def _plan(args: argparse.Namespace) -> int:
     else:
         print(
             f"wrote {len(plan)} sessions ({len(plan) // args.participants} per participant) for "
-            f"{args.participants} participants to {args.out} (gaze mode {plan[0].gaze_mode}, "
+            f"{args.participants} participants to {args.out} (robot {plan[0].robot}, gaze mode "
+            f"{plan[0].gaze_mode}, "
             f"position balanced: {report.position_balanced}, "
             f"carry-over balanced: {report.carryover_balanced})"
         )
@@ -319,7 +360,12 @@ def _analyze(args: argparse.Namespace) -> int:
     for m, b in result.bias.items():
         print(f"first/second bias {m}: S={b.s:.1f} p={b.p_value:.2f}")
     for q, b in result.bias_per_question.items():
-        print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_value:.2f}")
+        # The seed quotes z with its normal p (6.4.4: "like: z = -0.68, p = 0.50").
+        print(f"first/second bias {q}: S={b.s:.1f} z={b.z:.2f} p={b.p_z:.2f}")
+    for g, tests in result.bias_by_group.items():
+        for k, b in tests.items():
+            p = b.p_z if k.startswith("q") else b.p_value
+            print(f"first/second bias, group {g}, {k}: S={b.s:.1f} z={b.z:.2f} p={p:.2f}")
     for c in result.comparisons:
         print(
             f"{c.measure} {c.behavior_i} vs {c.behavior_j} ({c.design}, n={c.n_a}/{c.n_b}): "
@@ -381,9 +427,9 @@ def _serve(args: argparse.Namespace) -> int:
     from gazebot.study.web.server import serve
 
     if not 0 <= args.port <= 65535:
-        raise ValueError(f"--port must be in 0..65535, got {args.port}")
+        raise UsageError(f"--port must be in 0..65535, got {args.port}")
     if args.threads < 1:
-        raise ValueError(f"--threads must be >= 1, got {args.threads}")
+        raise UsageError(f"--threads must be >= 1, got {args.threads}")
     serve(
         str(args.dir),
         args.host,

@@ -38,7 +38,8 @@ class ReachObservation:
     zone_center: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self) -> None:
-        for name in ("x", "hand"):
+        names = ("x", "hand") if self.target is None else ("x", "hand", "target")
+        for name in names:
             v = np.asarray(getattr(self, name), float)
             if v.shape != (3,) or not np.all(np.isfinite(v)):
                 raise ValueError(f"{name} must be a finite 3D point, got {getattr(self, name)}")

@@ -81,6 +81,13 @@ class STLConfig(_Strict):
     history_steps: int = Field(
         default=5, ge=2, le=100, description="hand samples for the least-squares LDS fit (eq. 4.5)"
     )
+    force_sensor: bool = Field(
+        default=True,
+        description="Table 4.1: object states from the load share (True) or, without a gripper "
+        "force sensor, from the object's distance to gripper and hand and their openness",
+    )
+    eps_g: float = Field(default=0.1, gt=0, le=1, description="openness tolerance (no sensor)")
+    grip_width: float = Field(default=0.0, ge=0, le=1, description="g*: openness holding it")
     delta_1: float = Field(default=0.2, ge=0, le=1, description="load share: released at or below")
     delta_2: float = Field(default=0.8, ge=0, le=1, description="load share: held above")
     mip_gap: float = Field(default=1e-4, ge=0, lt=1)

@@ -32,13 +32,16 @@ class Rollout:
         """True when every step found an input meeting the timing."""
         return bool(np.all(self.feasible_steps))
 
-    def gap(self) -> np.ndarray:
-        """Euclidean end-effector-to-hand distance at each time (m)."""
-        return np.linalg.norm(self.positions - self.hands, axis=1)
+    def gap(self, goal: np.ndarray | None = None) -> np.ndarray:
+        """Euclidean end-effector distance (m) at each time to the hand, or to a fixed ``goal``
+        (a predetermined handover location)."""
+        to = self.hands if goal is None else np.asarray(goal, float)
+        return np.linalg.norm(self.positions - to, axis=1)
 
-    def reached_at(self, tol: float) -> float | None:
-        """First time the end effector is within ``tol`` (m) of the hand, None if never."""
-        hit = np.nonzero(self.gap() <= tol)[0]
+    def reached_at(self, tol: float, goal: np.ndarray | None = None) -> float | None:
+        """First time the end effector is within ``tol`` (m) of the hand (or ``goal``), None
+        if never."""
+        hit = np.nonzero(self.gap(goal) <= tol)[0]
         return float(self.times[hit[0]]) if hit.size else None
 
 

@@ -157,7 +157,11 @@ def near(a: str, b: str, eps: float) -> Formula:
 
 
 def object_states(cfg: STLConfig, eps_p: float) -> dict[str, Formula]:
-    """``o_r, o_s, o_h, o_g`` from the load share (Table 4.1, with a force sensor)."""
+    """``o_r, o_s, o_h, o_g`` (Table 4.1): from the load share ``alpha`` (``cfg.force_sensor``),
+    else from the object's distance to the gripper and the hand and their openness ``g_r``,
+    ``g_h`` (within ``cfg.eps_g`` of the grip width ``g*``)."""
+    if not cfg.force_sensor:
+        return _object_states_without_force(cfg, eps_p)
     d1, d2 = cfg.delta_1, cfg.delta_2
     alpha = Predicate  # alias for brevity below
     o_r = alpha("o_r", lambda s: s["alpha"] - d2)
@@ -166,6 +170,26 @@ def object_states(cfg: STLConfig, eps_p: float) -> dict[str, Formula]:
     o_h = And(released, near("p_o", "p_h", eps_p))
     o_g = And(released, Not(near("p_o", "p_h", eps_p)))
     return {"o_r": o_r, "o_s": o_s, "o_h": o_h, "o_g": o_g}
+
+
+def _object_states_without_force(cfg: STLConfig, eps_p: float) -> dict[str, Formula]:
+    """Table 4.1, left column: who grips the object, ``||p_o - p_i|| <= eps_p`` and
+    ``|g_i - g*| <= eps_g`` for the robot (``r``) and the human (``h``)."""
+
+    def grips(i: str) -> Formula:
+        closed = Predicate(
+            f"|g_{i}-g*|<={cfg.eps_g}",
+            lambda s: cfg.eps_g - np.abs(s[f"g_{i}"] - cfg.grip_width),
+        )
+        return And(near("p_o", f"p_{i}", eps_p), closed)
+
+    robot, human = grips("r"), grips("h")
+    return {
+        "o_r": And(robot, Not(human)),
+        "o_h": And(Not(robot), human),
+        "o_s": And(robot, human),
+        "o_g": And(Not(robot), Not(human)),
+    }
 
 
 def in_zone(radius: float) -> Formula:
@@ -188,17 +212,16 @@ def reach_spec(
     return Always(implies(trigger, Eventually(goal, 0.0, reach_time_s)))
 
 
-def transfer_spec(
-    cfg: STLConfig, t_s: float, role: Role, gripper_tol: float = 0.1, grip_width: float = 0.0
-) -> Formula:
-    """Table 4.2 transfer: receiver grasps within t_2 of reaching the shared/held object; giver
-    opens within t_8 once the object is shared."""
+def transfer_spec(cfg: STLConfig, t_s: float, role: Role) -> Formula:
+    """Table 4.2 transfer: receiver grasps (``|g_r - g*| < eps_g``) within t_2 of reaching the
+    shared/held object; giver opens within t_8 once the object is shared."""
     o = object_states(cfg, cfg.eps_p_m)
+    tol, width = cfg.eps_g, cfg.grip_width
     if role is Role.RECEIVER:
         at_obj = near("p_o", "p_r", cfg.eps_p_m)
-        grasped = Predicate("g_r=g*", lambda s: gripper_tol - np.abs(s["g_r"] - grip_width))
+        grasped = Predicate("g_r=g*", lambda s: tol - np.abs(s["g_r"] - width))
         return Always(implies(And(at_obj, Or(o["o_h"], o["o_s"])), Eventually(grasped, 0, t_s)))
-    opened = Predicate("g_r=1", lambda s: gripper_tol - np.abs(s["g_r"] - 1.0))
+    opened = Predicate("g_r=1", lambda s: tol - np.abs(s["g_r"] - 1.0))
     return Always(implies(o["o_s"], Eventually(opened, 0, t_s)))
 
 

@@ -42,6 +42,8 @@ class PhaseConfig(BaseModel):
         approach_fraction: gazebot: ... closing at least this fraction of the distance the
             hands started from.
         min_transfer: gazebot: shortest transfer kept (s).
+        still_closing: Online, hands that closed more than this over the last
+            ``min_transfer`` are still approaching: no transfer yet (m).
         settle_fraction: gazebot: the transfer starts where the relative speed falls below this
             fraction of the approach's peak relative speed ...
         settle_floor_factor: ... or below this many times the hold's speed floor, if higher.
@@ -58,6 +60,10 @@ class PhaseConfig(BaseModel):
         approach_ratio: ... and the giver's hand itself moved toward the receiver by this
             fraction of it.
         rest_speed: gazebot: the giver's hand is at rest below this speed (m/s).
+        rest_hold: Online, a hand whose retreat began before the detector saw it is at rest
+            after this long under ``rest_speed`` (s).
+        done_fraction: Online, a retreat whose speed fell below this fraction of its peak is
+            about to land: it ends at the mirrored onset.
         retreat_far_distance: gazebot: the retreat also ends once the giver's hand is this far
             from where the transfer happened (m).
         max_refine: gazebot: largest back-dating of a motion onset or release (s).
@@ -94,6 +100,7 @@ class PhaseConfig(BaseModel):
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
     min_transfer: float = Field(0.08, ge=0)
+    still_closing: float = Field(0.005, ge=0)
     settle_fraction: float = Field(0.03, gt=0, lt=1)
     settle_floor_factor: float = Field(1.5, ge=1)
     hold_floor_quantile: float = Field(0.25, ge=0, le=1)
@@ -104,15 +111,17 @@ class PhaseConfig(BaseModel):
     reach_confirm_distance: float = Field(0.02, gt=0)
     approach_ratio: float = Field(0.5, ge=0, le=1)
     rest_speed: float = Field(0.05, gt=0)
+    rest_hold: float = Field(0.15, ge=0)
+    done_fraction: float = Field(0.15, ge=0, lt=1)
     retreat_far_distance: float = Field(0.60, gt=0)
     max_refine: float = Field(0.4, ge=0)
     max_retreat: float = Field(4.0, gt=0)
-    smoothing: float = Field(0.16, gt=0)
+    smoothing: float = Field(0.12, gt=0)
     analysis_rate: float = Field(100.0, gt=0, le=2000)
     max_gap_hold: float = Field(0.25, ge=0)
     frozen_speed: float = Field(0.05, ge=0)
     online_period: float = Field(0.02, ge=0)
-    online_window: float = Field(8.0, gt=1)
+    online_window: float = Field(5.0, gt=1)
     edge_guard: float = Field(0.04, ge=0)
     load_share_shared: float = Field(0.1, ge=0, le=1)
     load_share_robot: float = Field(0.9, ge=0, le=1)

@@ -14,8 +14,9 @@ missed); a load share above ``load_share_robot`` starts the retreat. Once frames
 evidence, hand motion alone no longer starts a transfer (hands resting close together while the
 robot has not grasped are a giver waiting).
 
-A reach the analysis no longer shows for ``online_period`` + ``max_refine`` (the hands parted
-before any transfer) ends as ``handover_done`` with ``source = "aborted"``; a retreat longer
+A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
+back about as far apart as when it started (taken back before any transfer), ends as
+``handover_done`` with ``source = "aborted"``; a retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
 
 Bad samples: a frame with a non-finite time, or a time not after the last accepted one
@@ -40,6 +41,9 @@ from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals, compute_signals
 from gazebot.phases.methods import GazebotSegmenter, make_segmenter
 from gazebot.phases.prediction import predict_end
+from gazebot.phases.rules.release import transfer_end
+from gazebot.phases.rules.retreat import retreat_done
+from gazebot.phases.rules.transfer import TransferCore
 from gazebot.phases.segment import Segment, segments_from_events
 from gazebot.phases.trajectory import Trajectory
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
@@ -112,6 +116,8 @@ class PhaseDetector:
         self._signals: Signals | None = None
         self._reach_missing_since = math.nan
         self._floor = -math.inf  # the next phase never starts before this
+        # The current phase began before this detector saw the hands move (resync, restart).
+        self._joined_late = False
 
     # ----------------------------------------------------------------- public API
     @property
@@ -153,10 +159,13 @@ class PhaseDetector:
         if between and phase in (Phase.REACH, Phase.TRANSFER):
             self.handover += 1
         self._enter(phase, event.t)
+        self._joined_late = True
         self._queue.clear()
 
     # ----------------------------------------------------------------- internals
     def _enter(self, phase: Phase, t0: float) -> None:
+        # Joined late: fewer than two samples seen before the phase's start.
+        self._joined_late = len(self._t) < 3 or self._t[1] >= t0
         self.phase = phase
         self.phase_start = t0
         self._floor = t0
@@ -215,7 +224,9 @@ class PhaseDetector:
                 last = min(last_g, last_r)
                 if t - last > c.max_gap_hold:
                     self.tracking = False
-                    missing = [n for n, ok in (("giver_hand", g_ok), ("receiver_hand", r_ok)) if not ok]
+                    missing = [
+                        n for n, ok in (("giver_hand", g_ok), ("receiver_hand", r_ok)) if not ok
+                    ]
                     info = {"handover": max(self.handover, 0), "missing": missing}
                     self._queue.append(Event(EventKind.TRACKING_LOST, last, t, info))
             if not self.tracking:
@@ -262,15 +273,52 @@ class PhaseDetector:
         if n < 3:
             return
         traj = Trajectory(np.fromiter(self._t, float, n), np.array(self._g), np.array(self._r))
-        s = compute_signals(traj, c)
-        self._signals = s
+        if self.phase in (Phase.TRANSFER, Phase.RETREAT) and math.isfinite(self.phase_start):
+            # After contact the rules need the hold and what follows, not the whole window.
+            keep = np.flatnonzero(traj.t >= self.phase_start - c.reach_duration)
+            if keep.size >= 3 and keep[0] > 0:
+                traj = traj.take(keep)
         if isinstance(self.segmenter, GazebotSegmenter):
             cut = self.segmenter.signals(traj, partial=True)
-            segs = [] if cut is None else self.segmenter.segment_signals(cut, now, partial=True)
+            # The last edge_guard of the smoothed speed sags (one-sided window): predictions
+            # read the same trusted part as the rules.
+            self._signals = cut
+            if cut is not None:
+                # Once the hands are in contact, the release and retreat-end rules run from the
+                # phase's own start; before, the whole method finds the next handover.
+                self._rules_after_contact(cut, now)
+                if self.phase not in (Phase.TRANSFER, Phase.RETREAT):
+                    self._advance(self.segmenter.segment_signals(cut, now, True), now, True)
+                    self._rules_after_contact(cut, now)
         else:
-            segs = self.segmenter.segment_sorted(traj, partial=True)
-        self._advance(segs, now)
-        self.expected_phase_end = predict_end(self.phase, self.phase_start, s, now, c)
+            self._signals = compute_signals(traj, c)
+            self._advance(self.segmenter.segment_sorted(traj, partial=True), now)
+        self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
+
+    def _rules_after_contact(self, s: Signals, now: float) -> bool:
+        """``gazebot`` in a transfer or retreat: apply the release and retreat-end rules from
+        the current phase's start (so a phase adopted by :meth:`resync`, or older than the
+        window, ends like any other). True if the phase is one of these two."""
+        c = self.config
+        for _ in range(2):
+            if self.phase is Phase.TRANSFER:
+                i0 = min(int(np.searchsorted(s.t, self.phase_start)), s.t.shape[0] - 1)
+                n = s.t.shape[0]
+                core = TransferCore(0, i0, n - 1, n - 1, max(self.phase_start, float(s.t[0])))
+                t_end, open_end = transfer_end(s, c, core)
+                if open_end or t_end >= float(s.t[-1]):
+                    return True
+                self._start(Phase.RETREAT, t_end, now, "motion")
+                continue
+            if self.phase is Phase.RETREAT:
+                done = retreat_done(s, c, self.phase_start, self._joined_late)
+                if done is not None:
+                    self._done(done[0], now, done[1])
+                elif now - self.phase_start > c.max_retreat:
+                    self._done(now, now, "timeout")
+                return True
+            return False
+        return True
 
     def _find(self, segs: list[Segment], phase: Phase, after: float) -> Segment | None:
         for seg in segs:
@@ -278,7 +326,9 @@ class PhaseDetector:
                 return seg
         return None
 
-    def _advance(self, segs: list[Segment], now: float) -> None:
+    def _advance(self, segs: list[Segment], now: float, stop_at_contact: bool = False) -> None:
+        """Emit the phase starts ``segs`` show after the current phase (at most one handover);
+        ``stop_at_contact``: stop once in a transfer (the caller's rules take over)."""
         c = self.config
         for _ in range(4):  # at most one full handover per analysis
             ph = self.phase
@@ -306,10 +356,15 @@ class PhaseDetector:
                     self._reach_missing_since = math.nan
                 elif self._reach_missing_since != self._reach_missing_since:
                     self._reach_missing_since = now
-                elif now - self._reach_missing_since > c.online_period + c.max_refine:
+                elif (
+                    now - self._reach_missing_since > c.online_period + c.max_refine
+                    and self._hands_back_apart()
+                ):
                     self._done(now, now, "aborted")
                 return
             if ph is Phase.TRANSFER:
+                if stop_at_contact:
+                    return
                 ret = self._find(segs, Phase.RETREAT, self._floor)
                 if ret is not None:
                     self._start(Phase.RETREAT, ret.start, now, "motion")
@@ -327,6 +382,21 @@ class PhaseDetector:
             if now - self.phase_start > c.max_retreat:
                 self._done(now, now, "timeout")
             return
+
+    def _hands_back_apart(self) -> bool:
+        """The hands are (almost) as far apart as when the current reach started: the reach
+        was taken back, not merely paused (a reach that pauses is still a reach)."""
+        s = self._signals
+        if s is None or s.t.shape[0] == 0:
+            return True
+        d = s.distance
+        ok = np.flatnonzero(np.isfinite(d))
+        if ok.size == 0:
+            return True
+        i0 = int(np.searchsorted(s.t, self.phase_start))
+        before = ok[ok <= i0]
+        d0 = float(d[before[-1]] if before.size else d[ok[0]])
+        return float(d[ok[-1]]) >= d0 - self.config.reach_confirm_distance
 
     def _done(self, t0: float, now: float, source: str) -> None:
         t0 = max(min(t0, now), self.phase_start)

@@ -6,18 +6,22 @@
 2. Resampling onto a uniform grid (``analysis_rate``), bridging gaps up to ``max_gap_hold``
    (longer gaps stay unknown, NaN).
 3. Zero-lag Gaussian smoothing (``smoothing``, never narrower than two input samples) and
-   velocities by central differences.
+   velocities by central differences, unknown next to a tracking gap (where the window is
+   one-sided and would flatten the motion into a false rest).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import gaussian_filter1d
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.trajectory import Trajectory
+
+# Share of the smoothing window that must hold data for a velocity to be known.
+FULL_WINDOW = 0.6
 
 
 @dataclass(frozen=True)
@@ -101,26 +105,23 @@ def resample(t: np.ndarray, p: np.ndarray, grid: np.ndarray, max_gap: float) -> 
 
 
 def _gauss(x: np.ndarray, sigma: float) -> np.ndarray:
-    """Gaussian smoothing of the columns of ``x`` (edges padded with the end values)."""
-    radius = max(1, int(math.ceil(3.0 * sigma)))
-    k = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
-    k /= k.sum()
-    pad = np.pad(x, ((radius, radius),) + ((0, 0),) * (x.ndim - 1), mode="edge")
-    if x.ndim == 1:
-        return np.convolve(pad, k, mode="valid")
-    return np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(x.shape[1])], axis=1)
+    """Gaussian smoothing along axis 0, edges padded with the end values (scipy.ndimage)."""
+    return gaussian_filter1d(x, sigma, axis=0, mode="nearest", truncate=3.0)
 
 
-def smooth(x: np.ndarray, sigma: float) -> np.ndarray:
-    """NaN-aware Gaussian smoothing along axis 0 (normalised convolution), zero lag."""
+def smooth(x: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """NaN-aware Gaussian smoothing along axis 0 (normalised convolution), zero lag.
+
+    Returns the smoothed rows and, per row, the share of the smoothing window that held data
+    (1 away from tracking gaps)."""
     m = np.isfinite(x).all(axis=1)
     if sigma <= 0 or x.shape[0] < 2:
-        return x
+        return x, m.astype(float)
     num = _gauss(np.where(m[:, None], x, 0.0), sigma)
     den = _gauss(m.astype(float), sigma)
     out = num / np.maximum(den, 1e-12)[:, None]
     out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
-    return out
+    return out, den
 
 
 def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
@@ -137,11 +138,15 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     # corners at every sample that would otherwise show up as speed spikes.
     med_dt = float(np.median(np.diff(t))) if t.shape[0] > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
-    g = smooth(g, sigma_s / dt)
-    r = smooth(r, sigma_s / dt)
+    g, g_full = smooth(g, sigma_s / dt)
+    r, r_full = smooth(r, sigma_s / dt)
     if grid.shape[0] >= 2:
         gv = np.gradient(g, dt, axis=0)
         rv = np.gradient(r, dt, axis=0)
+        # Next to a tracking gap the window is one-sided and flattens the motion: velocities
+        # there are unknown, not slow.
+        gv[g_full < FULL_WINDOW] = np.nan
+        rv[r_full < FULL_WINDOW] = np.nan
     else:
         gv = np.full_like(g, np.nan)
         rv = np.full_like(r, np.nan)

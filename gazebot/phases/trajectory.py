@@ -2,7 +2,9 @@
 
 CSV header (issue 3): ``t,giver_hand_x,giver_hand_y,giver_hand_z,receiver_hand_x,
 receiver_hand_y,receiver_hand_z`` (s, m), optionally ``giver_face_x,giver_face_y,giver_face_z``,
-``gripper_closed`` (0/1) and ``load_share`` (0..1). An empty cell is a missing sample.
+``gripper_closed`` (0/1) and ``load_share`` (0..1). An empty cell, ``NaN`` or ``nan`` is a
+missing sample (motion-capture exports write NaN). Other formats and point names:
+:mod:`gazebot.recordings`.
 """
 
 from __future__ import annotations
@@ -190,7 +192,7 @@ def load_trajectory_csv(path: str | Path) -> Trajectory:
     Raises:
         FileNotFoundError: ``path`` does not exist.
         TrajectoryFormatError: Missing required column, unknown column, wrong number of cells,
-            a non-numeric or non-finite value, or a missing time (names line and column).
+            a non-numeric or infinite value, or a missing time (names line and column).
     """
     path = Path(path)
     if not path.is_file():
@@ -233,9 +235,14 @@ def load_trajectory_csv(path: str | Path) -> Trajectory:
                 value = float(text)
             except ValueError:
                 raise TrajectoryFormatError(path, lineno, col, f"not a number: {text!r}") from None
-            if not math.isfinite(value):
+            if math.isnan(value):
+                if col == "t":
+                    raise TrajectoryFormatError(path, lineno, col, "time is missing (NaN)")
+                data[col].append(math.nan)  # a missing sample, as an empty cell
+                continue
+            if math.isinf(value):
                 raise TrajectoryFormatError(
-                    path, lineno, col, f"not finite: {text!r} (leave the cell empty if missing)"
+                    path, lineno, col, f"infinite: {text!r} (NaN or an empty cell = missing)"
                 )
             if col == "load_share" and not 0.0 <= value <= 1.0:
                 raise TrajectoryFormatError(path, lineno, col, f"expected 0..1, got {value}")

@@ -18,8 +18,12 @@ from gazebot.recordings.pose_folder import read_pose_folder
 from gazebot.recordings.rosbag import read_bag
 
 
-def load_recording(path: str | Path, names: PointNames | None = None, unit: str | None = None,
-                   rate: float | None = None) -> Recording:
+def load_recording(
+    path: str | Path,
+    names: PointNames | None = None,
+    unit: str | None = None,
+    rate: float | None = None,
+) -> Recording:
     """Read any supported recording (see the module docstring).
 
     Args:
@@ -37,7 +41,11 @@ def load_recording(path: str | Path, names: PointNames | None = None, unit: str 
         raise RecordingError(path, "no such file")
     suffix = path.suffix.lower()
     if path.is_dir():
-        if (path / "metadata.yaml").is_file() or any(path.glob("*.db3")) or any(path.glob("*.mcap")):
+        if (
+            (path / "metadata.yaml").is_file()
+            or any(path.glob("*.db3"))
+            or any(path.glob("*.mcap"))
+        ):
             return read_bag(path, names)
         return read_pose_folder(path, names, rate, unit or "m")
     if suffix == ".csv":
@@ -48,8 +56,11 @@ def load_recording(path: str | Path, names: PointNames | None = None, unit: str 
         return read_c3d(path, names)
     if suffix in (".bag", ".db3", ".mcap"):
         return read_bag(path, names)
-    raise RecordingError(path, f"unknown format {suffix or '(no extension)'}: expected .csv, "
-                         ".c3d, .bag, a ROS 2 bag folder or a folder of pose CSVs")
+    raise RecordingError(
+        path,
+        f"unknown format {suffix or '(no extension)'}: expected .csv, "
+        ".c3d, .bag, a ROS 2 bag folder or a folder of pose CSVs",
+    )
 
 
 __all__ = [

@@ -84,20 +84,22 @@ def unit_scale(source: str | Path, unit: str) -> float:
     return UNITS[key]
 
 
-def pick(source: str | Path, role: str, wanted: str | None, available: list[str],
-         default: str | None) -> str | None:
+def pick(
+    source: str | Path, role: str, wanted: str | None, available: list[str], default: str | None
+) -> str | None:
     """The name to use for ``role``: ``wanted``, else ``default`` when the file has it.
 
     Raises:
         RecordingError: ``wanted`` is not in the file (the message lists the names it has), or
             no name was given and the default is absent (for a required role).
     """
+    have = ", ".join(available) or "(none)"
     if wanted is not None:
         if wanted in available:
             return wanted
         raise RecordingError(
             source,
-            f"no point named {wanted!r} for {role}; the file has: {', '.join(available) or '(none)'}",
+            f"no point named {wanted!r} for {role}; the file has: {have}",
         )
     if default is not None and default in available:
         return default
@@ -106,13 +108,20 @@ def pick(source: str | Path, role: str, wanted: str | None, available: list[str]
     flag = "--" + role.replace("_", "-")
     raise RecordingError(
         source,
-        f"which point is {role}? pass {flag} NAME; the file has: {', '.join(available) or '(none)'}",
+        f"which point is {role}? pass {flag} NAME; the file has: {have}",
     )
 
 
-def build(source: str | Path, fmt: str, t: np.ndarray, points: dict[str, np.ndarray],
-          names: PointNames, unit: str, defaults: tuple[str | None, str | None, str | None],
-          extra: dict[str, np.ndarray] | None = None) -> Recording:
+def build(
+    source: str | Path,
+    fmt: str,
+    t: np.ndarray,
+    points: dict[str, np.ndarray],
+    names: PointNames,
+    unit: str,
+    defaults: tuple[str | None, str | None, str | None],
+    extra: dict[str, np.ndarray] | None = None,
+) -> Recording:
     """Pick the three points from ``points`` (name -> (N, 3) in the file's unit) and build the
     recording in metres."""
     available = sorted(points)
@@ -131,5 +140,12 @@ def build(source: str | Path, fmt: str, t: np.ndarray, points: dict[str, np.ndar
         gripper_closed=extra.get("gripper_closed", np.zeros(0)),
         load_share=extra.get("load_share", np.zeros(0)),
     )
-    return Recording(traj, str(source), fmt, (g, r, f), tuple(available), unit,  # type: ignore[arg-type]
-                     median_rate(t))
+    return Recording(
+        traj,
+        str(source),
+        fmt,
+        (g, r, f),
+        tuple(available),
+        unit,  # type: ignore[arg-type]
+        median_rate(t),
+    )

@@ -54,7 +54,9 @@ def read_csv(path: str | Path, names: PointNames | None = None, unit: str = "m")
         if not row or all(not c.strip() for c in row):
             continue
         if len(row) != len(header):
-            raise RecordingError(path, f"line {lineno}: expected {len(header)} cells, got {len(row)}")
+            raise RecordingError(
+                path, f"line {lineno}: expected {len(header)} cells, got {len(row)}"
+            )
         out = []
         for col, raw in zip(header, row, strict=True):
             text = raw.strip()
@@ -76,7 +78,9 @@ def read_csv(path: str | Path, names: PointNames | None = None, unit: str = "m")
             if col == "load_share" and not 0.0 <= v <= 1.0:
                 raise RecordingError(path, f"line {lineno}, column '{col}': expected 0..1, got {v}")
             if col == "gripper_closed" and v not in (0.0, 1.0):
-                raise RecordingError(path, f"line {lineno}, column '{col}': expected 0 or 1, got {v}")
+                raise RecordingError(
+                    path, f"line {lineno}, column '{col}': expected 0 or 1, got {v}"
+                )
             out.append(v)
         values.append(out)
     data = np.array(values, dtype=float).reshape(-1, len(header))

@@ -20,8 +20,9 @@ def body_name(path: Path) -> str:
     return name
 
 
-def read_pose_folder(path: str | Path, names: PointNames | None = None, rate: float | None = None,
-                     unit: str = "m") -> Recording:
+def read_pose_folder(
+    path: str | Path, names: PointNames | None = None, rate: float | None = None, unit: str = "m"
+) -> Recording:
     """Read the bodies of a pose folder sampled at ``rate`` (Hz, required: the files hold no
     time).
 
@@ -40,8 +41,14 @@ def read_pose_folder(path: str | Path, names: PointNames | None = None, rate: fl
         if not {"x", "y", "z"} <= set(header):
             continue  # e.g. a wrench file
         try:
-            data = np.genfromtxt(f, delimiter=",", skip_header=1, usecols=[header.index(a) for a in "xyz"],
-                                 missing_values=("", "nan", "NaN"), filling_values=np.nan)
+            data = np.genfromtxt(
+                f,
+                delimiter=",",
+                skip_header=1,
+                usecols=[header.index(a) for a in "xyz"],
+                missing_values=("", "nan", "NaN"),
+                filling_values=np.nan,
+            )
         except ValueError as exc:
             raise RecordingError(f, f"not a numeric pose table ({exc})") from None
         points[body_name(f)] = np.atleast_2d(data).reshape(-1, 3)

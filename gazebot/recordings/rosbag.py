@@ -44,7 +44,8 @@ def read_bag(path: str | Path, names: PointNames | None = None, max_gap: float =
                     for tf in msg.transforms:
                         tr = tf.transform.translation
                         series.setdefault(tf.child_frame_id.lstrip("/"), []).append(
-                            (_stamp(tf.header), tr.x, tr.y, tr.z))
+                            (_stamp(tf.header), tr.x, tr.y, tr.z)
+                        )
                     continue
                 if conn.msgtype in _POSE:
                     p = msg.pose.position

@@ -10,6 +10,30 @@ import numpy as np
 
 from gazebot.controllers import ReachController, ReachObservation, VelocityPlan
 from gazebot.controllers.arm_ik import ArmIK
+from gazebot.controllers.config import ControllersConfig
+from gazebot.sim.scene_config import ControllerConfig
+
+
+def scene_controllers_config(ctrl: ControllerConfig, robot_gives: bool) -> ControllersConfig:
+    """What a scene's Cartesian reach works to: the controllers YAML (``ctrl.controllers``, else
+    ``configs/controllers.yaml``) with the scene's reach and stall times, and Table 4.3's giver
+    rows for STL when the robot gives (``robot_gives``).
+
+    Raises ``ValueError`` naming the field when the scene's times and the YAML's do not fit
+    together (e.g. a stall no shorter than the reach)."""
+    from gazebot.controllers import load_controllers_config
+
+    cfg = load_controllers_config(ctrl.controllers)
+    update: dict = {}
+    if robot_gives:
+        update["stl"] = {**cfg.stl.model_dump(), "role": "giver"}
+    if ctrl.reach_time_s is not None:
+        update["reach_time_s"] = ctrl.reach_time_s
+    if ctrl.stall_time_s is not None:
+        update["stall_time_s"] = ctrl.stall_time_s
+    if not update:
+        return cfg
+    return type(cfg).model_validate({**cfg.model_dump(), **update})
 
 
 @dataclass(frozen=True)

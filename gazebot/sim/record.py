@@ -83,6 +83,7 @@ def record_handover(
     progress: bool = True,
     on_tick: Callable[[HandoverSimulation, TickRecord], None] | None = None,
     loop: GazeLoop | None = None,
+    giver_factory=None,
 ) -> HandoverRecording:
     """Run one handover with the gaze engine in the loop; record the video when ``out_path``.
 
@@ -91,7 +92,8 @@ def record_handover(
     when given, sees the simulation after each control tick's head and eye commands (e.g. to
     inspect or render it); it must not step the simulation. ``loop`` replaces the default
     :class:`~gazebot.runtime.GazeLoop` (``behavior`` and ``seed`` for its engine and blinks); it
-    must be built for the same robot.
+    must be built for the same robot. ``giver_factory`` replaces the simulated giver (see
+    :class:`HandoverSimulation`; e.g. recorded motion, ``--giver-motion``).
 
     Returns the per-tick timeline, the frame count and the robot's events.
     """
@@ -106,7 +108,7 @@ def record_handover(
 
     check_video_size(width, height, fps)
     sim_robot = load_sim_robot(robot)
-    sim = HandoverSimulation(robot=sim_robot, scene=scene, seed=seed)
+    sim = HandoverSimulation(robot=sim_robot, scene=scene, seed=seed, giver_factory=giver_factory)
     if loop is None:
         loop = GazeLoop.from_config(robot=sim_robot.spec, behavior=behavior, seed=seed)
     dt = 1.0 / CONTROL_HZ
@@ -153,7 +155,7 @@ def record_handover(
                             eye_pitch=cmd.eye_pitch,
                             target_point=cmd.target_point.copy(),
                             hand=sim.giver.hand.copy(),
-                            face=sim.scene.giver.face_point.copy(),
+                            face=sim.face_point.copy(),
                             head_measured={j: state[j] for j in cmd.head if j in state},
                             events=tuple(e.kind.value for e in cmd.events),
                             reach_start_time=(
@@ -208,8 +210,12 @@ def render_handover_video(
     height: int = 480,
     fps: float = 30.0,
     progress: bool = True,
+    giver_factory=None,
 ) -> Path:
     """Render one full handover to ``out_path`` (H.264 MP4, yuv420p) and return the path; on an
-    error no file is left at ``out_path``."""
-    record_handover(robot, behavior, scene, out_path, seed, width, height, fps, progress)
+    error no file is left at ``out_path``. ``giver_factory``: see :func:`record_handover`."""
+    record_handover(
+        robot, behavior, scene, out_path, seed, width, height, fps, progress,
+        giver_factory=giver_factory,
+    )
     return Path(out_path)

@@ -160,6 +160,18 @@ class CameraConfig(_Strict):
     fovy_deg: float = Field(default=33.0, gt=5, lt=150)
 
 
+class GiverMotionConfig(_Strict):
+    """A recorded giver to replay instead of the simulated one (``--giver-motion``; see
+    :mod:`gazebot.sim.giver_replay`): any recording format, with its point names."""
+
+    file: str = Field(description="recording: CSV, C3D, ROS bag or pose folder")
+    giver_hand: str | None = None
+    receiver_hand: str | None = None
+    giver_face: str | None = None
+    unit: str | None = Field(default=None, description="m, cm or mm (CSV / pose folder)")
+    rate_hz: float | None = Field(default=None, gt=0, description="pose-folder rate")
+
+
 class SceneConfig(_Strict):
     """One handover setup (seed Table 6.3 conditions: object size, fragility, posture)."""
 
@@ -175,6 +187,9 @@ class SceneConfig(_Strict):
     tracking: TrackingNoiseConfig = Field(default_factory=TrackingNoiseConfig)
     camera: CameraConfig = Field(default_factory=CameraConfig)
     tail_s: float = Field(default=1.2, ge=0.0, description="video time kept after the handover")
+    giver_motion: GiverMotionConfig | None = Field(
+        default=None, description="replay a recorded giver instead of the simulated one"
+    )
 
     @property
     def has_table(self) -> bool:

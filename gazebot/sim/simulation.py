@@ -87,6 +87,10 @@ class HandoverSimulation:
         scene: Scene name (``configs/scenes/<name>.yaml``), YAML path or a :class:`SceneConfig`.
         seed: Seeds the giver's timing and the tracking noise (same seed, same handover).
         tracking_noise: Overrides the scene's tracking noise (``None``: the scene's).
+        giver_factory: Builds the person instead of the simulated one, called as
+            ``(rest, offer, plan, cued)`` (e.g. :func:`gazebot.sim.giver_replay.replay_factory`
+            for recorded motion); ``None``: the scene's ``giver_motion`` if it has one (study
+            scenes), else the simulated giver.
     """
 
     def __init__(
@@ -95,6 +99,7 @@ class HandoverSimulation:
         scene: str | Path | SceneConfig = "default",
         seed: int = 0,
         tracking_noise: TrackingNoiseConfig | None = None,
+        giver_factory=None,
     ) -> None:
         self.robot = robot if isinstance(robot, SimRobot) else load_sim_robot(robot)
         self.config = load_scene(scene)
@@ -134,6 +139,15 @@ class HandoverSimulation:
         # A robot-initiated giver waits for the robot's reach (respond_at) plus a reaction time.
         # ``giver`` is the simulated person: in a robot-to-human scene, the one who takes it.
         human = SimulatedReceiver if self.robot_to_human else SimulatedGiver
+        if giver_factory is None and self.config.giver_motion is not None:
+            from gazebot.sim.giver_replay import load_giver_motion
+
+            gm = self.config.giver_motion
+            giver_factory = load_giver_motion(
+                gm.file, gm.giver_hand, gm.receiver_hand, gm.giver_face, gm.unit, gm.rate_hz
+            )
+        if giver_factory is not None:
+            human = giver_factory  # e.g. a recorded giver (gazebot.sim.giver_replay)
         self.giver = human(
             self.layout.rest_hand, self.layout.offer_hand, plan, cued=self.robot_initiated
         )
@@ -173,19 +187,11 @@ class HandoverSimulation:
         """The seed's reach controller on the arm, or None for the joint-space reach."""
         if ctrl.reach_controller is ReachControllerName.JOINT:
             return None
-        from gazebot.controllers import load_controllers_config, make_controller
+        from gazebot.controllers import make_controller
         from gazebot.controllers.arm_ik import ArmIK
+        from gazebot.sim.cartesian_reach import scene_controllers_config
 
-        cfg = load_controllers_config(ctrl.controllers)
-        update = {}
-        if self.config.direction is Direction.ROBOT_TO_HUMAN:
-            update["stl"] = {**cfg.stl.model_dump(), "role": "giver"}  # Table 4.3's giver rows
-        if ctrl.reach_time_s is not None:
-            update["reach_time_s"] = ctrl.reach_time_s
-        if ctrl.stall_time_s is not None:
-            update["stall_time_s"] = ctrl.stall_time_s
-        if update:
-            cfg = type(cfg).model_validate({**cfg.model_dump(), **update})
+        cfg = scene_controllers_config(ctrl, self.config.direction is Direction.ROBOT_TO_HUMAN)
         m = self.model
         ranges = np.array([m.jnt_range[m.joint(j).id] for j in self.robot.arm_joints])
         ik = ArmIK(
@@ -400,10 +406,18 @@ class HandoverSimulation:
             self._t,
             giver_hand=noise(self.giver.hand),
             receiver_hand=noise(self.data.site_xpos[self._gripper_site]),
-            giver_face=noise(self.scene.giver.face_point),
+            giver_face=noise(self.face_point),
             gripper_closed=grasped,
             load_share=share,
         )
+
+    @property
+    def face_point(self) -> np.ndarray:
+        """The person's face (m, base frame): the scene's, moved by a replayed giver's recorded
+        head motion (``face_offset``) when there is one."""
+        offset = getattr(self.giver, "face_offset", None)
+        face = self.scene.giver.face_point
+        return face if offset is None else face + np.asarray(offset, float)
 
     def joint_state(self) -> dict[str, float]:
         """Every hinge/slide joint's position (rad or m) by name."""

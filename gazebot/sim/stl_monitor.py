@@ -18,15 +18,14 @@ import numpy as np
 from gazebot.controllers.config import ControllersConfig, Role
 from gazebot.controllers.stl_logic import (
     Always,
-    And,
     Eventually,
     Formula,
-    Not,
     Predicate,
     Signal,
     implies,
     near,
-    object_states,
+    retreat_spec,
+    transfer_spec,
 )
 
 
@@ -73,6 +72,8 @@ class HandoverMonitor:
             "p_o": obj,
             "alpha": alpha,
             "g_r": 1.0 - float(ctrl._gripper),
+            # The person's hand: closed on the object (g*) while holding it, else open.
+            "g_h": self.config.stl.grip_width if person else 1.0,
             "p_d": self.home,
             "p_home": self.home,
         }
@@ -89,26 +90,20 @@ class HandoverMonitor:
         return Signal(dt=self.dt or 1.0, values=values)
 
     def specs(self) -> dict[str, Formula]:
-        """Table 4.2's specs for the robot's role, with this run's tolerances."""
+        """Table 4.2's specs for the robot's role, with this run's tolerances: the reach as
+        triggered by the handover signal ``e``, the transfer and retreat as
+        :func:`~gazebot.controllers.stl_logic.transfer_spec` and ``retreat_spec`` state them."""
         assert self.config is not None, "sample a run first"
         stl = self.config.stl.model_copy(update={"eps_p_m": self.eps})
-        o = object_states(stl, self.eps)
         e = Predicate("e", lambda s: s["e"] - 0.5)
         reach = Always(
             implies(e, Eventually(near("p_h", "p_r", self.eps), 0, self.config.reach_time_s))
         )
-        closed = Predicate("g_r=0", lambda s: 0.1 - np.abs(s["g_r"]))
-        opened = Predicate("g_r=1", lambda s: 0.1 - np.abs(s["g_r"] - 1.0))
-        t_tr, t_re = stl.transfer_time_s, stl.retreat_time_s
-        if self.role is Role.RECEIVER:
-            at_obj = near("p_o", "p_r", self.eps)
-            transfer = Always(implies(And(at_obj, Not(o["o_r"])), Eventually(closed, 0, t_tr)))
-            retreat = Always(implies(o["o_r"], Eventually(near("p_r", "p_d", self.eps), 0, t_re)))
-        else:
-            transfer = Always(implies(o["o_s"], Eventually(opened, 0, t_tr)))
-            gone = Predicate("alpha<=d1", lambda s: stl.delta_1 - s["alpha"])
-            retreat = Always(implies(gone, Eventually(near("p_r", "p_home", self.eps), 0, t_re)))
-        return {"reach": reach, "transfer": transfer, "retreat": retreat}
+        return {
+            "reach": reach,
+            "transfer": transfer_spec(stl, stl.transfer_time_s, self.role),
+            "retreat": retreat_spec(stl, stl.retreat_time_s, self.role),
+        }
 
     def robustness(self) -> dict[str, float]:
         """Each spec's robustness over the run (positive: met)."""
@@ -133,4 +128,4 @@ def robot_timing(sim) -> ControllersConfig:
     return cfg
 
 
-_KEYS = ("t", "p_r", "p_h", "p_o", "alpha", "g_r", "p_d", "p_home")
+_KEYS = ("t", "p_r", "p_h", "p_o", "alpha", "g_r", "g_h", "p_d", "p_home")

@@ -65,6 +65,8 @@ from gazebot.study.stats import (
 RESPONSE_COLUMNS = ("participant", "session", "condition", "level", "first", "second") + tuple(
     QUESTIONS
 )
+# Rows of the seed's Tables 6.1 and 6.2.
+TABLE_6_1_ORDER = ("face", "hand", "long-face-hand", "short-face-hand")
 #: Optional column: independent participant groups (e.g. ``video`` / ``in-person``).
 GROUP_COLUMN = "group"
 
@@ -150,8 +152,11 @@ def read_responses(path: str | Path) -> list[Response]:
 
 
 def behaviors_of(responses: list[Response]) -> list[str]:
-    """The behaviors compared, the seed's defaults first (in their order), then the others."""
+    """The behaviors compared, the seed's first (in the order of its tables), then the others.
+    A study of the 6.3 behaviors only is ordered as Tables 6.1/6.2: Face, Hand, L-FH, S-FH."""
     seen = {r.first for r in responses} | {r.second for r in responses}
+    if seen <= set(REACH_BEHAVIORS):
+        return [b for b in TABLE_6_1_ORDER if b in seen]
     order = dict.fromkeys((*DEFAULT_BEHAVIORS, "hand-face", "face-hand-face", *REACH_BEHAVIORS))
     known = [b for b in order if b in seen]
     return known + sorted(seen - set(known))
@@ -252,6 +257,9 @@ class StudyAnalysis:
     per_level: dict[str, dict[str, MeasureResult]] = field(default_factory=dict)
     bias: dict[str, BiasTest] = field(default_factory=dict)
     bias_per_question: dict[str, BiasTest] = field(default_factory=dict)
+    #: With several ``group`` s: the bias tests of each group on its own (measures and
+    #: questions), as the seed reports each study's (6.4.4 video, 6.4.5 in person).
+    bias_by_group: dict[str, dict[str, BiasTest]] = field(default_factory=dict)
     comparisons: list[LevelComparison] = field(default_factory=list)
     sides: str = "one"
 
@@ -280,8 +288,29 @@ class StudyAnalysis:
                 for m, b in self.bias.items()
             },
             "bias_per_question": {
-                q: {"W": b.statistic, "S": b.s, "z": b.z, "n": b.n, "p_value": b.p_value}
+                q: {
+                    "W": b.statistic,
+                    "S": b.s,
+                    "z": b.z,
+                    "n": b.n,
+                    "p_value": b.p_value,
+                    "p_z": b.p_z,
+                }
                 for q, b in self.bias_per_question.items()
+            },
+            "bias_by_group": {
+                g: {
+                    k: {
+                        "W": b.statistic,
+                        "S": b.s,
+                        "z": b.z,
+                        "n": b.n,
+                        "p_value": b.p_value,
+                        "p_z": b.p_z,
+                    }
+                    for k, b in tests.items()
+                }
+                for g, tests in self.bias_by_group.items()
             },
             "sides": self.sides,
             "level_comparisons": [
@@ -335,7 +364,8 @@ def analyze(
     difference and equivalence tests (margin ``margin``) per pair of behaviors: matched or
     unmatched as the module doc explains. ``behaviors`` fixes the order of the conditions
     (default: :func:`behaviors_of`). The bias test is run per measure and per question (the seed
-    reports it per measure in 6.3 and per question in 6.4). ``sides``: p-values of the difference
+    reports it per measure in 6.3 and per question in 6.4), over all participants and, with
+    several groups, per group. ``sides``: p-values of the difference
     tests, ``"one"`` (one-sided in the observed direction, as the seed's Tables B.7-B.12) or
     ``"two"``."""
     if sides not in ("one", "two"):
@@ -355,10 +385,17 @@ def analyze(
         result.per_level[sample] = {}
         for measure, questions in MEASURES.items():
             w = win_matrix(rows, behaviors, questions)
-            fit = fit_bradley_terry(w, behaviors)
+            n = len({r.who for r in rows})
+            try:
+                fit = fit_bradley_terry(w, behaviors)
+            except ValueError as exc:  # say which sample: a study may hold several
+                raise ValueError(
+                    f"sample {sample or '(single scenario)'!r} ({n} participants, "
+                    f"{len(rows)} sessions), {measure}: {exc}"
+                ) from None
             result.per_level[sample][measure] = MeasureResult(
                 measure=measure,
-                participants=len({r.who for r in rows}),
+                participants=n,
                 wins=w,
                 fit=fit,
                 chi2=likelihood_ratio_chi2(w, fit.p),
@@ -369,6 +406,15 @@ def analyze(
     for q in QUESTIONS:
         diffs = position_differences(responses, (q,), bias_unit)
         result.bias_per_question[q] = position_bias_test(diffs)
+    groups = list(dict.fromkeys(r.group for r in responses))
+    if len(groups) > 1:  # independent studies: each its own bias test, as the seed reports them
+        for g in groups:
+            rows = [r for r in responses if r.group == g]
+            tests = dict(MEASURES) | {q: (q,) for q in QUESTIONS}
+            result.bias_by_group[g] = {
+                k: position_bias_test(position_differences(rows, qs, bias_unit))
+                for k, qs in tests.items()
+            }
     for a, b in comparable_samples(responses):
         result.comparisons += _compare(a, b, behaviors, margin, sides)
     return result

@@ -41,6 +41,17 @@ DEFAULT_GAZE_MODE_NO_CONDITION = "head-only"
 DEFAULT_GAZE_MODE_WITH_CONDITION = "eyes-only"
 
 
+# 6.3.2: "a Kinova Jaco-2 robot arm, accompanied by a simple robot head"; 6.4.3: "implemented
+# on a Sawyer cobot". Both ship as robot configs (configs/robots/<name>.yaml).
+DEFAULT_ROBOT_NO_CONDITION = "jaco2"
+DEFAULT_ROBOT_WITH_CONDITION = "sawyer"
+
+
+def default_robot(condition: str | None) -> str:
+    """The robot the seed's design ran on: the Jaco-2 with its head in 6.3, the Sawyer in 6.4."""
+    return DEFAULT_ROBOT_WITH_CONDITION if condition else DEFAULT_ROBOT_NO_CONDITION
+
+
 def default_behaviors(condition: str | None) -> tuple[str, ...]:
     """The seed's behaviors for a design: 6.3's four without a condition, 6.4's three with one."""
     return DEFAULT_BEHAVIORS if condition else REACH_BEHAVIORS

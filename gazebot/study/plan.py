@@ -39,6 +39,7 @@ from gazebot.study.conditions import (
     DEFAULT_SCENES,
     GAZE_MODES,
     default_gaze_mode,
+    default_robot,
 )
 from gazebot.study.csvio import check_output_file, open_text
 
@@ -119,7 +120,7 @@ def make_plan(
     condition: str | None = "object-size",
     participants: int = 24,
     seed: int = 0,
-    robot: str = "sawyer",
+    robot: str | None = None,
     scenes: dict[str, str] | None = None,
     video_seed: int = 0,
     gaze_mode: str | None = None,
@@ -127,8 +128,9 @@ def make_plan(
     """A counterbalanced plan (see the module doc): ``participants`` must be a positive multiple
     of the block size (``g (g - 1)`` without a condition, ``2 g (g - 1)`` with one). ``condition``
     ``None`` or ``""``: the 6.3 design (one scenario, level ``""``). ``scenes`` maps a level to a
-    scene name (overrides :data:`DEFAULT_SCENES`); ``gaze_mode`` defaults to the seed's for the
-    design (:func:`~gazebot.study.conditions.default_gaze_mode`). Raises ``ValueError`` for an
+    scene name (overrides :data:`DEFAULT_SCENES`); ``robot`` and ``gaze_mode`` default to the
+    seed's for the design (:func:`~gazebot.study.conditions.default_robot`,
+    :func:`~gazebot.study.conditions.default_gaze_mode`). Raises ``ValueError`` for an
     unknown condition or gaze mode or an invalid participant count."""
     condition = condition or ""
     if condition and condition not in CONDITION_LEVELS:
@@ -137,6 +139,7 @@ def make_plan(
             "(or none for the seed's 6.3 design)"
         )
     gaze_mode = gaze_mode or default_gaze_mode(condition)
+    robot = robot or default_robot(condition)
     if gaze_mode not in GAZE_MODES:
         raise ValueError(f"unknown gaze mode {gaze_mode!r}; expected one of {list(GAZE_MODES)}")
     pairings = ordered_pairings(behaviors)

@@ -79,7 +79,9 @@ class BiasTest:
     statistic ``W - m (m + 1) / 4`` (m = nonzero differences) that SAS reports as S and the seed
     quotes in 6.3; ``z``: S over its standard deviation under H0 (with the tie correction), the
     normal-approximation score the seed quotes per question in 6.4; ``n``: number of nonzero
-    differences; ``p_value``: two-sided.
+    differences; ``p_value``: two-sided, scipy's (exact for few differences without ties);
+    ``p_z``: two-sided p of ``z`` under the normal approximation, the p the seed quotes with its
+    z (6.4.4: "like: z = -0.68, p = 0.50").
     """
 
     statistic: float
@@ -87,6 +89,7 @@ class BiasTest:
     n: int
     p_value: float
     z: float = 0.0
+    p_z: float = 1.0
 
 
 def position_bias_test(differences: np.ndarray) -> BiasTest:
@@ -109,7 +112,8 @@ def position_bias_test(differences: np.ndarray) -> BiasTest:
     _, tie_counts = np.unique(np.abs(nz), return_counts=True)
     var = m * (m + 1) * (2 * m + 1) / 24.0 - float(np.sum(tie_counts**3 - tie_counts)) / 48.0
     z = s / math.sqrt(var) if var > 0 else 0.0
-    return BiasTest(statistic=w_plus, s=s, n=int(m), p_value=float(res.pvalue), z=float(z))
+    p_z = float(2 * sps.norm.sf(abs(z)))
+    return BiasTest(statistic=w_plus, s=s, n=int(m), p_value=float(res.pvalue), z=float(z), p_z=p_z)
 
 
 @dataclass(frozen=True)

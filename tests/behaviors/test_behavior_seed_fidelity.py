@@ -172,12 +172,14 @@ def test_long_face_hand_waits_for_the_end_of_the_robot_reach(timelines):
 
 
 def test_as_studied_behaviors_key_on_the_robots_own_events(timelines):
-    # Seed 6.4.3: face / hand / face by the robot's grasp and its retreat; hand-face turns to the
-    # face "After the robot started to retreat".
+    # Seed 6.4.3: face / hand / face by the end of the robot's reach (it then waits for its
+    # proximity sensor to grasp) and its retreat; hand-face turns to the face "After the robot
+    # started to retreat".
     handover, runs = timelines
     t, fhf = runs["face-hand-face-as-studied"]
     hand = t[np.array(fhf) == "hand"]
-    assert handover.grasp <= hand.min() <= handover.grasp + 1.5 / RATE
+    end = handover.robot_reach_end
+    assert end <= hand.min() <= end + 1.5 / RATE
     assert hand.max() < handover.robot_retreat
     t, hf = runs["hand-face-as-studied"]
     face = t[np.array(hf) == "face"]

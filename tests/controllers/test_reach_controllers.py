@@ -131,3 +131,8 @@ def test_stl_predetermined_goes_to_the_handover_location_not_the_hand():
 def test_observation_rejects_non_finite_points():
     with pytest.raises(ValueError, match="hand"):
         ReachObservation(t=0.0, x=START, hand=np.array([np.nan, 0, 0]))
+
+
+def test_observation_rejects_a_non_finite_handover_location():
+    with pytest.raises(ValueError, match="target"):
+        ReachObservation(t=0.0, x=START, hand=HAND, target=np.array([0.5, np.nan, 0.0]))

@@ -86,3 +86,58 @@ def test_demo_options_override_the_scene_controller():
                 scene="default", controller=None, reach_time=2.0, stall_time=None, retreat=None
             )
         )
+
+
+@pytest.mark.parametrize(
+    "extra,names",
+    [
+        (["--controller", "stl", "--strategy", "proactive-predetermined"], "--target"),
+        (["--controller", "stl", "--target", "nan", "0", "0"], "--target"),
+        (["--controller", "mcj", "--hand-velocity", "0", "inf", "0"], "--hand-velocity"),
+        (["--controller", "mcj", "--stall-time", "0.5"], "--stall-time"),
+        (["--controller", "pv", "--duration", "1e9"], "--duration"),
+    ],
+)
+def test_reach_plan_bad_input_is_a_usage_error_naming_the_option(capsys, extra, names):
+    rc = main(["reach-plan", "--start", "0", "0", "0", "--hand", "1", "0", "0", *extra])
+    assert rc == 2
+    assert names in capsys.readouterr().err
+
+
+def test_reach_plan_reports_arrival_at_a_predetermined_location(capsys):
+    rc, out = _plan(
+        capsys,
+        "--controller",
+        "stl",
+        "--strategy",
+        "proactive-predetermined",
+        "--target",
+        "0.8",
+        "0",
+        "0",
+        "--reach-time",
+        "2",
+    )
+    assert rc == 0 and out["feasible"] and out["goal"] == "target"
+    assert out["reached_at_s"] is not None and out["reached_at_s"] <= 2.0 + 1e-9
+    assert out["final_gap_m"] <= 0.01
+
+
+@pytest.mark.parametrize(
+    "options,message",
+    [
+        ({"controller": "mcj", "stall_time": 0.5}, "mce controller"),
+        ({"controller": "mce", "reach_time": 1.0, "stall_time": 2.0}, "stall_time_s"),
+        ({"controller": "mce", "stall_time": 3.5}, "stall_time_s"),  # the YAML's 3 s reach
+    ],
+)
+def test_demo_rejects_a_stall_without_mce_or_not_shorter_than_the_reach(options, message):
+    from gazebot.cli.demo import scene_with_overrides
+    from gazebot.cli.errors import UsageError
+
+    args = argparse.Namespace(
+        scene="default", controller=None, reach_time=None, stall_time=None, retreat=None
+    )
+    vars(args).update(options)
+    with pytest.raises(UsageError, match=message):
+        scene_with_overrides(args)

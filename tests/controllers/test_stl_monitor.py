@@ -102,3 +102,58 @@ def test_transfer_and_retreat_specs_sign():
     )
     assert transfer_spec(cfg, 0.3, Role.GIVER).robustness(sig) > 0
     assert transfer_spec(cfg, 0.2, Role.GIVER).robustness(sig) < 0
+
+
+def _monitor_rows(n: int, hand: np.ndarray) -> dict[str, list]:
+    """A receiving robot at the object (in the gripper's reach) that never closes its gripper."""
+    zero = np.zeros(3)
+    return {
+        "t": [0.1 * k for k in range(n)],
+        "p_r": [zero] * n,
+        "p_h": [hand] * n,
+        "p_o": [zero] * n,
+        "alpha": [0.0] * n,
+        "g_r": [1.0] * n,
+        "p_d": [zero] * n,
+        "p_home": [zero] * n,
+    }
+
+
+def test_run_monitor_transfer_binds_only_while_the_human_holds_or_shares_the_object():
+    from gazebot.sim.stl_monitor import HandoverMonitor
+
+    cfg = load_controllers_config()
+    # Table 4.2: (||p_o - p_r|| < eps and (o_h or o_s)) => <>[0, t_2] grasped. Object on the
+    # ground (o_g: released and away from the hand): the transfer spec does not bind.
+    dropped = HandoverMonitor(config=cfg, eps=0.05, dt=0.1)
+    dropped.rows = _monitor_rows(30, np.array([1.0, 0.0, 0.0]))
+    assert dropped.robustness()["transfer"] > 0
+    # Object in the human's hand at the gripper and no grasp within t_2: violated.
+    held = HandoverMonitor(config=cfg, eps=0.05, dt=0.1)
+    held.rows = _monitor_rows(30, np.zeros(3))
+    assert held.robustness()["transfer"] < 0
+
+
+def test_object_states_without_a_force_sensor_follow_table_4_1():
+    from gazebot.controllers.stl_logic import object_states
+
+    cfg = load_controllers_config().stl.model_copy(update={"force_sensor": False})
+    at, away = np.zeros(3), np.array([0.5, 0.0, 0.0])
+    # samples: robot grips it, human grips it, both grip it, nobody (on the ground)
+    sig = Signal(
+        0.1,
+        {
+            "p_o": np.zeros((4, 3)),
+            "p_r": np.array([at, away, at, away]),
+            "p_h": np.array([away, at, at, away]),
+            "g_r": np.array([0.0, 1.0, 0.0, 1.0]),
+            "g_h": np.array([1.0, 0.0, 0.0, 1.0]),
+        },
+    )
+    states = object_states(cfg, cfg.eps_p_m)
+    for k, name in enumerate(("o_r", "o_h", "o_s", "o_g")):
+        positive = {n for n, f in states.items() if f.rho(sig)[k] > 0}
+        assert positive == {name}, (k, positive)
+    # a gripper at the object but open does not hold it
+    open_gripper = Signal(0.1, {**sig.values, "g_r": np.ones(4)})
+    assert states["o_r"].rho(open_gripper)[0] < 0

@@ -1,5 +1,5 @@
 """Online latency of every event kind, and no false events on a fidgeting, noisy or aborted
-giver (pins the early onset, early release and predicted landing of ``gazebot.phases.online``)."""
+giver (pins the online reach rule, the release rule and the predicted landing)."""
 
 from __future__ import annotations
 
@@ -15,12 +15,12 @@ from gazebot.types import EventKind
 @pytest.mark.parametrize(
     ("kind", "median", "p90", "share"),
     [
-        # Measured 192 / 312 ms, 83 % (1.5 cm at 15 cm/s alone: 207 / 313 ms, 77 %). The tail
-        # is physical: dropouts over the onset, a gripper far off the reach's line, 3 mm noise.
-        (EventKind.REACH_STARTED, 0.195, 0.313, 0.83),
-        # Measured 224 / 315 ms, 69 % (1.5 cm of separation alone: 250 / 380 ms, 50 %).
-        (EventKind.RETREAT_STARTED, 0.23, 0.33, 0.66),
-        # Measured -14 / 43 ms, 100 % (0.15 s at rest: 345 / 444 ms, 25 %).
+        # Median / p90, share within 250 ms. Measured 284 / 392 ms, 40 %: 2 cm of closing with
+        # the giver's own share, past the smoothing's edge (40 ms).
+        (EventKind.REACH_STARTED, 0.3, 0.42, 0.35),
+        # Measured 264 / 376 ms, 33 % (1 cm of separation, or 4x the hold's jitter).
+        (EventKind.RETREAT_STARTED, 0.28, 0.4, 0.3),
+        # Measured -21 / 43 ms, 100 % (the predicted landing).
         (EventKind.HANDOVER_DONE, 0.0, 0.06, 1.0),
     ],
 )
@@ -34,8 +34,8 @@ def test_online_latency_on_the_varied_set(varied_set, online_results, kind, medi
 
 def test_predicted_landing_dates_the_end_of_the_retreat(varied_set, online_results):
     err, lat = event_errors(varied_set, online_results, EventKind.HANDOVER_DONE)
-    # Measured |err| median 35, p90 119, max 179 ms (rest-hold dating: 47 / 131 / 207 ms).
-    assert np.median(err) <= 0.045 and np.percentile(err, 90) <= 0.13 and err.max() <= 0.2
+    # Measured |err| median 63, p90 164, max 228 ms.
+    assert np.median(err) <= 0.07 and np.percentile(err, 90) <= 0.17 and err.max() <= 0.25
     assert lat.max() <= 0.12  # never waits for a rest hold
 
 
@@ -115,5 +115,6 @@ def test_a_reach_taken_back_ends_as_aborted_without_transfer(rate):
     events = _phase_events(traj)
     kinds = [e.kind for e in events]
     assert kinds == [EventKind.REACH_STARTED, EventKind.HANDOVER_DONE], rate
-    assert events[0].detected_at - 2.0 <= 0.25
+    # 2 cm of closing takes ~0.2 s; a sparse recording shows it up to one sample later.
+    assert events[0].detected_at - 2.0 <= 0.25 + 1.0 / rate
     assert events[1].info["source"] == "aborted"

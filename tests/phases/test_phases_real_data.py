@@ -41,7 +41,9 @@ def test_default_config_finds_the_kth_handover_within_100ms_of_the_force_truth()
 def test_default_beats_the_published_rule_at_the_kth_transfer_start():
     t0, t1 = force_truth(KTH)  # type: ignore[arg-type]
     ours = [s for s in segment(_kth(), PhaseConfig()) if s.phase is Phase.TRANSFER][0]
-    seed = [s for s in segment(_kth(), PhaseConfig(method="seed-7.2.5")) if s.phase is Phase.TRANSFER][0]
+    seed = [
+        s for s in segment(_kth(), PhaseConfig(method="seed-7.2.5")) if s.phase is Phase.TRANSFER
+    ][0]
     assert abs(ours.start - t0) < abs(seed.start - t0)
     assert abs(ours.end - t1) <= max(abs(seed.end - t1), 0.05)
 
@@ -51,8 +53,12 @@ def test_online_detects_the_kth_transfer_within_250ms_as_reach_transfer_retreat(
     t0, _ = force_truth(KTH)  # type: ignore[arg-type]
     res = run_online(_kth(), PhaseConfig())
     kinds = [e.kind for e in res.events]
-    assert kinds == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED,
-                     EventKind.RETREAT_STARTED, EventKind.HANDOVER_DONE]
+    assert kinds == [
+        EventKind.REACH_STARTED,
+        EventKind.TRANSFER_STARTED,
+        EventKind.RETREAT_STARTED,
+        EventKind.HANDOVER_DONE,
+    ]
     transfer = res.events[1]
     assert transfer.detected_at - t0 <= 0.250
 
@@ -61,9 +67,15 @@ def test_marker_offset_noisy_frozen_recordings_give_every_handover():
     errors = []
     for seed in range(6):
         rate = (30.0, 60.0, 120.0, 240.0, 45.0, 100.0)[seed]
-        opts = SyntheticOptions(rate=rate, noise=0.0015, marker_offset=0.3 + 0.04 * seed,
-                                frozen_per_s=1.0, dropouts_per_s=0.5, irregular=0.2,
-                                handovers=1 + seed % 2)
+        opts = SyntheticOptions(
+            rate=rate,
+            noise=0.0015,
+            marker_offset=0.3 + 0.04 * seed,
+            frozen_per_s=1.0,
+            dropouts_per_s=0.5,
+            irregular=0.2,
+            handovers=1 + seed % 2,
+        )
         sh = generate(100 + seed, opts)
         d = np.linalg.norm(sh.trajectory.receiver_hand - sh.trajectory.giver_hand, axis=1)
         assert np.nanmin(d) > 0.25  # hand frames never come close, as on real mocap
@@ -93,9 +105,13 @@ def test_frozen_samples_count_as_missing_not_as_a_stop():
 
 @pytest.mark.parametrize("seed", range(8))
 def test_seed_725_method_matches_an_independent_implementation_within_two_samples(seed):
-    opts = SyntheticOptions(rate=(30.0, 60.0, 120.0, 240.0)[seed % 4], noise=0.002,
-                            marker_offset=0.35 * (seed % 2), handovers=1 + seed % 3,
-                            dropouts_per_s=0.3 * (seed % 2))
+    opts = SyntheticOptions(
+        rate=(30.0, 60.0, 120.0, 240.0)[seed % 4],
+        noise=0.002,
+        marker_offset=0.35 * (seed % 2),
+        handovers=1 + seed % 3,
+        dropouts_per_s=0.3 * (seed % 2),
+    )
     traj = generate(300 + seed, opts).trajectory
     ref = seed_transfers(traj.t, traj.giver_hand, traj.receiver_hand)
     ours = [s for s in segment(traj, PhaseConfig(method="seed-7.2.5")) if s.phase is Phase.TRANSFER]
@@ -127,7 +143,9 @@ def test_seed_443_splits_one_giving_motion_with_the_published_fractions():
 
 def test_no_handover_gives_no_segments_with_every_method():
     t = np.arange(0, 5, 0.01)
-    g = np.tile([1.0, 0.0, 1.0], (t.size, 1)) + np.random.default_rng(0).normal(0, 0.001, (t.size, 3))
+    g = np.tile([1.0, 0.0, 1.0], (t.size, 1)) + np.random.default_rng(0).normal(
+        0, 0.001, (t.size, 3)
+    )
     r = np.tile([0.3, 0.0, 1.0], (t.size, 1))
     from gazebot.phases import Trajectory
 
@@ -135,3 +153,23 @@ def test_no_handover_gives_no_segments_with_every_method():
     for m in ("gazebot", "seed-7.2.5", "seed-4.4.3"):
         assert segment(traj, PhaseConfig(method=m)) == [] or m == "seed-4.4.3"
     assert segment(traj, PhaseConfig()) == []
+
+
+@needs_kth
+@pytest.mark.parametrize(
+    "giver, taker", [("giver_RFArm", "taker_RFArm"), ("giver_RHand", "taker_RFArm")]
+)
+def test_kth_with_forearm_markers_still_gives_one_handover(giver, taker):
+    # Another marker placement on the same recording: wrist-level frames, farther apart.
+    t0, t1 = force_truth(KTH)  # type: ignore[arg-type]
+    traj = load_recording(KTH, PointNames(giver, taker), rate=RATE).trajectory  # type: ignore[arg-type]
+    segs = segment(traj, PhaseConfig())
+    assert _phases(segs) == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT]
+    assert abs(segs[1].start - t0) <= 0.100 and abs(segs[1].end - t1) <= 0.100
+    kinds = [e.kind for e in run_online(traj, PhaseConfig()).events]
+    assert kinds == [
+        EventKind.REACH_STARTED,
+        EventKind.TRANSFER_STARTED,
+        EventKind.RETREAT_STARTED,
+        EventKind.HANDOVER_DONE,
+    ]

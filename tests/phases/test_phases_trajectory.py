@@ -50,7 +50,7 @@ def test_partly_missing_point_counts_as_missing(tmp_path):
         ("0,1,0,0,0.5,0,0\n,1,0,0,0.5,0,0\n", 3, "t"),
         ("0,1,0,0,0.5,0\n", 2, "receiver_hand_z"),
         ("0,1,0,0,0.5,0,inf\n", 2, "receiver_hand_z"),
-        ("0,1,0,0,0.5,0,nan\n", 2, "receiver_hand_z"),
+        ("nan,1,0,0,0.5,0,0\n", 2, "t"),
     ],
 )
 def test_malformed_cell_error_names_line_and_column(tmp_path, body, line, column):
@@ -59,6 +59,12 @@ def test_malformed_cell_error_names_line_and_column(tmp_path, body, line, column
     assert exc.value.line == line
     assert exc.value.column == column
     assert f"line {line}" in str(exc.value) and column in str(exc.value)
+
+
+def test_nan_cells_are_missing_samples_like_empty_ones(tmp_path):
+    tr = load_trajectory_csv(_write(tmp_path, HEADER + "\n0,NaN,0,0,0.5,0,0\n0.1,1,0,0,0.5,,nan\n"))
+    assert np.isnan(tr.giver_hand[0]).all() and np.isnan(tr.receiver_hand[1]).all()
+    assert np.isfinite(tr.receiver_hand[0]).all() and np.isfinite(tr.giver_hand[1]).all()
 
 
 def test_missing_and_unknown_columns_are_named(tmp_path):

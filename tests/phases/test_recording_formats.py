@@ -54,8 +54,13 @@ def _write_bag(path, traj):
             g, r = traj.giver_hand[i], traj.receiver_hand[i]
             stamp = int(t * 1e9) + 1
             if np.isfinite(g).all():
-                msg = Pose(header=hdr, pose=PoseM(position=P(x=g[0], y=g[1], z=g[2]),
-                                                  orientation=Q(x=0.0, y=0.0, z=0.0, w=1.0)))
+                msg = Pose(
+                    header=hdr,
+                    pose=PoseM(
+                        position=P(x=g[0], y=g[1], z=g[2]),
+                        orientation=Q(x=0.0, y=0.0, z=0.0, w=1.0),
+                    ),
+                )
                 w.write(cg, stamp, ts.serialize_cdr(msg, Pose.__msgtype__))
             if np.isfinite(r).all():
                 msg = PointS(header=hdr, point=P(x=r[0], y=r[1], z=r[2]))
@@ -82,8 +87,10 @@ def test_csv_c3d_and_ros2_bag_of_one_recording_give_the_same_segments(rec, tmp_p
 
 def test_csv_reads_nan_and_empty_cells_as_missing(tmp_path):
     f = tmp_path / "n.csv"
-    f.write_text("t,giver_hand_x,giver_hand_y,giver_hand_z,receiver_hand_x,receiver_hand_y,"
-                 "receiver_hand_z\n0,NaN,0,0,1,1,1\n0.1,nan,,0,1,1,1\n0.2,0,0,0,1,1,1\n")
+    f.write_text(
+        "t,giver_hand_x,giver_hand_y,giver_hand_z,receiver_hand_x,receiver_hand_y,"
+        "receiver_hand_z\n0,NaN,0,0,1,1,1\n0.1,nan,,0,1,1,1\n0.2,0,0,0,1,1,1\n"
+    )
     t = load_recording(f).trajectory
     assert np.isnan(t.giver_hand[:2]).all() and np.isfinite(t.giver_hand[2]).all()
 
@@ -91,7 +98,9 @@ def test_csv_reads_nan_and_empty_cells_as_missing(tmp_path):
 def test_no_handover_prints_an_empty_table_and_exits_0(tmp_path, capsys):
     t = np.arange(0, 3, 0.01)
     f = tmp_path / "still.csv"
-    rows = ["t,giver_hand_x,giver_hand_y,giver_hand_z,receiver_hand_x,receiver_hand_y,receiver_hand_z"]
+    rows = [
+        "t,giver_hand_x,giver_hand_y,giver_hand_z,receiver_hand_x,receiver_hand_y,receiver_hand_z"
+    ]
     rows += [f"{x:.2f},1,0,1,0.3,0,1" for x in t]
     f.write_text("\n".join(rows) + "\n")
     assert main(["phases", str(f)]) == 0

@@ -124,12 +124,14 @@ def test_robot_to_human_scene_the_person_takes_the_object(controller):
     assert sim.reach_start_time == pytest.approx(0.3, abs=0.05)  # robot first, then the person
 
 
-def _monitored(scene):
+def _monitored(scene, force_sensor: bool = True):
     from gazebot.sim.simulation import HandoverSimulation
-    from gazebot.sim.stl_monitor import HandoverMonitor
+    from gazebot.sim.stl_monitor import HandoverMonitor, robot_timing
 
     sim = HandoverSimulation(robot="jaco2", scene=scene, seed=0)
-    monitor = HandoverMonitor()
+    cfg = robot_timing(sim)
+    cfg = cfg.model_copy(update={"stl": cfg.stl.model_copy(update={"force_sensor": force_sensor})})
+    monitor = HandoverMonitor(config=cfg)
     while sim.t < 8.0 and not sim.done:
         sim.step(1 / 30)
         monitor.sample(sim)
@@ -138,6 +140,11 @@ def _monitored(scene):
 
 def test_stl_monitor_over_a_run_positive_when_met_negative_when_missed():
     met = _monitored(_scene(reach_controller="mce", reach_time_s=2.5, stall_time_s=0.5))
+    assert met["reach"] > 0 and met["transfer"] > 0 and met["retreat"] > 0
+    # Table 4.1 without a force sensor: object states from distances and grips, same verdicts
+    met = _monitored(
+        _scene(reach_controller="mce", reach_time_s=2.5, stall_time_s=0.5), force_sensor=False
+    )
     assert met["reach"] > 0 and met["transfer"] > 0 and met["retreat"] > 0
     missed = _monitored(_scene(reach_controller="mce", reach_time_s=0.3))
     assert missed["reach"] < 0

@@ -246,6 +246,58 @@ def test_bias_is_tested_per_question_as_in_6_4_and_sides_default_to_one(two_leve
     assert one.sides == "one" and one.to_json()["bias_per_question"]["q5"]["z"] == (
         one.bias_per_question["q5"].z
     )
+    assert one.to_json()["bias_per_question"]["q5"]["p_z"] == one.bias_per_question["q5"].p_z
     for c1, c2 in zip(one.comparisons, two.comparisons, strict=True):
         assert c1.difference.z == c2.difference.z
         assert c1.difference.p_value == pytest.approx(c2.difference.p_value / 2)
+
+
+def test_a_sample_without_a_finite_fit_is_named_in_the_error(tmp_path):
+    """An in-person group with two sessions entered so far: the error says which sample."""
+    path = tmp_path / "r.csv"
+    head = "participant,session,condition,level,first,second,q1,q2,q3,q4,q5,group\n"
+    rows = [
+        f"{p},{k},,,{a},{b},1,2,1,2,1,video"
+        for p in (1, 2)
+        for k, (a, b) in enumerate([("face", "hand"), ("hand", "face")], start=1)
+    ] + ["3,1,,,face,hand,1,1,1,1,1,in-person", "3,2,,,hand,face,2,2,2,2,2,in-person"]
+    path.write_text(head + "\n".join(rows) + "\n")
+    with pytest.raises(ValueError, match=r"sample 'in-person:' \(1 participants, 2 sessions\)"):
+        analyze(read_responses(path))
+
+
+def test_bias_is_also_tested_per_group_as_the_seed_tests_each_study(tmp_path):
+    """Video participants who always pick the 2nd, in-person ones who pick either: the video
+    group's bias shows on its own, the in-person group's does not."""
+    path = tmp_path / "r.csv"
+    head = "participant,session,condition,level,first,second,q1,q2,q3,q4,q5,group\n"
+    pairs = [("face", "hand"), ("hand", "face")]
+    rows = []
+    for p in range(1, 15):  # over 13: scipy's quick normal p, not a permutation test
+        for k, (a, b) in enumerate(pairs, start=1):
+            rows.append(f"{p},{k},,,{a},{b},2,2,2,2,2,video")
+            even = "1" if (p + k) % 2 else "2"
+            rows.append(f"{p},{k},,,{a},{b},{','.join([even] * 5)},in-person")
+    path.write_text(head + "\n".join(rows) + "\n")
+    result = analyze(read_responses(path))
+    assert set(result.bias_by_group) == {"video", "in-person"}
+    video, live = result.bias_by_group["video"], result.bias_by_group["in-person"]
+    assert video["q1"].z < -2.5 and video["q1"].p_z < 0.01 and video["likability"].p_value < 0.01
+    assert live["q1"].z == 0 and live["q1"].p_z == 1.0
+    assert result.to_json()["bias_by_group"]["video"]["q5"]["p_z"] == video["q5"].p_z
+
+
+def test_the_6_3_behaviors_are_reported_in_the_order_of_tables_6_1_and_6_2(tmp_path):
+    from gazebot.study.analysis import behaviors_of
+
+    path = tmp_path / "r.csv"
+    head = "participant,session,condition,level,first,second,q1,q2,q3,q4,q5\n"
+    pairs = [("short-face-hand", "hand"), ("face", "long-face-hand"), ("hand", "face")]
+    rows = [f"1,{k},,,{a},{b},1,2,1,2,1" for k, (a, b) in enumerate(pairs, start=1)]
+    path.write_text(head + "\n".join(rows) + "\n")
+    assert behaviors_of(read_responses(path)) == [
+        "face",
+        "hand",
+        "long-face-hand",
+        "short-face-hand",
+    ]

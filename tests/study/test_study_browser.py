@@ -108,6 +108,25 @@ def _wait_for_questions(d) -> None:
     assert d.find_element(By.ID, "v2").is_displayed()
 
 
+def _played_behaviors(d, study_dir) -> tuple[str, str]:
+    """The behaviors of the two videos the page played, found by their bytes among the rendered
+    handover videos (manifest.json names each file's behavior): what the participant saw, not
+    what the server says it served."""
+    manifest = json.loads((study_dir / "manifest.json").read_text())
+    by_bytes = {
+        (study_dir / rel).read_bytes(): v["behavior"] for rel, v in manifest["videos"].items()
+    }
+    srcs = d.execute_script(
+        "return ['v1', 'v2'].map(function (id) { return document.getElementById(id).currentSrc; })"
+    )
+    out = []
+    for src in srcs:
+        status, _, body = http("GET", src)
+        assert status == 200, src
+        out.append(by_bytes[body])
+    return out[0], out[1]
+
+
 def _click_answers(d, answers: dict[str, int], comment: str) -> None:
     from selenium.webdriver.common.by import By
 
@@ -156,7 +175,16 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
         assert "the robot's head movement" in d.find_element(By.ID, "instructions").text
         _submit(d)
         _at(d, "Practice session")
+        # Skipping to the end does not count: the video plays again, all of it, first.
+        _wait(lambda: d.execute_script("return document.getElementById('v1').readyState >= 1"))
+        d.execute_script("var v = document.getElementById('v1'); v.currentTime = v.duration;")
         _wait_for_questions(d)
+        played = d.execute_script(
+            "var v = document.getElementById('v1'), t = 0;"
+            "for (var i = 0; i < v.played.length; i++) t += v.played.end(i) - v.played.start(i);"
+            "return [t, v.duration];"
+        )
+        assert played[0] >= 0.9 * played[1], played
         _click_answers(d, {q: 1 for q in QUESTIONS}, "practice")
         _submit(d)
 
@@ -164,6 +192,9 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
         for s in sessions:
             _at(d, f"Session {s.session} of {len(sessions)}")
             _wait_for_questions(d)
+            # The 1st video played is the plan's first behavior: "1st" answers mean what export
+            # and analyze say they mean.
+            assert _played_behaviors(d, study_dir) == (s.first, s.second)
             answers = {q: int(rng.integers(1, 3)) for q in QUESTIONS}
             clicked[s.session] = answers
             _click_answers(d, answers, f"comment {s.session}")
@@ -184,9 +215,7 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
                 _wait_for_questions(d)
                 _click_answers(d, answers, f"comment {s.session}")
             # Two clicks in a row on the submit button: the page sends one form.
-            d.execute_script(
-                "var b = document.getElementById('next'); b.click(); b.click();"
-            )
+            d.execute_script("var b = document.getElementById('next'); b.click(); b.click();")
             _wait(
                 lambda s=s: _heading(d) not in ("", f"Session {s.session} of {len(sessions)}"),
                 what="the next page after a double click",

@@ -188,6 +188,7 @@ def test_plan_of_the_seed_6_3_design_needs_no_condition_and_no_out(tmp_path, mon
     doc = json.loads(capsys.readouterr().out)
     assert doc["sessions_per_participant"] == 12 and doc["condition"] == ""
     assert doc["gaze_mode"] == "head-only"
+    assert doc["robot"] == "jaco2"  # 6.3.2: the Jaco-2 with "a simple robot head"
     with (tmp_path / "plan.csv").open() as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 24 * 12
@@ -202,6 +203,19 @@ def test_plan_with_a_condition_defaults_to_the_as_studied_behaviors(tmp_path, ca
     doc = json.loads(capsys.readouterr().out)
     assert doc["behaviors"] == ["hand-face-as-studied", "face-hand-face-as-studied", "hand"]
     assert doc["gaze_mode"] == "eyes-only"
+    assert doc["robot"] == "sawyer"  # 6.4.3: "implemented on a Sawyer cobot"
+
+
+def test_plan_robot_defaults_to_the_designs_robot_and_robot_overrides_it(tmp_path, capsys):
+    from gazebot.study.plan import read_plan
+
+    out = tmp_path / "p.csv"
+    assert run(["study", "plan", "--participants", "12", "--out", str(out)]) == 0
+    assert {s.robot for s in read_plan(out)} == {"jaco2"}
+    assert "robot jaco2" in capsys.readouterr().out
+    argv = ["study", "plan", "--participants", "12", "--robot", "sawyer", "--out", str(out)]
+    assert run(argv) == 0
+    assert {s.robot for s in read_plan(out)} == {"sawyer"}
 
 
 def test_serve_and_export_on_a_folder_that_is_not_a_rendered_study_say_so(tmp_path):

@@ -53,6 +53,13 @@ def test_plan_rejects_unknown_behavior_naming_it_and_listing_available(tmp_path)
     assert not out.exists()
 
 
+def test_plan_rejects_unknown_robot_naming_the_known_ones(tmp_path):
+    out = tmp_path / "p.csv"
+    with pytest.raises(ValueError, match=r"--robot: unknown robot 'nosuch' \(known: .*jaco2"):
+        run(["study", "plan", "--participants", "12", "--robot", "nosuch", "--out", str(out)])
+    assert not out.exists()
+
+
 def test_plan_conditions_come_from_the_plan_module(tmp_path, capsys):
     for condition in CONDITION_LEVELS:
         assert run(_plan_argv(tmp_path / f"{condition}.csv", condition=condition)) == 0

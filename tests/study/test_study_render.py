@@ -25,7 +25,7 @@ CALL_LOG = "GAZEBOT_STUDY_TEST_CALL_LOG"
 def counting_renderer(robot, behavior, scene, out_path, **kw):
     """The synthetic renderer, logging each call (workers are processes: count via a file)."""
     with open(os.environ[CALL_LOG], "a") as fh:
-        fh.write(f"{robot},{behavior},{scene},{kw['seed']},{os.getpid()}\n")
+        fh.write(f"{robot},{behavior},{scene},{kw['seed']},{os.getpid()},{kw['gaze_mode']}\n")
     return render_synthetic_video(robot, behavior, scene, out_path, duration=CLIP_S, **kw)
 
 
@@ -65,6 +65,7 @@ def test_24_participant_plan_renders_each_distinct_video_exactly_once(rendered):
     assert len(distinct) == 6  # 3 behaviors x 2 fragility levels
     assert sorted(tuple(c[:3]) for c in calls) == sorted(distinct)
     assert all(int(c[4]) != os.getpid() for c in calls)  # rendered in worker processes
+    assert {c[5] for c in calls} == {"eyes-only"}  # the 6.4 plan's gaze mode reaches the renderer
     assert len(report.videos) == 6 and len(report.rendered) == 6
     assert all(p.is_file() for p in report.videos.values())
 
@@ -229,3 +230,30 @@ def test_plan_gaze_mode_needs_a_renderer_that_takes_it(tmp_path):
     plan = make_plan(["face", "hand"], condition=None, participants=2, gaze_mode="eyes-only")
     with pytest.raises(ValueError, match="gaze mode 'eyes-only'.*takes no gaze_mode"):
         render_study(plan, tmp_path, old_renderer, W, H, FPS, workers=1, progress=False)
+
+
+def test_plan_gaze_mode_reaches_the_renderer_and_sets_the_robot_config(monkeypatch, tmp_path):
+    """The MuJoCo study renderer gets the plan's gaze mode and renders the robot in it."""
+    import gazebot.sim.record as record
+    from gazebot.study.render import render_handover_in_gaze_mode
+
+    seen = {}
+
+    def fake_render(robot, behavior, scene, out_path, **kw):
+        seen.update(robot=robot, behavior=behavior, scene=scene, **kw)
+        return Path(out_path)
+
+    monkeypatch.setattr(record, "render_handover_video", fake_render)
+    try:
+        from gazebot.kinematics.config import with_gaze_mode  # noqa: F401
+    except ImportError:  # a gazebot without gaze modes in the robot config
+        with pytest.raises(ValueError, match="cannot render gaze mode 'eyes-only'"):
+            render_handover_in_gaze_mode(
+                "sawyer", "hand", "default", tmp_path / "v.mp4", gaze_mode="eyes-only"
+            )
+        return
+    render_handover_in_gaze_mode(
+        "sawyer", "hand", "default", tmp_path / "v.mp4", seed=3, gaze_mode="eyes-only"
+    )
+    assert seen["robot"].gaze_mode == "eyes-only"
+    assert (seen["behavior"], seen["scene"], seen["seed"]) == ("hand", "default", 3)

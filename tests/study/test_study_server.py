@@ -77,7 +77,7 @@ def test_session_page_shows_the_seed_questions_and_no_behavior_names(fresh):
     assert "Which handover did you like better? (1st or 2nd)" in page
     assert "wanted the giver to give the object? (1st or 2nd)" in page
     assert "Any other comments (optional)" in page
-    for name in ("face", "hand", "short-face-hand", "sawyer", ".mp4\">"):
+    for name in ("face", "hand", "short-face-hand", "jaco2", "sawyer", '.mp4">'):
         assert f"{name}_" not in page and f"/{name}" not in page
     assert page.count("<video") == 2 and "disabled" in page  # questions wait for both videos
 
@@ -192,6 +192,18 @@ def test_in_person_mode_enters_answers_in_plan_order_with_the_in_person_question
     assert study.store().progress(3).finished_at is not None
 
 
+def test_admin_table_shows_an_in_person_participants_next_live_pair_not_a_practice(fresh):
+    """In person there is no practice session: after two entered pairs the table says session
+    3 (it said "practice" for as long as the participant took part)."""
+    study = load_study(fresh)
+    c = client(fresh)
+    for s in study.sessions_of(3)[:2]:
+        resp = c.post("/admin/in-person/3", data={**ANSWERS, "session": str(s.session)})
+        assert resp.status_code == 303
+    row = "<td>3</td><td>in-person</td><td>2 / 6</td><td>session 3</td>"
+    assert row in c.get("/admin").get_data(as_text=True)
+
+
 def test_in_person_entry_for_an_online_participant_is_refused(fresh):
     c = client(fresh)
     start(c, 4)
@@ -290,3 +302,50 @@ def test_export_names_the_mode_as_group_when_a_study_has_both(fresh, tmp_path):
     assert (rows["1"]["group"], rows["1"]["mode"]) == ("video", "video")
     assert rows["3"]["group"] == "in-person" and float(rows["3"]["seconds"]) >= 0
     assert {r.group for r in read_responses(out)} == {"video", "in-person"}
+
+
+def test_export_and_analyze_commands_on_a_served_study(fresh, tmp_path, capsys):
+    import argparse
+
+    from gazebot.cli import study as study_cli
+
+    def run(argv):
+        parser = argparse.ArgumentParser(prog="gazebot")
+        study_cli.register(parser.add_subparsers(dest="command"))
+        args = parser.parse_args(argv)
+        return args.func(args)
+
+    c = client(fresh)
+    for pid in (1, 2):
+        start(c, pid)
+        for k in range(0, 7):
+            c.post(f"/p/{pid}/session/{k}", data={**ANSWERS, "q1": str(1 + (k + pid) % 2)})
+    out = tmp_path / "responses.csv"
+    assert run(["study", "export", str(fresh), "--out", str(out)]) == 0
+    assert "wrote 12 answered sessions" in capsys.readouterr().out
+    assert run(["study", "analyze", str(out), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["per_level"][""]["likability"]["participants"] == 2
+    assert set(doc["bias_per_question"]) == {"q1", "q2", "q3", "q4", "q5"}
+
+
+def test_the_study_folders_consent_text_replaces_the_default(fresh):
+    (fresh / "consent.txt").write_text("Approved text, part one.\n\nPart <two>.\n")
+    try:
+        page = client(fresh).get("/p/5").get_data(as_text=True)
+    finally:
+        (fresh / "consent.txt").unlink()
+    assert "<p>Approved text, part one.</p>" in page and "<p>Part &lt;two&gt;.</p>" in page
+    assert "You are invited" not in page
+    assert "You are invited" in client(fresh).get("/p/5").get_data(as_text=True)
+
+
+def test_serve_on_all_interfaces_prints_an_address_a_browser_can_open():
+    import socket
+
+    from gazebot.study.web.server import base_url
+
+    assert base_url("0.0.0.0", 8000) == f"http://{socket.gethostname()}:8000"
+    assert base_url("::", 80).startswith(f"http://{socket.gethostname()}")
+    assert base_url("127.0.0.1", 8000) == "http://127.0.0.1:8000"
+    assert base_url("::1", 8000) == "http://[::1]:8000"

@@ -120,6 +120,18 @@ def test_bias_z_is_the_tie_corrected_normal_score_scipy_reports():
     assert b.z > 0 and b.s > 0  # more "1st" than "2nd": positive S and z
 
 
+def test_bias_p_quoted_with_z_is_its_normal_p_as_the_seed_quotes_it():
+    # 6.4.4: "like: z = -0.68, p = 0.50 ... humanlike: z = 1.36, p = 0.17". With few differences
+    # and no ties scipy's p is exact and belongs to no z: one "1st" gives z = 1, exact p = 1.
+    one = position_bias_test(np.array([0.5]))
+    assert one.z == pytest.approx(1.0) and one.p_value == pytest.approx(1.0)
+    assert one.p_z == pytest.approx(0.3173, abs=1e-4)
+    d = np.array([0.5, -0.2, 0.5, 1, -1, 0.3, 0.5, -0.5, 0.2, 0.1, 0.0])
+    b = position_bias_test(d)
+    assert b.p_z == pytest.approx(2 * sps.norm.sf(abs(b.z)))
+    assert round(2 * sps.norm.sf(0.68), 2) == 0.50 and round(2 * sps.norm.sf(1.36), 2) == 0.17
+
+
 def test_one_sided_p_is_half_the_two_sided_p_in_the_observed_direction():
     rng = np.random.default_rng(3)
     a = (rng.random(24) < 0.7).astype(float)

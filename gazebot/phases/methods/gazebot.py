@@ -68,6 +68,15 @@ class GazebotSegmenter(Segmenter):
         trailing_ok = True
         for k, core in enumerate(cores):
             t_start = core.t_start
+            if partial and math.isfinite(t_start) and core.end >= n - 2:
+                # Online: a transfer is confirmed once the hands have held for min_transfer
+                # (the hold's floor, which dates the start, needs a few samples of it) without
+                # closing further (a giver waiting for a slowly arriving receiver).
+                recent = s.distance[int(np.searchsorted(s.t, grid_end - c.min_transfer)) :]
+                recent = recent[np.isfinite(recent)]
+                closing = float(recent[0] - recent.min()) if recent.size else 0.0
+                if t_start > grid_end - c.min_transfer or closing > c.still_closing:
+                    t_start = math.nan
             if not math.isfinite(t_start):
                 if partial:
                     # The approach has not settled yet: still a reach.

@@ -50,10 +50,10 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     """Onset of a reach still under way when the data end (after grid index ``lo``), else
     ``None``: the hands have closed by ``reach_confirm_distance`` from their farthest since
     ``lo`` and are at their closest now, and the giver's hand has itself moved toward the
-    receiver by ``approach_ratio`` of that distance, the hands closing faster than
-    ``reach_onset_speed`` within the last ``smoothing`` window (or, when the receiver did the closing, the
-    giver's hand moved faster than ``reach_onset_speed`` and the hands closed by
-    ``min_approach``)."""
+    receiver by ``approach_ratio`` of that distance, the hands closing and the giver's hand
+    moving faster than ``reach_onset_speed`` within the last ``smoothing`` window (or, when
+    the receiver did the closing, the giver's hand moved faster than ``reach_onset_speed``
+    and the hands closed by ``min_approach``)."""
     d = s.distance[lo:]
     seen = np.flatnonzero(np.isfinite(d))
     if seen.size < 3:
@@ -62,7 +62,10 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     i_last = int(seen[-1])
     last = float(d[i_last])
     closed = float(d[i_max]) - last
-    if closed < c.reach_confirm_distance or last > float(np.nanmin(d[i_max:])) + c.reach_confirm_distance:
+    if (
+        closed < c.reach_confirm_distance
+        or last > float(np.nanmin(d[i_max:])) + c.reach_confirm_distance
+    ):
         return None
     k = lo + i_last
     # The giver's own share of the closing: its displacement since the hands were farthest,
@@ -74,7 +77,9 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     closing = -np.einsum("ij,ij->i", s.rel_v[j0 : k + 1], s.rel[j0 : k + 1]) / np.maximum(
         s.distance[j0 : k + 1], 1e-9
     )
-    fast = bool(np.nanmax(closing, initial=0.0) >= c.reach_onset_speed)
+    fast = bool(np.nanmax(closing, initial=0.0) >= c.reach_onset_speed) and bool(
+        np.nanmax(s.giver_speed[j0 : k + 1], initial=0.0) >= c.reach_onset_speed
+    )
     moving = fast and own >= c.approach_ratio * c.reach_confirm_distance
     if not moving:
         if closed < c.min_approach:

@@ -48,7 +48,9 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)
-    held = np.nanmedian(s.rel[idx], axis=0)
+    rows = s.rel[idx]
+    rows = rows[np.isfinite(rows).all(axis=1)]
+    held = np.median(rows, axis=0) if rows.size else np.full(3, np.nan)
     sep_min = release_threshold(s, c, idx, held)
     n = s.t.shape[0]
     j = i_h

@@ -47,3 +47,65 @@ def far_after(s: Signals, c: PhaseConfig, i_end: int) -> float:
     moved = np.linalg.norm(s.giver[i_end:] - s.giver[int(seen[-1])], axis=1)
     far = np.flatnonzero(moved >= c.retreat_far_distance)
     return float(s.t[i_end + int(far[0])]) if far.size else math.inf
+
+
+def retreat_done(
+    s: Signals, c: PhaseConfig, t_release: float, joined_late: bool = False
+) -> tuple[float, str] | None:
+    """The end of a retreat that started at ``t_release``, as far as the data show it:
+    ``(time, source)`` with source ``rest``, ``far`` or ``landing`` (:func:`_landing`), or
+    ``None`` while it goes on.
+
+    When the release predates the data, or ``joined_late`` (an engine restarted mid-retreat),
+    the hand's motion since the release is unknown: a hand at rest (under ``rest_speed`` for
+    ``rest_hold``) ends the retreat.
+    """
+    n = s.t.shape[0]
+    if n < 2:
+        return None
+    i0 = int(np.searchsorted(s.t, t_release))
+    if i0 >= n - 1:
+        return None
+    t_rest, seen = rest_after(s, c, i0, n - 1)
+    landing = _landing(s, c, i0, t_release)
+    late = joined_late or t_release < s.t[0]
+    t_far = far_after(s, c, i0) if not late else math.inf
+    best: tuple[float, str] | None = None
+    if seen and t_rest < s.t[-1]:
+        best = (t_rest, "rest")
+    if math.isfinite(t_far) and (best is None or t_far < best[0]):
+        best = (t_far, "far")
+    if landing is not None and (best is None or landing < best[0]):
+        best = (landing, "landing")
+    if best is None and late:
+        v = s.giver_speed
+        hold = int(round(c.rest_hold * c.analysis_rate))
+        slow = np.isfinite(v) & (v < c.rest_speed)
+        if n > hold and slow[-hold - 1 :].all():
+            k = n - 1
+            while k > i0 and slow[k - 1]:
+                k -= 1
+            best = (max(float(s.t[k]), t_release), "rest")
+    return best
+
+
+def _landing(s: Signals, c: PhaseConfig, i0: int, t_release: float) -> float | None:
+    """A predicted landing: the giver's hand, having moved ``min_approach`` since the release,
+    slowed below ``done_fraction`` of its peak speed. A bell-shaped (minimum-jerk) profile is
+    then within a few percent of its end, which mirrors the onset about the peak:
+    ``t_release + 2 (t_peak - t_release)`` (not after the last sample)."""
+    if t_release < s.t[0]:
+        return None
+    v = s.giver_speed[i0:]
+    ok = np.isfinite(v)
+    if not ok.any():
+        return None
+    k = int(np.nanargmax(v))
+    peak = float(v[k])
+    last = int(np.flatnonzero(ok)[-1])
+    moved = float(np.linalg.norm(s.giver[i0 + last] - s.giver[i0]))
+    if peak < c.reach_onset_speed or last <= k or not moved >= c.min_approach:
+        return None
+    if not v[last] < c.done_fraction * peak:
+        return None
+    return min(t_release + 2.0 * (float(s.t[i0 + k]) - t_release), float(s.t[i0 + last]))

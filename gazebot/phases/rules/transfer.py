@@ -2,20 +2,22 @@
 
 A handover is a dip of the hands' distance at least ``min_approach`` deep (the recording's ends
 count as high ground) that closes at least ``approach_fraction`` of the distance the hands
-started from (a pause of a slow approach is no handover). Its minimum is the seed's "minimum distance" (section 7.2.5), whatever it
-is: on real motion capture the hand frames sit on the back of the hand or at the wrist and the
-object has size, so they never come closer than 0.3-0.5 m; no absolute contact distance is
-assumed. Within the dip, the seed's rule (within ``transfer_distance_margin`` of the minimum,
-relative speed under ``transfer_speed_max``) gives the transfer's core; runs split by short
-blips under ``transfer_exit_speed`` or by tracking gaps merge. The giver's hand must have moved
-(``reach_onset_speed``) before the core: a receiver (robot) returning home near a resting
-giver makes a dip too; the receiver may move more than the giver.
+started from (a pause of a slow approach is no handover). Its minimum is the seed's "minimum
+distance" (section 7.2.5), whatever it is: on real motion capture the hand frames sit on the
+back of the hand or at the wrist and the object has size, so they never come closer than
+0.3-0.5 m; no absolute contact distance is assumed. Within the dip, the seed's rule (within
+``transfer_distance_margin`` of the minimum, relative speed under ``transfer_speed_max``)
+gives the transfer's core; runs split by short blips under ``transfer_exit_speed`` or by
+tracking gaps merge. The giver's hand must have moved (``reach_onset_speed``) before the core:
+a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
+more than the giver.
 
 The seed's 15 cm/s is crossed on the tail of the approach, before contact. The transfer starts
 where the approach has stopped: the relative speed falls below ``settle_fraction`` of the
 approach's own peak relative speed (scale-free: fast and slow approaches alike), or below
 ``settle_floor_factor`` times the hold's speed floor (marker noise and both hands carrying the
-object keep the relative speed of a real hold at 3-7 cm/s).
+object keep the relative speed of a real hold at 3-7 cm/s), whichever is higher; a clean
+approach's parabolic tail is then extrapolated down to the floor (:func:`transfer_start`).
 """
 
 from __future__ import annotations
@@ -145,6 +147,11 @@ def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
     return float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
 
 
+def v_settle_fraction(s: Signals, c: PhaseConfig, lo: int, a: int) -> float:
+    """``settle_fraction`` of the approach's peak relative speed (m/s)."""
+    return c.settle_fraction * float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
+
+
 def settle_speed(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
     """The relative speed below which the approach of the core ``[a, b]`` has stopped (m/s)."""
     peak = float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
@@ -186,9 +193,18 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
             return float(s.t[a + int(np.argmin(seen))]) if seen.size else float(s.t[a])
         return math.nan
     i = a + int(below[0])
+    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
+    # The core's first part is the approach's tail: once the crossing is known, the hold's
+    # floor is measured on the samples after it (a short, early hold otherwise reads high).
+    for _ in range(2):
+        v_f = c.settle_floor_factor * hold_floor(s, c, i, b)
+        v_new = min(max(v_f, v_settle_fraction(s, c, lo, a)), c.transfer_speed_max)
+        below = np.flatnonzero(seen < v_new)
+        if v_new >= v_settle or below.size == 0:
+            break
+        v_settle, i = v_new, a + int(below[0])
     t_s = _crossing(s, i, v_settle)
     t_a = _crossing(s, a, c.transfer_speed_max)
-    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
     v_a = c.transfer_speed_max
     if v_f < v_settle < v_a and t_s > t_a:
         ext = (t_s - t_a) * (math.sqrt(v_settle) - math.sqrt(v_f))

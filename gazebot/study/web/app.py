@@ -49,6 +49,13 @@ from gazebot.study.questionnaire import (
 from gazebot.study.store import Progress, ResponseStore
 
 ADMIN_COOKIE = "gazebot_admin"
+CONSENT_FILE = "consent.txt"  # the study's own consent text, in the study folder
+DEFAULT_CONSENT = (
+    "You are invited to take part in a study of how people perceive a robot's gaze when a person "
+    "hands an object to the robot. You will watch short videos of handovers and answer a few "
+    "questions after each pair of videos. Taking part is voluntary: you may stop at any time. "
+    "Your answers are stored under your participant number only."
+)
 MAX_COMMENT = 4000  # characters kept of a comment
 
 
@@ -71,7 +78,9 @@ def current_step(
     if prog.instructions_at is None:
         return Step("instructions")
     done = set(prog.answered)
-    for k in [PRACTICE] + [s.session for s in study.sessions_of(participant)]:
+    # In person the experimenter enters the plan's sessions only: there is no practice to wait for.
+    practice = [] if prog.mode == "in-person" else [PRACTICE]
+    for k in practice + [s.session for s in study.sessions_of(participant)]:
         if k not in done:
             return Step("session", k)
     return Step("done")
@@ -113,6 +122,12 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
     app.config["ADMIN_TOKEN"] = admin_token or secrets.token_urlsafe(16)
     app.config["STUDY"] = study
     app.config["STORE"] = store
+    consent_file = study.root / CONSENT_FILE
+    # The ethics board's text replaces ours: paragraphs separated by blank lines.
+    consent_text = (
+        consent_file.read_text(encoding="utf-8") if consent_file.is_file() else DEFAULT_CONSENT
+    )
+    consent_paragraphs = [p.strip() for p in consent_text.split("\n\n") if p.strip()]
     n_sessions = {p: len(study.sessions_of(p)) for p in study.participants}
     last_session = {p: max(s.session for s in study.sessions_of(p)) for p in study.participants}
 
@@ -177,7 +192,7 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
             return in_person_page(participant)
         step = current_step(study, store, participant, prog)
         if step.kind == "consent":
-            return page("consent.html", participant=participant)
+            return page("consent.html", participant=participant, paragraphs=consent_paragraphs)
         if step.kind == "instructions":
             return page(
                 "instructions.html",

@@ -3,10 +3,20 @@
 from __future__ import annotations
 
 import secrets
+import socket
 import sys
 from typing import TextIO
 
 from gazebot.study.web.app import create_app
+
+
+def base_url(host: str, port: int) -> str:
+    """The address to print for a server on ``host``: a wildcard address (all interfaces) is
+    not one a browser can open, so the machine's name stands for it."""
+    if host in ("", "0.0.0.0", "::"):
+        host = socket.gethostname()
+    shown = f"[{host}]" if ":" in host else host
+    return f"http://{shown}:{port}"
 
 
 def serve(
@@ -27,8 +37,7 @@ def serve(
     token = admin_token or secrets.token_urlsafe(16)
     app = create_app(study_dir, admin_token=token, local_admin=local_admin)
     server = create_server(app, host=host, port=port, threads=threads, ident="gazebot-study")
-    shown = f"[{host}]" if ":" in host else host
-    base = f"http://{shown}:{server.effective_port}"
+    base = base_url(host, server.effective_port)
     study = app.config["STUDY"]
     print(
         f"serving {len(study.participants)} participants of {study.root} at {base}/p/N "
