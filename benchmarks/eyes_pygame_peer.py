@@ -150,20 +150,8 @@ class PygameEyeRenderer(EyeRenderer):
                 c = (px + ox * r_p * squash, py + oy * r_p)
                 pygame.draw.aacircle(surf, s.pupil.highlight_color, c, radius)
         lids = s.lids
-        b = g.b
-        y_close = g.cy + lids.closed_at * b
-        y_up = g.cy - lids.upper_open * b + lids.follow * v
-        y_up = min(y_up, y_close - 1.0)
-        y_up += (y_close + 1.5 - y_up) * blink
-        y_lo = g.cy + lids.lower_open * b + lids.lower_follow * v
-        y_lo = max(y_lo, y_close + 1.0)
-        y_lo += (y_close - 1.5 - y_lo) * blink
-        curve = (lids.curve_open + (lids.curve_closed - lids.curve_open) * blink) * b
-        xs = np.linspace(-g.a - self._outline - 3.0, g.a + self._outline + 3.0, 25)
-        rel = (xs / g.a) ** 2
+        upper, lower = self.lid_curves(g, g.cx, g.cy, v, blink)
         top, bottom = lay.y0 - 8.0, lay.y1 + 8.0
-        upper = np.column_stack([g.cx + xs, y_up + curve * rel])
-        lower = np.column_stack([g.cx + xs, y_lo - lids.lower_curve * b * rel])
         for edge, end in ((lower, bottom), (upper, top)):
             poly = np.vstack([edge, [[edge[-1, 0], end], [edge[0, 0], end]]]).tolist()
             pygame.draw.polygon(surf, lids.color, poly)

@@ -19,7 +19,6 @@ from gazebot.kinematics import GazeController, GazeShiftConfig, RobotConfig, Rob
 from gazebot.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.types import (
     Event,
-    EventKind,
     GazeCommand,
     GazeContext,
     Phase,
@@ -80,7 +79,6 @@ class GazeEngine:
         self._memory = _PointMemory()
         self._pending: list[Event] = []
         self._last_t = -math.inf
-        self._lost_since = math.nan
         self._fixed_points = {k: np.asarray(v, float) for k, v in robot.points.items()}
 
     @classmethod
@@ -135,7 +133,8 @@ class GazeEngine:
         events = self.detector.update_all(frame)
         events.extend(self._pending)
         self._pending.clear()
-        self._handle(events)
+        for event in events:
+            self.behavior.handle(event)
 
         if math.isfinite(frame.t):
             t = self._last_t = max(frame.t, self._last_t)
@@ -162,21 +161,12 @@ class GazeEngine:
             events=tuple(events),
         )
 
-    def _handle(self, events: list[Event]) -> None:
-        for event in events:
-            self.behavior.handle(event)
-            if event.kind is EventKind.TRACKING_LOST and not math.isfinite(self._lost_since):
-                self._lost_since = event.t
-        if not self.behavior.lost:
-            self._lost_since = math.nan
-
-    def tracking_state(self, t: float) -> str:
-        """``ok``; ``hold`` while tracking is lost and the behavior still holds the gaze (its
-        ``tracking_lost.hold_s``); ``lost`` once it looks at its ``tracking_lost`` target."""
-        if not self.behavior.lost:
-            return "ok"
-        since = self._lost_since if math.isfinite(self._lost_since) else t
-        return "hold" if t < since + self.behavior_spec.tracking_lost.hold_s else "lost"
+    @property
+    def tracking(self) -> str:
+        """The behavior's tracking state after the last step: ``ok``; ``hold`` while tracking is
+        lost and the behavior holds the gaze (its ``tracking_lost.hold_s``); ``lost`` once it
+        looks at its ``tracking_lost`` target."""
+        return self.behavior.tracking
 
     def look_at(
         self,
@@ -211,7 +201,7 @@ class GazeEngine:
         phase and robot events published before the restart, oldest first."""
         for event in sorted(events, key=lambda e: e.t):
             self.detector.resync(event)
-            self._handle([event])
+            self.behavior.handle(event)
 
     def reset(self, head: Mapping[str, float] | None = None) -> None:
         """Forget the current handover (e.g. after a restart) and optionally the head pose."""
@@ -221,4 +211,3 @@ class GazeEngine:
         self._memory = _PointMemory()
         self._pending.clear()
         self._last_t = -math.inf
-        self._lost_since = math.nan

@@ -436,6 +436,12 @@ class BehaviorMachine:
         return self._target_of[self._leaf[self._model.state[0]][1]]
 
     @property
+    def tracking(self) -> str:
+        """The ``tracking`` region's state: ``ok``, ``hold`` (tracking lost, the gaze held for
+        ``tracking_lost.hold_s``) or ``lost`` (looking at the ``tracking_lost`` target)."""
+        return self._tracking_leaf[self._model.state[1]]
+
+    @property
     def lost(self) -> bool:
         """True while tracking is lost."""
         return self._model.state[1] != _TRACKING_OK

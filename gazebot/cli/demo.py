@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError
+from gazebot.cli.errors import UsageError, robot_with_gaze_mode
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -208,11 +208,10 @@ def _last_reach_start_time(ticks) -> float | None:
 
 
 def _record(args: argparse.Namespace, out: Path, monitor=None):
-    from gazebot.kinematics.config import with_gaze_mode
     from gazebot.sim.record import record_handover
 
     return record_handover(
-        robot=with_gaze_mode(args.robot, args.gaze_mode),
+        robot=robot_with_gaze_mode(args.robot, args.gaze_mode),
         behavior=args.behavior,
         scene=scene_with_overrides(args),
         on_tick=None if monitor is None else monitor.on_tick,

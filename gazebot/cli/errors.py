@@ -1,6 +1,9 @@
-"""The one exception a command raises for a wrong command-line input."""
+"""The one exception a command raises for a wrong command-line input, and the checks of inputs
+several commands share."""
 
 from __future__ import annotations
+
+from typing import Any
 
 
 class UsageError(ValueError):
@@ -10,3 +13,13 @@ class UsageError(ValueError):
     input file (:class:`gazebot.config.ConfigError`); any other ``ValueError`` is a bug and
     keeps its traceback.
     """
+
+
+def robot_with_gaze_mode(robot: Any, mode: str | None) -> Any:
+    """``robot`` in the ``--gaze-mode`` ``mode`` (:func:`gazebot.kinematics.config.with_gaze_mode`);
+    an unknown mode is a :class:`UsageError` naming the known ones."""
+    from gazebot.kinematics.config import GAZE_MODES, with_gaze_mode
+
+    if mode is not None and mode not in GAZE_MODES:
+        raise UsageError(f"--gaze-mode must be one of {', '.join(GAZE_MODES)}, not {mode!r}")
+    return with_gaze_mode(robot, mode)

@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError
+from gazebot.cli.errors import UsageError, robot_with_gaze_mode
 
 
 def register(kinds: argparse._SubParsersAction) -> None:
@@ -42,7 +42,6 @@ def register(kinds: argparse._SubParsersAction) -> None:
 
 def run_render_video(args: argparse.Namespace) -> int:
     from gazebot.cli.demo import giver_factory
-    from gazebot.kinematics.config import with_gaze_mode
     from gazebot.sim.gl_check import OffscreenRenderingError
     from gazebot.sim.record import check_video_size, render_handover_video
     from gazebot.sim.scene_config import with_inset
@@ -55,7 +54,7 @@ def run_render_video(args: argparse.Namespace) -> int:
         raise UsageError(f"--width/--height/--fps: {exc}") from None
     try:
         path = render_handover_video(
-            with_gaze_mode(args.robot, args.gaze_mode),
+            robot_with_gaze_mode(args.robot, args.gaze_mode),
             args.behavior,
             with_inset(args.scene, False) if args.no_inset else args.scene,
             args.out,

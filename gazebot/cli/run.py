@@ -8,6 +8,7 @@ import json
 import sys
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
+from gazebot.cli.errors import robot_with_gaze_mode
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -55,10 +56,9 @@ def handle(args: argparse.Namespace) -> int:
         no_robot_warning=args.no_robot_warning,
     )
     # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
-    from gazebot.kinematics.config import with_gaze_mode
     from gazebot.runtime import GazeLoop
 
-    robot = with_gaze_mode(args.robot, args.gaze_mode)
+    robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
     loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
     driver = ZenohRobotDriver.open(cfg, "engine")
     try:

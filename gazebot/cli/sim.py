@@ -10,7 +10,7 @@ import threading
 from typing import Any
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
-from gazebot.cli.errors import UsageError
+from gazebot.cli.errors import UsageError, robot_with_gaze_mode
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -104,9 +104,8 @@ def handle(args: argparse.Namespace) -> int:
             from gazebot.runtime import GazeLoop
 
             driver = ZenohRobotDriver(endpoint.session, cfg.keys, "engine")
-            from gazebot.kinematics.config import with_gaze_mode
 
-            robot = with_gaze_mode(args.robot, args.gaze_mode)
+            robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
             loop = GazeLoop.from_config(robot, args.behavior, seed=args.seed)
             engine_node = EngineNode.with_eye_frames(loop, driver)
             thread = threading.Thread(target=engine_node.run, kwargs={"stop": stop},

@@ -6,7 +6,8 @@ versioned JSON topics under ``gazebot/<robot id>/`` (see :mod:`gazebot.drivers.k
   :class:`gazebot.sim.HandoverSimulation`.
 * :class:`ZenohRobotEndpoint`: the robot's side of the bus (simulator node, robot bridges).
 * :class:`EngineNode` / :class:`SimNode`: the two node loops behind ``gazebot run`` and
-  ``gazebot sim``.
+  ``gazebot sim``; the engine node runs :class:`gazebot.runtime.GazeLoop`.
+* :class:`ZenohDisplayNode`: the head screen's side of the bus (``gazebot display``).
 * :class:`BusConfig` / :func:`open_session`: peer mode, ``tcp/127.0.0.1:7447``, no multicast.
 
 Zenoh and MuJoCo are imported only when a session is opened or a simulation built.
@@ -26,12 +27,14 @@ from gazebot.drivers.payloads import (
     HeadCommandMsg,
     JointStateMsg,
     PayloadError,
+    PayloadVersionError,
     StatusMsg,
     TrackingMsg,
 )
 from gazebot.drivers.session import DEFAULT_ENDPOINT, EPHEMERAL_ENDPOINT, BusConfig, open_session
 from gazebot.drivers.sim_driver import SimRobotDriver, apply_arm_command
 from gazebot.drivers.sim_node import SimNode, SimNodeConfig
+from gazebot.drivers.zenoh_display import ZenohDisplayNode
 from gazebot.drivers.zenoh_driver import ZenohRobotDriver
 from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
 
@@ -50,12 +53,14 @@ __all__ = [
     "JointStateMsg",
     "KeyLayout",
     "PayloadError",
+    "PayloadVersionError",
     "RobotDriver",
     "SimNode",
     "SimNodeConfig",
     "SimRobotDriver",
     "StatusMsg",
     "TrackingMsg",
+    "ZenohDisplayNode",
     "ZenohRobotDriver",
     "ZenohRobotEndpoint",
     "apply_arm_command",

@@ -97,11 +97,6 @@ class BlinkModel:
         self.blink_times.append(t)
         self._next = t + self._interval()
 
-    @property
-    def blinking(self) -> bool:
-        """Whether a blink is in progress at the last update time."""
-        return self._t is not None and self._t - self._start < self.config.duration_s
-
     def value_at(self, t: float) -> float:
         """The lid closure of the current/last blink at time ``t`` (no state change)."""
         c = self.config

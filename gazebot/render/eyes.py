@@ -425,6 +425,30 @@ class EyeRenderer:
                 sprite.paint(frame, dy)
         return frame
 
+    def lid_curves(
+        self, g: EyeGeometry, ex: float, ey: float, v: float, blink: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The upper and lower lid edges ``(25, 2)`` (x, y px) of eye ``g`` centred at
+        ``(ex, ey)``, for a pupil ``v`` px below the centre and a ``blink`` (0..1).
+
+        The upper lid follows the pupil's vertical offset; a blink brings both lids to
+        ``closed_at`` (overlapping by a pixel so a closed eye has no antialiasing seam).
+        """
+        lids, b = self.style.lids, g.b
+        y_close = ey + lids.closed_at * b
+        y_up = ey - lids.upper_open * b + lids.follow * v
+        y_up = min(y_up, y_close - 1.0)
+        y_up += (y_close + 1.5 - y_up) * blink
+        y_lo = ey + lids.lower_open * b + lids.lower_follow * v
+        y_lo = max(y_lo, y_close + 1.0)
+        y_lo += (y_close - 1.5 - y_lo) * blink
+        curve = (lids.curve_open + (lids.curve_closed - lids.curve_open) * blink) * b
+        xs = np.linspace(-g.a - self._outline - 3.0, g.a + self._outline + 3.0, 25)
+        rel = (xs / g.a) ** 2
+        upper = np.column_stack([ex + xs, y_up + curve * rel])
+        lower = np.column_stack([ex + xs, y_lo - lids.lower_curve * b * rel])
+        return upper, lower
+
     def _draw_eye(self, lay: _EyeLayer, u: float, v: float, blink: float) -> None:
         s, H, g = self.style, float(self.height), lay.geom
         img = lay.layer
@@ -452,23 +476,9 @@ class EyeRenderer:
             if radius > 0.25:
                 c = (_fixed(px + ox * r_p * squash), _fixed(py + oy * r_p))
                 cv2.circle(img, c, _fixed(radius), s.pupil.highlight_color, -1, cv2.LINE_AA, _SHIFT)
-        # Lids: the upper lid follows the pupil's vertical offset; a blink brings both lids to
-        # ``closed_at`` (overlapping by a pixel so a closed eye has no antialiasing seam).
         lids = s.lids
-        b = g.b
-        y_close = lay.ey + lids.closed_at * b
-        y_up = lay.ey - lids.upper_open * b + lids.follow * v
-        y_up = min(y_up, y_close - 1.0)
-        y_up += (y_close + 1.5 - y_up) * blink
-        y_lo = lay.ey + lids.lower_open * b + lids.lower_follow * v
-        y_lo = max(y_lo, y_close + 1.0)
-        y_lo += (y_close - 1.5 - y_lo) * blink
-        curve = (lids.curve_open + (lids.curve_closed - lids.curve_open) * blink) * b
-        xs = np.linspace(-g.a - self._outline - 3.0, g.a + self._outline + 3.0, 25)
-        rel = (xs / g.a) ** 2
+        upper, lower = self.lid_curves(g, lay.ex, lay.ey, v, blink)
         top, bottom = -8.0, img.shape[0] + 8.0
-        upper = np.column_stack([lay.ex + xs, y_up + curve * rel])
-        lower = np.column_stack([lay.ex + xs, y_lo - lids.lower_curve * b * rel])
         upper_poly = np.vstack([upper, [[upper[-1, 0], top], [upper[0, 0], top]]])
         lower_poly = np.vstack([lower, [[lower[-1, 0], bottom], [lower[0, 0], bottom]]])
         # Two calls: one call with overlapping polygons would leave the overlap unfilled.

@@ -92,7 +92,7 @@ class GazeLoop:
 
     Args:
         engine: A :class:`gazebot.engine.GazeEngine` (``step``, ``notify``, ``reset``, ``resync``,
-            ``tracking_state``, and ``robot`` with ``head_joints``, ``lower``, ``upper``,
+            ``tracking``, and ``robot`` with ``head_joints``, ``lower``, ``upper``,
             ``rest``, ``eyes.clip`` and ``gaze_frame_lists``).
         blink: The blink model; ``None`` for ``BlinkModel(seed)``.
         seed: Seed of the default blink model.
@@ -206,7 +206,7 @@ class GazeLoop:
             eye_pitch=float(pitch),
             blink=blink,
             distance=distance,
-            tracking=self.engine.tracking_state(cmd.t),
+            tracking=self.engine.tracking,
             answers_sample=answers,
             residual=float(cmd.residual),
             events=cmd.events,

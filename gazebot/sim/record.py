@@ -20,13 +20,16 @@ from typing import TYPE_CHECKING
 from gazebot.kinematics.config import RobotConfig
 from gazebot.render.timeline import TickRecord
 from gazebot.runtime import GazeLoop
-from gazebot.types import Event
+from gazebot.types import Event, Phase
 
 if TYPE_CHECKING:
     from gazebot.sim.simulation import HandoverSimulation
 
 CONTROL_HZ = 120.0  # tracking rate of the seed's motion capture setup
 MAX_DURATION_S = 30.0  # a handover that has not finished by then is cut (and reported)
+# After the simulated handover ends, the engine confirms it from the tracking (the giver's hand
+# back at rest): wait this long at most for that before the tail.
+CONFIRM_WAIT_S = 4.0
 
 
 @dataclass
@@ -112,7 +115,8 @@ def record_handover(
     tail = sim.config.tail_s
     ticks: list[TickRecord] = []
     events: list[Event] = []
-    frames, done_at = 0, None
+    frames, done_at, sim_done_at = 0, None, None
+    phase = None
     label = f"{sim_robot.name} {Path(str(behavior)).stem}"
     try:
         writer_ctx = (
@@ -166,7 +170,15 @@ def record_handover(
                     writer.append(sim.render(width=width, height=height))
                     frames += 1
                     bar.update(1)
-                if done_at is None and sim.done:
+                if cmd is not None:
+                    phase = cmd.phase
+                if sim_done_at is None and sim.done:
+                    sim_done_at = sim.t
+                # The video ends a tail after the engine too has seen the handover end.
+                confirmed = phase is Phase.DONE or (
+                    sim_done_at is not None and sim.t >= sim_done_at + CONFIRM_WAIT_S
+                )
+                if done_at is None and sim_done_at is not None and confirmed:
                     done_at = sim.t
                 if (done_at is not None and sim.t >= done_at + tail) or sim.t >= MAX_DURATION_S:
                     break
@@ -183,7 +195,7 @@ def record_handover(
         fps=fps,
         width=width,
         height=height,
-        completed=done_at is not None,
+        completed=sim_done_at is not None,
         robot_events=events,
     )
 

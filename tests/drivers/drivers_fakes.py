@@ -93,6 +93,7 @@ class FakeEngine:
     def __init__(self) -> None:
         self.robot = FakeRobot()
         self.lost_since: float | None = None
+        self.last_t = 0.0
         self.gaze = FakeGaze()
         self.behavior = SimpleNamespace(state="start")
         self.phase = Phase.IDLE
@@ -102,13 +103,15 @@ class FakeEngine:
         self.frames: list[TrackingFrame] = []
         self._face = self.robot.points["face"]
 
-    def tracking_state(self, t: float) -> str:
+    @property
+    def tracking(self) -> str:
         if self.lost_since is None:
             return "ok"
-        return "hold" if t < self.lost_since + 0.1 else "lost"
+        return "hold" if self.last_t < self.lost_since + 0.1 else "lost"
 
     def step(self, frame: TrackingFrame, arm: dict | None = None) -> GazeCommand:
         self.frames.append(frame)
+        self.last_t = frame.t
         events = []
         tracked = is_valid_point(frame.giver_hand) or is_valid_point(frame.giver_face)
         if not tracked and self.lost_since is None:

@@ -100,6 +100,8 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     pan0 = head_pan(sim)
     sim_thread.start()
     assert wait_until(lambda: sim.done, timeout=120)
+    # the engine confirms the end from the tracking a little after the simulation's own end
+    assert wait_until(lambda: "handover_done" in events.kinds("engine"), timeout=120)
     pan_end = head_pan(sim)
     # every phase of the handover was detected by the engine and published once, in order
     assert events.kinds("engine") == PHASES
@@ -136,6 +138,7 @@ def test_engine_restarted_mid_handover_resumes_the_phase_over_the_bus(bus, sim):
     assert resync.info["events"] >= 2 and resync.info["head_from_joint_state"] is True
     assert resync.info["phase"] in ("transfer", "retreat")
     assert wait_until(lambda: sim.done, timeout=120)
+    assert wait_until(lambda: "handover_done" in events.kinds("engine"), timeout=120)
     # the second engine carried on from the transfer: no second reach, the rest in order
     kinds = events.kinds("engine")
     assert kinds.count("reach_started") == 1

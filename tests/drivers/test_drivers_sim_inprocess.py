@@ -23,7 +23,10 @@ def run_handover(seed: int):
         node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face", seed=seed)),
                           driver)
         node.start()
-        while not sim.done and sim.t < 15:
+        # until both the simulation and the engine (from the tracking) have seen the end
+        while sim.t < 20 and not (
+            sim.done and any(m.kind == "handover_done" for m in driver.events)
+        ):
             node.tick()
         pan = float(sim.data.qpos[sim.model.joint("head_pan").qposadr[0]])
         return sim.done, sent, driver, pan

@@ -1,0 +1,81 @@
+"""The command line's error contract: input errors print ``gazebot: error:`` and exit 2, a bug
+keeps its traceback; and the command and transport modules import each other in one direction."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+from gazebot import cli
+from gazebot.cli.errors import UsageError
+
+ROOT = Path(cli.__file__).resolve().parents[1]
+
+
+def _fake_command(monkeypatch, exc: BaseException) -> None:
+    """``gazebot boom`` raises ``exc``."""
+    import argparse
+
+    def boom(args):
+        raise exc
+
+    def parser():
+        p = argparse.ArgumentParser(prog="gazebot")
+        p.add_subparsers().add_parser("boom").set_defaults(func=boom)
+        return p
+
+    monkeypatch.setattr(cli, "build_parser", parser)
+
+
+def test_a_usage_error_prints_gazebot_error_and_exits_2(monkeypatch, capsys):
+    _fake_command(monkeypatch, UsageError("--fps must be positive"))
+    assert cli.main(["boom"]) == 2
+    assert capsys.readouterr().err.strip() == "gazebot: error: --fps must be positive"
+
+
+def test_a_missing_file_is_an_input_error(monkeypatch, capsys):
+    _fake_command(monkeypatch, FileNotFoundError("no such file: x.csv"))
+    assert cli.main(["boom"]) == 2
+    assert "gazebot: error: no such file: x.csv" in capsys.readouterr().err
+
+
+def test_a_bugs_value_error_keeps_its_traceback(monkeypatch):
+    _fake_command(monkeypatch, ValueError("math domain error"))
+    with pytest.raises(ValueError, match="math domain error"):
+        cli.main(["boom"])
+
+
+def test_a_wrong_option_value_of_a_real_command_is_a_usage_error(tmp_path, capsys):
+    rc = cli.main(["render", "eyes", "--width", "3", "--out", str(tmp_path / "e.png")])
+    assert rc == 2
+    assert "gazebot: error: width must be an integer" in capsys.readouterr().err
+
+
+def _imports(path: Path) -> set[str]:
+    """Every gazebot module ``path`` imports, at module level or inside functions."""
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("gazebot"):
+            out.add(node.module)
+            out.update(f"{node.module}.{a.name}" for a in node.names)
+        elif isinstance(node, ast.Import):
+            out.update(a.name for a in node.names if a.name.startswith("gazebot"))
+    return out
+
+
+@pytest.mark.parametrize("package", ["cli", "drivers", "runtime", "render"])
+def test_modules_of_a_package_import_each_other_without_a_circle(package):
+    files = {f"gazebot.{package}.{p.stem}": p for p in (ROOT / package).glob("*.py")
+             if p.stem != "__init__"}
+    graph = {m: _imports(p) & set(files) for m, p in files.items()}
+
+    def visit(m, stack):
+        if m in stack:
+            raise AssertionError("import circle: " + " -> ".join([*stack, m]))
+        for n in graph[m]:
+            visit(n, [*stack, m])
+
+    for m in graph:
+        visit(m, [])
