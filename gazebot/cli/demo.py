@@ -10,7 +10,10 @@ import sys
 import time
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError, robot_with_gaze_mode
+from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode
+
+# The scene's controller fields the command line sets, for error messages.
+_OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -127,7 +130,7 @@ def scene_with_overrides(args: argparse.Namespace):
             # The reach and stall times against the controllers YAML, as the simulation will.
             scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field
-        raise UsageError(f"invalid controller options: {exc}") from exc
+        raise option_error(exc, _OPTIONS, "invalid controller options") from exc
     return scene
 
 

@@ -10,7 +10,18 @@ import argparse
 import json
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError
+from gazebot.cli.errors import UsageError, option_error
+
+# The controllers config fields the command line sets, for error messages.
+_OPTIONS = {
+    "reach_time_s": "--reach-time",
+    "stall_time_s": "--stall-time",
+    "u_max_m_s": "--u-max",
+    "dt_s": "--dt",
+    "horizon": "--horizon",
+    "strategy": "--strategy",
+    "role": "--role",
+}
 
 # A reach longer than this is no reach; the bound also keeps a typo from planning for hours.
 MAX_DURATION_S = 120.0
@@ -92,8 +103,8 @@ def controllers_config_from_args(args: argparse.Namespace):
         data["stl"]["role"] = args.role
     try:
         return ControllersConfig.model_validate(data)
-    except Exception as exc:  # pydantic's message names the field
-        raise UsageError(f"invalid controller options: {exc}") from exc
+    except ValueError as exc:  # pydantic's ValidationError is one; it names the field
+        raise option_error(exc, _OPTIONS, "invalid controller options") from exc
 
 
 def run_reach_plan(args: argparse.Namespace) -> int:

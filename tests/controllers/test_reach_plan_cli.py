@@ -141,3 +141,29 @@ def test_demo_rejects_a_stall_without_mce_or_not_shorter_than_the_reach(options,
     vars(args).update(options)
     with pytest.raises(UsageError, match=message):
         scene_with_overrides(args)
+
+
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (["reach-plan", "--controller", "mcj", "--reach-time", "-2"], "--reach-time: expected"),
+        (["reach-plan", "--controller", "mcj", "--horizon", "0"], "--horizon: expected"),
+        (["reach-plan", "--controller", "mcj", "--dt", "0"], "--dt: expected"),
+    ],
+)
+def test_reach_plan_out_of_range_option_names_it_without_pydantics_report(capsys, argv, message):
+    rc = main([*argv, "--start", "0", "0", "0", "--hand", "1", "0", "0"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith(f"gazebot: error: {message}")
+    assert "errors.pydantic.dev" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_demo_out_of_range_reach_time_names_the_option():
+    from gazebot.cli.demo import scene_with_overrides
+    from gazebot.cli.errors import UsageError
+
+    args = argparse.Namespace(
+        scene="default", controller="mcj", reach_time=-1.0, stall_time=None, retreat=None
+    )
+    with pytest.raises(UsageError, match=r"^--reach-time: expected greater than 0, got -1.0$"):
+        scene_with_overrides(args)
