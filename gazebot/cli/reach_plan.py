@@ -149,6 +149,7 @@ def run_reach_plan(args: argparse.Namespace) -> int:
         args.controller == "stl" and cfg.stl.strategy.towards_human
     )
     goal = target if to_target else None
+    reached = run.reached_at(tol + 1e-6, goal)
     result = {
         "controller": args.controller,
         "feasible": run.feasible,
@@ -159,7 +160,7 @@ def run_reach_plan(args: argparse.Namespace) -> int:
         "reach_time_s": None if args.controller == "pv" else cfg.reach_time_s,
         "stall_time_s": cfg.stall_time_s if args.controller == "mce" else None,
         "goal": "target" if to_target else "hand",
-        "reached_at_s": run.reached_at(tol + 1e-6, goal),
+        "reached_at_s": None if reached is None else round(float(reached), 4),
         "final_gap_m": round(float(run.gap(goal)[-1]), 5),
         "path": [
             [round(float(t), 4), *np.round(p, 5).tolist()]
@@ -173,8 +174,9 @@ def run_reach_plan(args: argparse.Namespace) -> int:
         print(json.dumps(result))
     else:
         state = "feasible" if run.feasible else f"INFEASIBLE: {INFEASIBLE_MESSAGE}"
+        arrival = "not reached" if reached is None else f"reached at {result['reached_at_s']:g} s"
         print(
-            f"{args.controller}: {state}; reached at {result['reached_at_s']} s, "
+            f"{args.controller}: {state}; {arrival}, "
             f"final gap {result['final_gap_m']} m; solve {result['solve_ms']} ms median "
             f"(max {result['solve_ms_max']}) per {result['control_period_ms']:.0f} ms step"
         )

@@ -167,3 +167,17 @@ def test_demo_out_of_range_reach_time_names_the_option():
     )
     with pytest.raises(UsageError, match=r"^--reach-time: expected greater than 0, got -1.0$"):
         scene_with_overrides(args)
+
+
+@pytest.mark.parametrize(
+    "controller,reach_time,arrival",
+    [("mcj", "3", "; reached at 2.8 s,"), ("stl", "1", "; not reached,")],
+)
+def test_reach_plan_text_prints_a_rounded_arrival_or_not_reached(
+    capsys, controller, reach_time, arrival
+):
+    """Fig. 4.4's setting: MCJ arrives at 2.8 s (not 2.8000000000000003), STL in 1 s never."""
+    argv = ["reach-plan", "--controller", controller, "--reach-time", reach_time]
+    rc = main([*argv, "--start", "0", "0", "0", "--hand", "1.5", "0", "0", "--horizon", "15"])
+    out = capsys.readouterr().out
+    assert rc == 0 and arrival in out and "None" not in out
