@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from gazebot.cli.errors import UsageError
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("behaviors", help="list or show gaze behaviors")
@@ -59,6 +61,8 @@ def _show(args: argparse.Namespace) -> int:
     if args.diagram is not None:
         from gazebot.behaviors.machine import write_diagram
 
+        if not Path(args.diagram).parent.is_dir():
+            raise UsageError(f"--diagram {args.diagram}: output folder does not exist")
         write_diagram(spec, args.diagram)
         print(f"wrote {args.diagram} (state machine of {spec.name})")
         return 0

@@ -62,6 +62,15 @@ def test_show_diagram_writes_the_machine_with_its_phase_and_gaze_states(tmp_path
     )
 
 
+def test_show_diagram_into_a_missing_folder_is_a_usage_error_naming_the_option(tmp_path):
+    from gazebot.cli.errors import UsageError
+
+    out = tmp_path / "no-such-folder" / "fhf.md"
+    with pytest.raises(UsageError, match=r"^--diagram .*fhf\.md: output folder does not exist$"):
+        run(["behaviors", "show", "face-hand-face", "--diagram", str(out)])
+    assert not out.parent.exists()
+
+
 def test_the_diagram_is_the_machine_the_behavior_runs_on():
     from gazebot.behaviors import BehaviorMachine, load_behavior
     from gazebot.behaviors.machine import diagram
