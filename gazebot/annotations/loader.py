@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
+from gazebot.config import ConfigError
+
 HEADER = ("Frame number", "Giver Gaze", "Giver Phase", "Receiver Gaze", "Receiver Phase")
 FPS = 8.0  # frame rate of the annotated videos
 
@@ -146,7 +148,7 @@ def load_handover(path: str | Path) -> AnnotatedHandover:
     try:
         wb = openpyxl.load_workbook(path, read_only=True, data_only=True)
     except Exception as exc:  # openpyxl raises several types for a broken file
-        raise ValueError(f"{path}: not a readable xlsx file ({exc})") from exc
+        raise ConfigError(path, "<file>", "a readable xlsx file", str(exc)) from exc
     issues: list[LoadIssue] = []
     cols: list[list[str]] = [[], [], [], []]
     try:
@@ -155,7 +157,7 @@ def load_handover(path: str | Path) -> AnnotatedHandover:
         header = next(rows, ())
         got = tuple(str(h).strip() if h is not None else "" for h in header[: len(HEADER)])
         if got != HEADER:
-            raise ValueError(f"{path}: header must be {list(HEADER)}, got {list(got)}")
+            raise ConfigError(path, "header", f"the columns {list(HEADER)}", list(got))
         extra_header = [h for h in header[len(HEADER) :] if h is not None and str(h).strip()]
         if extra_header:
             issues.append(LoadIssue(path, 1, "header", extra_header, "extra header cells ignored"))

@@ -84,3 +84,12 @@ def test_summarize_prints_reach_shares_with_own_hand_as_hand_and_as_other(tmp_pa
     rows = {tuple(line.split()[:3]): line.split()[3:] for line in out.splitlines() if line}
     assert rows[("receiver", "Short", "Face-Hand")][:3] == ["100.0", "0.0", "-100.0"]
     assert rows[("receiver", "Long", "Face-Hand")][:3] == ["0.0", "100.0", "+100.0"]
+
+
+def test_summarize_a_folder_with_a_broken_xlsx_is_an_input_error_exit_2(tmp_path, capsys):
+    from gazebot.cli import main
+
+    (tmp_path / "volunteer_1_volunteer_2 1.xlsx").write_bytes(b"not a zip")
+    assert main(["annotations", "summarize", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("gazebot: error: ") and "expected a readable xlsx file" in err

@@ -6,6 +6,7 @@ import pytest
 from annotation_helpers import GIVER, PHASES, RECEIVER, handover_rows, write_xlsx
 
 from gazebot.annotations import load_annotations, load_handover
+from gazebot.config import ConfigError
 
 
 def test_reads_labels_until_the_first_empty_frame_number(tmp_path):
@@ -63,14 +64,14 @@ def test_a_second_handover_in_one_file_is_reported(tmp_path):
 
 def test_a_wrong_header_is_a_clear_error(tmp_path):
     path = write_xlsx(tmp_path / "a 1.xlsx", handover_rows(), header=["Frame", "Gaze"])
-    with pytest.raises(ValueError, match="header must be"):
+    with pytest.raises(ConfigError, match=r"a 1\.xlsx: field 'header': expected the columns"):
         load_handover(path)
 
 
 def test_a_broken_file_is_a_clear_error(tmp_path):
     path = tmp_path / "a 1.xlsx"
     path.write_bytes(b"not a zip")
-    with pytest.raises(ValueError, match="not a readable xlsx"):
+    with pytest.raises(ConfigError, match=r"a 1\.xlsx: field '<file>': expected a readable xlsx"):
         load_handover(path)
 
 
