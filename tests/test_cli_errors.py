@@ -53,6 +53,33 @@ def test_a_wrong_option_value_of_a_real_command_is_a_usage_error(tmp_path, capsy
     assert "gazebot: error: width must be an integer" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["demo", "--seed", "-1"],
+        ["render", "video", "--behavior", "face", "--out", "v.mp4", "--seed", "-1"],
+        ["sim", "--headless", "--seed", "-1"],
+        ["run", "--seed", "-1"],
+        ["display", "--seed", "-1"],
+        ["study", "plan", "--participants", "12", "--video-seed", "-2"],
+        ["annotations", "replay", "DIR", "--behavior", "face", "--seed", "-1"],
+    ],
+)
+def test_a_negative_seed_is_an_argument_error_before_any_work(argv, capsys):
+    """NumPy takes no negative seed: it used to be a traceback after the scene was built."""
+    with pytest.raises(SystemExit) as stop:
+        cli.main(argv)
+    assert stop.value.code == 2
+    assert "seed: expected an integer >= 0, got '-" in capsys.readouterr().err
+
+
+def test_demo_odd_video_width_is_a_usage_error(tmp_path, capsys):
+    assert cli.main(["demo", "--width", "7", "--out", str(tmp_path / "d")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("gazebot: error: --width/--height: video width must be an even")
+    assert not (tmp_path / "d").exists()
+
+
 def _imports(path: Path) -> set[str]:
     """Every gazebot module ``path`` imports, at module level or inside functions."""
     out = set()

@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from gazebot.cli.errors import seed_value
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("annotations", help="analyse the human-human gaze annotations")
@@ -31,7 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="behavior name or YAML file (repeatable; 'all' = every available behavior)",
     )
     p.add_argument("--role", choices=("receiver", "giver"), default="receiver")
-    p.add_argument("--seed", type=int, default=0, help="seed of data-driven behaviors")
+    p.add_argument("--seed", type=seed_value, default=0, help="seed of data-driven behaviors")
     p.add_argument("--json", action="store_true", help="print one JSON document")
     p.set_defaults(func=_replay)
 

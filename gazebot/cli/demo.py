@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode
+from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode, seed_value
 
 # The scene's controller fields the command line sets, for error messages.
 _OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
@@ -36,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
     )
     parser.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    parser.add_argument("--seed", type=seed_value, default=0, help="random seed (default: 0)")
     parser.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
     parser.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -143,6 +143,12 @@ def run_demo(args: argparse.Namespace) -> int:
         raise UsageError(
             f"--gaze-mode must be one of {', '.join(GAZE_MODES)}, not {args.gaze_mode!r}"
         )
+    from gazebot.sim.record import check_video_size
+
+    try:
+        check_video_size(args.width, args.height, 30.0)  # the demo records at 30 frames/s
+    except ValueError as exc:
+        raise UsageError(f"--width/--height: {exc}") from None
     out: Path = args.out
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out} exists and is not a folder")

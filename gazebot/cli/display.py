@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
-from gazebot.cli.errors import UsageError
+from gazebot.cli.errors import UsageError, seed_value
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -36,7 +36,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--silent-after", type=positive, default=0.5, metavar="S",
                    help="s without eye state before the engine counts as silent (default 0.5)")
     p.add_argument("--no-status", action="store_true", help="no status line on the screen")
-    p.add_argument("--seed", type=int, default=0, help="seed of the eyes' own motion and blinks")
+    p.add_argument(
+        "--seed", type=seed_value, default=0, help="seed of the eyes' own motion and blinks"
+    )
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
     add_bus_arguments(p, listens_by_default=False)
     p.set_defaults(func=handle)

@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError, robot_with_gaze_mode
+from gazebot.cli.errors import UsageError, robot_with_gaze_mode, seed_value
 
 
 def register(kinds: argparse._SubParsersAction) -> None:
@@ -24,7 +24,7 @@ def register(kinds: argparse._SubParsersAction) -> None:
         "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
     )
     parser.add_argument("--out", type=Path, required=True, help="output FILE.mp4")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    parser.add_argument("--seed", type=seed_value, default=0, help="random seed (default: 0)")
     parser.add_argument("--width", type=int, default=640, help="width, px, even (default: 640)")
     parser.add_argument("--height", type=int, default=480, help="height, px, even (default: 480)")
     parser.add_argument("--fps", type=float, default=30.0, help="frames per second (default: 30)")

@@ -8,7 +8,7 @@ import json
 import sys
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
-from gazebot.cli.errors import robot_with_gaze_mode
+from gazebot.cli.errors import robot_with_gaze_mode, seed_value
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -28,7 +28,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
     )
     p.add_argument("--phases", default=None, help="phase config YAML (default configs/phases.yaml)")
-    p.add_argument("--seed", type=int, default=0, help="seed of behavior timings and blinks")
+    p.add_argument("--seed", type=seed_value, default=0, help="seed of behavior timings and blinks")
     p.add_argument("--duration", type=positive, default=None,
                    help="seconds to run (default: until Ctrl-C)")
     p.add_argument("--silence-after", type=positive, default=0.15, metavar="S",

@@ -10,7 +10,7 @@ import threading
 from typing import Any
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
-from gazebot.cli.errors import UsageError, robot_with_gaze_mode
+from gazebot.cli.errors import UsageError, robot_with_gaze_mode, seed_value
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,7 +22,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
     p.add_argument("--scene", default="default", help="scene name in configs/scenes/ or YAML")
-    p.add_argument("--seed", type=int, default=0, help="seed of the giver and the tracking noise")
+    p.add_argument(
+        "--seed", type=seed_value, default=0, help="seed of the giver and the tracking noise"
+    )
     p.add_argument("--with-engine", action="store_true", help="run a gaze engine in-process too")
     p.add_argument("--behavior", default="face-hand-face", help="behavior for --with-engine")
     p.add_argument(

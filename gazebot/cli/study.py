@@ -11,7 +11,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError
+from gazebot.cli.errors import UsageError, seed_value
 from gazebot.config import ConfigError
 from gazebot.study.conditions import (
     CONDITION_LEVELS,
@@ -72,14 +72,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="how the robot shows its gaze (default: the seed's: head-only without a condition, "
         "eyes-only with one); the instructions name the head or the eyes to match",
     )
-    p.add_argument("--seed", type=int, default=0, help="randomisation seed")
+    p.add_argument("--seed", type=seed_value, default=0, help="randomisation seed")
     p.add_argument(
         "--robot",
         default=None,
         help="robot config (default: the seed's: jaco2, the Jaco-2 with its head, without a "
         "condition (6.3); sawyer with one (6.4))",
     )
-    p.add_argument("--video-seed", type=int, default=0, help="seed of every rendered handover")
+    p.add_argument(
+        "--video-seed", type=seed_value, default=0, help="seed of every rendered handover"
+    )
     p.add_argument(
         "--scene",
         action="append",
