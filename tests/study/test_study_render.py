@@ -344,3 +344,16 @@ def test_malformed_times_sidecar_names_the_file_and_field(tmp_path):
     times_path(video).write_text("[1, 2]")
     with pytest.raises(ValueError, match=r"v\.json.*JSON object"):
         read_video_times(video)
+
+
+def test_a_manifest_without_reach_start_times_reads_as_unknown_and_a_bad_one_is_named():
+    from gazebot.study.folder import SessionVideos
+
+    old = SessionVideos.from_manifest({"first": "videos/a.mp4", "second": "videos/b.mp4"})
+    assert (old.first_reach_start_time, old.second_reach_start_time) == (None, None)
+    new = SessionVideos.from_manifest(
+        {"first": "a", "second": "b", "first_reach_start_time": -0.25, "second_reach_start_time": 1}
+    )
+    assert (new.first_reach_start_time, new.second_reach_start_time) == (-0.25, 1.0)
+    with pytest.raises(ValueError, match="second_reach_start_time.*seconds or null"):
+        SessionVideos.from_manifest({"first": "a", "second": "b", "second_reach_start_time": "x"})
