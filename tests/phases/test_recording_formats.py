@@ -18,9 +18,9 @@ def rec():
 
 
 def _write_c3d(path, traj):
-    import c3d
-
     import warnings
+
+    import c3d
 
     warnings.filterwarnings("ignore", "No analog data found", UserWarning)  # points only
     w = c3d.Writer(point_rate=100.0, point_units="mm  ")
