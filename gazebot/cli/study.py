@@ -317,7 +317,8 @@ def _render(args: argparse.Namespace) -> int:
     print(
         f"{len(rep.videos)} handover videos ({len(rep.rendered)} rendered, "
         f"{len(rep.videos) - len(rep.rendered)} cached), {len(rep.pairs)} pair videos, "
-        f"{sum(len(v) for v in rep.sessions.values())} session files; "
+        f"{sum(len(v) for v in rep.sessions.values())} session files, video times in "
+        f"{Path(args.out) / 'videos.csv'}; "
         f"response sheet {rep.questionnaire_csv}"
     )
     return 0

@@ -5,6 +5,7 @@ missing.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,9 @@ def read_c3d(path: str | Path, names: PointNames | None = None) -> Recording:
 
     path = Path(path)
     try:
-        with path.open("rb") as fh:
+        with path.open("rb") as fh, warnings.catch_warnings():
+            # Motion-capture C3D files often carry no analog channels; only points are read.
+            warnings.filterwarnings("ignore", "No analog data found", UserWarning)
             reader = c3d.Reader(fh)
             labels = [str(s).strip() for s in reader.point_labels]
             rate = float(reader.point_rate)

@@ -1,6 +1,7 @@
 """``gazebot study export``: the answers stored by ``gazebot study serve`` as the responses CSV
-that ``gazebot study analyze`` reads (:mod:`gazebot.study.analysis`), with timestamps and the
-time spent per session."""
+that ``gazebot study analyze`` reads (:mod:`gazebot.study.analysis`), with timestamps, the time
+spent per session and the seed's reach-start time of both handovers (giver's reach start minus
+the robot's, s; empty when unknown)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from pathlib import Path
 from gazebot.study.csvio import check_output_file
 from gazebot.study.folder import load_study
 from gazebot.study.store import QUESTION_KEYS
+from gazebot.study.video_times import fmt_seconds
 
 EXPORT_COLUMNS = (
     "participant",
@@ -26,6 +28,8 @@ EXPORT_COLUMNS = (
     "scene",
     "robot",
     "gaze_mode",
+    "first_reach_start_time",
+    "second_reach_start_time",
     "shown_at",
     "submitted_at",
     "seconds",
@@ -68,6 +72,10 @@ def export_responses(
                     f"{a.session}, which the plan does not have"
                 )
             seconds = a.seconds
+            try:
+                shown = study.session_videos(a.participant, a.session)
+            except KeyError:
+                shown = None
             writer.writerow(
                 [
                     a.participant,
@@ -83,6 +91,8 @@ def export_responses(
                     s.scene if s else "",
                     s.robot if s else "",
                     study.gaze_mode,
+                    fmt_seconds(shown.first_reach_start_time if shown else None),
+                    fmt_seconds(shown.second_reach_start_time if shown else None),
                     _iso(a.shown_at),
                     _iso(a.submitted_at),
                     "" if seconds is None else f"{seconds:.3f}",

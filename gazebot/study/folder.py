@@ -15,10 +15,23 @@ PRACTICE = 0  # session number of the practice session
 
 @dataclass(frozen=True)
 class SessionVideos:
-    """The two handover videos of one session, relative to the study folder."""
+    """The two handover videos of one session, relative to the study folder, and their seed's
+    reach-start times (s; ``None``: unknown, e.g. a study rendered before they were recorded)."""
 
     first: str
     second: str
+    first_reach_start_time: float | None = None
+    second_reach_start_time: float | None = None
+
+    @classmethod
+    def from_manifest(cls, entry: dict) -> SessionVideos:
+        times = []
+        for key in ("first_reach_start_time", "second_reach_start_time"):
+            v = entry.get(key)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+                raise ValueError(f"{key!r} (expected seconds or null, got {v!r})")
+            times.append(None if v is None else float(v))
+        return cls(str(entry["first"]), str(entry["second"]), *times)
 
 
 @dataclass(frozen=True)
@@ -42,9 +55,13 @@ class StudyFolder:
             (s for s in self.plan if s.participant == participant), key=lambda s: s.session
         )
 
+    def session_videos(self, participant: int, session: int) -> SessionVideos:
+        """What a session shows (session 0: the practice); ``KeyError`` if none."""
+        return self.practice if session == PRACTICE else self.videos[(participant, session)]
+
     def video_path(self, participant: int, session: int, which: int) -> Path:
         """The file of handover ``which`` (1 or 2) of a session; ``KeyError`` if none."""
-        v = self.practice if session == PRACTICE else self.videos[(participant, session)]
+        v = self.session_videos(participant, session)
         rel = v.first if which == 1 else v.second if which == 2 else None
         if rel is None:
             raise KeyError(which)
@@ -74,9 +91,9 @@ def load_study(root: str | Path) -> StudyFolder:
     plan = read_plan(plan_path)
     try:
         manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
-        practice = SessionVideos(manifest["practice"]["first"], manifest["practice"]["second"])
+        practice = SessionVideos.from_manifest(manifest["practice"])
         videos = {
-            (int(p), int(k)): SessionVideos(v["first"], v["second"])
+            (int(p), int(k)): SessionVideos.from_manifest(v)
             for p, sessions in manifest["participants"].items()
             for k, v in sessions.items()
         }

@@ -3,7 +3,9 @@
 1. Every distinct handover video of the plan (robot, behavior, scene, seed) is rendered once, in
    parallel worker processes, into ``DIR/videos/``; its file name holds a content hash of
    (robot, behavior, scene, seed, resolution, fps, code version), so a rerun renders only what
-   changed (a cached file is reused; a crashed render leaves no file behind).
+   changed (a cached file is reused; a crashed render leaves no file behind). Beside each video,
+   ``NAME.json`` holds its times (:mod:`gazebot.study.video_times`: the seed's reach-start time,
+   the robot's events and the phase starts); a cached video without one is rendered again.
 2. Every distinct session (first behavior, second behavior, scene) becomes one pair video in
    ``DIR/pairs/``: a "Handover 1" title card, the first handover, a "Handover 2" title card, the
    second handover (H.264, yuv420p). Each participant's session files in
@@ -13,7 +15,8 @@
    ``DIR/participants/PNN/index.html`` a blind offline page with the videos in order and the five
    questions.
 4. ``DIR/plan.csv`` is the plan and ``DIR/manifest.json`` maps every participant's session (and
-   the practice session) to its two handover videos: what ``gazebot study serve`` shows.
+   the practice session) to its two handover videos and their reach-start times: what
+   ``gazebot study serve`` shows. ``DIR/videos.csv`` lists every video with its times.
 
 The practice session shows the plan's first ordered pairing in reverse order (a pair every
 participant also sees as a study session): the seed names a practice session but not its content.
@@ -21,6 +24,7 @@ participant also sees as a study session): the seed names a practice session but
 
 from __future__ import annotations
 
+import csv
 import functools
 import hashlib
 import inspect
@@ -37,6 +41,13 @@ from gazebot.study.cache import RenderFn, VideoSpec, code_version, inputs_digest
 from gazebot.study.pair_video import make_pair_video
 from gazebot.study.plan import Session, write_plan
 from gazebot.study.questionnaire import write_participant_page, write_questionnaire
+from gazebot.study.video_times import (
+    TIME_COLUMNS,
+    VideoTimes,
+    read_video_times,
+    times_path,
+    write_video_times,
+)
 
 __all__ = [
     "RenderReport",
@@ -52,8 +63,8 @@ __all__ = [
 class RenderReport:
     """What :func:`render_study` produced: ``videos`` (spec -> file), ``rendered`` (specs
     rendered in this run; the rest came from the cache), ``pairs`` ((first video, second
-    video) -> pair file), ``sessions`` (participant -> session files in order) and the
-    questionnaire files."""
+    video) -> pair file), ``sessions`` (participant -> session files in order), the
+    questionnaire files and ``times`` (spec -> the video's times)."""
 
     videos: dict[VideoSpec, Path]
     rendered: list[VideoSpec]
@@ -61,6 +72,7 @@ class RenderReport:
     sessions: dict[int, list[Path]]
     questionnaire_csv: Path
     questionnaire_md: Path
+    times: dict[VideoSpec, VideoTimes]
 
 
 def render_handover_in_gaze_mode(
@@ -76,8 +88,9 @@ def render_handover_in_gaze_mode(
     gaze_mode: str = "head-and-eyes",
 ) -> Path:
     """The SIM package's MuJoCo handover renderer on ``robot`` with its gaze mode set to the
-    plan's (the robot config's ``gaze_mode``, as ``--gaze-mode`` sets it on the other commands)."""
-    from gazebot.sim.record import render_handover_video
+    plan's (the robot config's ``gaze_mode``, as ``--gaze-mode`` sets it on the other commands).
+    Writes the handover's times beside the video (:func:`write_video_times`)."""
+    from gazebot.sim.record import record_handover
 
     try:
         from gazebot.kinematics.config import with_gaze_mode
@@ -87,7 +100,7 @@ def render_handover_in_gaze_mode(
         robot_arg = robot
     else:
         robot_arg = with_gaze_mode(robot, gaze_mode)
-    return render_handover_video(
+    rec = record_handover(
         robot_arg,
         behavior,
         scene,
@@ -98,6 +111,8 @@ def render_handover_in_gaze_mode(
         fps=fps,
         progress=progress,
     )
+    write_video_times(out_path, VideoTimes.from_recording(rec))
+    return Path(out_path)
 
 
 def default_renderer() -> RenderFn:
@@ -117,8 +132,11 @@ def _render_video_job(
     render_fn: RenderFn, spec: VideoSpec, out_path: Path, pass_mode: bool = True
 ) -> Path:
     """Worker: render into a temporary name, then rename, so the cache never holds a partial
-    file. ``pass_mode``: give the renderer the spec's ``gaze_mode``."""
+    file. ``pass_mode``: give the renderer the spec's ``gaze_mode``. The renderer's times sidecar
+    is moved first (a renderer that writes none gets one with unknown times), so a cached video
+    always has its times."""
     tmp = out_path.with_name(out_path.stem + f".part{os.getpid()}.mp4")
+    tmp_times = times_path(tmp)
     extra = {"gaze_mode": spec.gaze_mode} if pass_mode else {}
     try:
         render_fn(
@@ -135,9 +153,13 @@ def _render_video_job(
         )
         if not tmp.is_file() or tmp.stat().st_size == 0:
             raise RuntimeError(f"renderer wrote no video for {spec}")
+        if read_video_times(tmp) is None:
+            write_video_times(tmp, VideoTimes())
+        os.replace(tmp_times, times_path(out_path))
         os.replace(tmp, out_path)
     finally:
         tmp.unlink(missing_ok=True)
+        tmp_times.unlink(missing_ok=True)
     return out_path
 
 
@@ -244,13 +266,14 @@ def render_study(
 
     specs = list(dict.fromkeys(spec(s, b) for s in plan for b in (s.first, s.second)))
     videos = {sp: video_dir / sp.file_name(version) for sp in specs}
-    todo = [sp for sp in specs if not videos[sp].is_file()]
+    todo = [sp for sp in specs if not _cached(videos[sp])]
     _run_jobs(
         [(_render_video_job, (render_fn, sp, videos[sp], pass_mode)) for sp in todo],
         workers,
         progress,
         "handover videos",
     )
+    times = {sp: read_video_times(videos[sp]) or VideoTimes() for sp in specs}
 
     pair_of: dict[Session, tuple[VideoSpec, VideoSpec]] = {
         s: (spec(s, s.first), spec(s, s.second)) for s in plan
@@ -293,7 +316,13 @@ def render_study(
 
     def entry(s: Session) -> dict:
         a, b = pair_of[s]
-        return {"first": rel(videos[a]), "second": rel(videos[b]), "pair": rel(pairs[(a, b)])}
+        return {
+            "first": rel(videos[a]),
+            "second": rel(videos[b]),
+            "pair": rel(pairs[(a, b)]),
+            "first_reach_start_time": times[a].reach_start_time,
+            "second_reach_start_time": times[b].reach_start_time,
+        }
 
     first = min(plan, key=lambda s: (s.participant, s.session))
     reverse = (first.second, first.first, first.level)
@@ -310,8 +339,34 @@ def render_study(
             }
             for p in sorted({s.participant for s in plan})
         },
-        "videos": {rel(p): asdict(sp) for sp, p in videos.items()},
+        "videos": {rel(p): {**asdict(sp), "times": asdict(times[sp])} for sp, p in videos.items()},
         "pairs": {rel(p): [rel(videos[a]), rel(videos[b])] for (a, b), p in pairs.items()},
     }
     (out_dir / "manifest.json").write_text(json.dumps(manifest, indent=2), encoding="utf-8")
-    return RenderReport(videos, todo, pairs, sessions, csv_path, md_path)
+    write_videos_csv(out_dir / "videos.csv", {rel(p): (sp, times[sp]) for sp, p in videos.items()})
+    return RenderReport(videos, todo, pairs, sessions, csv_path, md_path, times)
+
+
+def _cached(video: Path) -> bool:
+    """Whether ``video`` and a readable times sidecar are in the cache (a video rendered before
+    the sidecars existed, or with a damaged one, is rendered again)."""
+    try:
+        return video.is_file() and read_video_times(video) is not None
+    except ValueError:
+        return False
+
+
+VIDEO_COLUMNS = ("video", "robot", "behavior", "scene", "seed", "gaze_mode", *TIME_COLUMNS)
+
+
+def write_videos_csv(path: Path, rows: dict[str, tuple[VideoSpec, VideoTimes]]) -> Path:
+    """``videos.csv``: one row per handover video (columns :data:`VIDEO_COLUMNS`, seconds,
+    empty = unknown)."""
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(VIDEO_COLUMNS)
+        for name, (sp, t) in sorted(rows.items()):
+            writer.writerow(
+                [name, sp.robot, sp.behavior, sp.scene, sp.seed, sp.gaze_mode, *t.row()]
+            )
+    return path

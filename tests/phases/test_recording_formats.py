@@ -18,8 +18,11 @@ def rec():
 
 
 def _write_c3d(path, traj):
+    import warnings
+
     import c3d
 
+    warnings.filterwarnings("ignore", "No analog data found", UserWarning)  # points only
     w = c3d.Writer(point_rate=100.0, point_units="mm  ")
     w.set_point_labels(["RHAND_G", "RHAND_R", "HEAD_G"])
     frames = []

@@ -18,6 +18,7 @@ from pathlib import Path
 from gazebot.study.plan import make_plan
 from gazebot.study.render import render_study
 from gazebot.study.synthetic import render_synthetic_video
+from gazebot.study.video_times import VideoTimes, write_video_times
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -26,9 +27,21 @@ def render_tiny_study(out: Path, behaviors=("face", "hand", "short-face-hand"), 
     """A rendered 6.3-style study (no condition): g (g - 1) sessions per participant, each
     handover a 0.4 s synthetic clip at 64x48."""
     plan = make_plan(list(behaviors), condition=None, participants=participants, seed=1)
-    fn = functools.partial(render_synthetic_video, duration=0.4)
+    fn = functools.partial(timed_synthetic_video, duration=0.4)
     render_study(plan, out, fn, 64, 48, 10, workers=1, card_seconds=0.1, progress=False)
     return plan
+
+
+def reach_start_time_of(behavior: str) -> float:
+    """The reach-start time :func:`timed_synthetic_video` reports: distinct per behavior."""
+    return round(0.05 * len(behavior) - 0.4, 3)
+
+
+def timed_synthetic_video(robot, behavior, scene, out_path, **kw):
+    """The synthetic clip, with a times sidecar as the MuJoCo renderer writes one."""
+    path = render_synthetic_video(robot, behavior, scene, out_path, **kw)
+    write_video_times(path, VideoTimes(reach_start_time=reach_start_time_of(behavior)))
+    return path
 
 
 class StudyServer:

@@ -74,13 +74,21 @@ def _wait(predicate, timeout_s: float = 60.0, what: str = "condition"):
 
 def _heading(d) -> str:
     """The page's heading, "" while a page is loading (no h1 yet, or the old one going)."""
-    from selenium.common.exceptions import NoSuchElementException, StaleElementReferenceException
+    from selenium.common.exceptions import (
+        NoSuchElementException,
+        StaleElementReferenceException,
+        WebDriverException,
+    )
     from selenium.webdriver.common.by import By
 
     try:
         return d.find_element(By.TAG_NAME, "h1").text
     except (NoSuchElementException, StaleElementReferenceException):
         return ""
+    except WebDriverException as exc:
+        if _gone(exc):
+            return ""
+        raise
 
 
 def _at(d, heading: str) -> None:
@@ -145,13 +153,25 @@ def _submit(d) -> None:
     _wait(lambda: _stale(old), what="the next page")
 
 
-def _stale(element) -> bool:
+def _gone(exc: Exception) -> bool:
+    """Chromium reports an element of a replaced document either as stale or, mid-navigation,
+    as a node that "does not belong to the document": both mean the page was left."""
     from selenium.common.exceptions import StaleElementReferenceException
+
+    return isinstance(exc, StaleElementReferenceException) or (
+        "does not belong to the document" in str(exc)
+    )
+
+
+def _stale(element) -> bool:
+    from selenium.common.exceptions import WebDriverException
 
     try:
         element.is_enabled()
-    except StaleElementReferenceException:
-        return True
+    except WebDriverException as exc:
+        if _gone(exc):
+            return True
+        raise
     return False
 
 

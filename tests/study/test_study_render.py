@@ -16,6 +16,7 @@ from gazebot.study.pair_video import title_card
 from gazebot.study.plan import make_plan
 from gazebot.study.render import VideoSpec, code_version, render_study
 from gazebot.study.synthetic import render_synthetic_video
+from gazebot.study.video_times import VideoTimes, read_video_times, times_path, write_video_times
 
 W, H, FPS = 32, 24, 10
 CLIP_S, CARD_S = 0.5, 0.3
@@ -26,7 +27,14 @@ def counting_renderer(robot, behavior, scene, out_path, **kw):
     """The synthetic renderer, logging each call (workers are processes: count via a file)."""
     with open(os.environ[CALL_LOG], "a") as fh:
         fh.write(f"{robot},{behavior},{scene},{kw['seed']},{os.getpid()},{kw['gaze_mode']}\n")
-    return render_synthetic_video(robot, behavior, scene, out_path, duration=CLIP_S, **kw)
+    path = render_synthetic_video(robot, behavior, scene, out_path, duration=CLIP_S, **kw)
+    write_video_times(path, VideoTimes(reach_start_time=_rst(behavior, scene)))
+    return path
+
+
+def _rst(behavior: str, scene: str) -> float:
+    """The reach-start time :func:`counting_renderer` reports: distinct per video."""
+    return round(0.01 * (len(behavior) + 7 * len(scene)) - 0.3, 3)
 
 
 def _calls(log: Path) -> list[list[str]]:
@@ -173,6 +181,12 @@ def test_real_renderer_at_tiny_resolution_renders_distinct_videos(tmp_path):
     assert all(len(c) > 5 and c[0].shape == (48, 64, 3) for c in clips)
     pair = _frames(next(iter(report.pairs.values())))
     assert len(pair) == 2 * 2 + len(clips[0]) + len(clips[1])  # 0.2 s cards at 10 fps
+    for times in report.times.values():  # the real handover's times, beside each video
+        assert times.reach_start_time is not None and times.robot_reach_start is not None
+        assert times.giver_reach_start == pytest.approx(
+            times.robot_reach_start + times.reach_start_time
+        )
+        assert 0 < times.phase_starts["reach"] < times.phase_starts["transfer"] < times.duration
 
 
 def test_manifest_maps_every_session_and_the_practice_to_its_two_videos(rendered):
@@ -233,17 +247,34 @@ def test_plan_gaze_mode_needs_a_renderer_that_takes_it(tmp_path):
 
 
 def test_plan_gaze_mode_reaches_the_renderer_and_sets_the_robot_config(monkeypatch, tmp_path):
-    """The MuJoCo study renderer gets the plan's gaze mode and renders the robot in it."""
+    """The MuJoCo study renderer gets the plan's gaze mode and renders the robot in it, and
+    writes the recording's times beside the video."""
+    import math
+
     import gazebot.sim.record as record
+    from gazebot.render.timeline import TickRecord
     from gazebot.study.render import render_handover_in_gaze_mode
+    from gazebot.types import Event, EventKind
 
     seen = {}
 
-    def fake_render(robot, behavior, scene, out_path, **kw):
-        seen.update(robot=robot, behavior=behavior, scene=scene, **kw)
-        return Path(out_path)
+    def tick(t, phase, rst=math.nan):
+        z = np.zeros(3)
+        return TickRecord(
+            t=t, phase=phase, target="face", head={}, eye_yaw=0.0, eye_pitch=0.0,
+            target_point=z, hand=z, face=z, reach_start_time=rst,
+        )  # fmt: skip
 
-    monkeypatch.setattr(record, "render_handover_video", fake_render)
+    def fake_record(robot, behavior, scene, out_path, **kw):
+        seen.update(robot=robot, behavior=behavior, scene=scene, **kw)
+        Path(out_path).write_bytes(b"video")
+        ticks = [tick(0.0, "idle"), tick(0.5, "reach"), tick(1.25, "transfer", -0.2)]
+        ticks.append(tick(2.0, "retreat", 0.35))
+        events = [Event(EventKind.ROBOT_REACH_STARTED, 0.4, 0.4)]
+        events.append(Event(EventKind.ROBOT_REACH_ENDED, 1.1, 1.1))
+        return record.HandoverRecording(ticks, Path(out_path), 60, 30, 64, 48, True, events)
+
+    monkeypatch.setattr(record, "record_handover", fake_record)
     try:
         from gazebot.kinematics.config import with_gaze_mode  # noqa: F401
     except ImportError:  # a gazebot without gaze modes in the robot config
@@ -257,3 +288,72 @@ def test_plan_gaze_mode_reaches_the_renderer_and_sets_the_robot_config(monkeypat
     )
     assert seen["robot"].gaze_mode == "eyes-only"
     assert (seen["behavior"], seen["scene"], seen["seed"]) == ("hand", "default", 3)
+    times = read_video_times(tmp_path / "v.mp4")
+    assert times.reach_start_time == 0.35  # the last tick's: both reaches had started by then
+    assert (times.robot_reach_start, times.giver_reach_start) == (0.4, 0.75)
+    assert times.phase_starts == {"reach": 0.5, "transfer": 1.25, "retreat": 2.0}
+    assert times.robot_events == {"robot_reach_started": 0.4, "robot_reach_ended": 1.1}
+    assert (times.duration, times.completed) == (2.0, True)
+
+
+def test_each_video_has_its_reach_start_time_in_a_sidecar_videos_csv_and_the_manifest(rendered):
+    import json
+
+    from gazebot.study.folder import load_study
+
+    plan, report, out, _ = rendered
+    for sp, path in report.videos.items():
+        assert read_video_times(path).reach_start_time == _rst(sp.behavior, sp.scene)
+        assert report.times[sp].reach_start_time == _rst(sp.behavior, sp.scene)
+    with (out / "videos.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == len(report.videos)
+    assert all(float(r["reach_start_time"]) == _rst(r["behavior"], r["scene"]) for r in rows)
+    assert all(r["robot_reach_start"] == "" for r in rows)  # not reported: unknown, not 0
+    study = load_study(out)
+    for s in plan:
+        shown = study.session_videos(s.participant, s.session)
+        assert shown.first_reach_start_time == _rst(s.first, s.scene)
+        assert shown.second_reach_start_time == _rst(s.second, s.scene)
+    manifest = json.loads((out / "manifest.json").read_text())
+    entry = next(iter(manifest["videos"].values()))
+    assert entry["times"]["reach_start_time"] == _rst(entry["behavior"], entry["scene"])
+
+
+def test_a_cached_video_without_its_times_is_rendered_again(tmp_path):
+    plan = make_plan(["face", "hand"], condition=None, participants=2, gaze_mode="head-only")
+    fn = functools.partial(render_synthetic_video, duration=0.2)
+    first = render_study(plan, tmp_path, fn, W, H, FPS, workers=1, progress=False)
+    assert len(first.rendered) == 2
+    # A renderer that reports no times gets a sidecar of unknowns, and is cached with it.
+    assert all(t == VideoTimes() for t in first.times.values())
+    assert render_study(plan, tmp_path, fn, W, H, FPS, workers=1, progress=False).rendered == []
+    lost, damaged = first.videos.values()
+    times_path(lost).unlink()  # e.g. rendered before the sidecars existed
+    times_path(damaged).write_text('{"reach_start_time": "soon"}')
+    again = render_study(plan, tmp_path, fn, W, H, FPS, workers=1, progress=False)
+    assert sorted(v.behavior for v in again.rendered) == ["face", "hand"]
+    assert all(read_video_times(p) == VideoTimes() for p in again.videos.values())
+
+
+def test_malformed_times_sidecar_names_the_file_and_field(tmp_path):
+    video = tmp_path / "v.mp4"
+    times_path(video).write_text('{"phase_starts": {"reach": "late"}}')
+    with pytest.raises(ValueError, match=r"v\.json.*'reach'.*seconds"):
+        read_video_times(video)
+    times_path(video).write_text("[1, 2]")
+    with pytest.raises(ValueError, match=r"v\.json.*JSON object"):
+        read_video_times(video)
+
+
+def test_a_manifest_without_reach_start_times_reads_as_unknown_and_a_bad_one_is_named():
+    from gazebot.study.folder import SessionVideos
+
+    old = SessionVideos.from_manifest({"first": "videos/a.mp4", "second": "videos/b.mp4"})
+    assert (old.first_reach_start_time, old.second_reach_start_time) == (None, None)
+    new = SessionVideos.from_manifest(
+        {"first": "a", "second": "b", "first_reach_start_time": -0.25, "second_reach_start_time": 1}
+    )
+    assert (new.first_reach_start_time, new.second_reach_start_time) == (-0.25, 1.0)
+    with pytest.raises(ValueError, match="second_reach_start_time.*seconds or null"):
+        SessionVideos.from_manifest({"first": "a", "second": "b", "second_reach_start_time": "x"})

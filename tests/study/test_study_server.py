@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from study_responses import BEHAVIORS, responses_from_tables
 from study_seed_tables import TABLE_6_1
-from study_web import render_tiny_study
+from study_web import reach_start_time_of, render_tiny_study
 
 from gazebot.study.analysis import analyze, read_responses
 from gazebot.study.export import export_responses
@@ -232,6 +232,9 @@ def test_export_writes_what_analyze_reads_with_timestamps_and_time_per_session(f
         s = plan[(int(r["participant"]), int(r["session"]))]
         assert (r["first"], r["second"]) == (s.first, s.second)
         assert r["q2"] == str(1 + (int(r["session"]) + int(r["participant"])) % 2)
+        # The seed's reach-start time of both handovers the session showed.
+        for k in ("first", "second"):
+            assert float(r[f"{k}_reach_start_time"]) == reach_start_time_of(r[k])
     result = analyze(read_responses(out))
     assert result.per_level[""]["likability"].participants == 2
 
