@@ -71,6 +71,20 @@ def scene_with_overrides(args: argparse.Namespace):
     scene = load_scene(args.scene)
     data = scene.model_dump()
     data["controller"].update(overrides)
+    if (
+        "stall_time_s" in overrides
+        and str(
+            getattr(
+                data["controller"]["reach_controller"],
+                "value",
+                data["controller"]["reach_controller"],
+            )
+        )
+        != "mce"
+    ):
+        raise ValueError(
+            "--stall-time is the MCE controller's (seed eq. 3.5); use --controller mce"
+        )
     timed = "reach_time_s" in overrides or "stall_time_s" in overrides
     if (
         timed

@@ -97,6 +97,10 @@ def run_reach_plan(args: argparse.Namespace) -> int:
     from gazebot.controllers import INFEASIBLE_MESSAGE, make_controller
     from gazebot.controllers.rollout import run_reach
 
+    if args.stall_time is not None and args.controller != "mce":
+        raise ValueError(
+            "--stall-time is the MCE controller's (seed eq. 3.5); use --controller mce"
+        )
     cfg = controllers_config_from_args(args)
     start = np.array(args.start, float)
     hand0 = np.array(args.hand, float)

@@ -67,6 +67,27 @@ def test_reach_plan_rejects_a_stall_longer_than_the_reach(capsys):
     assert "stall_time_s" in capsys.readouterr().err
 
 
+def test_stall_time_is_only_for_mce(capsys):
+    rc = main(
+        [
+            "reach-plan",
+            "--controller",
+            "mcj",
+            "--start",
+            "0",
+            "0",
+            "0",
+            "--hand",
+            "1",
+            "0",
+            "0",
+            "--stall-time",
+            "0.5",
+        ]
+    )
+    assert rc == 2 and "mce" in capsys.readouterr().err
+
+
 def test_demo_options_override_the_scene_controller():
     from gazebot.cli.demo import scene_with_overrides
 
