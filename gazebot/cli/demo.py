@@ -68,36 +68,15 @@ def scene_with_overrides(args: argparse.Namespace):
 
     from gazebot.sim.scene_config import SceneConfig, load_scene
 
-    scene = load_scene(args.scene)
-    data = scene.model_dump()
+    data = load_scene(args.scene).model_dump(mode="json")
     data["controller"].update(overrides)
-    if (
-        "stall_time_s" in overrides
-        and str(
-            getattr(
-                data["controller"]["reach_controller"],
-                "value",
-                data["controller"]["reach_controller"],
-            )
-        )
-        != "mce"
-    ):
+    chosen = data["controller"]["reach_controller"]
+    if "stall_time_s" in overrides and chosen != "mce":
         raise ValueError(
             "--stall-time is the MCE controller's (seed eq. 3.5); use --controller mce"
         )
-    timed = "reach_time_s" in overrides or "stall_time_s" in overrides
-    if (
-        timed
-        and str(
-            getattr(
-                data["controller"]["reach_controller"],
-                "value",
-                data["controller"]["reach_controller"],
-            )
-        )
-        == "joint"
-    ):
-        raise ValueError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+    if "reach_time_s" in overrides and chosen == "joint":
+        raise ValueError("--reach-time needs --controller pv, mcj, mce or stl")
     try:
         return SceneConfig.model_validate(data)
     except ValidationError as exc:

@@ -101,7 +101,7 @@ def test_demo_options_override_the_scene_controller():
         scene="default", controller=None, reach_time=None, stall_time=None, retreat=None
     )
     assert scene_with_overrides(plain) == "default"
-    with pytest.raises(ValueError, match="--controller"):
+    with pytest.raises(ValueError, match="--controller"):  # a reach time needs a timed controller
         scene_with_overrides(
             argparse.Namespace(
                 scene="default", controller=None, reach_time=2.0, stall_time=None, retreat=None
