@@ -116,7 +116,9 @@ def run_reach_plan(args: argparse.Namespace) -> int:
     if not duration > 0:
         raise ValueError(f"--duration must be positive, got {duration}")
     target = None if args.target is None else np.array(args.target, float)
-    run = run_reach(controller, start, hand, duration, target=target)
+    # A giving robot holds the object during its reach (Table 4.3's giver rows trigger on it).
+    giver = cfg.stl.role.value == "giver"
+    run = run_reach(controller, start, hand, duration, target=target, robot_holds_object=giver)
     tol = cfg.stl.eps_p_m if args.controller == "stl" else cfg.mcj.eps_x_m
     result = {
         "controller": args.controller,

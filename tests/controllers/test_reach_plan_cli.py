@@ -43,6 +43,13 @@ def test_reach_plan_path_ends_at_the_hand(capsys):
     assert out["solve_ms"] > 0 and out["control_period_ms"] == pytest.approx(200)
 
 
+def test_reach_plan_giver_role_reaches_with_the_object(capsys):
+    rc, out = _plan(
+        capsys, "--controller", "stl", "--role", "giver", "--reach-time", "2", "--duration", "2.2"
+    )
+    assert rc == 0 and out["feasible"] and out["reached_at_s"] <= 2.0
+
+
 def test_reach_plan_rejects_a_stall_longer_than_the_reach(capsys):
     rc = main(
         [
