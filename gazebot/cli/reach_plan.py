@@ -142,7 +142,9 @@ def run_reach_plan(args: argparse.Namespace) -> int:
     duration = args.duration if args.duration is not None else cfg.reach_time_s + 1.0
     if not 0 < duration <= MAX_DURATION_S:
         raise UsageError(f"--duration must be in (0, {MAX_DURATION_S:g}] s, got {duration}")
-    run = run_reach(controller, start, hand, duration, target=target)
+    # A giving robot holds the object during its reach (Table 4.3's giver rows trigger on it).
+    giver = cfg.stl.role.value == "giver"
+    run = run_reach(controller, start, hand, duration, target=target, robot_holds_object=giver)
     tol = cfg.stl.eps_p_m if args.controller == "stl" else cfg.mcj.eps_x_m
     # What the controller goes to: the --target, unless an stl strategy goes towards the hand.
     to_target = target is not None and not (

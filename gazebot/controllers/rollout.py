@@ -52,9 +52,11 @@ def run_reach(
     duration_s: float,
     target: np.ndarray | None = None,
     zone_center: np.ndarray | None = None,
+    robot_holds_object: bool = False,
 ) -> Rollout:
     """Run ``controller`` from ``start`` toward ``hand`` (a point or ``t -> point``) for
-    ``duration_s`` seconds of control steps."""
+    ``duration_s`` seconds of control steps; ``robot_holds_object`` is the object state
+    throughout (True for a giving robot's reach)."""
     controller.reset()
     dt = controller.dt
     if callable(hand):
@@ -82,6 +84,7 @@ def run_reach(
             x=x,
             hand=h,
             target=target,
+            robot_holds_object=robot_holds_object,
             zone_center=np.zeros(3) if zone_center is None else zone_center,
         )
         plan = controller.plan(obs)

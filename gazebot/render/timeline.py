@@ -110,6 +110,12 @@ def plot_timeline(
     ax_t.set_ylim(-0.6, len(levels) - 0.4)
     ax_t.set_ylabel("gaze target")
     ax_t.set_title(title)
+    # The robot's failure feedback (seed 3.2): where no reach met the timing.
+    for k in ticks:
+        if "robot_reach_infeasible" in k.events:
+            ax_t.axvline(k.t, color="darkred", lw=1.5, ls="--")
+            ax_t.annotate("reach infeasible", (k.t, len(levels) - 0.5), color="darkred",
+                          fontsize=8, xytext=(3, 0), textcoords="offset points", va="top")
     handles = [Patch(color=c, alpha=0.5, label=p) for p, c in PHASE_COLORS.items()]
     ax_t.legend(handles=handles, loc="upper right", ncol=3, fontsize=8, frameon=False)
 

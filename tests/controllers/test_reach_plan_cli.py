@@ -43,6 +43,13 @@ def test_reach_plan_path_ends_at_the_hand(capsys):
     assert out["solve_ms"] > 0 and out["control_period_ms"] == pytest.approx(200)
 
 
+def test_reach_plan_giver_role_reaches_with_the_object(capsys):
+    rc, out = _plan(
+        capsys, "--controller", "stl", "--role", "giver", "--reach-time", "2", "--duration", "2.2"
+    )
+    assert rc == 0 and out["feasible"] and out["reached_at_s"] <= 2.0
+
+
 def test_reach_plan_rejects_a_stall_longer_than_the_reach(capsys):
     rc = main(
         [
@@ -67,6 +74,27 @@ def test_reach_plan_rejects_a_stall_longer_than_the_reach(capsys):
     assert "stall_time_s" in capsys.readouterr().err
 
 
+def test_stall_time_is_only_for_mce(capsys):
+    rc = main(
+        [
+            "reach-plan",
+            "--controller",
+            "mcj",
+            "--start",
+            "0",
+            "0",
+            "0",
+            "--hand",
+            "1",
+            "0",
+            "0",
+            "--stall-time",
+            "0.5",
+        ]
+    )
+    assert rc == 2 and "mce" in capsys.readouterr().err
+
+
 def test_demo_options_override_the_scene_controller():
     from gazebot.cli.demo import scene_with_overrides
 
@@ -80,7 +108,7 @@ def test_demo_options_override_the_scene_controller():
         scene="default", controller=None, reach_time=None, stall_time=None, retreat=None
     )
     assert scene_with_overrides(plain) == "default"
-    with pytest.raises(ValueError, match="--controller"):
+    with pytest.raises(ValueError, match="--controller"):  # a reach time needs a timed controller
         scene_with_overrides(
             argparse.Namespace(
                 scene="default", controller=None, reach_time=2.0, stall_time=None, retreat=None

@@ -42,12 +42,12 @@ def test_eventually_and_always_robustness_by_hand():
     assert Eventually(pos).robustness(s) == 2.0
 
 
-@pytest.mark.parametrize("reach_time,meets", [(2.0, True), (3.0, True)])
-def test_reach_spec_robustness_positive_on_a_run_that_meets_it(reach_time, meets):
+@pytest.mark.parametrize("reach_time", [2.0, 3.0])
+def test_reach_spec_robustness_positive_on_a_run_that_meets_it(reach_time):
     cfg = load_controllers_config().model_copy(update={"reach_time_s": reach_time})
     run = run_reach(make_controller("stl", cfg), np.zeros(3), np.array([1.5, 0, 0]), reach_time + 1)
     rho = reach_spec(cfg.stl, reach_time).robustness(_signal_from_run(run, cfg.dt_s))
-    assert (rho > 0) == meets
+    assert rho > 0
 
 
 def test_reach_spec_robustness_negative_on_a_run_that_misses_it():

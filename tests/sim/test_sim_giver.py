@@ -70,3 +70,27 @@ def test_plan_draws_seeded_human_like_durations():
 def test_min_jerk_rejects_a_non_positive_duration():
     with pytest.raises(ValueError, match="duration"):
         MinJerkSegment(REST, OFFER, 0.0, 0.0)
+
+
+def test_receiver_takes_the_object_holds_after_release_and_retreats():
+    from gazebot.sim.giver import GiverPlan
+    from gazebot.sim.receiver import ReceiverState, SimulatedReceiver
+
+    plan = GiverPlan(start_t=0.0, reach_s=1.0, transfer_s=0.5, retreat_s=1.0)
+    rest, offer = np.array([1.2, 0.0, 1.0]), np.array([0.8, 0.0, 1.1])
+    person = SimulatedReceiver(rest, offer, plan, cued=True)
+    person.update(0.5, object_near=False, robot_released=False)
+    assert person.state is ReceiverState.IDLE  # waits for the robot's cue
+    person.respond_at(0.5)
+    person.update(1.0, False, False)
+    assert person.state is ReceiverState.REACH and person.reach_started_at == 0.5
+    person.update(1.6, False, False)
+    assert person.state is ReceiverState.WAIT and np.allclose(person.hand, offer)
+    person.update(1.7, True, False)
+    assert person.state is ReceiverState.SHARE and person.holds_object
+    person.update(1.9, True, True)
+    assert person.state is ReceiverState.HOLD
+    person.update(2.5, True, True)
+    assert person.state is ReceiverState.RETREAT
+    person.update(3.5, True, True)
+    assert person.state is ReceiverState.DONE and np.allclose(person.hand, rest)
