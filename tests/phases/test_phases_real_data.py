@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.kth_data import RATE, force_truth, kth_dir
 from gazebot.phases import PhaseConfig, run_online, segment
 from gazebot.phases.synthetic import SyntheticOptions, generate
 from gazebot.recordings import PointNames, load_recording
 from gazebot.types import EventKind, Phase
-from tests.phases.kth import RATE, force_truth, kth_dir
 from tests.phases.seed725_reference import seed_transfers
 
 KTH = kth_dir()
