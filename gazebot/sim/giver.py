@@ -43,7 +43,35 @@ class GiverPlan:
         )
 
 
-class SimulatedGiver:
+class GiverCues:
+    """What the simulation asks of any giver, simulated or replayed: answer a robot-initiated
+    handover, let go early, tell whether it still holds the object. Subclasses keep ``state``,
+    ``plan``, ``_cued`` and ``_share_end``."""
+
+    state: GiverState
+    plan: GiverPlan
+    _cued: bool
+    _share_end: float
+
+    def respond_at(self, t: float) -> None:
+        """Start the reach at ``t`` (s) if it has not started: the giver answering a
+        robot-initiated handover (a ``cued`` giver waits for this call)."""
+        if self.state is GiverState.IDLE:
+            self.plan = replace(self.plan, start_t=float(t))
+            self._cued = False
+
+    def let_go(self, t: float) -> None:
+        """End the transfer now (the robot pulls the object away right after grasping it)."""
+        if self.state is GiverState.SHARE:
+            self._share_end = min(self._share_end, float(t))
+
+    @property
+    def holds_object(self) -> bool:
+        """True until the giver lets go (at the end of the transfer)."""
+        return self.state not in (GiverState.RETREAT, GiverState.DONE)
+
+
+class SimulatedGiver(GiverCues):
     """Moves the giver's hand between ``rest`` and ``offer`` (base frame, m).
 
     Args:
@@ -67,23 +95,6 @@ class SimulatedGiver:
         self.released_at: float | None = None
         self.reach_started_at: float | None = None
         self._cued = cued
-
-    def respond_at(self, t: float) -> None:
-        """Start the reach at ``t`` (s) if it has not started: the giver answering a
-        robot-initiated handover (a ``cued`` giver waits for this call)."""
-        if self.state is GiverState.IDLE:
-            self.plan = replace(self.plan, start_t=float(t))
-            self._cued = False
-
-    def let_go(self, t: float) -> None:
-        """End the transfer now (the robot pulls the object away right after grasping it)."""
-        if self.state is GiverState.SHARE:
-            self._share_end = min(self._share_end, float(t))
-
-    @property
-    def holds_object(self) -> bool:
-        """True until the giver lets go (at the end of the transfer)."""
-        return self.state not in (GiverState.RETREAT, GiverState.DONE)
 
     def update(self, t: float, robot_grasped: bool) -> None:
         """Advance to time ``t`` (s); ``robot_grasped`` is whether the robot holds the object."""

@@ -21,12 +21,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from gazebot.phases import PhaseConfig, Trajectory, segment
-from gazebot.sim.giver import GiverPlan, GiverState
+from gazebot.sim.giver import GiverCues, GiverPlan, GiverState
 from gazebot.types import Phase
 
 
@@ -128,7 +128,7 @@ class _Retarget:
         return self.rot @ (f - f0)
 
 
-class ReplayedGiver:
+class ReplayedGiver(GiverCues):
     """A recorded giver's hand (and face) in the simulator (see the module docstring).
 
     Args:
@@ -172,22 +172,6 @@ class ReplayedGiver:
         # The face's displacement from where it was at the reach start (m, base frame); the
         # simulation adds it to the scene's face. Zero when the recording has no face.
         self.face_offset = np.zeros(3)
-
-    def respond_at(self, t: float) -> None:
-        """Start the reach at ``t`` (s) if it has not started (robot-initiated handovers)."""
-        if self.state is GiverState.IDLE:
-            self.plan = replace(self.plan, start_t=float(t))
-            self._cued = False
-
-    def let_go(self, t: float) -> None:
-        """End the transfer now (the robot pulls the object away right after grasping it)."""
-        if self.state is GiverState.SHARE:
-            self._share_end = min(self._share_end, float(t))
-
-    @property
-    def holds_object(self) -> bool:
-        """True until the giver lets go (at the end of the transfer)."""
-        return self.state not in (GiverState.RETREAT, GiverState.DONE)
 
     def update(self, t: float, robot_grasped: bool) -> None:
         """Advance to time ``t`` (s); ``robot_grasped`` is whether the robot holds the object."""
