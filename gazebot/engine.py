@@ -28,7 +28,9 @@ from gazebot.handover import HandoverState, PhaseChange
 from gazebot.kinematics import GazeController, GazeShiftConfig, RobotConfig, RobotModel
 from gazebot.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.types import (
+    EVENT_OF_PHASE,
     NAN3,
+    PHASE_OF_EVENT,
     Event,
     EventKind,
     GazeCommand,
@@ -182,9 +184,10 @@ class GazeEngine:
             faults.append(self._fault(t, "phases", err))
         events.extend(self._pending)
         self._pending.clear()
+        stream: list[Event] = []  # the tick's events, phase events as the handover state's
         for event in events:
             try:
-                self._apply(event)
+                stream.extend(self._apply(event))
             except Exception as err:  # noqa: BLE001 - an event must never kill the engine
                 faults.append(self._fault(t, f"event {getattr(event, 'kind', event)!r}", err))
         detector = self.detector
@@ -199,7 +202,7 @@ class GazeEngine:
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
-        return self._command(t, kind, point, arm, tuple(events) + tuple(faults), faults)
+        return self._command(t, kind, point, arm, tuple(stream) + tuple(faults), faults)
 
     def look_at(
         self,
@@ -281,12 +284,29 @@ class GazeEngine:
             load_share=frame.load_share,
         )
 
-    def _apply(self, event: Event) -> None:
-        """One event through the behavior (and so the handover state); a grasp or a release
-        the detector cannot see moves its phase too."""
+    def _apply(self, event: Event) -> list[Event]:
+        """One event through the behavior (and so the handover state); returns what it adds
+        to the tick's events. A phase event is passed on only when it changed the handover's
+        phase (the stream published is the one phase stream); a robot event that changed it
+        is followed by that phase's event (``info.source`` ``robot`` or ``gripper``,
+        ``info.evidence`` the robot event). A grasp or a release the detector cannot see moves
+        its phase too."""
         change: PhaseChange | None = self.behavior.handle(event)
-        if change is not None and change.rule.trigger in _DETECTOR_ADOPTS:
-            self.detector.adopt(change.phase, change.t)
+        kind = getattr(event, "kind", None)
+        if kind in PHASE_OF_EVENT:
+            return [event] if change is not None else []
+        out = [event]
+        if change is not None:
+            if change.rule.trigger in _DETECTOR_ADOPTS:
+                self.detector.adopt(change.phase, change.t)
+            info = {
+                "handover": self.handover.handover,
+                "source": change.source,
+                "evidence": change.rule.trigger.value,
+            }
+            detected = getattr(event, "detected_at", change.t)
+            out.append(Event(EVENT_OF_PHASE[change.phase], change.t, detected, info))
+        return out
 
     def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
         points = dict(self._fixed_points)
