@@ -208,8 +208,8 @@ class GazeLoop:
             x, y, z = cmd.target_point.tolist()
             dx, dy, dz = x - rows[0][3], y - rows[1][3], z - rows[2][3]
             d = math.sqrt(dx * dx + dy * dy + dz * dz)
-            # A target at the display itself has no defined vergence: unknown.
-            distance = d if d > 1e-3 else None
+            # A target at the display itself (or beyond any float) has no defined vergence.
+            distance = d if 1e-3 < d < math.inf else None
         # Blink times never go back (the engine's t never does either).
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
