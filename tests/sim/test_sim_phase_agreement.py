@@ -113,4 +113,4 @@ def test_no_target_comes_from_another_phase_than_the_one_reported(scene, initiat
         phases = {p for _, p, _, _, _ in ticks}
         assert Phase.REACH in phases, f"{name}: the handover's reach was never reported"
         wrong = [tick for tick in ticks if tick[1] is not tick[3]]
-        assert not wrong, f"{name}: first tick (t, reported, target, rule's phase, rule): {wrong[0]}"
+        assert not wrong, f"{name}: (t, reported, target, rule phase, rule) {wrong[0]}"
