@@ -229,11 +229,15 @@ class GazeEngine:
     def reset(self, head: Mapping[str, float] | None = None) -> None:
         """Forget the current handover (e.g. after a restart) and optionally the head pose."""
         self.detector: PhaseDetectorLike = make_detector(self._phase_config)
-        self.handover = HandoverState()
-        seed = self.behavior.seed if hasattr(self, "behavior") else self._seed
-        self.behavior = BehaviorMachine(
-            self.behavior_spec, seed=seed, handover=self.handover, defaults=self._defaults
-        )
+        if hasattr(self, "behavior"):  # reuse the machine: building one costs milliseconds
+            self.handover.reset()
+            self.behavior.reset()
+        else:
+            self.handover = HandoverState()
+            self.behavior = BehaviorMachine(
+                self.behavior_spec, seed=self._seed, handover=self.handover,
+                defaults=self._defaults,
+            )
         self.gaze.reset(head)
         self.stats = EngineStats()
         self._pending: list[Event] = []
@@ -257,20 +261,25 @@ class GazeEngine:
         return self._last_t if math.isfinite(self._last_t) else 0.0
 
     def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
-        """``frame`` with every point beyond the workspace (or not a finite 3-vector) missing."""
+        """``frame`` with every point beyond the workspace (or not a numeric 3-vector) missing."""
         changed = {}
+        r = self._radius
         for name in ("giver_hand", "receiver_hand", "giver_face"):
             p = getattr(frame, name)
-            try:
-                x, y, z = (float(v) for v in np.asarray(p, dtype=float).reshape(3))
-            except (TypeError, ValueError, OverflowError):
-                changed[name] = NAN3.copy()
-                continue
+            if type(p) is np.ndarray and p.shape == (3,) and p.dtype.kind == "f":
+                x, y, z = p.tolist()  # plain floats: numpy per-call overhead is microseconds
+            else:
+                try:
+                    x, y, z = (float(v) for v in np.asarray(p, dtype=float).reshape(3))
+                except (TypeError, ValueError, OverflowError):
+                    changed[name] = NAN3.copy()
+                    continue
+                changed[name] = np.array([x, y, z])
             if x != x or y != y or z != z:
                 continue  # already missing (NaN)
-            r = self._radius
-            # Comparisons per coordinate first: a huge finite value must not overflow x * x.
-            if not (abs(x) <= r and abs(y) <= r and abs(z) <= r and x * x + y * y + z * z <= r * r):
+            # Per coordinate first: a huge finite value must not overflow x * x.
+            if not (-r <= x <= r and -r <= y <= r and -r <= z <= r
+                    and x * x + y * y + z * z <= r * r):
                 self.stats.implausible += 1
                 changed[name] = NAN3.copy()
         if not changed:
