@@ -30,13 +30,9 @@ from gazebot.annotations.rules import DEFAULT_RULE, GazeRule
 from gazebot.annotations.three_phase import HANDOVER_PHASES
 from gazebot.behaviors.machine import BehaviorMachine
 from gazebot.behaviors.spec import BehaviorSpec
-from gazebot.types import Event, EventKind, GazeContext
+from gazebot.types import EVENT_OF_PHASE, Event, EventKind, GazeContext, Phase
 
-_START_EVENT = {
-    "reach": EventKind.REACH_STARTED,
-    "transfer": EventKind.TRANSFER_STARTED,
-    "retreat": EventKind.RETREAT_STARTED,
-}
+_START_EVENT = {p.value: k for p, k in EVENT_OF_PHASE.items() if p is not Phase.DONE}
 _AS_HAND = {"hand": "hand", "object": "hand", "face": "face"}
 # Stand-in positions: only the target kind matters for the comparison.
 _POINTS = {
