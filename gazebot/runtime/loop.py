@@ -29,7 +29,6 @@ wire).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Protocol
@@ -213,8 +212,7 @@ class GazeLoop:
         # Blink times never go back (the engine's t never does either).
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
-        return dataclasses.replace(
-            cmd,
+        return cmd.replaced(
             head=head,
             eye_yaw=float(yaw),
             eye_pitch=float(pitch),

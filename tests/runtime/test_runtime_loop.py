@@ -127,3 +127,15 @@ def test_big_gaze_shifts_bring_blinks_and_the_blink_stream_is_seeded(sawyer):
     assert a == b and max(a) == 1.0
     hit = sum(any(abs(bt - k) < 0.05 for bt in times) for k in range(1, 5))
     assert hit >= 2  # shift_probability 0.9: most jumps blink at once
+
+
+def test_the_loop_fills_the_engines_command_without_copying_its_fields_by_hand(sawyer):
+    engine = _Engine(sawyer)
+    loop = GazeLoop(engine)
+    engine.next = _cmd({"head_pan": 0.2})
+    cmd = loop.tick(TrackingFrame(t=1.0))
+    assert type(cmd) is GazeCommand and cmd.head == {"head_pan": 0.2}
+    assert engine.next.blink == 0.0 and engine.next.distance is None  # the engine's is untouched
+    assert cmd.replaced(blink=0.5).blink == 0.5
+    with pytest.raises(TypeError, match="no fields"):
+        cmd.replaced(blinks=0.5)
