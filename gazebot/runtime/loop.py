@@ -110,6 +110,8 @@ class GazeLoop:
         self.faults = 0  # ticks the engine raised on (answered with None)
         self.ticks = 0
         self._t = -math.inf
+        self._frame_key: tuple | None = None
+        self._frame_rows: list[list[float]] = []
         robot = engine.robot
         self._limits = [(str(n), float(lo), float(hi))
                         for n, lo, hi in zip(robot.head_joints, robot.lower, robot.upper,
@@ -203,7 +205,7 @@ class GazeLoop:
             self.clipped += 1
         distance = None
         if is_valid_point(cmd.target_point):
-            rows = robot.gaze_frame_lists(self._display_pose(head, joints))
+            rows = self._gaze_frame(self._display_pose(head, joints))
             x, y, z = cmd.target_point.tolist()
             dx, dy, dz = x - rows[0][3], y - rows[1][3], z - rows[2][3]
             d = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -220,6 +222,15 @@ class GazeLoop:
             distance=distance,
             answers_sample=answers,
         )
+
+    def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
+        """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
+        the arm carrying the head moved (a head at rest: no forward kinematics)."""
+        key = (*pose, getattr(self.robot, "arm_revision", None))
+        if key != self._frame_key:
+            self._frame_key = key
+            self._frame_rows = self.robot.gaze_frame_lists(pose)
+        return self._frame_rows
 
     def _display_pose(
         self, head: dict[str, float], joints: Mapping[str, float] | None
