@@ -112,11 +112,16 @@ class STLConfig(_Strict):
         le=100,
         description="|dg_r/dt| cap: gripper openness (0 closed .. 1 open) per second (eq. 4.2)",
     )
+    gripper_margin: float = Field(
+        default=0.02, ge=0, description="synthesize the openness this far inside eps_g"
+    )
 
     @model_validator(mode="after")
     def _ordered(self) -> STLConfig:
         if self.margin_m >= self.eps_p_m:
             raise ValueError("margin_m < eps_p_m")
+        if self.gripper_margin >= self.eps_g:
+            raise ValueError("gripper_margin < eps_g")
         if self.delta_1 > self.delta_2:
             raise ValueError("delta_1 <= delta_2")
         return self
