@@ -68,11 +68,11 @@ def _robustness(p: ReachMILP, U: np.ndarray) -> float:
 
 def _reference_optimum(p: ReachMILP) -> float | None:
     """min sum |u| by enumerating the near steps, one LP over positions per choice."""
-    H = p.horizon
-    n = 3 * H  # x (positions), s (|x_j - x_{j-1}| per axis), t (|x_j - target_j| per axis)
+    H, d = p.horizon, len(np.ravel(p.x0))
+    n = d * H  # x (positions), s (|x_j - x_{j-1}| per axis), t (|x_j - target_j| per axis)
     # x_j - x_{j-1} as a matrix D on x (x_0 fixed: its term moves to the bounds)
-    D = sparse.kron(sparse.eye(H) - sparse.eye(H, k=-1), sparse.eye(3))
-    x0_term = np.r_[np.asarray(p.x0, float), np.zeros(n - 3)]
+    D = sparse.kron(sparse.eye(H) - sparse.eye(H, k=-1), sparse.eye(d))
+    x0_term = np.r_[np.asarray(p.x0, float), np.zeros(n - d)]
     Id, Z = sparse.eye(n), sparse.csr_matrix((n, n))
     base_ub = [
         (sparse.hstack([D, -Id, Z]), x0_term),  # (x_j - x_{j-1}) <= s
@@ -88,7 +88,7 @@ def _reference_optimum(p: ReachMILP) -> float | None:
         rhs = [r[1] for r in base_ub]
         for j in sorted(set(near)):  # sum over axes of t_j <= eps
             sel = np.zeros((1, 3 * n))
-            sel[0, 2 * n + 3 * j : 2 * n + 3 * j + 3] = 1
+            sel[0, 2 * n + d * j : 2 * n + d * j + d] = 1
             rows.append(sparse.csr_matrix(sel))
             rhs.append(np.array([p.eps]))
         res = linprog(
@@ -129,6 +129,17 @@ def test_two_windows_on_a_moving_target_agree_with_the_disjunctive_lp(seed):
     U, _ = solve_reach_milp(p)
     gap = np.abs(_positions(p, U) - p.target).sum(axis=1)
     assert (gap[:4] <= p.eps + TOL).any() and (gap[3:] <= p.eps + TOL).any()
+
+
+def test_a_one_dimensional_state_the_gripper_agrees_with_the_disjunctive_lp():
+    """The gripper's openness (``STLGripper``): 1 -> within 0.08 of 0 at 4/s in 0.2 s steps."""
+    H = 6
+    W = np.zeros((1, H))
+    W[0, :3] = 1
+    p = ReachMILP(np.array([1.0]), np.zeros((H, 1)), W, np.ones(1), 0.2, 4.0, 0.08)
+    assert independent_discrepancies(p) == []
+    U, _ = solve_reach_milp(p)
+    assert U.shape == (H, 1) and np.abs(U).sum() * p.dt == pytest.approx(0.92, abs=1e-6)
 
 
 def _tiny(target, deadline=3, eps=0.01) -> ReachMILP:
