@@ -10,7 +10,8 @@ Table 4.2's whole task (the ``stl`` reach with an :class:`~gazebot.controllers.s
 STLGripper`): a giving robot given a ``pickup`` point starts with an open, empty gripper, goes to
 the object (t_5) and grasps it (t_6) before its handover starts; a receiving robot given a
 ``dropoff`` point carries the object there (t_3), opens its gripper (t_4), leaves the object and
-returns home."""
+returns home. In these scenes the transfer's grasp (t_2) and release (t_8) are synthesized by the
+same gripper; elsewhere the gripper closes or opens over ``gripper_close_s``."""
 
 from __future__ import annotations
 
@@ -138,6 +139,7 @@ class HandoverController:
         self._g_u = 0.0
         self.gripper_infeasible_at: float | None = None
         self.dropped = False  # the object was left at the drop-off
+        self._last_tick_dt: float | None = None
         if self.pickup is not None:
             self.state = ControllerState.PICKING_UP
             self._gripper = 0.0  # open, empty
@@ -199,8 +201,14 @@ class HandoverController:
             self._grasp_t0 = t
             s = ControllerState.RELEASING
         if s is ControllerState.RELEASING:
-            self._gripper = max(0.0, 1.0 - (t - self._grasp_t0) / cfg.gripper_close_s)
-            if self._gripper <= 0.0:
+            if self._gripper_synthesized(t, release=True):  # t_8
+                released = True
+            elif self.gripper_synth is not None:
+                released = False
+            else:
+                self._gripper = max(0.0, 1.0 - (t - self._grasp_t0) / cfg.gripper_close_s)
+                released = self._gripper <= 0.0
+            if released:
                 self._emit(EventKind.ROBOT_RELEASED, t)
                 start = self.reach.hold() if self.reach is not None else self._last_q
                 duration = self._move(t, start, self.home, cfg.retreat_min_duration_s)
@@ -224,6 +232,19 @@ class HandoverController:
             self._g_next += g.dt
         self._gripper = float(np.clip(self._gripper - self._g_u * dt, 0.0, 1.0))
         return abs((1.0 - self._gripper) - goal) < g.stl.eps_g
+
+    def _gripper_synthesized(self, t: float, release: bool) -> bool:
+        """With the STL gripper: one tick of the transfer's grasp (t_2, to ``g*``) or release
+        (t_8, open); True once met. Without it: False (the ramp of ``gripper_close_s`` runs)."""
+        if self.gripper_synth is None:
+            return False
+        assert self.reach is not None and self._last_tick_dt is not None
+        stl = self.reach.controller.config.stl
+        goal = 1.0 if release else stl.grip_width
+        if self._gripper_tick(t, self._last_tick_dt, goal, stl.transfer_time_s):
+            self._gripper_done()
+            return True
+        return False
 
     def _gripper_done(self) -> None:
         self._g_t0, self._g_u = None, 0.0
@@ -282,6 +303,7 @@ class HandoverController:
         cfg, s = self.config, self.state
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
         self._last_t = t
+        self._last_tick_dt = dt
         self._last_q = np.asarray(q, float)
         arm_goal: np.ndarray | None = None
         if self._hand0 is None and np.all(np.isfinite(sensed.giver_hand)):
@@ -315,8 +337,14 @@ class HandoverController:
             self._grasp_t0 = t
             s = ControllerState.GRASPING
         if s is ControllerState.GRASPING:
-            self._gripper = min(1.0, (t - self._grasp_t0) / cfg.gripper_close_s)
-            if self._gripper >= 1.0:
+            if self._gripper_synthesized(t, release=False):  # t_2
+                grasped = True
+            elif self.gripper_synth is not None:
+                grasped = False
+            else:
+                self._gripper = min(1.0, (t - self._grasp_t0) / cfg.gripper_close_s)
+                grasped = self._gripper >= 1.0
+            if grasped:
                 self._emit(EventKind.ROBOT_GRASPED, t)
                 s = ControllerState.HOLDING
         retreat_now = (
