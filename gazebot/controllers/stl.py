@@ -49,7 +49,8 @@ class ActiveSpec:
 
 
 class STLController(ReachController):
-    """Receding-horizon MILP synthesis of the Table 4.3 reach specification."""
+    """Receding-horizon MILP synthesis of the Table 4.3 reach specification and of Table 4.2's
+    pick-up (t_5) and carry to the drop-off (t_3); ``active`` names the last step's."""
 
     name = "stl"
 
