@@ -403,10 +403,17 @@ class HandoverSimulation:
             object_pos=into_hand,
         )
 
+    @property
+    def robot_load_share(self) -> float:
+        """The robot's share of the object's weight, ``alpha_r`` (seed 4.3): 0 while it does not
+        grip it, 0.5 while the person grips it too, 1 alone."""
+        if not self.controller.grasped:
+            return 0.0
+        return 0.5 if self.giver.holds_object else 1.0
+
     def _sense_robot_receiver(self, obj: np.ndarray, gripper: np.ndarray) -> Sensed:
-        grasped = self.controller.grasped
         return Sensed(
-            load_share=0.0 if not grasped else (0.5 if self.giver.holds_object else 1.0),
+            load_share=self.robot_load_share,
             giver_hand=self.giver.hand.copy(),
             object_gap=float(np.linalg.norm(obj - gripper)),
             hand_object_gap=float(

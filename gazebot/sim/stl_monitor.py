@@ -73,9 +73,8 @@ class HandoverMonitor:
         if self._last_t is not None and self.dt is None:
             self.dt = sim.t - self._last_t
         self._last_t = sim.t
-        grasped = ctrl.grasped
         person = sim.giver.holds_object
-        alpha = 0.0 if not grasped else (0.5 if person else 1.0)
+        alpha = sim.robot_load_share
         obj = sim.data.mocap_pos[sim.scene.object_mocap].copy()
         row = {
             "t": sim.t,
