@@ -252,7 +252,7 @@ class SceneConfig(_Strict):
         ):
             if getattr(ctrl, field) is None:
                 continue
-            if ctrl.reach_controller is not ReachControllerName.STL:
+            if ctrl.reach_controller != "stl":
                 raise ValueError(f"controller.{field} needs reach_controller: stl (Table 4.2)")
             if self.direction is not direction:
                 raise ValueError(f"controller.{field} needs direction: {direction.value}")
