@@ -13,6 +13,7 @@ from typing import Any
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
 from gazebot.cli.errors import UsageError, seed_value
+from gazebot.ros2 import topics
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -64,10 +65,10 @@ def handle(args: argparse.Namespace) -> int:
                             caption=f"gazebot display: {renderer.style.name}")
         if args.record is not None:
             writer = open_h264_writer(args.record, fps, screen.size)
-        print(f"gazebot display: {args.robot} eyes from {cfg.keys.eyes} "
+        print(f"gazebot display: {args.robot} eyes from {cfg.names.resolve(topics.EYES.name)} "
               f"(connect {list(cfg.connect)}) at {fps:g} frames/s", file=sys.stderr)
         summary = run_display(node, screen, animator, fps, args.duration, writer,
-                              key=cfg.keys.eyes, robot=args.robot)
+                              key=cfg.names.resolve(topics.EYES.name), robot=args.robot)
         if writer is not None:
             writer.close()
             summary["video"] = str(args.record)

@@ -1,5 +1,5 @@
-"""``gazebot run``: the gaze engine node alone, driving any robot that speaks gazebot's keys on
-the Zenoh bus (the simulator of ``gazebot sim`` or a real robot's bridge)."""
+"""``gazebot run``: the gaze engine node alone, driving any robot that speaks gazebot's ROS 2
+topics on the Zenoh bus (the simulator of ``gazebot sim`` or a real robot's bridge)."""
 
 from __future__ import annotations
 
@@ -70,7 +70,7 @@ def handle(args: argparse.Namespace) -> int:
         node = (EngineNode.with_eye_frames(loop, driver, node_cfg, warn=warn)
                 if not args.no_eye_frames else EngineNode(loop, driver, node_cfg, warn=warn))
         print(
-            f"gazebot run: {args.behavior} on {node.engine.robot.name} at gazebot/{cfg.robot_id}/ "
+            f"gazebot run: {args.behavior} on {node.engine.robot.name} under {cfg.names.namespace} "
             f"({endpoints})",
             file=sys.stderr,
         )
@@ -88,6 +88,7 @@ def handle(args: argparse.Namespace) -> int:
             "warnings": node.warnings,
             "dropped": driver.dropped(),
             "tracking_skipped": driver.tracking_skipped,
+            "type_mismatches": {k: str(v) for k, v in driver.type_mismatches().items()},
         }
     finally:
         driver.close()

@@ -37,7 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--eye-frames",
         action="store_true",
-        help="show the engine's rendered eye frames on the display (gazebot/<id>/eyes/frame) "
+        help="show the engine's rendered eye frames on the display (eyes/image/compressed) "
         "instead of drawing the eyes from the eye state",
     )
     p.add_argument("--duration", type=positive, default=None,
@@ -105,7 +105,7 @@ def handle(args: argparse.Namespace) -> int:
             from gazebot.drivers.zenoh_driver import ZenohRobotDriver
             from gazebot.runtime import GazeLoop
 
-            driver = ZenohRobotDriver(endpoint.session, cfg.keys, "engine")
+            driver = ZenohRobotDriver(endpoint.session, cfg.names, "engine")
 
             robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
             loop = GazeLoop.from_config(robot, args.behavior, seed=args.seed)
@@ -117,7 +117,8 @@ def handle(args: argparse.Namespace) -> int:
             if not engine_node.ready.wait(60.0):
                 raise TimeoutError("the in-process engine node did not start within 60 s")
         print(
-            f"gazebot sim: robot {sim.robot.name} scene {args.scene} on gazebot/{cfg.robot_id}/ "
+            f"gazebot sim: robot {sim.robot.name} scene {args.scene} under {cfg.names.namespace} "
+            f"(ROS domain {cfg.names.domain_id}) "
             f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})"
             + (f", engine '{args.behavior}' in-process" if args.with_engine else ""),
             file=sys.stderr,

@@ -47,7 +47,13 @@ EVENTS = Topic("handover/events", cv.HANDOVER_EVENT)
 PHASE = Topic("handover/phase", cv.HANDOVER_PHASE)
 DIAGNOSTICS = Topic("/diagnostics", cv.DIAGNOSTIC_ARRAY)
 
+# Arm goals from an operator or planner: joint goals (``gripper`` 0..1 among them) and named
+# modes (``home``, ``handover``: the robot config's poses; ``resume``: back to the robot's own
+# handover controller).
+ARM_COMMAND = Topic("arm/command", cv.JOINT_TRAJECTORY)
+ARM_MODE = Topic("arm/mode", "std_msgs/msg/String")
+
 ALL = (
     GIVER_HAND, RECEIVER_HAND, GIVER_FACE, TF, JOINT_STATES, ROBOT_EVENTS, GRIPPER, LOAD_SHARE,
-    HEAD_COMMAND, GAZE_TARGET, EYES, EYE_IMAGE, EVENTS, PHASE, DIAGNOSTICS,
+    HEAD_COMMAND, GAZE_TARGET, EYES, EYE_IMAGE, EVENTS, PHASE, DIAGNOSTICS, ARM_COMMAND, ARM_MODE,
 )
