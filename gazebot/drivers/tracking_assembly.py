@@ -9,7 +9,9 @@ Zenoh keeps the order within a topic, not across topics, so a sample is complete
 2. a part of a newer stamp arrived (a part that is not tracked now is simply not sent), or
 3. it waited ``timeout`` s of wall time (the last sample before the robot stops).
 
-A part that arrives after its sample was complete is too late: counted in ``late`` and dropped.
+A part that arrives after its sample was complete is too late: counted in ``late`` and dropped,
+unless it is older than the last sample by more than ``clock_reset`` s: then the robot's clock
+restarted (a restarted simulator), and the samples start over (the engine node resynchronises).
 Stamps are compared to the nanosecond, the resolution of ``builtin_interfaces/Time``.
 """
 
@@ -36,13 +38,16 @@ class SampleAssembler:
     Args:
         expected: The parts that currently have a publisher.
         timeout: Wall time (s) after which a pending sample is complete anyway.
+        clock_reset: A part this much older (s) than the last sample starts a new timeline.
         clock: Monotonic clock (s).
     """
 
     def __init__(self, expected: Callable[[], set[str]], timeout: float = 0.05,
+                 clock_reset: float = 0.5,
                  clock: Callable[[], float] = time.monotonic) -> None:
         self.expected = expected
         self.timeout = timeout
+        self.clock_reset = clock_reset
         self.clock = clock
         self.late = 0
         self._pending: dict[int, _Pending] = {}
@@ -53,7 +58,11 @@ class SampleAssembler:
         """Add one part at robot time ``t`` (s); returns the samples it completed, oldest
         first."""
         ns = round(t * 1e9)
-        if self._last_ns is not None and ns <= self._last_ns:
+        restarted: list[TrackingMsg] = []
+        if self._last_ns is not None and ns < self._last_ns - self.clock_reset * 1e9:
+            restarted = [self._emit(s) for s in sorted(self._pending)]
+            self._last_ns = None
+        elif self._last_ns is not None and ns <= self._last_ns:
             self.late += 1
             return []
         pending = self._pending.setdefault(ns, _Pending(self.clock()))
@@ -62,7 +71,7 @@ class SampleAssembler:
         expected = self.expected()
         if expected and expected <= pending.parts.keys():
             done.append(ns)
-        return [self._emit(s) for s in done]
+        return restarted + [self._emit(s) for s in done]
 
     def flush_stale(self) -> list[TrackingMsg]:
         """Samples pending for longer than ``timeout``, oldest first."""
@@ -80,7 +89,7 @@ class SampleAssembler:
 
     def _emit(self, ns: int) -> TrackingMsg:
         parts = self._pending.pop(ns).parts
-        self._last_ns = ns if self._last_ns is None else max(self._last_ns, ns)
+        self._last_ns = ns
         msg = TrackingMsg(
             seq=self._seq,
             t=ns / 1e9,

@@ -76,7 +76,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self.tracking_received = 0
         self.tracking_skipped = 0
         self._joints: JointStateMsg | None = None
-        self._assembler = SampleAssembler(self._expected_parts, assemble_timeout, clock)
+        self._assembler = SampleAssembler(self._expected_parts, assemble_timeout, clock=clock)
         ros = self.ros
         self._head_pub = ros.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
         self._target_pub = ros.publisher(topics.GAZE_TARGET.name, topics.GAZE_TARGET.type)

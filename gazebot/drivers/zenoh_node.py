@@ -243,7 +243,13 @@ class ZenohNode:
         selector = self._history_key("*")
         codec = self._event_pubs["other"].codec
         merged: dict[tuple[str, str, int, int], EventMsg] = {}
-        for reply in self.session.get(selector, timeout=timeout):
+        import zenoh
+
+        # One reply per event from each node: no consolidation (by default Zenoh keeps only
+        # the latest reply per key).
+        replies = self.session.get(selector, timeout=timeout,
+                                   consolidation=zenoh.ConsolidationMode.NONE)
+        for reply in replies:
             if reply.ok is None:
                 continue
             sample = reply.ok
