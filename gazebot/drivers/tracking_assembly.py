@@ -90,9 +90,10 @@ class SampleAssembler:
     def _emit(self, ns: int) -> TrackingMsg:
         parts = self._pending.pop(ns).parts
         self._last_ns = ns
+        sec, nanosec = divmod(ns, 1_000_000_000)
         msg = TrackingMsg(
             seq=self._seq,
-            t=ns / 1e9,
+            t=float(sec) + 1e-9 * float(nanosec),  # as convert.from_time reads a stamp
             stamp=time.time(),
             giver_hand=point_or_none(parts.get("giver_hand")),
             receiver_hand=point_or_none(parts.get("receiver_hand")),
