@@ -2,12 +2,13 @@
 arrive as separate messages stamped with the robot time of their sample; this groups them by
 stamp into one :class:`~gazebot.drivers.payloads.TrackingMsg`.
 
-Zenoh keeps the order within a topic, not across topics, so a sample is complete when
+Zenoh keeps the order within a topic, not across topics: once a topic delivered a newer stamp,
+it will not deliver an older one. So a sample is complete when
 
 1. every part that currently has a publisher (``expected()``, from the graph) has arrived for
-   its stamp, or
-2. a part of a newer stamp arrived (a part that is not tracked now is simply not sent), or
-3. it waited ``timeout`` s of wall time (the last sample before the robot stops).
+   its stamp or moved on to a newer stamp (a part that is not tracked now is simply not sent),
+2. or, while no publisher is known, a part of a newer stamp arrived,
+3. or it waited ``timeout`` s of wall time (the last sample before the robot stops).
 
 A part that arrives after its sample was complete is too late: counted in ``late`` and dropped,
 unless it is older than the last sample by more than ``clock_reset`` s: then the robot's clock
@@ -51,6 +52,7 @@ class SampleAssembler:
         self.clock = clock
         self.late = 0
         self._pending: dict[int, _Pending] = {}
+        self._newest: dict[str, int] = {}
         self._last_ns: int | None = None
         self._seq = 0
 
@@ -62,15 +64,24 @@ class SampleAssembler:
         if self._last_ns is not None and ns < self._last_ns - self.clock_reset * 1e9:
             restarted = [self._emit(s) for s in sorted(self._pending)]
             self._last_ns = None
+            self._newest.clear()
         elif self._last_ns is not None and ns <= self._last_ns:
             self.late += 1
             return []
         pending = self._pending.setdefault(ns, _Pending(self.clock()))
         pending.parts[part] = value
-        done = [s for s in sorted(self._pending) if s < ns]
+        self._newest[part] = max(ns, self._newest.get(part, ns))
         expected = self.expected()
-        if expected and expected <= pending.parts.keys():
-            done.append(ns)
+        done = []
+        for s in sorted(self._pending):
+            parts = self._pending[s].parts
+            if expected:
+                complete = all(p in parts or self._newest.get(p, s) > s for p in expected)
+            else:
+                complete = s < ns
+            if not complete:
+                break  # a part still to come for this stamp cannot have come for a newer one
+            done.append(s)
         return restarted + [self._emit(s) for s in done]
 
     def flush_stale(self) -> list[TrackingMsg]:
