@@ -3,6 +3,7 @@ sample, whatever order they arrive in across topics."""
 
 from __future__ import annotations
 
+import pytest
 from drivers_fakes import FakeClock
 
 from gazebot.drivers.tracking_assembly import SampleAssembler
@@ -31,7 +32,7 @@ def test_interleaved_topics_do_not_split_samples():
     out = []
     for p in (a[0], b[0], c[0], *a[1:], *b[1:], *c[1:]):
         out += asm.add(*p)
-    assert [m.t for m in out] == [0.1, 0.2, 0.3]
+    assert [m.t for m in out] == pytest.approx([0.1, 0.2, 0.3], abs=1e-9)
     assert all(m.giver_face is not None and m.receiver_hand is not None for m in out)
 
 
