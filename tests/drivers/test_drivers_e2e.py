@@ -16,8 +16,8 @@ from drivers_fakes import Recorder, wait_until
 
 from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
 from gazebot.drivers.sim_node import SimNode, SimNodeConfig
-from gazebot.drivers.zenoh_node import event_from_ros
 from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+from gazebot.drivers.zenoh_node import event_from_ros
 from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
 from gazebot.ros2 import convert, topics
 

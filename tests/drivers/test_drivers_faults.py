@@ -144,7 +144,7 @@ def test_bad_input_is_counted_dropped_reported_with_its_topic_and_never_crashes(
             ep.session.put(_key(ep, topic), raw)
         ep.session.put(_key(ep, topics.HEAD_COMMAND), raw)  # the robot side drops these
     ep.publish_tracking(frame(1.0))
-    assert wait_until(lambda: (m := ep.head.peek()) is not None)
+    assert wait_until(lambda: ep.head.peek() is not None)
     n = len(cdr_garbage)
     resolved = {t: ep.names.resolve(t.name) for t in
                 (topics.GIVER_HAND, topics.JOINT_STATES, topics.EVENTS, topics.DIAGNOSTICS)}
