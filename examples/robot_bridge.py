@@ -3,8 +3,10 @@
 It publishes tracking (from your motion capture) and joint states as ROS 2 messages on the
 rmw_zenoh wire (``/gazebot/tracking/*`` PointStamped, ``/joint_states``), and applies the head
 commands (``/gazebot/head/command``, JointTrajectory) the engine sends. A ROS 2 robot running
-rmw_zenoh needs no bridge at all: its own nodes publish and subscribe to these topics. Here the "robot" is a stand-in that applies head goals instantly and
-the "motion capture" replays a synthetic handover; swap both for your hardware interfaces.
+rmw_zenoh needs no bridge at all: its own nodes publish and subscribe to these topics.
+
+Here the "robot" is a stand-in that applies head goals instantly and the "motion capture"
+replays a synthetic handover; swap both for your hardware interfaces.
 
 Terminal 1:  python examples/robot_bridge.py --duration 10
 Terminal 2:  gazebot run --robot sawyer --behavior face-hand-face --duration 10

@@ -183,7 +183,8 @@ class HeadCommandMsg(Msg):
 class EyeStateMsg(Msg):
     """``eyes/state`` (``gazebot_msgs/EyeState``): eye direction on the display (rad; ``yaw``
     + = robot's left, ``pitch`` + = down), eyelid closure ``blink`` (0 open .. 1 closed) and
-    ``distance`` (m, > 0) from the display (the head's ``gaze`` site) to the gaze target, for the eyes' vergence.
+    ``distance`` (m, > 0) from the display (the head's ``gaze`` site) to the gaze target, for the
+    eyes' vergence.
 
     ``distance`` ``None``: unknown (parallel eyes; NaN on the wire).
     """
