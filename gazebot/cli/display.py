@@ -20,7 +20,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "display",
         help="show the robot's eyes on its head screen, driven by the engine over the bus",
-        description="Subscribe to gazebot/<id>/eyes (yaw, pitch, blink, distance) and draw the "
+        description="Subscribe to the engine's eyes/state (yaw, pitch, blink, distance) and draw the "
         "robot's eyes at the screen rate; between updates the eyes drift slightly; when the "
         "engine goes silent they return to a neutral pose, blink on their own and the status "
         "line says so. Headless with SDL_VIDEODRIVER=dummy (e.g. with --record).",
