@@ -99,8 +99,11 @@ def graph(port: int, ns: str, wait: float) -> dict:
     topics = dict(get_topic_names_and_types(router_port=port, timeout=1.0))
     out = {}
     for name, types in topics.items():
-        info = get_topic_info(name, router_port=port, timeout=1.0, verbose=True)
-        endpoints = (info.publishers + info.subscribers) if info else []
+        for _ in range(10):  # a liveliness query on a busy machine may come back short
+            info = get_topic_info(name, router_port=port, timeout=1.0, verbose=True)
+            endpoints = (info.publishers + info.subscribers) if info else []
+            if endpoints:
+                break
         out[name] = {"types": types,
                      "hashes": sorted({e.type_hash for e in endpoints}),
                      "publishers": sorted({e.node_name for e in info.publishers}) if info else []}
