@@ -37,6 +37,12 @@ class LoopStatus:
     info: dict[str, Any] = field(default_factory=dict)
 
 
+def _next_slot(t: float, period: float) -> float:
+    """The first multiple of ``period`` after ``t`` (less a nanosecond: tick times are sums
+    of floats), so a periodic topic keeps its rate on any tick grid."""
+    return (math.floor(t / period + 1e-9) + 1) * period - 1e-9
+
+
 class HandoverMcap:
     """Writes each tick of a handover to ``path`` as ROS 2 messages.
 
@@ -119,12 +125,12 @@ class HandoverMcap:
             self._phase = (phase, float(cmd.t))
         self._write(tp.PHASE, cv.handover_phase(float(cmd.t), cmd.phase, self._phase[1]), t)
         if self.eye_image is not None and t >= self._next_image:
-            self._next_image = t + self.eye_image_period
+            self._next_image = _next_slot(t, self.eye_image_period)
             img = self.eye_image(cmd.eye_yaw, cmd.eye_pitch, getattr(cmd, "blink", 0.0),
                                  getattr(cmd, "distance", None))
             self._write(tp.EYE_IMAGE, cv.compressed_image(img, t, "display"), t)
         if t >= self._next_diag:
-            self._next_diag = t + self.diagnostics_period
+            self._next_diag = _next_slot(t, self.diagnostics_period)
             tracking = str(getattr(cmd, "tracking", "ok"))
             status = LoopStatus(
                 node=self.node, state="ok" if tracking == "ok" else "degraded",
