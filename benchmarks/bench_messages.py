@@ -1,5 +1,5 @@
 """Message encode + decode: ROS 2 CDR (``gazebot.ros2``: rosbags' serializer, what the ROS 2 wire
-sends) against the JSON payloads it replaces (``gazebot.drivers.payloads``: strict pydantic
+sends) against the JSON payloads it replaced (``benchmarks/json_payload_peer.py``: strict pydantic
 models), per message, in one run.
 
 Each side does the whole trip a bus message makes between gazebot values: value -> message ->
@@ -15,15 +15,15 @@ from __future__ import annotations
 import base64
 import statistics
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
 
+from benchmarks import json_payload_peer as js
 from benchmarks.common import Result, median_time
-from gazebot.drivers import payloads as js
 from gazebot.ros2 import Codec, typestore
 from gazebot.ros2 import convert as cv
-from gazebot.runtime.loop import LoopCommand
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
 
 N = 200  # messages per timed round
@@ -68,12 +68,24 @@ def _tracking() -> tuple[Callable[[], object], Callable[[], object], int, int]:
     return ours, peer, ours_bytes, len(js.TrackingMsg.from_frame(frame, 7, 1.7e9).encode())
 
 
-def _command() -> LoopCommand:
-    return LoopCommand(
-        t=2.5, phase=Phase.REACH, target="hand", target_point=np.array([0.6, 0.0, 1.05]),
-        head={"head_pan": 0.31}, eye_yaw=0.05, eye_pitch=-0.02, blink=0.0, distance=0.9,
-        tracking="ok", answers_sample=True, residual=0.01,
-    )
+@dataclass(frozen=True)
+class _Command:
+    """The engine command's attributes both sides read."""
+
+    t: float = 2.5
+    phase: Phase = Phase.REACH
+    target: str = "hand"
+    target_point: np.ndarray = field(default_factory=lambda: np.array([0.6, 0.0, 1.05]))
+    head: dict = field(default_factory=lambda: {"head_pan": 0.31})
+    eye_yaw: float = 0.05
+    eye_pitch: float = -0.02
+    blink: float = 0.0
+    distance: float | None = 0.9
+    residual: float = 0.01
+
+
+def _command() -> _Command:
+    return _Command()
 
 
 def _head() -> tuple[Callable[[], object], Callable[[], object], int, int]:
