@@ -120,10 +120,11 @@ class HandoverMcap:
                 self._write(topic, msgs[role], t)
         for msg in msgs["events"]:  # type: ignore[union-attr]
             self._write(tp.EVENTS, msg, t)
-        phase, _ = cv.phase_parts(cmd.phase)
+        phase, source = cv.command_phase(cmd)
         if self._phase is None or self._phase[0] is not phase:
             self._phase = (phase, float(cmd.t))
-        self._write(tp.PHASE, cv.handover_phase(float(cmd.t), cmd.phase, self._phase[1]), t)
+        self._write(tp.PHASE, cv.handover_phase(float(cmd.t), phase, self._phase[1],
+                                                source=source), t)
         if self.eye_image is not None and t >= self._next_image:
             self._next_image = _next_slot(t, self.eye_image_period)
             img = self.eye_image(cmd.eye_yaw, cmd.eye_pitch, getattr(cmd, "blink", 0.0),
@@ -132,8 +133,9 @@ class HandoverMcap:
         if t >= self._next_diag:
             self._next_diag = _next_slot(t, self.diagnostics_period)
             tracking = str(getattr(cmd, "tracking", "ok"))
+            state = getattr(cmd, "status", None) or ("ok" if tracking == "ok" else "degraded")
             status = LoopStatus(
-                node=self.node, state="ok" if tracking == "ok" else "degraded",
+                node=self.node, state=str(state),
                 tracking=tracking, phase=phase.value, uptime=t - self._t0,
             )
             self._write(tp.DIAGNOSTICS, cv.diagnostics(status, t), t)
