@@ -23,14 +23,13 @@ from gazebot.runtime import GazeLoop
 from gazebot.types import Event, Phase
 
 if TYPE_CHECKING:
-    from gazebot.runtime.loop import LoopCommand
+    from typing import Any
+
     from gazebot.sim.simulation import HandoverSimulation
     from gazebot.types import TrackingFrame
 
     # t, tracking frame, measured joints, robot events, the loop's command (None: unsafe).
-    StepObserver = Callable[
-        [float, TrackingFrame, dict[str, float], list[Event], LoopCommand | None], None
-    ]
+    StepObserver = Callable[[float, TrackingFrame, dict[str, float], list[Event], Any], None]
 
 CONTROL_HZ = 120.0  # tracking rate of the seed's motion capture setup
 MAX_DURATION_S = 30.0  # a handover that has not finished by then is cut (and reported)
@@ -150,10 +149,7 @@ def record_handover(
                 events.extend(robot_events)
                 loop.notify(robot_events)
                 # The measured arm pose: on Sawyer the head rides on right_j0.
-                joints = sim.joint_state()
-                cmd = loop.tick(frame.t, frame, joints=joints)
-                if on_step is not None:
-                    on_step(frame.t, frame, joints, robot_events, cmd)
+                cmd = loop.tick(frame.t, frame, joints=sim.joint_state())
                 if cmd is not None:  # None: an unsafe command, never applied
                     sim.apply_head(cmd.head)
                     sim.apply_eyes(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)
@@ -176,6 +172,8 @@ def record_handover(
                             ),
                         )
                     )
+                if on_step is not None:  # the tick's input and answer (the sim has not moved)
+                    on_step(frame.t, frame, sim.joint_state(), robot_events, cmd)
                 if on_tick is not None and ticks:
                     on_tick(sim, ticks[-1])
                 # Frame k shows the first tick at or after k / fps.
