@@ -64,6 +64,7 @@ PhaseSource = Literal["tracking", "robot", "gripper"]
 _CATEGORIES = ("phase", "robot", "behavior", "fault", "node")
 _SOURCES = ("tracking", "robot", "gripper")
 _INT32 = 2**31
+_TIME_TYPES = {"Time": "builtin_interfaces/msg/Time", "Duration": "builtin_interfaces/msg/Duration"}
 
 
 def _store(store: Typestore | None) -> Typestore:
@@ -71,8 +72,9 @@ def _store(store: Typestore | None) -> Typestore:
 
 
 def _finite(type_name: str, what: str, *values: float) -> None:
-    if not all(math.isfinite(v) for v in values):
-        raise MessageError(type_name, f"{what} is not finite: {values}")
+    for v in values:  # a plain loop: this runs for every field of every message
+        if not math.isfinite(v):
+            raise MessageError(type_name, f"{what} is not finite: {values}")
 
 
 # -- time ---------------------------------------------------------------------------------------
@@ -84,8 +86,9 @@ def to_time(t: float, store: Typestore | None = None, kind: str = "Time") -> obj
     Raises:
         MessageError: ``t`` is not finite or outside the int32 seconds ROS 2 time holds.
     """
-    type_name = f"builtin_interfaces/msg/{kind}"
-    _finite(type_name, "time", t)
+    type_name = _TIME_TYPES[kind]
+    if not math.isfinite(t):
+        raise MessageError(type_name, f"time is not finite: {t}")
     ns = round(t * 1e9)
     sec, nanosec = divmod(ns, 1_000_000_000)
     if not -_INT32 <= sec < _INT32:
