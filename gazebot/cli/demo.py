@@ -10,8 +10,13 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode, seed_value
+
+if TYPE_CHECKING:
+    from gazebot.kinematics.config import RobotConfig
+    from gazebot.ros2.handover_log import HandoverMcap
 
 # The scene's controller fields the command line sets, for error messages.
 _OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
@@ -244,9 +249,9 @@ def _record(args: argparse.Namespace, out: Path, monitor=None):
     return rec
 
 
-def handover_mcap(robot, path: Path):
+def handover_mcap(robot: str | Path | RobotConfig, path: Path) -> HandoverMcap:
     """The MCAP log of a demo run on ``robot`` (name, YAML or config): every topic, eye images
-    at 10 Hz from the robot's own eye renderer."""
+    at 5 Hz from the robot's own eye renderer (JPEG at the display's size costs milliseconds)."""
     from gazebot.kinematics.config import RobotConfig, load_robot_config
     from gazebot.render import EyeRenderer
     from gazebot.ros2.handover_log import HandoverMcap
@@ -258,4 +263,5 @@ def handover_mcap(robot, path: Path):
         path, config.base_frame, config.gaze_site, 1.0 / CONTROL_HZ,
         eye_image=lambda yaw, pitch, blink, distance: eyes.render(
             yaw, pitch, blink=blink, distance=distance),
+        eye_image_period=0.2,
     )
