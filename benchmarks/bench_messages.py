@@ -26,8 +26,8 @@ from gazebot.ros2 import Codec, typestore
 from gazebot.ros2 import convert as cv
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
 
-N = 200  # messages per timed round
-ROUNDS = 7
+N = 50  # messages per timed round (short rounds, interleaved: load hits both alike)
+ROUNDS = 21
 
 
 def _paired(ours: Callable[[], object], peer: Callable[[], object]) -> tuple[float, float]:
