@@ -81,14 +81,31 @@ class McapRecorder:
                 recorded with another type.
         """
         type_name = getattr(msg, "__msgtype__", type(msg).__name__)
+        _, codec = self._channel(topic, type_name)
+        self._add(topic, type_name, codec.encode(msg), t)
+
+    def write_cdr(self, topic: str, type_name: str, data: bytes, t: float) -> None:
+        """Record CDR bytes received for ``topic`` as they are (what a bus recorder does, as
+        ``ros2 bag record`` stores what it receives): no re-encoding, but they must decode as
+        ``type_name``.
+
+        Raises:
+            MessageError: An unknown type, bytes that do not decode, a bad ``t``, or a topic
+                recorded with another type.
+        """
+        _, codec = self._channel(topic, type_name)
+        codec.decode(data)
+        self._add(topic, type_name, bytes(data), t)
+
+    def _add(self, topic: str, type_name: str, data: bytes, t: float) -> None:
         if not math.isfinite(t) or t < 0:
             raise MessageError(type_name, f"log time must be finite and >= 0 s, got {t}")
-        channel, codec = self._channel(topic, type_name)
+        channel, _ = self._channels[topic]
         ns = round(t * 1e9)
         seq = self._sequence.get(topic, 0) + 1
         self._sequence[topic] = seq
         self._writer.add_message(
-            channel_id=channel, log_time=ns, data=codec.encode(msg), publish_time=ns, sequence=seq
+            channel_id=channel, log_time=ns, data=data, publish_time=ns, sequence=seq
         )
         self.messages += 1
 

@@ -106,3 +106,19 @@ def test_a_topic_keeps_its_type_and_times_must_be_finite(tmp_path: Path) -> None
             with pytest.raises(MessageError, match="log time"):
                 rec.write("/a", cv.point_stamped(0.0, [0, 0, 0], "w"), bad)
         assert rec.topics == {"/a": "geometry_msgs/msg/PointStamped"}
+
+
+def test_received_cdr_bytes_are_recorded_as_they_are(tmp_path: Path) -> None:
+    from mcap.reader import make_reader
+
+    from gazebot.ros2 import Codec, typestore
+
+    codec = Codec.for_type(typestore(), cv.POINT_STAMPED)
+    raw = codec.encode(cv.point_stamped(2.0, [1, 2, 3], "world"))
+    with McapRecorder(tmp_path / "bus.mcap") as rec:
+        rec.write_cdr("/gazebot/gaze_target", cv.POINT_STAMPED, raw, 2.0)
+        with pytest.raises(MessageError, match="does not decode"):
+            rec.write_cdr("/gazebot/gaze_target", cv.POINT_STAMPED, raw[:-3], 2.1)
+    with (tmp_path / "bus.mcap").open("rb") as f:
+        (msg,) = [m for _, _, m in make_reader(f).iter_messages()]
+    assert msg.data == raw and msg.log_time == 2 * 10**9
