@@ -94,6 +94,8 @@ def handle(args: argparse.Namespace) -> int:
     names = PointNames(args.giver_hand, args.receiver_hand, args.giver_face)
     rec = load_recording(args.file, names, unit=args.unit, rate=args.rate)
     traj = rec.trajectory
+    for note in rec.notes:
+        print(f"gazebot phases: warning: {rec.source}: {note}", file=sys.stderr)
     _, reordered, dropped = traj.cleaned()
     if reordered or dropped:
         print(

@@ -47,6 +47,7 @@ class Recording:
         available: Every point name the file has.
         unit: The file's length unit (converted to m).
         rate: Median sampling rate found (Hz; NaN with fewer than two samples).
+        notes: What the reader had to work around (e.g. a file cut short), one line each.
     """
 
     trajectory: Trajectory
@@ -56,6 +57,7 @@ class Recording:
     available: tuple[str, ...]
     unit: str
     rate: float
+    notes: tuple[str, ...] = ()
 
     def describe(self) -> str:
         """One line: format, names, units and rate (what the CLI prints)."""
@@ -121,9 +123,10 @@ def build(
     unit: str,
     defaults: tuple[str | None, str | None, str | None],
     extra: dict[str, np.ndarray] | None = None,
+    notes: tuple[str, ...] = (),
 ) -> Recording:
     """Pick the three points from ``points`` (name -> (N, 3) in the file's unit) and build the
-    recording in metres."""
+    recording in metres (``notes``: see :attr:`Recording.notes`)."""
     available = sorted(points)
     scale = unit_scale(source, unit)
     g = pick(source, "giver_hand", names.giver_hand, available, defaults[0])
@@ -148,6 +151,7 @@ def build(
         tuple(available),
         unit,  # type: ignore[arg-type]
         median_rate(t),
+        notes,
     )
 
 

@@ -13,7 +13,10 @@ as in :mod:`.rosbag`. A coordinate that is NaN or infinite is a missing sample.
 from __future__ import annotations
 
 import math
+import struct
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any, BinaryIO
 
 from gazebot.recordings.base import (
     PointNames,
@@ -59,7 +62,6 @@ def read_mcap(
             (naming topic and log time), no usable topic, or a name the file lacks.
     """
     from mcap.exceptions import McapError
-    from mcap.reader import make_reader
     from rosbags.typesys import Stores, get_typestore
 
     from gazebot.ros2.errors import MessageError
@@ -77,9 +79,10 @@ def read_mcap(
         if math.isfinite(t) and all(math.isfinite(v) for v in xyz):
             series.setdefault(name, []).append((t, *xyz))
 
+    notes: list[str] = []
     try:
         with open(path, "rb") as f:
-            for schema, channel, message in make_reader(f).iter_messages():
+            for schema, channel, message in _messages(f, notes):
                 if schema is None or schema.encoding != "ros2msg":
                     continue
                 if channel.message_encoding != "cdr":
@@ -124,5 +127,35 @@ def read_mcap(
     extra = {"gripper_closed": hold_values(t, grip), "load_share": hold_values(t, load)}
     return build(
         path, "mcap", t, points, names or PointNames(), "m", defaults,  # type: ignore[arg-type]
-        extra,
+        extra, tuple(notes),
     )
+
+
+def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
+    """``(schema, channel, message)`` of every message: indexed reading of a finished file, else
+    (a recording cut short, e.g. by a crash) every complete chunk up to the cut, with a note."""
+    from mcap.exceptions import McapError
+    from mcap.reader import NonSeekingReader, make_reader
+
+    try:
+        reader = make_reader(f)
+        reader.get_summary()  # a finished file has its footer
+    except McapError:
+        f.seek(0)
+        count, last = 0, None
+        try:
+            # In file order (a time-ordered stream would hold everything back to sort it).
+            for item in NonSeekingReader(f).iter_messages(log_time_order=False):
+                count, last = count + 1, item[2].log_time
+                yield item
+        except (McapError, struct.error) as exc:  # the stream reader meets the cut
+            if not count:
+                raise ValueError(
+                    f"no footer, and cut short before the first complete chunk ({exc!r})"
+                ) from None
+            notes.append(
+                f"the file is cut short ({exc!r}); read the {count} messages before the cut "
+                f"(up to log time {last * 1e-9:.3f} s)"
+            )
+        return
+    yield from reader.iter_messages()

@@ -32,10 +32,15 @@ class McapRecorder:
         path: The ``.mcap`` file to write.
         store: The type system (default: the shipped one).
         compression: ``zstd`` (rosbag2's default for MCAP), ``lz4`` or ``none``.
+        chunk_size: Bytes of messages per (compressed) chunk.
     """
 
     def __init__(
-        self, path: str | Path, store: Typestore | None = None, compression: str = "zstd"
+        self,
+        path: str | Path,
+        store: Typestore | None = None,
+        compression: str = "zstd",
+        chunk_size: int = 1024 * 1024,
     ) -> None:
         kinds = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
                  "none": CompressionType.NONE}
@@ -45,7 +50,7 @@ class McapRecorder:
         self.store = typestore() if store is None else store
         self._part = self.path.with_name(self.path.name + ".part")
         self._file = open(self._part, "wb")  # noqa: SIM115 - closed in close()/abort()
-        self._writer = Writer(self._file, compression=kinds[compression])
+        self._writer = Writer(self._file, chunk_size=chunk_size, compression=kinds[compression])
         self._writer.start(profile="ros2", library=LIBRARY)
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, tuple[int, Codec]] = {}

@@ -156,3 +156,29 @@ def test_gazebot_phases_prints_the_phases_of_an_mcap(traj, tmp_path, capsys):
     out = capsys.readouterr().out
     assert "mcap, " in out
     assert [line.split()[1] for line in out.splitlines()[2:]] == ["reach", "transfer", "retreat"]
+
+
+def test_a_recording_cut_short_reads_up_to_the_cut_with_a_warning(traj, tmp_path, capsys):
+    """A recorder killed mid-file leaves no footer: every complete chunk is still read."""
+    path = tmp_path / "cut.mcap"
+    with McapRecorder(path, chunk_size=4096) as rec:
+        for i, t in enumerate(traj.t):
+            for body in ("giver_hand", "receiver_hand"):
+                p = getattr(traj, body)[i]
+                if np.isfinite(p).all():
+                    rec.write(tp.TRACKING[body].resolve(), cv.point_stamped(t, p, "world"), t)
+    data = path.read_bytes()
+    cut = tmp_path / "cut_short.mcap"
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    whole, short = load_recording(path), load_recording(cut)
+    assert whole.notes == ()
+    (note,) = short.notes
+    assert "cut short" in note
+    n = len(short.trajectory)
+    assert 0.5 * len(whole.trajectory) < n < len(whole.trajectory)
+    np.testing.assert_array_equal(short.trajectory.giver_hand, whole.trajectory.giver_hand[:n])
+    assert main(["phases", str(cut)]) == 0
+    assert "warning" in capsys.readouterr().err
+    cut.write_bytes(data[:200])
+    with pytest.raises(RecordingError, match="before the first complete chunk"):
+        load_recording(cut)
