@@ -352,6 +352,8 @@ def eye_state(cmd: Any, frame_id: str, store: Typestore | None = None) -> object
     yaw, pitch = float(cmd.eye_yaw), float(cmd.eye_pitch)
     blink = float(getattr(cmd, "blink", 0.0))
     _finite(EYE_STATE, "yaw/pitch/blink", yaw, pitch, blink)
+    if not 0.0 <= blink <= 1.0:
+        raise MessageError(EYE_STATE, f"blink must be within 0..1, got {blink}")
     distance = getattr(cmd, "distance", None)
     d = math.nan if distance is None else float(distance)
     if not (math.isnan(d) or (math.isfinite(d) and d > 0.0)):

@@ -126,6 +126,8 @@ def test_eye_state_round_trips_with_unknown_distance_as_nan() -> None:
     msg.blink = 1.5
     with pytest.raises(MessageError, match="blink"):
         cv.eyes_of(msg)
+    with pytest.raises(MessageError, match="blink"):
+        cv.eye_state(Command(blink=1.5), "gaze")
 
 
 def test_events_round_trip_with_their_info() -> None:
