@@ -4,12 +4,12 @@ SI units both sides (m, s, rad); points in the robot base frame, whose ROS name
 (``RobotConfig.base_frame``) the caller passes as ``frame_id``. Times are the robot's clock
 (simulation time in the simulator) as ``builtin_interfaces/Time``.
 
-Engine commands are read by attribute (``t``, ``phase``, ``target``, ``target_point``, ``head``,
-``eye_yaw``, ``eye_pitch``, ``blink``, ``distance``, ``events``), so any command value with those
-attributes converts. Nothing non-finite goes on the wire and nothing non-finite comes off it:
-a NaN or infinite coordinate, joint value or time, in either direction, raises
-:class:`~gazebot.ros2.errors.MessageError` (which a transport counts and drops), as do arrays
-of inconsistent lengths and images that do not decode.
+Engine commands are read by attribute (``t``, ``phase`` and optionally ``phase_source``,
+``target_point``, ``head``, ``eye_yaw``, ``eye_pitch``, ``blink``, ``distance``, ``events``), so
+any command value with those attributes converts. Nothing non-finite goes on the wire and
+nothing non-finite comes off it: a NaN or infinite coordinate, joint value or time, in either
+direction, raises :class:`~gazebot.ros2.errors.MessageError` (which a transport counts and
+drops), as do arrays of inconsistent lengths and images that do not decode.
 
 Every function takes the type system as ``store`` (default: the shipped
 :func:`~gazebot.ros2.typestore.typestore`).
@@ -64,6 +64,7 @@ PhaseSource = Literal["tracking", "robot", "gripper"]
 _CATEGORIES = ("phase", "robot", "behavior", "fault", "node")
 _SOURCES = ("tracking", "robot", "gripper")
 _INT32 = 2**31
+_TIME_TYPES = {"Time": "builtin_interfaces/msg/Time", "Duration": "builtin_interfaces/msg/Duration"}
 
 
 def _store(store: Typestore | None) -> Typestore:
@@ -71,8 +72,9 @@ def _store(store: Typestore | None) -> Typestore:
 
 
 def _finite(type_name: str, what: str, *values: float) -> None:
-    if not all(math.isfinite(v) for v in values):
-        raise MessageError(type_name, f"{what} is not finite: {values}")
+    for v in values:  # a plain loop: this runs for every field of every message
+        if not math.isfinite(v):
+            raise MessageError(type_name, f"{what} is not finite: {values}")
 
 
 # -- time ---------------------------------------------------------------------------------------
@@ -84,8 +86,9 @@ def to_time(t: float, store: Typestore | None = None, kind: str = "Time") -> obj
     Raises:
         MessageError: ``t`` is not finite or outside the int32 seconds ROS 2 time holds.
     """
-    type_name = f"builtin_interfaces/msg/{kind}"
-    _finite(type_name, "time", t)
+    type_name = _TIME_TYPES[kind]
+    if not math.isfinite(t):
+        raise MessageError(type_name, f"time is not finite: {t}")
     ns = round(t * 1e9)
     sec, nanosec = divmod(ns, 1_000_000_000)
     if not -_INT32 <= sec < _INT32:
@@ -349,6 +352,8 @@ def eye_state(cmd: Any, frame_id: str, store: Typestore | None = None) -> object
     yaw, pitch = float(cmd.eye_yaw), float(cmd.eye_pitch)
     blink = float(getattr(cmd, "blink", 0.0))
     _finite(EYE_STATE, "yaw/pitch/blink", yaw, pitch, blink)
+    if not 0.0 <= blink <= 1.0:
+        raise MessageError(EYE_STATE, f"blink must be within 0..1, got {blink}")
     distance = getattr(cmd, "distance", None)
     d = math.nan if distance is None else float(distance)
     if not (math.isnan(d) or (math.isfinite(d) and d > 0.0)):
@@ -389,13 +394,19 @@ def eyes_of(msg: Any) -> Eyes:
 # -- phase --------------------------------------------------------------------------------------
 
 
-def phase_parts(phase: Any) -> tuple[Phase, str]:
-    """The :class:`Phase` and its source (``tracking``, ``robot``, ``gripper``) of a command's
-    ``phase``: a plain :class:`Phase` (source ``tracking``) or a value with ``phase`` and
-    ``source`` attributes."""
-    source = getattr(phase, "source", None) or "tracking"
+def phase_parts(phase: Any, source: str | None = None) -> tuple[Phase, str]:
+    """The :class:`Phase` and its source (``tracking``, ``robot``, ``gripper``): ``phase`` is a
+    plain :class:`Phase` or a value with ``phase`` and ``source`` attributes; ``source``, when
+    given, says where it came from (default ``tracking``)."""
+    src = source or getattr(phase, "source", None) or "tracking"
     base = getattr(phase, "phase", phase)
-    return Phase(getattr(base, "value", base)), str(getattr(source, "value", source))
+    return Phase(getattr(base, "value", base)), str(getattr(src, "value", src))
+
+
+def command_phase(cmd: Any) -> tuple[Phase, str]:
+    """The phase of an engine command and what decided it (``cmd.phase_source`` when the
+    command carries one)."""
+    return phase_parts(cmd.phase, getattr(cmd, "phase_source", None))
 
 
 @dataclass(frozen=True)
@@ -414,12 +425,14 @@ def handover_phase(
     phase: Any,
     phase_start: float,
     expected_end: float = math.nan,
+    source: str | None = None,
     store: Typestore | None = None,
 ) -> object:
-    """``gazebot_msgs/HandoverPhase`` at ``t``: ``phase`` (see :func:`phase_parts`) started
-    at ``phase_start``, predicted to end at ``expected_end`` (NaN: unknown, zero on the wire)."""
+    """``gazebot_msgs/HandoverPhase`` at ``t``: ``phase`` from ``source`` (see
+    :func:`phase_parts`) started at ``phase_start``, predicted to end at ``expected_end`` (NaN:
+    unknown, zero on the wire)."""
     s = _store(store)
-    value, source = phase_parts(phase)
+    value, source = phase_parts(phase, source)
     if source not in _SOURCES:
         raise MessageError(HANDOVER_PHASE, f"source must be one of {_SOURCES}, got {source!r}")
     end = to_time(expected_end, s) if math.isfinite(expected_end) else to_time(0.0, s)

@@ -55,6 +55,38 @@ def build_typestore(package_dir: Path | None = None) -> Typestore:
     return store
 
 
+def definition_types(type_name: str, text: str) -> dict[str, object]:
+    """The types of a full message definition as ``ros2 bag`` embeds it in MCAP (``ros2msg``):
+    ``type_name``'s own fields, then a ``===`` line and ``MSG: pkg/Name`` before each
+    dependency. Returns rosbags' type dict, ready for ``Typestore.register``.
+
+    Raises:
+        MessageError: A section that does not parse.
+    """
+    sections: list[tuple[str, list[str]]] = [(type_name, [])]
+    for line in text.splitlines():
+        stripped = line.strip()
+        if len(stripped) >= 3 and set(stripped) == {"="}:
+            sections.append(("", []))
+        elif not sections[-1][0] and stripped.startswith("MSG:"):
+            name = stripped[4:].strip()
+            pkg, _, short = name.rpartition("/")
+            if "/msg/" not in name:
+                name = f"{pkg}/msg/{short}"
+            sections[-1] = (name, sections[-1][1])
+        else:
+            sections[-1][1].append(line)
+    types: dict[str, object] = {}
+    for name, lines in sections:
+        if not name:
+            raise MessageError(type_name, "a definition section without 'MSG: pkg/Name'")
+        try:
+            types.update(get_types_from_msg("\n".join(lines), name))
+        except Exception as exc:  # rosbags raises its own parse errors
+            raise MessageError(name, f"definition does not parse ({exc})") from None
+    return types
+
+
 @cache
 def typestore() -> Typestore:
     """The shipped type system (built once per process: a pure function of the package files)."""

@@ -126,6 +126,8 @@ def test_eye_state_round_trips_with_unknown_distance_as_nan() -> None:
     msg.blink = 1.5
     with pytest.raises(MessageError, match="blink"):
         cv.eyes_of(msg)
+    with pytest.raises(MessageError, match="blink"):
+        cv.eye_state(Command(blink=1.5), "gaze")
 
 
 def test_events_round_trip_with_their_info() -> None:
@@ -160,6 +162,13 @@ def test_phase_round_trips_with_its_source_and_unknown_end() -> None:
     state = cv.phase_of(wire(cv.handover_phase(3.0, Sourced(Phase.RETREAT, "gripper"), 2.9)))
     assert (state.phase, state.source) == (Phase.RETREAT, "gripper")
     assert math.isnan(state.expected_end)
+    # The engine's command names the source beside the phase.
+    cmd = Command(phase=Phase.TRANSFER)
+    assert cv.command_phase(cmd) == (Phase.TRANSFER, "tracking")
+    sourced = type("Sourced", (), {"phase": Phase.TRANSFER, "phase_source": "robot"})()
+    assert cv.command_phase(sourced) == (Phase.TRANSFER, "robot")
+    with pytest.raises(MessageError, match="source"):
+        cv.handover_phase(3.0, Phase.TRANSFER, 2.5, source="weather")
 
 
 def test_gripper_and_load_share_round_trip_and_share_outside_0_1_is_refused() -> None:
