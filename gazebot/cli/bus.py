@@ -79,6 +79,13 @@ def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool)
     )
 
 
+def add_record_argument(parser: argparse.ArgumentParser) -> None:
+    """``--record FILE.mcap``: record the bus to MCAP while the node runs."""
+    parser.add_argument("--record", metavar="FILE.mcap", default=None,
+                        help="record every gazebot topic on the bus (ROS 2 schemas embedded, "
+                        "log time = receive time) to this MCAP file, as ros2 bag record does")
+
+
 def bus_names(args: argparse.Namespace) -> Names:
     """The :class:`Names` of parsed ``add_bus_arguments`` options (``ValueError`` if bad)."""
     domain = args.domain_id

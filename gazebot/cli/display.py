@@ -20,10 +20,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "display",
         help="show the robot's eyes on its head screen, driven by the engine over the bus",
-        description="Subscribe to the engine's eyes/state (yaw, pitch, blink, distance) and draw the "
-        "robot's eyes at the screen rate; between updates the eyes drift slightly; when the "
-        "engine goes silent they return to a neutral pose, blink on their own and the status "
-        "line says so. Headless with SDL_VIDEODRIVER=dummy (e.g. with --record).",
+        description="Subscribe to the engine's eyes/state (yaw, pitch, blink, distance) and "
+        "draw the robot's eyes at the screen rate; between updates the eyes drift slightly; "
+        "when the engine goes silent they return to a neutral pose, blink on their own and the "
+        "status line says so. Headless with SDL_VIDEODRIVER=dummy (e.g. with --record).",
     )
     p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
     p.add_argument("--style", default=None, help="eye style name or YAML (default: the robot's)")

@@ -7,7 +7,7 @@ import argparse
 import json
 import sys
 
-from gazebot.cli.bus import add_bus_arguments, bus_config, positive
+from gazebot.cli.bus import add_bus_arguments, add_record_argument, bus_config, positive
 from gazebot.cli.errors import robot_with_gaze_mode, seed_value
 
 
@@ -42,6 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="never render eye frames (eye state is always published)")
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
     add_bus_arguments(p, listens_by_default=False)
+    add_record_argument(p)
     p.set_defaults(func=handle)
 
 
@@ -61,7 +62,12 @@ def handle(args: argparse.Namespace) -> int:
     robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
     loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
     driver = ZenohRobotDriver.open(cfg, "engine")
+    recorder = None
     try:
+        if args.record:
+            from gazebot.drivers.recorder import BusRecorder
+
+            recorder = BusRecorder(driver.session, cfg.names, args.record)
         endpoints = f"listen {list(cfg.listen)}, connect {list(cfg.connect)}"
 
         def warn(text: str) -> None:
@@ -90,7 +96,11 @@ def handle(args: argparse.Namespace) -> int:
             "tracking_skipped": driver.tracking_skipped,
             "type_mismatches": {k: str(v) for k, v in driver.type_mismatches().items()},
         }
+        if recorder is not None:
+            summary["recorded"] = {"file": str(recorder.close()), "messages": recorder.messages}
     finally:
+        if recorder is not None:
+            recorder.close()
         driver.close()
     print(json.dumps(summary) if args.json else "\n".join(f"{k}: {v}" for k, v in summary.items()))
     return 0

@@ -9,7 +9,7 @@ import sys
 import threading
 from typing import Any
 
-from gazebot.cli.bus import add_bus_arguments, bus_config, positive
+from gazebot.cli.bus import add_bus_arguments, add_record_argument, bus_config, positive
 from gazebot.cli.errors import UsageError, robot_with_gaze_mode, seed_value
 
 
@@ -46,6 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="simulated seconds per real second (default 1: real time)")
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
     add_bus_arguments(p, listens_by_default=True)
+    add_record_argument(p)
     p.set_defaults(func=handle)
 
 
@@ -91,13 +92,17 @@ def handle(args: argparse.Namespace) -> int:
     from gazebot.sim import HandoverSimulation
 
     cfg = bus_config(args, listens_by_default=True)
-    view = sim = endpoint = driver = engine_node = thread = None
+    view = sim = endpoint = driver = engine_node = thread = recorder = None
     stop = threading.Event()
     summary: dict[str, Any] = {}
     try:
         view = None if args.headless else PygameView()
         sim = HandoverSimulation(args.robot, args.scene, seed=args.seed)
         endpoint = ZenohRobotEndpoint.open(cfg, "sim", eye_frames=args.eye_frames)
+        if args.record:
+            from gazebot.drivers.recorder import BusRecorder
+
+            recorder = BusRecorder(endpoint.session, cfg.names, args.record)
         node = SimNode(sim, endpoint, SimNodeConfig(speed=args.speed), view=view)
         node.publish_state()
         if args.with_engine:
@@ -142,6 +147,10 @@ def handle(args: argparse.Namespace) -> int:
         stop.set()
         if thread is not None:
             thread.join(timeout=5)
+        if recorder is not None:
+            path = recorder.close()  # before the session closes
+            if summary:
+                summary["recorded"] = {"file": str(path), "messages": recorder.messages}
         if engine_node is not None and summary:
             summary["engine"] = {
                 "frames": engine_node.frames_processed,

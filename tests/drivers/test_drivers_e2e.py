@@ -153,7 +153,7 @@ def test_engine_restarted_mid_handover_resumes_the_phase_over_the_bus(bus, sim):
     assert second.frames_processed > 0
 
 
-def test_sim_cli_with_engine_runs_a_handover_and_reports(bus, capsys):
+def test_sim_cli_with_engine_runs_a_handover_reports_and_records_the_bus(bus, capsys, tmp_path):
     import argparse
 
     from gazebot.cli import run as run_cli
@@ -166,11 +166,25 @@ def test_sim_cli_with_engine_runs_a_handover_and_reports(bus, capsys):
     args = parser.parse_args(
         ["sim", "--robot", "sawyer", "--with-engine", "--behavior", "face-hand-face",
          "--headless", "--duration", "3", "--speed", "2", "--namespace", bus.names.namespace,
-         "--listen", bus.endpoint, "--json"]
+         "--listen", bus.endpoint, "--record", str(tmp_path / "bus.mcap"), "--json"]
     )
     assert args.func(args) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["t"] == pytest.approx(3.0, abs=0.01)
+    # the recording holds the bus' topics as ROS 2 messages rosbags reads back
+    from rosbags.highlevel import AnyReader
+
+    ns = bus.names.namespace
+    with AnyReader([tmp_path / "bus.mcap"]) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+        types = {c.topic: c.msgtype for c in reader.connections}
+        [conn] = [c for c in reader.connections if c.topic == f"{ns}/gaze_target"]
+        _, _, raw = next(reader.messages(connections=[conn]))
+        target = reader.deserialize(raw, conn.msgtype)
+    assert types[f"{ns}/head/command"] == "trajectory_msgs/msg/JointTrajectory"
+    assert counts[f"{ns}/tracking/giver_hand"] > 100 and counts["/joint_states"] > 50
+    assert target.header.frame_id == "base"
+    assert summary["recorded"]["messages"] == sum(counts.values())
     assert summary["applied"]["head"] > 0 and summary["engine"]["frames"] > 0
     assert summary["engine"]["phase"] in ("reach", "transfer")
 

@@ -161,10 +161,11 @@ class Subscription:
     type: the one ``ros2 topic list -t`` shows)."""
 
     def __init__(self, node: RosNode, topic: str, codecs: Sequence[Codec], handler: Handler,
-                 qos: QosProfile) -> None:
+                 qos: QosProfile, raw: bool = False) -> None:
         self.node = node
         self.topic = topic
         self.handler = handler
+        self.raw = raw
         self._by_dds = {c.info.dds_name: c for c in codecs}
         self._expected = tuple(f"{c.info.name} ({c.info.hash})" for c in codecs)
         self.entity = node.entity("MS", topic, codecs[0], qos)
@@ -186,8 +187,9 @@ class Subscription:
             mismatch = TypeMismatch(self.topic, self._expected, f"{name} ({type_hash})")
             drops.drop(self.topic, str(mismatch), mismatch)
             return
+        data = sample.payload.to_bytes()
         try:
-            msg = codec.decode(sample.payload.to_bytes())
+            msg = data if self.raw else codec.decode(data)
         except MessageError as exc:
             drops.drop(self.topic, exc.reason)
             return
@@ -305,12 +307,13 @@ class RosNode:
         return pub
 
     def subscription(self, name: str, ros_types: str | Sequence[str], handler: Handler,
-                     qos: QosProfile = DEFAULT) -> Subscription:
+                     qos: QosProfile = DEFAULT, raw: bool = False) -> Subscription:
         """Subscribe to topic ``name`` accepting ``ros_types`` (the first one is advertised);
-        ``handler(msg, received)`` runs on Zenoh's thread for each well-formed message."""
+        ``handler(msg, received)`` runs on Zenoh's thread for each well-formed message (``raw``:
+        with the CDR bytes as received instead of the message)."""
         topic = self.names.resolve(name)
         types = [ros_types] if isinstance(ros_types, str) else list(ros_types)
-        sub = Subscription(self, topic, [self.codec(t, topic) for t in types], handler, qos)
+        sub = Subscription(self, topic, [self.codec(t, topic) for t in types], handler, qos, raw)
         self._entities.append(sub)
         return sub
 
