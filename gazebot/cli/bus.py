@@ -55,9 +55,9 @@ def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool)
                         "(e.g. gaze_target:=/robot/look_at)")
     parser.add_argument("--domain-id", type=_domain_id, default=None, metavar="N",
                         help="ROS domain id (default: $ROS_DOMAIN_ID, else 0)")
-    parser.add_argument("--base-frame", default="base", metavar="FRAME",
+    parser.add_argument("--base-frame", default=None, metavar="FRAME",
                         help="TF name of the robot base frame: frame_id of the points sent "
-                        "and accepted (default base)")
+                        "and accepted (default: the robot YAML's base_frame)")
     parser.add_argument("--tf-frame", action="append", type=_tf_frame, default=[],
                         metavar="BODY=FRAME", help="also take BODY (giver_hand, receiver_hand, "
                         "giver_face) from /tf: FRAME's transform from the base frame; repeatable")
@@ -86,25 +86,35 @@ def add_record_argument(parser: argparse.ArgumentParser) -> None:
                         "log time = receive time) to this MCAP file, as ros2 bag record does")
 
 
-def bus_names(args: argparse.Namespace) -> Names:
-    """The :class:`Names` of parsed ``add_bus_arguments`` options (``ValueError`` if bad)."""
+def bus_names(args: argparse.Namespace, base_frame: str = "world") -> Names:
+    """The :class:`Names` of parsed ``add_bus_arguments`` options (``ValueError`` if bad);
+    ``base_frame``: the robot's, unless ``--base-frame`` names another."""
     domain = args.domain_id
     if domain is None:
         env = os.environ.get("ROS_DOMAIN_ID", "").strip()
         domain = _domain_id(env) if env else 0
-    return Names(args.namespace, dict(args.remap), domain, base_frame=args.base_frame,
-                 tf_frames=dict(args.tf_frame))
+    return Names(args.namespace, dict(args.remap), domain,
+                 base_frame=args.base_frame or base_frame, tf_frames=dict(args.tf_frame))
 
 
-def bus_config(args: argparse.Namespace, listens_by_default: bool) -> BusConfig:
-    """The :class:`BusConfig` of parsed ``add_bus_arguments`` options."""
+def robot_base_frame(robot: str) -> str:
+    """The base frame of robot ``robot`` (name or YAML file) as its YAML names it."""
+    from gazebot.kinematics.config import load_robot_config
+
+    return load_robot_config(robot)[0].base_frame
+
+
+def bus_config(args: argparse.Namespace, listens_by_default: bool,
+               base_frame: str = "world") -> BusConfig:
+    """The :class:`BusConfig` of parsed ``add_bus_arguments`` options (``base_frame``: the
+    robot's, see :func:`bus_names`)."""
     listen = args.listen if args.listen is not None else (
         [DEFAULT_ENDPOINT] if listens_by_default else [EPHEMERAL_ENDPOINT])
     connect = args.connect if args.connect is not None else (
         [] if listens_by_default else [DEFAULT_ENDPOINT])
     try:
         return BusConfig(
-            names=bus_names(args),
+            names=bus_names(args, base_frame),
             listen=tuple(listen),
             connect=tuple(connect),
             multicast_scouting=args.multicast,

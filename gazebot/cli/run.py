@@ -7,7 +7,13 @@ import argparse
 import json
 import sys
 
-from gazebot.cli.bus import add_bus_arguments, add_record_argument, bus_config, positive
+from gazebot.cli.bus import (
+    add_bus_arguments,
+    add_record_argument,
+    bus_config,
+    positive,
+    robot_base_frame,
+)
 from gazebot.cli.errors import robot_with_gaze_mode, seed_value
 
 
@@ -50,7 +56,7 @@ def handle(args: argparse.Namespace) -> int:
     from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
     from gazebot.drivers.zenoh_driver import ZenohRobotDriver
 
-    cfg = bus_config(args, listens_by_default=False)
+    cfg = bus_config(args, listens_by_default=False, base_frame=robot_base_frame(args.robot))
     node_cfg = EngineNodeConfig(
         silence_after=args.silence_after,
         resync=not args.no_resync,

@@ -9,7 +9,13 @@ import sys
 import threading
 from typing import Any
 
-from gazebot.cli.bus import add_bus_arguments, add_record_argument, bus_config, positive
+from gazebot.cli.bus import (
+    add_bus_arguments,
+    add_record_argument,
+    bus_config,
+    positive,
+    robot_base_frame,
+)
 from gazebot.cli.errors import UsageError, robot_with_gaze_mode, seed_value
 
 
@@ -91,7 +97,7 @@ def handle(args: argparse.Namespace) -> int:
     from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
     from gazebot.sim import HandoverSimulation
 
-    cfg = bus_config(args, listens_by_default=True)
+    cfg = bus_config(args, listens_by_default=True, base_frame=robot_base_frame(args.robot))
     view = sim = endpoint = driver = engine_node = thread = recorder = None
     stop = threading.Event()
     summary: dict[str, Any] = {}

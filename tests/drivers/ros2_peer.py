@@ -166,7 +166,7 @@ def drive(args) -> dict:
         for body in BODIES:
             p = tick[body]
             if p is not None:
-                pubs[body].publish(header=header(t, "base"), point=Point(x=p[0], y=p[1], z=p[2]))
+                pubs[body].publish(header=header(t, "world"), point=Point(x=p[0], y=p[1], z=p[2]))
         gripper.publish(header=header(t), closed=bool(tick["gripper_closed"]))
         share.publish(header=header(t), share=float(tick["load_share"]))
     deadline = time.monotonic() + args.duration

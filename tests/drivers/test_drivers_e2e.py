@@ -183,7 +183,7 @@ def test_sim_cli_with_engine_runs_a_handover_reports_and_records_the_bus(bus, ca
         target = reader.deserialize(raw, conn.msgtype)
     assert types[f"{ns}/head/command"] == "trajectory_msgs/msg/JointTrajectory"
     assert counts[f"{ns}/tracking/giver_hand"] > 100 and counts["/joint_states"] > 50
-    assert target.header.frame_id == "base"
+    assert target.header.frame_id == "world"
     assert summary["recorded"]["messages"] == sum(counts.values())
     assert summary["applied"]["head"] > 0 and summary["engine"]["frames"] > 0
     assert summary["engine"]["phase"] in ("reach", "transfer")

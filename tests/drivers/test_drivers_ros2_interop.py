@@ -153,7 +153,7 @@ def test_a_ros2_node_sees_gazebots_topics_and_decodes_a_handovers_gaze(router, m
     # the SDK's own type hashes (from the .msg files) found gazebot's keys
     for topic, h in out["sdk_hashes"].items():
         assert h == out["topics"][topic]["hashes"][0]
-    assert out["targets"] and all(frame == "base" for *_, frame in out["targets"])
+    assert out["targets"] and all(frame == "world" for *_, frame in out["targets"])
     assert _face_hand_face(_labels(out["targets"], out["points"])), out["phases"]
     heads = out["heads"]
     assert heads and all(h["joint_names"] == ["head_pan"] and len(h["positions"]) == 1

@@ -71,7 +71,8 @@ class Names:
             name, ``TO`` is resolved against ``namespace`` when relative.
         domain_id: The ROS domain id (first chunk of every key).
         base_frame: The robot base frame's TF name: ``frame_id`` of every point gazebot sends
-            and of the tracking it accepts (an empty ``frame_id`` is taken as this frame).
+            and of the tracking it accepts (an empty ``frame_id`` is taken as this frame); the
+            robot YAML's ``base_frame`` (``world`` by default).
         tf_frames: Tracked body (``giver_hand``, ...) -> TF child frame whose transform from
             :attr:`base_frame` on ``/tf`` gives its position (an alternative to the tracking
             topics; empty: ``/tf`` is not read).
@@ -80,7 +81,7 @@ class Names:
     namespace: str = "/gazebot"
     remap: Mapping[str, str] = field(default_factory=dict)
     domain_id: int = 0
-    base_frame: str = "base"
+    base_frame: str = "world"
     tf_frames: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
