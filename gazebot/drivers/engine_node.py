@@ -8,9 +8,10 @@ Faults (each pinned by ``tests/drivers``):
   bridges ``max_gap_hold``, then the behavior holds the gaze for its ``tracking_lost.hold_s``:
   event ``tracking_stale``, status ``tracking: hold``; then it looks at its ``tracking_lost``
   target, by default the last known face: event ``tracking_timeout`` with ``info.face``, status
-  ``tracking: lost``). Head commands meanwhile say ``mode: tracking_lost``; when samples return,
-  ``tracking_resumed``. A sample older than a silence tick already answered is too late and
-  is dropped by the phase detector (its time is the robot clock estimated from the wall clock).
+  ``tracking: lost``). The status' ``tracking`` says which policy commands the head; when
+  samples return, ``tracking_resumed``. A sample older than a silence tick already answered is
+  too late and is dropped by the phase detector (its time is the robot clock estimated from the
+  wall clock).
 * engine restart: at start the node takes the head pose from the joint state and replays the
   current handover's phase and robot events from the other nodes' event history
   (``GazeEngine.resync``), then reports ``engine_resynced``.
@@ -328,7 +329,7 @@ class EngineNode:
                              joints=joints.position if joints is not None else None)
         self.frames_processed += 1
         if cmd is not None:
-            self._send(cmd, answers=msg.seq)
+            self._send(cmd)
 
     def on_silence(self) -> None:
         """No sample arrived: after ``silence_after``, tick the loop without one (its
@@ -342,7 +343,7 @@ class EngineNode:
         self._last_silence_tick = now
         cmd = self.loop.tick(self._now_t())
         if cmd is not None:
-            self._send(cmd, answers=None)
+            self._send(cmd)
 
     @property
     def unsafe_commands(self) -> int:
@@ -366,7 +367,7 @@ class EngineNode:
             self.emit("tracking_timeout", t=cmd.t, silence=silence, target=cmd.target,
                       face=point_or_none(cmd.target_point))
 
-    def _send(self, cmd: LoopCommand, answers: int | None) -> None:
+    def _send(self, cmd: LoopCommand) -> None:
         self._track(cmd)
         for event in cmd.events:
             if category_of(event.kind.value) == "phase":

@@ -10,6 +10,8 @@ from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar
 
+import numpy as np
+
 from gazebot.drivers.base import RobotDriver
 from gazebot.drivers.payloads import (
     ArmCommandMsg,
@@ -191,10 +193,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
 
     def send_eye_frame(self, msg: EyeFrameMsg) -> None:
         image = self.ros.store.types[convert.COMPRESSED_IMAGE]
-        header = convert.header(msg.t, GAZE_FRAME)
-        import numpy as np
-
-        self._frame_pub.publish(image(header=header, format=msg.format,
+        self._frame_pub.publish(image(header=convert.header(msg.t, GAZE_FRAME), format=msg.format,
                                       data=np.frombuffer(msg.data, np.uint8)))
 
     def wants_eye_frames(self) -> bool:

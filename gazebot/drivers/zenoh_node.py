@@ -130,6 +130,7 @@ class ZenohNode:
         self._history_keys: set[tuple[str, str, int, int]] = set()
         self._last_beat: dict[str, float] = {}
         self._status_seq = 0
+        self._event_seq = 0
         self._seen_nodes: set[str] = set()
         self.ros.on_graph = self._on_graph
 
@@ -215,8 +216,10 @@ class ZenohNode:
         return self._event_pubs["robot" if msg.category == "robot" else "other"]
 
     def next_event_seq(self) -> int:
+        """The number of this node's next event (from 0)."""
         with self._lock:
-            return len(self._history)
+            self._event_seq += 1
+            return self._event_seq - 1
 
     def publish_event(self, msg: EventMsg) -> None:
         """Publish one of this node's events (and keep it in the history)."""

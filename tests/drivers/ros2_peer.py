@@ -96,7 +96,17 @@ def graph(port: int, ns: str, wait: float) -> dict:
         if time.monotonic() > deadline:
             break
         time.sleep(0.2)
-    topics = dict(get_topic_names_and_types(router_port=port, timeout=1.0))
+    # The union of a few listings, as the ROS 2 daemon's graph builds up: one liveliness query
+    # on a busy machine may come back before every router answered.
+    topics: dict = {}
+    quiet = 0
+    while quiet < 3:
+        before = {k: set(v) for k, v in topics.items()}
+        for name, types in get_topic_names_and_types(router_port=port, timeout=2.0):
+            topics.setdefault(name, set()).update(types)
+        quiet = quiet + 1 if topics == before else 0
+        time.sleep(0.2)
+    topics = {k: sorted(v) for k, v in topics.items()}
     out = {}
     for name, types in topics.items():
         for _ in range(10):  # a liveliness query on a busy machine may come back short

@@ -7,8 +7,9 @@ One concept per module:
 * :mod:`.attachment`: the attachment of every sample (sequence number, source timestamp, GID).
 * :mod:`.graph`: liveliness tokens of nodes, publishers and subscriptions under ``@ros2_lv``
   and the graph they describe.
-* :mod:`.typesupport`: CDR and RIHS01 type hashes of the message types (rosbags).
 * :mod:`.node`: a ROS 2 node on a Zenoh session: publishers, subscriptions, graph.
+
+Message types, CDR and RIHS01 type hashes are :mod:`gazebot.ros2`'s (rosbags).
 
 Key expressions (rmw_zenoh ``docs/design.md``):
 
