@@ -48,8 +48,11 @@ def test_a_wrong_sequence_length_is_a_message_error() -> None:
     from gazebot.ros2.convert import joint_state
 
     raw = bytearray(js.encode(joint_state(0.0, {"head_pan": 0.1})))
-    raw[-40:-36] = (2**30).to_bytes(4, "little")  # a huge sequence length mid-message
-    with pytest.raises(MessageError):
+    # After the encapsulation (4), stamp (8) and the empty frame_id (4 + 1, padded to 8): the
+    # length of the `name` sequence.
+    assert raw[20:24] == (1).to_bytes(4, "little")
+    raw[20:24] = (2**30).to_bytes(4, "little")
+    with pytest.raises(MessageError, match="does not decode"):
         js.decode(bytes(raw))
 
 
