@@ -376,3 +376,41 @@ def test_robot_clock_going_back_resets_and_resyncs_the_engine(bus):
     assert wait_until(lambda: events.where(kind="tracking_clock_reset"))
     assert wait_until(lambda: node.engine.frames and node.engine.frames[-1].t == 0.0)
     assert node.engine.reset_heads == [{"head_pan": 0.2}, {"head_pan": -0.3}]
+
+
+def test_pose_stamped_and_tf_frames_are_tracking_too_and_remapped_topics_are_used(bus):
+    from gazebot.drivers.rmw.names import Names
+    from gazebot.drivers.rmw.node import RosNode
+
+    names = Names(bus.names.namespace, {"gaze_target": "/robot/look_at"},
+                  tf_frames={"giver_face": "mocap/face"})
+    ep = ZenohRobotEndpoint(bus.listener(), names, "sim")
+    bus.closers.append(ep.close)
+    drv = ZenohRobotDriver(bus.connector(), names, "engine")
+    bus.closers.append(drv.close)
+    mocap = RosNode(ep.session, names, "mocap")
+    bus.closers.append(mocap.close)
+    pose = mocap.publisher(topics.GIVER_HAND.name, convert.POSE_STAMPED)
+    tf = mocap.publisher(topics.TF.name, topics.TF.type)
+    targets = Recorder(ep, topics.GAZE_TARGET, convert.point_of)  # resolves the remap
+    assert targets.key.startswith("0/robot/look_at/")
+    node = EngineNode(GazeLoop(FakeEngine()), drv, FAST)
+    assert wait_until(lambda: connected(ep, drv))
+    for i in range(3):
+        t = 0.5 + i / 120
+        sample = TrackingFrame.make(t, giver_hand=[0.9, 0.0, 1.0], giver_face=[1.1, 0.2, 1.6])
+        pose.publish(convert.pose_stamped(t, sample.giver_hand, "world"))
+        tf.publish(convert.tracking_tf(TrackingFrame.make(t, giver_face=sample.giver_face),
+                                       "world", {"giver_face": "mocap/face"}))
+    got = []
+
+    def three_samples() -> bool:
+        if (m := drv.wait_tracking(0.05)) is not None:
+            got.append(m)
+        return len(got) >= 3
+
+    assert wait_until(three_samples)
+    assert got[0].giver_hand == (0.9, 0.0, 1.0) and got[0].giver_face == (1.1, 0.2, 1.6)
+    node.on_tracking(got[-1])
+    assert wait_until(lambda: targets.msgs)
+    assert targets.msgs[-1][1].tolist() == [1.1, 0.2, 1.6]  # the fake engine looks at the face
