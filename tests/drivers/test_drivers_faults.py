@@ -317,8 +317,8 @@ def test_robot_whose_heartbeat_stops_counts_as_lost(bus):
         return bool(events.where(kind="peer_lost"))
 
     assert wait_until(hung)
-    ep.heartbeat()
-    assert wait_until(lambda: events.where(kind="peer_restored"))
+    # it beats again (as a live robot does, every 0.5 s): restored
+    assert wait_until(lambda: ep.heartbeat() and events.where(kind="peer_restored"), poll=0.1)
 
 
 class CountingRenderer:
