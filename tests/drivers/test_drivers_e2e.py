@@ -202,20 +202,24 @@ def _parser():
     return parser
 
 
-def test_run_cli_drives_a_simulator_on_the_bus(bus, sim, capsys):
+def test_run_cli_drives_a_simulator_on_the_bus_and_records_it(bus, sim, capsys, tmp_path):
     # Real time: the simulator must still run while the engine loads on a slow machine.
     sim_node, ep, sim_thread, _ = start_sim_node(bus, sim, speed=1.0)
     sim_thread.start()
     args = _parser().parse_args(
         ["run", "--robot", "sawyer", "--behavior", "face-hand-face", "--duration", "1.5",
-         "--namespace", bus.names.namespace, "--connect", bus.endpoint, "--json"]
+         "--namespace", bus.names.namespace, "--connect", bus.endpoint,
+         "--record", str(tmp_path / "run.mcap"), "--json"]
     )
     assert args.func(args) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["frames"] > 0 and summary["commands"] > 0
-    assert summary["peers"] == {"sim": True} and summary["dropped"] == {}
+    # the recorder is a node of its own (as ros2 bag's is)
+    assert summary["peers"] == {"sim": True, "recorder": True} and summary["dropped"] == {}
     assert summary["robot_seen"] is True and summary["warnings"] == []
     assert sim_node.applied["head"] > 0
+    recorded = summary["recorded"]
+    assert recorded["file"] == str(tmp_path / "run.mcap") and recorded["messages"] > 100
 
 
 def test_simulator_node_obeys_arm_commands(bus, sim):
