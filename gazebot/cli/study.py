@@ -124,7 +124,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     sv.add_argument("--port", type=int, default=8000, help="port (0: any free port)")
     sv.add_argument("--threads", type=int, default=4, help="server worker threads")
     sv.add_argument(
-        "--admin-token", default=None, help="token for /admin from other hosts (default: random)"
+        "--admin-token-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="file holding the token that opens /admin from other hosts (default: the "
+        "environment variable GAZEBOT_STUDY_ADMIN_TOKEN, else a random token written to "
+        "DIR/admin-token); never on the command line, where ps shows it",
     )
     sv.add_argument(
         "--token-only",
@@ -438,7 +444,7 @@ def _serve(args: argparse.Namespace) -> int:
         args.host,
         args.port,
         args.threads,
-        args.admin_token,
+        args.admin_token_file,
         local_admin=not args.token_only,
     )
     return 0
