@@ -9,7 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
-from gazebot.recordings.base import PointNames, Recording, RecordingError, build
+from gazebot.recordings.base import (
+    PointNames,
+    Recording,
+    RecordingError,
+    RecordingLimits,
+    build,
+)
 
 
 def body_name(path: Path) -> str:
@@ -21,10 +27,14 @@ def body_name(path: Path) -> str:
 
 
 def read_pose_folder(
-    path: str | Path, names: PointNames | None = None, rate: float | None = None, unit: str = "m"
+    path: str | Path,
+    names: PointNames | None = None,
+    rate: float | None = None,
+    unit: str = "m",
+    limits: RecordingLimits | None = None,
 ) -> Recording:
     """Read the bodies of a pose folder sampled at ``rate`` (Hz, required: the files hold no
-    time).
+    time); ``limits``: see :class:`~gazebot.recordings.base.RecordingLimits`.
 
     Raises:
         RecordingError: No rate, no pose CSV, a file without x,y,z columns or with another row
@@ -58,4 +68,14 @@ def read_pose_folder(
     n = min(counts)
     points = {k: v[:n] for k, v in points.items()}
     t = np.arange(n) / float(rate)
-    return build(path, "pose-folder", t, points, names or PointNames(), unit, (None, None, None))
+    return build(
+        path,
+        "pose-folder",
+        t,
+        points,
+        names or PointNames(),
+        unit,
+        (None, None, None),
+        limits=limits,
+        where=lambda i: f"row {i + 2}",
+    )
