@@ -58,7 +58,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ConfigError, TrajectoryFormatError, RecordingError, UsageError, OSError) as exc:
         # Input errors only: a malformed file, a wrong option, a missing file, a directory where
         # a file was expected, permissions. Any other exception is a bug: it keeps its traceback.
-        print(f"gazebot: error: {exc}", file=sys.stderr)
+        # A file name that is not UTF-8 is kept as surrogates: shown escaped, not a crash.
+        text = str(exc).encode("utf-8", "backslashreplace").decode("utf-8")
+        print(f"gazebot: error: {text}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130
