@@ -64,6 +64,15 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
+    except Exception as exc:
+        # A node that cannot join the bus (its port taken, a bad endpoint) is not a bug.
+        from gazebot.cli.bus import bus_failure
+
+        message = bus_failure(exc)
+        if message is None:
+            raise
+        print(f"gazebot: error: {message}", file=sys.stderr)
+        return 2
     return int(result or 0)
 
 
