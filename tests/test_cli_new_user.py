@@ -64,3 +64,40 @@ def test_offline_seed_rules_run_online_say_so_on_stderr(method, capsys):
     assert capsys.readouterr().err == ""  # offline, as meant: no warning
     assert main(["phases", str(SAMPLE), "--online"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def _parsers(parser=None, path=("gazebot",)):
+    import argparse
+
+    parser = parser or build_parser()
+    yield path, parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield from _parsers(sub, (*path, name))
+
+
+def test_help_texts_show_no_raw_rest_markup():
+    for path, parser in _parsers():
+        assert "``" not in parser.format_help(), " ".join(path)
+
+
+def test_every_option_of_every_command_says_what_it_does():
+    import argparse
+
+    missing = [
+        f"{' '.join(path)} {a.option_strings or a.dest}"
+        for path, parser in _parsers()
+        for a in parser._actions
+        if a.help is None and not isinstance(a, (argparse._HelpAction, argparse._SubParsersAction))
+    ]
+    assert missing == []
+
+
+def test_study_render_help_describes_its_options(capsys):
+    with pytest.raises(SystemExit):
+        main(["study", "render", "--help"])
+    out = capsys.readouterr().out
+    for words in ("plan CSV written by", "study folder to write", "video width, px",
+                  "frames per second", "no progress bar"):
+        assert words in out

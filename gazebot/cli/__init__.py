@@ -41,7 +41,25 @@ def build_parser() -> argparse.ArgumentParser:
     for name in COMMAND_MODULES:
         module = importlib.import_module(f"gazebot.cli.{name}")
         module.register(sub)
+    _plain_help(parser)
     return parser
+
+
+def _plain_help(parser: argparse.ArgumentParser) -> None:
+    """Strip the reST literal markup (````x````) that module docstrings used as descriptions
+    carry: ``--help`` is read in a terminal. In place, for every sub-command."""
+    parser.description = _plain(parser.description)
+    for action in parser._actions:
+        action.help = _plain(action.help)
+        if isinstance(action, argparse._SubParsersAction):
+            for choice in action._choices_actions:
+                choice.help = _plain(choice.help)
+            for sub in set(action.choices.values()):
+                _plain_help(sub)
+
+
+def _plain(text: str | None) -> str | None:
+    return None if text is None else text.replace("``", "")
 
 
 def main(argv: list[str] | None = None) -> int:
