@@ -97,6 +97,9 @@ class HandoverController:
         self.handover_start: float | None = None  # the "handover's start" of the timing
         self.reach_started_at: float | None = None  # the robot's reach start (first motion)
         self.infeasible_at: float | None = None
+        # The seed's STL reach: "If no feasible control input is found, the robot stops." Set
+        # once the reach was infeasible and the arm is commanded still (None while it moves).
+        self.stopped_at: float | None = None
         self._last_t: float | None = None
         self._last_q = self.home.copy()
 
@@ -143,6 +146,12 @@ class HandoverController:
                 reach_time=float(self.reach.controller.config.reach_time_s),
                 since_start=float(self.reach.elapsed(t)),
             )
+        if self.infeasible_at is not None:
+            still = float(np.linalg.norm(step.velocity)) <= 1e-9
+            if not still:
+                self.stopped_at = None
+            elif self.stopped_at is None:
+                self.stopped_at = t
         if self.reach_started_at is None and float(np.linalg.norm(step.velocity)) > 1e-6:
             self.reach_started_at = t
             left = self.reach.controller.config.reach_time_s - self.reach.elapsed(t)
