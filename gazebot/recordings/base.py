@@ -19,6 +19,8 @@ class RecordingError(ValueError):
 
     def __init__(self, source: str | Path, problem: str) -> None:
         self.source = str(source)
+        # One line, whatever a library's message held (the CLI prints one line per error).
+        problem = " ".join(str(problem).split())
         self.problem = problem
         super().__init__(f"{self.source}: {problem}")
 

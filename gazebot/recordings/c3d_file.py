@@ -34,8 +34,9 @@ def read_c3d(
     path = Path(path)
     try:
         with path.open("rb") as fh, warnings.catch_warnings(), np.errstate(all="ignore"):
-            # Motion-capture C3D files often carry no analog channels; only points are read.
-            warnings.filterwarnings("ignore", "No analog data found", UserWarning)
+            # The library's notes on odd headers (no analog channels, parameter pointers it
+            # works around) are not the user's business: only points are read, checked below.
+            warnings.simplefilter("ignore")
             # The reader only warns when the file ends early and returns the frames so far.
             warnings.filterwarnings("error", "reached end of file", UserWarning)
             reader = c3d.Reader(fh)
