@@ -28,7 +28,7 @@ class ConfigError(ValueError):
         msg = f"{self.source}: field '{field}': expected {expected}"
         if got is not None:
             msg += f", got {got!r}"
-        super().__init__(msg)
+        super().__init__(" ".join(msg.splitlines()))  # one line, whatever a library said
 
 
 def configs_dir() -> Path:
@@ -99,8 +99,9 @@ def read_yaml(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> Any:
             "UTF-8 text",
             f"byte 0x{exc.object[exc.start]:02x} at offset {exc.start}",
         ) from exc
-    loader = _BoundedLoader(text)
+    loader = None
     try:
+        loader = _BoundedLoader(text)  # checks the characters: a control character is an error
         return loader.get_single_data()
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
@@ -110,7 +111,8 @@ def read_yaml(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> Any:
     except RecursionError:  # a nesting PyYAML's scanner recursed on before the composer
         raise ConfigError(path, "<document>", "valid YAML", "too deeply nested") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def validate(model: type[M], data: Any, source: str | Path = "<config>") -> M:
