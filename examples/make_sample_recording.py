@@ -24,7 +24,8 @@ def rows(seed: int = SEED, options: SyntheticOptions = OPTIONS) -> tuple[list[st
     """The CSV lines (0.1 mm and 1 ms resolution keep the file small) and the truth (s)."""
     h = generate(seed, options)
     tr = h.trajectory
-    cols = ["t"] + [f"{p}_{a}" for p in ("giver_hand", "receiver_hand", "giver_face") for a in "xyz"]
+    points = ("giver_hand", "receiver_hand", "giver_face")
+    cols = ["t"] + [f"{p}_{a}" for p in points for a in "xyz"]
     cols += ["gripper_closed", "load_share"]
     lines = [",".join(cols)]
 

@@ -67,11 +67,12 @@ class Recording:
     Attributes:
         trajectory: The samples (s, m).
         source: The file read.
-        format: ``csv``, ``c3d``, ``rosbag`` or ``pose-folder``.
+        format: ``csv``, ``c3d``, ``rosbag``, ``mcap`` or ``pose-folder``.
         names: The names used for giver hand, receiver hand and giver face.
         available: Every point name the file has.
         unit: The file's length unit (converted to m).
         rate: Median sampling rate found (Hz; NaN with fewer than two samples).
+        notes: What the reader had to work around (e.g. a file cut short), one line each.
         out_of_workspace: Samples of the three chosen points made missing because a
             coordinate was beyond :attr:`RecordingLimits.workspace_m` (or infinite).
     """
@@ -83,6 +84,7 @@ class Recording:
     available: tuple[str, ...]
     unit: str
     rate: float
+    notes: tuple[str, ...] = ()
     out_of_workspace: int = 0
 
     def describe(self) -> str:
@@ -203,12 +205,14 @@ def build(
     unit: str,
     defaults: tuple[str | None, str | None, str | None],
     extra: dict[str, np.ndarray] | None = None,
+    notes: tuple[str, ...] = (),
     limits: RecordingLimits | None = None,
     where: Callable[[int], str] | None = None,
 ) -> Recording:
     """Pick the three points from ``points`` (name -> (N, 3) in the file's unit) and build the
-    recording in metres: times checked (:func:`check_times`; ``where(i)`` names sample ``i``
-    in the file, default "sample i"), points beyond the workspace made missing and counted."""
+    recording in metres (``notes``: see :attr:`Recording.notes`): times checked
+    (:func:`check_times`; ``where(i)`` names sample ``i`` in the file, default "sample i"),
+    points beyond the workspace made missing and counted."""
     limits = limits or RecordingLimits()
     check_times(source, t, where or (lambda i: f"sample {i + 1}"), limits)
     available = sorted(points)
@@ -240,5 +244,74 @@ def build(
         tuple(available),
         unit,  # type: ignore[arg-type]
         median_rate(t),
+        notes,
         dropped,
     )
+
+
+Series = dict[str, list[tuple[float, float, float, float]]]  # name -> (t, x, y, z) rows
+
+
+def bound_streams(
+    source: str | Path, series: Series, limits: RecordingLimits
+) -> tuple[Series, dict[str, int], Callable[[np.ndarray], Callable[[int], str]]]:
+    """Stream readers' (bags, MCAP) checks before :func:`sample_streams`: a stamp that is not
+    finite is an error; a row beyond the workspace (or not finite) is left out, so that
+    interpolation neither overflows nor smears it into its neighbours. Returns the kept rows,
+    how many rows each name lost, and ``namer(t)``: the ``where`` of :func:`build` for the
+    union of stamps ``t`` (the message stamped ``t[i]`` and its topics)."""
+    kept: Series = {}
+    beyond: dict[str, int] = {}
+    for name, rows in series.items():
+        a = np.array(rows, dtype=float).reshape(-1, 4)
+        if not np.isfinite(a[:, 0]).all():
+            raise RecordingError(source, f"{name}: a message header stamp is not a finite time")
+        xyz, beyond[name] = in_workspace(a[:, 1:], limits.workspace_m)
+        ok = np.isfinite(xyz).all(axis=1)
+        kept[name] = [tuple(r) for r in a[ok].tolist()]
+
+    def namer(t: np.ndarray) -> Callable[[int], str]:
+        def where(i: int) -> str:
+            topics = sorted(n for n, rows in series.items() if any(r[0] == t[i] for r in rows))
+            return f"the message stamped {t[i]:.9g} s on {', '.join(topics)}"
+
+        return where
+
+    return kept, beyond, namer
+
+
+def sample_streams(series: Series, max_gap: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Points sampled on the union of all stamps: ``(t, {name: (N, 3)})`` from per-name
+    ``(t, x, y, z)`` rows (any order). Each name is linearly interpolated between its own
+    samples, missing (NaN) outside them and across gaps longer than ``max_gap`` (s)."""
+    stamps = [[s[0] for s in v] for v in series.values()]
+    t = np.unique(np.concatenate(stamps)) if any(stamps) else np.zeros(0)
+    points: dict[str, np.ndarray] = {}
+    for name, rows in series.items():
+        if not rows:  # every row left out (beyond the workspace)
+            points[name] = np.full((t.shape[0], 3), np.nan)
+            continue
+        a = np.array(sorted(rows))
+        _, keep = np.unique(a[:, 0], return_index=True)
+        a = a[keep]
+        p = np.stack([np.interp(t, a[:, 0], a[:, k]) for k in (1, 2, 3)], axis=1)
+        j = np.searchsorted(a[:, 0], t, side="right")
+        exact = np.isin(t, a[:, 0])
+        inside = (j > 0) & (j < a.shape[0])
+        gap = np.full(t.shape[0], np.inf)
+        gap[inside] = a[j[inside], 0] - a[j[inside] - 1, 0]
+        p[~exact & (gap > max_gap)] = np.nan
+        points[name] = p
+    return t, points
+
+
+def hold_values(t: np.ndarray, rows: list[tuple[float, float]]) -> np.ndarray:
+    """The last of ``(stamp, value)`` ``rows`` at or before each time in ``t`` (NaN before the
+    first; an empty ``rows`` gives an empty array: the value is not recorded)."""
+    if not rows:
+        return np.zeros(0)
+    a = np.array(sorted(rows), dtype=float)
+    j = np.searchsorted(a[:, 0], t, side="right") - 1
+    out = np.full(t.shape[0], np.nan)
+    out[j >= 0] = a[j[j >= 0], 1]
+    return out

@@ -117,6 +117,6 @@ def read_csv(
         unit,
         DEFAULTS,
         extra,
-        limits,
-        lambda i: f"line {lines[i]}",
+        limits=limits,
+        where=lambda i: f"line {lines[i]}",
     )

@@ -9,15 +9,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from gazebot.recordings.base import (
     PointNames,
     Recording,
     RecordingError,
     RecordingLimits,
+    bound_streams,
     build,
-    in_workspace,
+    sample_streams,
 )
 
 _POSE = ("geometry_msgs/msg/PoseStamped", "geometry_msgs/PoseStamped")
@@ -74,39 +73,9 @@ def read_bag(
         raise RecordingError(path, f"not a readable ROS bag ({exc})") from None
     if not series:
         raise RecordingError(path, "no PoseStamped, PointStamped, TransformStamped or /tf data")
-    stamps = np.concatenate([[s[0] for s in v] for v in series.values()])
-    finite = stamps[np.isfinite(stamps)]
-    t = np.unique(finite)
-    if finite.shape[0] < stamps.shape[0]:
-        raise RecordingError(path, "a message header stamp is not a finite time")
-
-    def where(i: int) -> str:
-        topics = sorted(n for n, rows in series.items() if any(r[0] == t[i] for r in rows))
-        return f"the message stamped {t[i]:.9g} s on {', '.join(topics)}"
-
     limits = limits or RecordingLimits()
-    points: dict[str, np.ndarray] = {}
-    beyond: dict[str, int] = {}
-    for name, rows in series.items():
-        a = np.array(sorted(rows))
-        _, keep = np.unique(a[:, 0], return_index=True)
-        a = a[keep]
-        # A message beyond the workspace (or not finite) is missing: left out before
-        # interpolating, where 1e308 would overflow and smear into its neighbours.
-        xyz, n_out = in_workspace(a[:, 1:], limits.workspace_m)
-        beyond[name] = n_out
-        a = a[np.isfinite(xyz).all(axis=1)]
-        if a.shape[0] == 0:
-            points[name] = np.full((t.shape[0], 3), np.nan)
-            continue
-        p = np.stack([np.interp(t, a[:, 0], a[:, k]) for k in (1, 2, 3)], axis=1)
-        j = np.searchsorted(a[:, 0], t, side="right")
-        exact = np.isin(t, a[:, 0])
-        inside = (j > 0) & (j < a.shape[0])
-        gap = np.full(t.shape[0], np.inf)
-        gap[inside] = a[j[inside], 0] - a[j[inside] - 1, 0]
-        p[~exact & (gap > max_gap)] = np.nan
-        points[name] = p
+    series, beyond, namer = bound_streams(path, series, limits)
+    t, points = sample_streams(series, max_gap)
     rec = build(
         path,
         "rosbag",
@@ -116,7 +85,7 @@ def read_bag(
         "m",
         (None, None, None),
         limits=limits,
-        where=where,
+        where=namer(t),
     )
     rec.out_of_workspace += sum(beyond[n] for n in set(rec.names) - {None})
     return rec
