@@ -153,3 +153,30 @@ def test_bag_coordinates_beyond_the_workspace_are_left_out_before_interpolating(
     g = rec.trajectory.giver_hand
     assert np.isfinite(g).all() and np.abs(g).max() < 2.0
     _no_warnings_through_the_phases(rec)
+
+
+def _write_mcap(path, t, pts):
+    from gazebot.ros2 import convert as cv
+    from gazebot.ros2 import topics as tp
+    from gazebot.ros2.mcap_writer import McapRecorder
+
+    with McapRecorder(path) as rec:
+        for i, ti in enumerate(t):
+            for body in cv.BODIES:
+                rec.write(tp.TRACKING[body].resolve(), cv.point_stamped(ti, pts[body][i], "world"),
+                          ti)
+    return path
+
+
+def test_mcap_outlier_stamp_is_an_error_and_huge_coordinates_are_counted(tmp_path):
+    t, pts = sample()
+    t2 = t.copy()
+    t2[30] = 1e5
+    with pytest.raises(RecordingError, match=r"stamped 100000 s on .*gaps over 60 s"):
+        load_recording(_write_mcap(tmp_path / "outlier.mcap", t2, pts))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rec = load_recording(_write_mcap(tmp_path / "huge.mcap", t, _huge(pts)))
+    assert rec.out_of_workspace == 3
+    assert np.isfinite(rec.trajectory.giver_hand).all()  # interpolated over the left-out rows
+    _no_warnings_through_the_phases(rec)
