@@ -12,6 +12,7 @@ as in :mod:`.rosbag`. A coordinate that is NaN or infinite is a missing sample.
 
 from __future__ import annotations
 
+import os
 import struct
 from collections.abc import Iterator
 from pathlib import Path
@@ -66,10 +67,8 @@ def read_mcap(
         RecordingError: Not a readable MCAP file, a message that does not decode as its schema
             (naming topic and log time), no usable topic, or a name the file lacks.
     """
-    from mcap.exceptions import McapError
     from rosbags.typesys import Stores, get_typestore
 
-    from gazebot.ros2.errors import MessageError
     from gazebot.ros2.typestore import definition_types
 
     path = Path(path)
@@ -86,8 +85,9 @@ def read_mcap(
 
     notes: list[str] = []
     try:
-        with open(path, "rb") as f:
-            for schema, channel, message in _messages(f, notes):
+        with open(path, "rb") as raw:
+            f = _CappedReads(raw)
+            for schema, channel, message in _messages(f, notes):  # type: ignore[arg-type]
                 if schema is None or schema.encoding != "ros2msg":
                     continue
                 if channel.message_encoding != "cdr":
@@ -122,7 +122,8 @@ def read_mcap(
                     load.append((_stamp(msg.header), float(msg.share)))
     except (RecordingError, FileNotFoundError):
         raise
-    except (McapError, MessageError, OSError, ValueError, KeyError) as exc:
+    except Exception as exc:  # mcap, its decompressors (zstd, lz4), struct: a damaged file
+        # McapError, MessageError, OSError, ValueError, KeyError, struct.error, ZstdError...
         raise RecordingError(path, f"not a readable MCAP file of ROS 2 messages ({exc})") from None
     if not series:
         raise RecordingError(path, "no PoseStamped, PointStamped, TransformStamped or /tf data")
@@ -140,6 +141,24 @@ def read_mcap(
     return rec
 
 
+class _CappedReads:
+    """A binary file whose ``read(n)`` never asks for more than is left in it: the mcap reader
+    reads a record's length field and then that many bytes, so one damaged length in a 1 kB
+    file would otherwise allocate up to gigabytes before finding the file too short."""
+
+    def __init__(self, f: BinaryIO) -> None:
+        self._f = f
+        self._size = os.fstat(f.fileno()).st_size
+
+    def read(self, n: int | None = -1) -> bytes:
+        if n is None or n < 0:
+            return self._f.read()
+        return self._f.read(max(0, min(n, self._size - self._f.tell())))
+
+    def __getattr__(self, name: str) -> Any:  # seek, tell, seekable, ... of the file
+        return getattr(self._f, name)
+
+
 def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
     """``(schema, channel, message)`` of every message: indexed reading of a finished file, else
     (a recording cut short, e.g. by a crash) every complete chunk up to the cut, with a note."""
@@ -149,7 +168,7 @@ def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
     try:
         reader = make_reader(f)
         reader.get_summary()  # a finished file has its footer
-    except McapError:
+    except (McapError, struct.error):  # struct.error: shorter than the magic and a record
         f.seek(0)
         count, last = 0, None
         try:

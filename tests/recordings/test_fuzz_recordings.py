@@ -176,3 +176,27 @@ def test_rosbag_with_any_bytes_changed(work, bounded_memory, bag_dir, flips):
     db.write_bytes(bytes(data))
     with bounded_memory(100e6):
         _read(d, names=PointNames("/giver_hand", "/receiver_hand", "/giver_face"))
+
+
+@pytest.fixture(scope="module")
+def mcap_bytes(tmp_path_factory):
+    from test_recording_limits import _write_mcap
+
+    t, pts = sample(20)
+    return _write_mcap(tmp_path_factory.mktemp("mcap") / "r.mcap", t, pts).read_bytes()
+
+
+@pytest.mark.timeout(300)
+@settings(FUZZ, max_examples=30)
+@given(
+    cut=st.floats(0, 1),
+    flips=st.lists(st.tuples(st.floats(0, 1), st.integers(0, 255)), max_size=6),
+)
+def test_mcap_cut_or_with_any_bytes_changed(work, bounded_memory, mcap_bytes, cut, flips):
+    data = bytearray(mcap_bytes[: max(1, int(cut * len(mcap_bytes)))] if cut < 1 else mcap_bytes)
+    for where, value in flips:
+        data[int(where * (len(data) - 1))] = value
+    f = work / "fuzz.mcap"
+    f.write_bytes(bytes(data))
+    with bounded_memory(100e6):
+        _read(f)
