@@ -167,6 +167,21 @@ def test_real_server_on_a_relative_folder_writes_links_and_refuses_a_huge_body_u
             )
             reply = s.recv(4096).decode(errors="replace")
         assert reply.startswith("HTTP/1.1 413"), reply[:200]
+        # Chunked, no length announced: waitress counts and stops at the cap.
+        with socket.create_connection(("127.0.0.1", server.port), timeout=30) as s:
+            s.sendall(
+                f"POST {path}/session/0 HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+                "Content-Type: application/x-www-form-urlencoded\r\n"
+                "Transfer-Encoding: chunked\r\n\r\n".encode()
+            )
+            chunk = b"x" * 8192
+            try:
+                for _ in range(MAX_BODY_BYTES // len(chunk) + 2):
+                    s.sendall(b"%x\r\n" % len(chunk) + chunk + b"\r\n")
+            except OSError:  # the server answered and closed while we were still sending
+                pass
+            reply = s.recv(4096).decode(errors="replace")
+        assert reply.startswith("HTTP/1.1 413"), reply[:200]
         cmdline = open(f"/proc/{server.proc.pid}/cmdline", "rb").read()
         assert server.token.encode() not in cmdline
         assert os.environ.get("GAZEBOT_STUDY_ADMIN_TOKEN") is None
