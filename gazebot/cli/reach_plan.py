@@ -34,7 +34,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "reach-plan", help="plan a timed reach (pv, mcj, mce, stl)", description=__doc__
     )
-    p.add_argument("--controller", required=True, choices=CONTROLLER_NAMES)
+    p.add_argument(
+        "--controller",
+        required=True,
+        choices=CONTROLLER_NAMES,
+        help="pv: proportional velocity baseline (eq. 3.6); mcj: minimum cumulative jerk with "
+        "a reach time (eqs. 3.2-3.3); mce: minimum cumulative error with stall and reach times "
+        "(eqs. 3.4-3.5); stl: an STL specification as a MILP in receding horizon (eqs. 4.1-4.5)",
+    )
     p.add_argument(
         "--start",
         nargs=3,
