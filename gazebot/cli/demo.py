@@ -18,6 +18,8 @@ if TYPE_CHECKING:
     from gazebot.kinematics.config import RobotConfig
     from gazebot.ros2.handover_log import HandoverMcap
 
+EXIT_INFEASIBLE = 3  # the reach controller found no feasible reach and the robot stopped
+
 # The scene's controller fields the command line sets, for error messages.
 _OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
 
@@ -196,7 +198,7 @@ def run_demo(args: argparse.Namespace) -> int:
         "frames": rec.frames,
         "fps": rec.fps,
         "duration_s": round(rec.ticks[-1].t, 4),
-        "completed": rec.completed,
+        "completed": rec.completed and not infeasible,
         "phases": [
             {"phase": p, "start": round(a, 3), "end": round(b, 3)}
             for p, a, b in phase_spans(rec.ticks)
@@ -219,6 +221,15 @@ def run_demo(args: argparse.Namespace) -> int:
         print(f"STL robustness (Table 4.2, positive = met): {rob}")
         for path in (rec.video, csv_path, png_path, out / "handover.mcap"):
             print(f"wrote {path}")
+    if infeasible:
+        # The robot stopped and said so: a run that ended as the seed says it should, but no
+        # handover happened.
+        print(
+            f"gazebot: the reach was infeasible at {infeasible[0].t:.2f} s: the robot stopped "
+            f"(exit {EXIT_INFEASIBLE})",
+            file=sys.stderr,
+        )
+        return EXIT_INFEASIBLE
     if not rec.completed:
         print("gazebot: warning: the handover did not finish in time; the video is cut")
         return 1

@@ -352,7 +352,11 @@ class HandoverSimulation:
 
     @property
     def done(self) -> bool:
-        """True once the robot is back home with the object and the giver has retreated."""
+        """True once the robot is back home with the object and the giver has retreated, or
+        once the robot has stopped after finding its reach infeasible (it has said so: the
+        failure feedback is on its frames; nothing more will happen)."""
+        if self.controller.gave_up(self._t):
+            return True
         human_done = self.giver.state in (GiverState.DONE, ReceiverState.DONE)
         return self.controller.state is ControllerState.DONE and human_done
 
