@@ -28,19 +28,18 @@ MAX_DURATION_S = 120.0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from gazebot.controllers import CONTROLLER_NAMES
+    from gazebot.controllers import CONTROLLERS
     from gazebot.controllers.config import Role, Strategy
 
     p = sub.add_parser(
-        "reach-plan", help="plan a timed reach (pv, mcj, mce, stl)", description=__doc__
+        "reach-plan", help=f"plan a timed reach ({', '.join(CONTROLLERS.names())})",
+        description=__doc__,
     )
     p.add_argument(
         "--controller",
         required=True,
-        choices=CONTROLLER_NAMES,
-        help="pv: proportional velocity baseline (eq. 3.6); mcj: minimum cumulative jerk with "
-        "a reach time (eqs. 3.2-3.3); mce: minimum cumulative error with stall and reach times "
-        "(eqs. 3.4-3.5); stl: an STL specification as a MILP in receding horizon (eqs. 4.1-4.5)",
+        choices=CONTROLLERS.names(),
+        help="; ".join(f"{n}: {CONTROLLERS.entry(n).description}" for n in CONTROLLERS.names()),
     )
     p.add_argument(
         "--start",
