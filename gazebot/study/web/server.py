@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import csv
+import ipaddress
 import os
+import re
 import socket
 import sys
 from pathlib import Path
@@ -30,6 +32,27 @@ def base_url(host: str, port: int) -> str:
         host = socket.gethostname()
     shown = f"[{host}]" if ":" in host else host
     return f"http://{shown}:{port}"
+
+
+_LABEL = r"[A-Za-z0-9][A-Za-z0-9-]{0,62}"
+_HOST_NAME_RE = re.compile(rf"{_LABEL}(\.{_LABEL})*\.?")
+
+
+def check_host_name(name: str) -> str:
+    """``name`` if it is a host name or an IP address (what ``--allowed-host`` takes), else
+    ``ValueError`` saying what was expected."""
+    bare = name.strip("[]")
+    try:
+        ipaddress.ip_address(bare)
+        return bare
+    except ValueError:
+        pass
+    if len(name) <= 253 and _HOST_NAME_RE.fullmatch(name):
+        return name
+    raise ValueError(
+        f"--allowed-host: {name!r} is not a host name (expected a name such as "
+        "study.lab.example or an IP address: no scheme, port or path)"
+    )
 
 
 def served_host_names(host: str, extra: tuple[str, ...] = ()) -> tuple[str, ...]:
@@ -113,6 +136,7 @@ def serve(
     from waitress import create_server
 
     out = out or sys.stdout
+    allowed_hosts = tuple(check_host_name(n) for n in allowed_hosts)
     root = Path(study_dir).expanduser().resolve()
     load_study(root)  # a folder that is not a study says so before a token file is written
     token, where = admin_token_source(root, admin_token_file)
