@@ -29,6 +29,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals
+from gazebot.phases.rules.onset import min_jerk_span
 
 
 @dataclass(frozen=True)
@@ -231,4 +232,4 @@ def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
     v = float(s.rel_speed[i])
     if not (math.isfinite(x) and v > 1e-6):
         return t_a
-    return min(float(s.t[i]) + 3.0 * x / v, t_a)
+    return min(float(s.t[i]) + min_jerk_span(x, v), t_a)

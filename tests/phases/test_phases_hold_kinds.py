@@ -1,0 +1,100 @@
+"""Issue 20's failing cases, generated with known phase times: joint carrying (the hands move
+together ~1 s), long still holds (~1.3 s), quick light-cup handovers at 30 Hz or with 5 mm of
+noise. Pins the generator's shape of each case and the detector's transfer on them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gazebot.phases import PhaseConfig, compute_signals, run_online, segment
+from gazebot.phases.synthetic import CASE_KINDS, case_set
+from gazebot.types import EventKind, Phase
+
+
+@pytest.fixture(scope="module")
+def cases():
+    return {kind: case_set(kind, 12, seed=1) for kind in CASE_KINDS}
+
+
+def _hold_stats(case):
+    s = compute_signals(case.trajectory, PhaseConfig())
+    h = case.truth[0]
+    m = (s.t > h.transfer_start + 0.1) & (s.t < h.transfer_end - 0.05)
+    common = np.linalg.norm(s.giver_v + s.receiver_v, axis=1)[m] / 2
+    return s.distance[m], s.rel_speed[m], common
+
+
+def test_carry_case_moves_together_with_small_relative_motion(cases):
+    for case in cases["carry"]:
+        h = case.truth[0]
+        assert 0.85 <= h.transfer_end - h.transfer_start <= 1.25
+        d, rel, common = _hold_stats(case)
+        assert 0.25 <= d.mean() <= 0.5 and d.std() < 0.01  # hand frames ~0.35 m apart
+        assert 0.1 <= np.median(common) <= 0.35  # the pair carries the object
+        assert 0.015 <= np.median(rel) <= 0.10 and np.percentile(rel, 90) <= 0.12
+
+
+def test_still_case_holds_steady_for_over_a_second(cases):
+    for case in cases["still"]:
+        h = case.truth[0]
+        assert h.transfer_end - h.transfer_start >= 1.15
+        _, rel, common = _hold_stats(case)
+        assert np.percentile(rel, 90) < 0.03 and np.median(common) < 0.03
+
+
+def test_quick_cases_are_short_at_their_rate_and_noise(cases):
+    for kind, rate, noise in (("quick30", 30.0, 0.0015), ("quick_noisy", 120.0, 0.005)):
+        for case in cases[kind]:
+            h = case.truth[0]
+            assert h.transfer_end - h.transfer_start <= 0.4
+            assert np.median(np.diff(case.trajectory.t)) == pytest.approx(1 / rate, rel=0.15)
+            assert case.options.noise == noise
+
+
+def _transfer_errors(group):
+    start, end = [], []
+    for case in group:
+        tr = [s for s in segment(case.trajectory, PhaseConfig()) if s.phase is Phase.TRANSFER]
+        assert len(tr) == len(case.truth) == 1, case.options  # one transfer, never two
+        start.append(tr[0].start - case.truth[0].transfer_start)
+        end.append(tr[0].end - case.truth[0].transfer_end)
+    return np.abs(start), np.abs(end)
+
+
+@pytest.mark.parametrize(
+    ("kind", "start_max", "end_med", "end_max"),
+    [
+        # Measured |start| med 51 / max 119 ms, |end| med 42 / max 184 ms (before the hold was
+        # judged against the common motion: end med 77 / p90 303 / max 312 ms).
+        ("carry", 0.15, 0.06, 0.22),
+        # Measured start max 30, end med 16 / max 98 ms.
+        ("still", 0.06, 0.03, 0.12),
+        # Measured start max 77, end med 23 / max 58 ms.
+        ("quick30", 0.10, 0.04, 0.08),
+        # Measured start max 104, end med 25 / max 81 ms.
+        ("quick_noisy", 0.13, 0.04, 0.10),
+    ],
+)
+def test_each_case_gives_one_transfer_spanning_the_whole_hold(
+    cases, kind, start_max, end_med, end_max
+):
+    start, end = _transfer_errors(cases[kind])
+    assert start.max() <= start_max
+    assert np.median(end) <= end_med and end.max() <= end_max
+
+
+@pytest.mark.parametrize("kind", CASE_KINDS)
+def test_online_reports_each_case_once_in_order(cases, kind):
+    for case in cases[kind]:
+        kinds = [
+            e.kind
+            for e in run_online(case.trajectory).events
+            if e.kind not in (EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED)
+        ]
+        assert kinds == [
+            EventKind.REACH_STARTED,
+            EventKind.TRANSFER_STARTED,
+            EventKind.RETREAT_STARTED,
+            EventKind.HANDOVER_DONE,
+        ], case.options
