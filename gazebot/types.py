@@ -75,6 +75,17 @@ class EventKind(str, Enum):
     ROBOT_RELEASED = "robot_released"  # robot-to-human: the robot let go of the object
 
 
+#: The phase each phase event starts (the one event -> phase mapping; detector, handover state,
+#: behaviors and the bus all read it).
+PHASE_OF_EVENT: dict[EventKind, Phase] = {
+    EventKind.REACH_STARTED: Phase.REACH,
+    EventKind.TRANSFER_STARTED: Phase.TRANSFER,
+    EventKind.RETREAT_STARTED: Phase.RETREAT,
+    EventKind.HANDOVER_DONE: Phase.DONE,
+}
+#: The event that starts each phase (the inverse of :data:`PHASE_OF_EVENT`).
+EVENT_OF_PHASE: dict[Phase, EventKind] = {p: k for k, p in PHASE_OF_EVENT.items()}
+
 @dataclass(frozen=True)
 class Event:
     """Something that happened in a handover.
