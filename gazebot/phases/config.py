@@ -82,6 +82,23 @@ class PhaseConfig(BaseModel):
             trigger on the recent samples says the next boundary may have passed.
         edge_guard: Online, a phase boundary closer than this to the newest sample is not yet
             reported (s): the smoothing has not seen what follows it.
+        online_slack: Online, back-dated boundaries are compared with the current phase's
+            start with this slack (s): one analysis may place a boundary a grid step or two
+            off the previous one.
+        reach_lookback: Online, in a reach the analysis reads this many ``reach_duration``
+            before the reach's start (the rest before it dates the onset).
+        trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
+            the distances its rules need (loose: it fires before the rule can).
+        trigger_speed_baseline: ... speeds from mean positions this far apart (s).
+        trigger_deep_fraction: ... the hands closing this share of ``min_approach`` is a deep
+            dip (whoever closed it) ...
+        trigger_own_fraction: ... else the giver's own share of the closing must reach this
+            share of ``reach_confirm_distance``.
+        trigger_still_factor: ... a reach may have ended once the hands closed less than this
+            many ``still_closing`` over the recent samples.
+        trigger_far_fraction: ... a retreat may have ended once the giver's hand is this share
+            of ``retreat_far_distance`` away ...
+        trigger_landing_fraction: ... or its speed fell below this share of its peak.
         load_share_shared: Load share above which the object is shared (seed delta_1).
         load_share_robot: Load share above which the robot holds the object alone (seed delta_2).
         reach_duration: Typical giver reach (s; seed Fig. 6.1: 8.10 frames at 8 fps).
@@ -127,6 +144,15 @@ class PhaseConfig(BaseModel):
     online_window: float = Field(5.0, gt=1)
     online_refresh: float = Field(0.1, ge=0)
     edge_guard: float = Field(0.04, ge=0)
+    online_slack: float = Field(0.03, ge=0)
+    reach_lookback: float = Field(2.0, ge=1)
+    trigger_distance_factor: float = Field(0.5, gt=0, le=1)
+    trigger_speed_baseline: float = Field(0.1, gt=0)
+    trigger_deep_fraction: float = Field(0.8, gt=0, le=1)
+    trigger_own_fraction: float = Field(0.25, ge=0, le=1)
+    trigger_still_factor: float = Field(2.0, ge=1)
+    trigger_far_fraction: float = Field(0.8, gt=0, le=1)
+    trigger_landing_fraction: float = Field(0.5, gt=0, lt=1)
     load_share_shared: float = Field(0.1, ge=0, le=1)
     load_share_robot: float = Field(0.9, ge=0, le=1)
     reach_duration: float = Field(1.01, gt=0)
