@@ -20,6 +20,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from gazebot.config import configs_dir, load_model
+from gazebot.phases.durations import REACH_S, RETREAT_S, TRANSFER_S
 
 Method = Literal["gazebot", "seed-7.2.5", "seed-4.4.3"]
 METHODS: tuple[str, ...] = ("gazebot", "seed-7.2.5", "seed-4.4.3")
@@ -101,9 +102,9 @@ class PhaseConfig(BaseModel):
         trigger_landing_fraction: ... or its speed fell below this share of its peak.
         load_share_shared: Load share above which the object is shared (seed delta_1).
         load_share_robot: Load share above which the robot holds the object alone (seed delta_2).
-        reach_duration: Typical giver reach (s; seed Fig. 6.1: 8.10 frames at 8 fps).
-        transfer_duration: Typical transfer (s; seed annotations mean).
-        retreat_duration: Typical retreat (s; seed annotations mean).
+        reach_duration: Typical giver reach (s; :mod:`gazebot.phases.durations`).
+        transfer_duration: Typical transfer (s; same source).
+        retreat_duration: Typical retreat (s; same source).
         peak_passed_fraction: A motion is past its speed peak once its speed has fallen below
             this fraction of the peak (end-of-phase prediction).
     """
@@ -155,9 +156,9 @@ class PhaseConfig(BaseModel):
     trigger_landing_fraction: float = Field(0.5, gt=0, lt=1)
     load_share_shared: float = Field(0.1, ge=0, le=1)
     load_share_robot: float = Field(0.9, ge=0, le=1)
-    reach_duration: float = Field(1.01, gt=0)
-    transfer_duration: float = Field(0.59, gt=0)
-    retreat_duration: float = Field(1.05, gt=0)
+    reach_duration: float = Field(REACH_S, gt=0)
+    transfer_duration: float = Field(TRANSFER_S, gt=0)
+    retreat_duration: float = Field(RETREAT_S, gt=0)
     peak_passed_fraction: float = Field(0.8, gt=0, lt=1)
 
     @model_validator(mode="after")
