@@ -38,6 +38,8 @@ class PhaseConfig(BaseModel):
             ``|p(t + h) - p(t - h)| / 2h`` with this ``h`` (s) in both seed methods.
         seed_d1: Seed 4.4.3: distance-from-start fraction of its maximum (seed 0.41).
         seed_v1: Seed 4.4.3: signed-speed fraction of its maximum (seed 0.43).
+        seed_min_motion: Seed 4.4.3, our addition: a giving motion moves the hand at least
+            this far from its start (m); else no segments (the fractions would split noise).
         transfer_exit_speed: gazebot: seed-rule runs split by blips slower than this merge (m/s).
         min_approach: gazebot: a handover is a dip of the hands' distance at least this deep (m).
         approach_fraction: gazebot: ... closing at least this fraction of the distance the
@@ -117,6 +119,7 @@ class PhaseConfig(BaseModel):
     seed_speed_half_window: float = Field(0.05, gt=0)
     seed_d1: float = Field(0.41, gt=0, lt=1)
     seed_v1: float = Field(0.43, gt=0, lt=1)
+    seed_min_motion: float = Field(0.10, ge=0)
     transfer_exit_speed: float = Field(0.20, gt=0)
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
