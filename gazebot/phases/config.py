@@ -45,6 +45,8 @@ class PhaseConfig(BaseModel):
         approach_fraction: gazebot: ... closing at least this fraction of the distance the
             hands started from.
         min_transfer: gazebot: shortest transfer kept (s).
+        pass_min_samples: gazebot: a handover without a hold (the hands pass the object on
+            the move) needs this many analysis-grid samples under ``transfer_exit_speed``.
         still_closing: Online, hands that closed more than this over the last
             ``min_transfer`` are still approaching: no transfer yet (m).
         settle_fraction: gazebot: the transfer starts where the relative speed falls below this
@@ -124,6 +126,7 @@ class PhaseConfig(BaseModel):
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
     min_transfer: float = Field(0.08, ge=0)
+    pass_min_samples: int = Field(3, ge=1)
     still_closing: float = Field(0.005, ge=0)
     settle_fraction: float = Field(0.03, gt=0, lt=1)
     settle_floor_factor: float = Field(1.5, ge=1)

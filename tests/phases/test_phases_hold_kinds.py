@@ -98,3 +98,38 @@ def test_online_reports_each_case_once_in_order(cases, kind):
             EventKind.RETREAT_STARTED,
             EventKind.HANDOVER_DONE,
         ], case.options
+
+
+def _pass_on_the_move(rate=30.0, noise=0.0):
+    """The giver's hand sweeps past the receiver's without stopping: the relative speed dips
+    to 0.17 m/s (never under the seed's 0.15) at the closest point, t = 2 s."""
+    t = np.arange(0.0, 4.0, 1.0 / rate)
+    u = np.clip(t - 2.0, -1.2, 1.2)
+    rel = np.stack([0.15 + 0.5 * u**2, 0.17 * u, np.zeros_like(u)], axis=1)
+    rng = np.random.default_rng(0)
+    receiver = np.tile([0.4, 0.0, 1.0], (t.size, 1)) + rng.normal(0, noise, (t.size, 3))
+    giver = receiver - rel + rng.normal(0, noise, (t.size, 3))
+    from gazebot.phases import Trajectory
+
+    return Trajectory(t, giver, receiver)
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.002])
+def test_a_pass_on_the_move_is_one_short_transfer_at_the_closest_slowest_point(noise):
+    traj = _pass_on_the_move(noise=noise)
+    assert segment(traj, PhaseConfig(method="seed-7.2.5")) == []  # never under 15 cm/s
+    segs = segment(traj, PhaseConfig())
+    assert [s.phase for s in segs] == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT]
+    assert segs[1].start <= 2.0 <= segs[1].end and segs[1].duration <= 0.3
+
+
+def test_a_sweep_that_stays_fast_is_no_transfer():
+    # The same sweep at 0.3 m/s across: too fast to hand anything over.
+    t = np.arange(0.0, 4.0, 1.0 / 30.0)
+    u = np.clip(t - 2.0, -1.2, 1.2)
+    rel = np.stack([0.15 + 0.5 * u**2, 0.3 * u, np.zeros_like(u)], axis=1)
+    receiver = np.tile([0.4, 0.0, 1.0], (t.size, 1))
+    from gazebot.phases import Trajectory
+
+    traj = Trajectory(t, receiver - rel, receiver)
+    assert [s for s in segment(traj, PhaseConfig()) if s.phase is Phase.TRANSFER] == []
