@@ -3,16 +3,15 @@
 The detector keeps the last ``online_window`` seconds of samples and, at most every
 ``online_period``, runs the configured method (:mod:`gazebot.phases.methods`) on the samples
 seen so far (``partial``: a boundary the data do not show yet stays open, and the last
-``edge_guard`` is not trusted). For ``gazebot`` that analysis costs milliseconds, so each period
-first checks a cheap trigger on the hands' mean positions per period: a necessary condition,
-loosened, of the rule that ends the current phase (idle: the hands closed with the giver's
-hand moving; reach: the hands stopped closing fast; transfer: the relative position left the
-held pose; retreat: the giver's hand slowing or far). Only when it fires does the method run;
-a reach or retreat still refreshes its end prediction every ``online_refresh``.
-Each phase start the analysis shows beyond the current phase is
-emitted once, in order (reach -> transfer -> retreat -> done), back-dated to where the
-analysis puts it (never before the current phase's start). So online and offline share every
-rule; the online latency is what the data need to show a boundary.
+``edge_guard`` is not trusted). A method may offer a cheap trigger (the
+:meth:`~gazebot.phases.methods.base.Segmenter.trigger` hook; ``gazebot``'s is
+:mod:`~gazebot.phases.methods.gazebot_trigger`) that says per period whether its analysis
+needs to run, and its own rules for when a transfer or retreat ends once the hands are in
+contact (``rules_after_contact`` / ``phase_end``); the detector has no method-specific branch.
+Each phase start the analysis shows beyond the current phase is emitted once, in order
+(reach -> transfer -> retreat -> done), back-dated to where the analysis puts it (never before
+the current phase's start). So online and offline share every rule; the online latency is what
+the data need to show a boundary.
 
 Robot evidence (seed section 4.3) comes first: a rising edge of "gripper closed" or of a load
 share above ``load_share_shared`` starts the transfer at once (and reports the reach if it was

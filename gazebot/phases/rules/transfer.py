@@ -12,6 +12,10 @@ tracking gaps merge. The giver's hand must have moved (``reach_onset_speed``) be
 a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
 more than the giver.
 
+A dip with no such run at least ``min_transfer`` long is a handover on the move when the
+hands pass the object without stopping (:func:`pass_core`): its core is the short stretch
+under ``transfer_exit_speed`` at the closest, slowest point, once the hands are seen parting.
+
 The seed's 15 cm/s is crossed on the tail of the approach, before contact. The transfer starts
 where the approach has stopped: the relative speed falls below ``settle_fraction`` of the
 approach's own peak relative speed (scale-free: fast and slow approaches alike), or below
