@@ -17,6 +17,8 @@ _OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "ret
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from gazebot.sim.scene_config import reach_controller_names
+
     parser = sub.add_parser(
         "demo",
         help="simulate a handover with gaze and write a video, a timeline CSV and a plot",
@@ -48,7 +50,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", action="store_true", help="print a JSON summary to stdout")
     parser.add_argument(
         "--controller",
-        choices=["joint", "pv", "mcj", "mce", "stl"],
+        choices=reach_controller_names(),
         help="the robot's reach controller (default: the scene's; seed chapters 3-4)",
     )
     parser.add_argument(
@@ -114,19 +116,27 @@ def scene_with_overrides(args: argparse.Namespace):
     if not overrides:
         return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
-    from gazebot.sim.scene_config import Direction, ReachControllerName, SceneConfig, load_scene
+    from gazebot.sim.scene_config import (
+        JOINT_REACH,
+        Direction,
+        SceneConfig,
+        load_scene,
+        reach_controller_names,
+    )
 
     data = load_scene(base).model_dump()
     data["controller"].update(overrides)
-    controller = ReachControllerName(data["controller"]["reach_controller"]).value
+    controller = str(data["controller"]["reach_controller"])
     timed = "reach_time_s" in overrides or "stall_time_s" in overrides
     if timed and controller == "joint":
-        raise UsageError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+        *others, last = (n for n in reach_controller_names() if n != JOINT_REACH)
+        need = f"{', '.join(others)} or {last}"
+        raise UsageError(f"--reach-time/--stall-time need --controller {need}")
     if "stall_time_s" in overrides and controller != "mce":
         raise UsageError("--stall-time ('Don't move until') is the mce controller's")
     try:
         scene = SceneConfig.model_validate(data)
-        if scene.controller.reach_controller is not ReachControllerName.JOINT:
+        if scene.controller.reach_controller != JOINT_REACH:
             # The reach and stall times against the controllers YAML, as the simulation will.
             scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field

@@ -61,11 +61,13 @@ def register(sub: argparse._SubParsersAction) -> None:
             "recording); --online replays it through the causal detector the engine runs."
         ),
     )
+    from gazebot.phases.methods import PHASE_METHODS
+
     p.add_argument("file", metavar="FILE", help="recording: .csv, .c3d, .bag, ROS 2 bag, folder")
     p.add_argument(
         "--method",
         default=None,
-        choices=("gazebot", "seed-7.2.5", "seed-4.4.3"),
+        choices=PHASE_METHODS.names(),
         help="phase rules (default: method in the config, gazebot)",
     )
     p.add_argument("--online", action="store_true", help="replay through the online detector")

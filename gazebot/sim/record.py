@@ -140,7 +140,7 @@ def record_handover(
                 events.extend(robot_events)
                 loop.notify(robot_events)
                 # The measured arm pose: on Sawyer the head rides on right_j0.
-                cmd = loop.tick(frame.t, frame, joints=sim.joint_state())
+                cmd = loop.tick(frame, joints=sim.joint_state())
                 if cmd is not None:  # None: an unsafe command, never applied
                     sim.apply_head(cmd.head)
                     sim.apply_eyes(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)

@@ -41,7 +41,7 @@ def in_process(ticks):
     out = []
     for frame, events, joints in ticks:
         loop.notify(events)
-        c = loop.tick(frame.t, frame, joints=joints)
+        c = loop.tick(frame, joints=joints)
         out.append(_key(c.head, c.eye_yaw, c.eye_pitch, c.blink, c.distance, c.target,
                         c.phase.value))
     return out

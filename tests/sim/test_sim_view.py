@@ -205,5 +205,5 @@ def test_no_inset_option_of_the_demo_turns_the_close_up_off_and_keeps_the_other_
     args = argparse.Namespace(scene="sitting", no_inset=True, controller="mce", retreat=None)
     scene = scene_with_overrides(args)
     assert not scene.camera.inset.enabled
-    assert scene.controller.reach_controller.value == "mce" and scene.posture.value == "sitting"
+    assert scene.controller.reach_controller == "mce" and scene.posture.value == "sitting"
     assert scene_with_overrides(argparse.Namespace(scene="sitting")) == "sitting"
