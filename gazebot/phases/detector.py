@@ -310,11 +310,12 @@ class PhaseDetector:
             return
         t = np.fromiter(self._t, float, n)
         i0 = 0
-        if self.phase not in (Phase.IDLE, Phase.DONE) and math.isfinite(self.phase_start):
-            # After contact the rules need the hold and what follows, a reach its rest before
-            # and what follows, not the whole window (the cost grows with the samples).
-            back = c.reach_duration * (c.reach_lookback if self.phase is Phase.REACH else 1.0)
-            i0 = int(np.searchsorted(t, self.phase_start - back))
+        if self.phase is not Phase.IDLE and math.isfinite(self.phase_start):
+            # After contact the rules need the hold and what follows, a reach (or, once done,
+            # the next reach) its rest before and what follows, not the whole window (the cost
+            # grows with the samples; after a handover, re-analysing it is wasted).
+            look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
+            i0 = int(np.searchsorted(t, self.phase_start - c.reach_duration * look))
             if n - i0 < 3:
                 i0 = 0
         traj = Trajectory(
