@@ -22,7 +22,8 @@ import numpy as np
 
 from benchmarks.common import Result
 from benchmarks.kth_data import RATE, force_truth, kth_dir
-from gazebot.phases import METHODS, PhaseConfig, PhaseDetector, Trajectory, run_online, segment
+from gazebot.phases import PhaseConfig, PhaseDetector, Trajectory, run_online, segment
+from gazebot.phases.methods import PHASE_METHODS
 from gazebot.phases.synthetic import CASE_KINDS, case_set, rest_recording, synthetic_set
 from gazebot.types import EventKind, Phase
 
@@ -62,7 +63,7 @@ def _kth_results() -> list[Result]:
     traj, t0, t1 = found
     out = []
     errs = {}
-    for m in METHODS:
+    for m in PHASE_METHODS.names():
         c = PhaseConfig(method=m)
         tr = [s for s in segment(traj, c) if s.phase is Phase.TRANSFER]
         ev = [e for e in run_online(traj, c).events if e.kind is EventKind.TRANSFER_STARTED]
@@ -167,7 +168,7 @@ def run() -> list[Result]:
     cases = synthetic_set(12, seed=7, rate=100.0, handovers=1)
     trajs = [c.trajectory for c in cases]
     seed_cfg = PhaseConfig(method=SEED)
-    for m in METHODS:
+    for m in PHASE_METHODS.names():
         if m == SEED:
             continue
         cfg = PhaseConfig(method=m)
