@@ -86,6 +86,11 @@ class PhaseConfig(BaseModel):
         online_slack: Online, back-dated boundaries are compared with the current phase's
             start with this slack (s): one analysis may place a boundary a grid step or two
             off the previous one.
+        reach_stall: Online, a reach whose giver's hand rested this long (s), nobody
+            approaching, was an earlier movement: it ends (``stalled``) and the final
+            approach is reported as the reach ...
+        stall_travel: ... if the giver's hand is less than this far (m) from where the reach
+            started (a lift; a hand held out at the handover place has come farther).
         reach_lookback: Online, in a reach the analysis reads this many ``reach_duration``
             before the reach's start (the rest before it dates the onset).
         trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
@@ -148,6 +153,8 @@ class PhaseConfig(BaseModel):
     online_refresh: float = Field(0.1, ge=0)
     edge_guard: float = Field(0.04, ge=0)
     online_slack: float = Field(0.03, ge=0)
+    reach_stall: float = Field(1.0, gt=0)
+    stall_travel: float = Field(0.18, gt=0)
     reach_lookback: float = Field(2.0, ge=1)
     trigger_distance_factor: float = Field(0.5, gt=0, le=1)
     trigger_speed_baseline: float = Field(0.1, gt=0)

@@ -21,7 +21,9 @@ robot has not grasped are a giver waiting).
 
 A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
 back about as far apart as when it started (taken back before any transfer), ends as
-``handover_done`` with ``source = "aborted"``; a retreat longer
+``handover_done`` with ``source = "aborted"``; one it no longer shows for ``reach_stall``
+(the giver moved early, e.g. lifted the object, then waited) ends with ``source = "stalled"``,
+so the final approach is reported as the reach; a retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
 
 Bad samples: a frame with a non-finite time, or a time not after the last accepted one
@@ -115,6 +117,7 @@ class PhaseDetector:
         self._trigger = self.segmenter.trigger()
         self._last_full = -math.inf
         self._reach_missing_since = math.nan
+        self._stalled = False  # the last handover ended as a stalled reach
         self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
         self._joined_late = False
@@ -185,6 +188,7 @@ class PhaseDetector:
         self.phase_start = t0
         self._floor = t0
         self._reach_missing_since = math.nan
+        self._stalled = False
         self.expected_phase_end = predict_end(phase, t0, self._signals, t0, self.config)
 
     def _start(self, phase: Phase, t0: float, now: float, source: str) -> None:
@@ -315,7 +319,12 @@ class PhaseDetector:
             # the next reach) its rest before and what follows, not the whole window (the cost
             # grows with the samples; after a handover, re-analysing it is wasted).
             look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
-            i0 = int(np.searchsorted(t, self.phase_start - c.reach_duration * look))
+            back = c.reach_duration * look
+            if self._stalled:
+                # After a stalled reach only the smoothing and the largest onset back-dating
+                # before it matter: the stalled movement must not date the next reach.
+                back = c.max_refine + c.smoothing
+            i0 = int(np.searchsorted(t, self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
         traj = Trajectory(
@@ -389,7 +398,11 @@ class PhaseDetector:
                     and sg.end >= self._floor - c.online_slack
                     for sg in segs
                 )
-                if alive:
+                if self._reach_stalled():
+                    # An earlier movement (the giver lifted the object, then waited): the reach
+                    # that leads into the transfer is the approach still to come.
+                    self._done(now, now, "stalled")
+                elif alive:
                     self._reach_missing_since = math.nan
                 elif self._reach_missing_since != self._reach_missing_since:
                     self._reach_missing_since = now
@@ -420,6 +433,29 @@ class PhaseDetector:
                 self._done(now, now, "timeout")
             return
 
+    def _reach_stalled(self) -> bool:
+        """The reach under way has stalled short of the receiver: for the last
+        ``reach_stall`` the giver's hand rested (under ``rest_speed``) and the hands' distance
+        stayed within ``reach_confirm_distance`` (nobody approaching), and the giver's hand is
+        less than ``stall_travel`` from where the reach started (a lift or an adjustment; a
+        giver holding the object out at the handover place, waiting for the robot, has come
+        farther)."""
+        c = self.config
+        s = self._signals
+        if s is None or s.t.shape[0] < 2 or s.t[-1] - self.phase_start < c.reach_stall:
+            return False
+        i0 = int(np.searchsorted(s.t, s.t[-1] - c.reach_stall))
+        v, d = s.giver_speed[i0:], s.distance[i0:]
+        if not (np.isfinite(v).all() and np.isfinite(d).all() and (v < c.rest_speed).all()):
+            return False
+        if float(d.max() - d.min()) > c.reach_confirm_distance:
+            return False
+        i_start = int(np.searchsorted(s.t, self.phase_start))
+        seen = np.flatnonzero(np.isfinite(s.giver[: i_start + 1]).all(axis=1))
+        if seen.size == 0:
+            return False
+        return float(np.linalg.norm(s.giver[-1] - s.giver[seen[-1]])) < c.stall_travel
+
     def _hands_back_apart(self) -> bool:
         """The hands are (almost) as far apart as when the current reach started: the reach
         was taken back, not merely paused (a reach that pauses is still a reach)."""
@@ -440,6 +476,7 @@ class PhaseDetector:
         info = {"handover": max(self.handover, 0), "source": source}
         self._queue.append(Event(EventKind.HANDOVER_DONE, t0, now, info))
         self._enter(Phase.DONE, t0)
+        self._stalled = source == "stalled"
 
 
 @dataclass

@@ -22,6 +22,7 @@ The hold (``SyntheticOptions.hold``) is one of the kinds seen on real handovers 
 - ``still``: a full cup: both hands steady (relative speed under 0.03 m/s) for about 1.3 s.
 
 :func:`case_set` makes those and the quick light-cup handover (30 Hz, 5 mm noise);
+:func:`early_lift_set` makes givers who lift the object early and wait before the final approach;
 :func:`rest_recording` makes recordings with no handover at all (a resting or fidgeting giver
 under marker noise) for the no-false-event checks.
 """
@@ -124,6 +125,11 @@ class SyntheticOptions:
         hold_time: ``(low, high)`` range the hold's duration is drawn from (s, before the
             ``speed`` scaling); ``None``: the hold kind's own (pull 0.3-1.2, carry 0.9-1.1,
             still 1.2-1.4).
+        early_lift: When > 0, before each reach the giver lifts the object (10-15 cm up, a
+            few cm toward the robot) and waits this long (s) before the final approach, which
+            is the reach (issue 20: a giver who lifted the cup early, then waited).
+        robot_delay: The robot sets off this much later (s) than it would: the giver holds
+            the object out at the handover place and waits.
     """
 
     rate: float = 100.0
@@ -140,6 +146,8 @@ class SyntheticOptions:
     robot_lead: float = 0.0
     hold: Hold = "pull"
     hold_time: tuple[float, float] | None = None
+    early_lift: float = 0.0
+    robot_delay: float = 0.0
 
     def __post_init__(self) -> None:
         if not 1.0 <= self.rate <= 2000.0:
@@ -211,6 +219,13 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
     truth: list[HandoverTruth] = []
     t = u(0.4, 1.2) + opts.robot_lead
     for _ in range(opts.handovers):
+        if opts.early_lift > 0:
+            # The giver lifts the object early (10-15 cm up, 3-6 cm toward the robot, 0.6 s)
+            # and waits before the final approach: the reach is the final approach.
+            lifted = rest + np.array([-u(0.03, 0.06), u(-0.02, 0.02), u(0.10, 0.15)])
+            hand.move(t, 0.6, lifted)
+            rest = lifted
+            t += 0.6 + opts.early_lift
         onset = t
         reach = float(np.clip(u(0.7, 1.25) / opts.speed, 0.4, 2.5))
         target = np.array([giver[0] - u(0.3, 0.5), giver[1] + u(-0.12, 0.12), u(*hand_z)])
@@ -221,6 +236,7 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
         lag = u(0.05, 0.4)
         if opts.robot_lead > 0:
             lag = -opts.robot_lead
+        lag += opts.robot_delay
         g_dur = u(0.8, 1.5)
         offset = np.array([-u(0.04, 0.15), u(-0.01, 0.01), u(-0.01, 0.01)])
         grip.move(onset + lag, g_dur, target + offset)
@@ -405,3 +421,21 @@ def rest_recording(
             t0 += dur + rng.uniform(0.2, 1.0)
     r = np.array([0.35, -0.3, 0.25]) + rng.normal(0.0, 0.0003, (n, 3))
     return Trajectory(t, g, r)
+
+
+def early_lift_set(n: int = 12, seed: int = 0) -> list[SyntheticHandover]:
+    """``n`` recordings of issue 20's early movement: the giver lifts the object 1.5-2.5 s
+    before the final approach and waits (120 Hz, 1.5 mm noise, marker offsets); the truth's
+    reach is the final approach."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        opts = SyntheticOptions(
+            rate=120.0,
+            noise=0.0015,
+            posture="standing" if i % 2 else "sitting",
+            early_lift=float(rng.uniform(1.5, 2.5)),
+            marker_offset=0.3,
+        )
+        out.append(generate(int(rng.integers(2**31)), opts))
+    return out
