@@ -86,10 +86,10 @@ class PhaseConfig(BaseModel):
         online_slack: Online, back-dated boundaries are compared with the current phase's
             start with this slack (s): one analysis may place a boundary a grid step or two
             off the previous one.
-        reach_stall: Online, a reach whose giver's hand rested this long (s), nobody
-            approaching, was an earlier movement: it ends (``stalled``) and the final
-            approach is reported as the reach ...
-        stall_travel: ... if the giver's hand is less than this far (m) from where the reach
+        reach_stall: Online, a reach whose giver's hand then rested this long (s) and set off
+            again toward the receiver was an earlier movement: it ends (``stalled``) and the
+            final approach is the reach ...
+        stall_travel: ... if the hand rested less than this far (m) from where the reach
             started (a lift; a hand held out at the handover place has come farther).
         reach_lookback: Online, in a reach the analysis reads this many ``reach_duration``
             before the reach's start (the rest before it dates the onset).

@@ -21,9 +21,10 @@ robot has not grasped are a giver waiting).
 
 A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
 back about as far apart as when it started (taken back before any transfer), ends as
-``handover_done`` with ``source = "aborted"``; one it no longer shows for ``reach_stall``
-(the giver moved early, e.g. lifted the object, then waited) ends with ``source = "stalled"``,
-so the final approach is reported as the reach; a retreat longer
+``handover_done`` with ``source = "aborted"``. A reach that was an earlier movement (the giver
+lifted the object, rested ``reach_stall``, then set off toward the receiver) ends with
+``source = "stalled"`` when the final approach shows, and that approach is the reach (a new
+``reach_started``); a retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
 
 Bad samples: a frame with a non-finite time, or a time not after the last accepted one
@@ -117,7 +118,6 @@ class PhaseDetector:
         self._trigger = self.segmenter.trigger()
         self._last_full = -math.inf
         self._reach_missing_since = math.nan
-        self._stalled = False  # the last handover ended as a stalled reach
         self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
         self._joined_late = False
@@ -188,7 +188,6 @@ class PhaseDetector:
         self.phase_start = t0
         self._floor = t0
         self._reach_missing_since = math.nan
-        self._stalled = False
         self.expected_phase_end = predict_end(phase, t0, self._signals, t0, self.config)
 
     def _start(self, phase: Phase, t0: float, now: float, source: str) -> None:
@@ -320,10 +319,6 @@ class PhaseDetector:
             # grows with the samples; after a handover, re-analysing it is wasted).
             look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
             back = c.reach_duration * look
-            if self._stalled:
-                # After a stalled reach only the smoothing and the largest onset back-dating
-                # before it matter: the stalled movement must not date the next reach.
-                back = c.max_refine + c.smoothing
             i0 = int(np.searchsorted(t, self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
@@ -334,6 +329,13 @@ class PhaseDetector:
         )
         s = self.segmenter.online_signals(traj)
         self._signals = s
+        if s is not None and self.phase is Phase.REACH:
+            restart = self._reach_restart()
+            if restart is not None:
+                # The reach was an earlier movement (the giver lifted the object, waited, and
+                # only now approaches): it ends, and the approach is the reach.
+                self._done(restart, now, "stalled")
+                self._start(Phase.REACH, restart, now, "motion")
         if s is not None and not predict_only:
             if not self.segmenter.rules_after_contact:
                 self._advance(self.segmenter.online_segments(traj, s, now), now)
@@ -398,11 +400,7 @@ class PhaseDetector:
                     and sg.end >= self._floor - c.online_slack
                     for sg in segs
                 )
-                if self._reach_stalled():
-                    # An earlier movement (the giver lifted the object, then waited): the reach
-                    # that leads into the transfer is the approach still to come.
-                    self._done(now, now, "stalled")
-                elif alive:
+                if alive:
                     self._reach_missing_since = math.nan
                 elif self._reach_missing_since != self._reach_missing_since:
                     self._reach_missing_since = now
@@ -433,28 +431,41 @@ class PhaseDetector:
                 self._done(now, now, "timeout")
             return
 
-    def _reach_stalled(self) -> bool:
-        """The reach under way has stalled short of the receiver: for the last
-        ``reach_stall`` the giver's hand rested (under ``rest_speed``) and the hands' distance
-        stayed within ``reach_confirm_distance`` (nobody approaching), and the giver's hand is
-        less than ``stall_travel`` from where the reach started (a lift or an adjustment; a
-        giver holding the object out at the handover place, waiting for the robot, has come
-        farther)."""
+    def _reach_restart(self) -> float | None:
+        """When the final approach began, if the reach under way was an earlier movement: the
+        giver's hand, less than ``stall_travel`` from where the reach started, rested (under
+        ``rest_speed``) for ``reach_stall``, then moved again (``reach_onset_speed``) and the
+        hands have closed ``reach_confirm_distance`` since. ``None`` otherwise (a giver holding
+        the object out for a slow robot rests too, but does not set off again)."""
         c = self.config
         s = self._signals
-        if s is None or s.t.shape[0] < 2 or s.t[-1] - self.phase_start < c.reach_stall:
-            return False
-        i0 = int(np.searchsorted(s.t, s.t[-1] - c.reach_stall))
-        v, d = s.giver_speed[i0:], s.distance[i0:]
-        if not (np.isfinite(v).all() and np.isfinite(d).all() and (v < c.rest_speed).all()):
-            return False
-        if float(d.max() - d.min()) > c.reach_confirm_distance:
-            return False
+        if s is None or s.t.shape[0] < 3:
+            return None
         i_start = int(np.searchsorted(s.t, self.phase_start))
-        seen = np.flatnonzero(np.isfinite(s.giver[: i_start + 1]).all(axis=1))
-        if seen.size == 0:
-            return False
-        return float(np.linalg.norm(s.giver[-1] - s.giver[seen[-1]])) < c.stall_travel
+        v = s.giver_speed[i_start:]
+        rest = np.isfinite(v) & (v < c.rest_speed)
+        need = int(round(c.reach_stall / max(s.dt, 1e-9)))
+        if need < 1 or rest.size <= need:
+            return None
+        # the last sample of the last rest at least reach_stall long
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
+        runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+        runs = [(a, b) for a, b in runs if b - a + 1 >= need and b < rest.size - 1]
+        if not runs:
+            return None
+        a, b = runs[-1]
+        i_a, i_b = i_start + a, i_start + b
+        if not np.isfinite(s.giver[[i_start, i_a]]).all():
+            return None
+        if float(np.linalg.norm(s.giver[i_a] - s.giver[i_start])) >= c.stall_travel:
+            return None  # the hand was held out at the handover place: the reach goes on
+        after = s.giver_speed[i_b + 1 :]
+        d = s.distance[i_b:]
+        if not np.nanmax(after, initial=0.0) >= c.reach_onset_speed:
+            return None
+        if not float(d[0]) - float(np.nanmin(d)) >= c.reach_confirm_distance:
+            return None
+        return float(s.t[i_b])
 
     def _hands_back_apart(self) -> bool:
         """The hands are (almost) as far apart as when the current reach started: the reach
@@ -476,7 +487,6 @@ class PhaseDetector:
         info = {"handover": max(self.handover, 0), "source": source}
         self._queue.append(Event(EventKind.HANDOVER_DONE, t0, now, info))
         self._enter(Phase.DONE, t0)
-        self._stalled = source == "stalled"
 
 
 @dataclass
