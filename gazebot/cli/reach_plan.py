@@ -35,7 +35,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "reach-plan", help=f"plan a timed reach ({', '.join(CONTROLLERS.names())})",
         description=__doc__,
     )
-    p.add_argument("--controller", required=True, choices=CONTROLLERS.names())
+    p.add_argument(
+        "--controller",
+        required=True,
+        choices=CONTROLLERS.names(),
+        help="; ".join(f"{n}: {CONTROLLERS.entry(n).description}" for n in CONTROLLERS.names()),
+    )
     p.add_argument(
         "--start",
         nargs=3,

@@ -17,10 +17,12 @@ simulated driver. What it adds to :meth:`gazebot.engine.GazeEngine.step`:
   after ``max_gap_hold``; the behavior then applies its own ``tracking_lost`` policy (hold for
   ``hold_s``, then look at its target, by default the last known face). There is no other
   fallback: the behavior's timings are the only ones.
-* **Safety**: a head goal outside the joint limits is clipped into them, eye angles into the
-  eye range, the blink into 0..1; a command with any non-finite value is never returned (the
-  tick returns ``None`` and counts it in :attr:`GazeLoop.unsafe`). An engine that raises is
-  answered the same way (counted in :attr:`GazeLoop.faults`): the loop never dies on input.
+* **Safety**: the gaze controller is the one place that clips the head goals into the joint
+  limits and the eyes into their range; the loop checks: a command with any non-finite value, a
+  head goal outside the limits (or for a joint the robot lacks) or eyes outside their range is
+  never returned (the tick returns ``None`` and counts it in :attr:`GazeLoop.unsafe`); the blink
+  is kept in 0..1. An engine that raises is answered the same way (counted in
+  :attr:`GazeLoop.faults`): the loop never dies on input.
 
 The loop's output is the engine's :class:`~gazebot.types.GazeCommand` with the lids, the
 vergence distance and ``answers_sample`` filled in (one command type from the engine to the
@@ -29,7 +31,6 @@ wire).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Protocol
@@ -106,11 +107,12 @@ class GazeLoop:
     def __init__(self, engine: EngineLike, blink: BlinkModel | None = None, seed: int = 0) -> None:
         self.engine = engine
         self.blinks = blink if blink is not None else BlinkModel(seed)
-        self.unsafe = 0  # commands refused for non-finite values
-        self.clipped = 0  # commands brought into the joint or eye limits
+        self.unsafe = 0  # commands refused: non-finite, or outside the joint or eye limits
         self.faults = 0  # ticks the engine raised on (answered with None)
         self.ticks = 0
         self._t = -math.inf
+        self._frame_key: tuple | None = None
+        self._frame_rows: list[list[float]] = []
         robot = engine.robot
         self._limits = [(str(n), float(lo), float(hi))
                         for n, lo, hi in zip(robot.head_joints, robot.lower, robot.upper,
@@ -166,8 +168,8 @@ class GazeLoop:
         ``t`` is the tick's robot time (s): required without a frame; with a frame it may be
         given only if it agrees with ``frame.t``. ``joints`` is the robot's measured joint
         positions (rad) by name: the arm joints that carry the head (Sawyer's ``right_j0``) and
-        the head joints. Returns the command, or ``None`` when the engine produced a non-finite
-        one or raised (never sent).
+        the head joints. Returns the command, or ``None`` when the engine produced an unsafe one
+        (non-finite, or outside the joint or eye limits) or raised (never sent).
 
         Raises:
             ValueError: no frame and no ``t``, or a ``t`` that disagrees with ``frame.t``
@@ -197,14 +199,14 @@ class GazeLoop:
         if not (cmd.is_finite() and math.isfinite(cmd.gaze_shift)):
             self.unsafe += 1
             return None
-        robot = self.robot
-        head, clipped = self._safe_head(cmd.head)
-        yaw, pitch, eyes_clipped = robot.eyes.clip(cmd.eye_yaw, cmd.eye_pitch)
-        if clipped or eyes_clipped:
-            self.clipped += 1
+        head = cmd.head
+        if not (self._within_limits(head) and not self.robot.eyes.clip(cmd.eye_yaw,
+                                                                        cmd.eye_pitch)[2]):
+            self.unsafe += 1
+            return None
         distance = None
         if is_valid_point(cmd.target_point):
-            rows = robot.gaze_frame_lists(self._display_pose(head, joints))
+            rows = self._gaze_frame(self._display_pose(head, joints))
             x, y, z = cmd.target_point.tolist()
             dx, dy, dz = x - rows[0][3], y - rows[1][3], z - rows[2][3]
             d = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -213,15 +215,20 @@ class GazeLoop:
         # Blink times never go back (the engine's t never does either).
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
-        return dataclasses.replace(
-            cmd,
-            head=head,
-            eye_yaw=float(yaw),
-            eye_pitch=float(pitch),
+        return cmd.replaced(
             blink=blink,
             distance=distance,
             answers_sample=answers,
         )
+
+    def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
+        """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
+        the arm carrying the head moved (a head at rest: no forward kinematics)."""
+        key = (*pose, getattr(self.robot, "arm_revision", None))
+        if key != self._frame_key:
+            self._frame_key = key
+            self._frame_rows = self.robot.gaze_frame_lists(pose)
+        return self._frame_rows
 
     def _display_pose(
         self, head: dict[str, float], joints: Mapping[str, float] | None
@@ -235,17 +242,13 @@ class GazeLoop:
                         for v, (_, lo, hi) in zip(measured, self._limits, strict=True)]
         return [head.get(n, r) for (n, _, _), r in zip(self._limits, self._rest, strict=True)]
 
-    def _safe_head(self, head: Mapping[str, float]) -> tuple[dict[str, float], bool]:
-        """``head`` clipped into the joint limits (the one clip of the command on its way out;
-        the gaze controller plans within them), and whether anything was clipped. Joints the
-        robot does not have are dropped (counted as clipped)."""
-        out: dict[str, float] = {}
-        clipped = bool(set(head).difference(n for n, _, _ in self._limits))
+    def _within_limits(self, head: Mapping[str, float]) -> bool:
+        """Every head goal is for a joint of the robot and within its limits (a check, not a
+        clip: the gaze controller clips)."""
+        known = 0
         for name, lo, hi in self._limits:
-            if name not in head:
-                continue
-            q = float(head[name])
-            x = min(max(q, lo), hi)
-            clipped = clipped or x != q
-            out[name] = x
-        return out, clipped
+            if name in head:
+                known += 1
+                if not lo <= head[name] <= hi:
+                    return False
+        return known == len(head)

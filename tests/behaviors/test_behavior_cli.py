@@ -125,3 +125,13 @@ def test_a_seed_behaviors_diagram_shows_every_segment_that_decides_its_targets(n
             label += f"{at.fraction:g} of the {seg.phase} (end: "
         assert label in text, label
     assert f"timer [held {spec.tracking_lost.hold_s:g} s]" in text
+
+
+def test_the_readmes_diagram_is_the_one_the_machine_draws():
+    from pathlib import Path
+
+    from gazebot.behaviors import load_behavior
+    from gazebot.behaviors.machine import diagram
+
+    readme = Path(__file__).resolve().parents[2] / "README.md"
+    assert diagram(load_behavior("face-hand-face")).strip() in readme.read_text(encoding="utf-8")

@@ -87,15 +87,23 @@ def test_a_non_finite_head_goal_is_never_returned(sawyer, bad):
     assert loop.unsafe == 2
 
 
-def test_out_of_limit_head_and_eye_commands_are_clipped_into_the_limits(sawyer):
+def test_out_of_limit_head_and_eye_commands_are_refused_not_clipped_again(sawyer):
+    # The gaze controller is the one clip; the loop only checks what any engine hands it.
     engine = _Engine(sawyer)
     loop = GazeLoop(engine)
-    engine.next = _cmd({"head_pan": 50.0}, yaw=3.0, pitch=-3.0)
-    cmd = loop.tick(TrackingFrame(t=1.0))
-    assert cmd.head["head_pan"] == pytest.approx(float(sawyer.upper[0]))
-    assert cmd.eye_yaw == pytest.approx(sawyer.eyes.yaw_range[1])
-    assert cmd.eye_pitch == pytest.approx(sawyer.eyes.pitch_range[0])
-    assert loop.clipped == 1 and 0.0 <= cmd.blink <= 1.0
+    for t, cmd in enumerate([
+        _cmd({"head_pan": 50.0}),
+        _cmd({"head_pan": 0.0}, yaw=3.0),
+        _cmd({"head_pan": 0.0}, pitch=-3.0),
+        _cmd({"head_pan": 0.0, "elbow": 0.0}),  # a joint the robot lacks
+    ]):
+        engine.next = cmd.replaced(t=float(t))
+        assert loop.tick(TrackingFrame(t=float(t))) is None
+    assert loop.unsafe == 4
+    hi = float(sawyer.upper[0])
+    engine.next = _cmd({"head_pan": hi}, yaw=sawyer.eyes.yaw_range[1], t=5.0)
+    cmd = loop.tick(TrackingFrame(t=5.0))  # at the limits is within them
+    assert cmd.head == {"head_pan": hi} and 0.0 <= cmd.blink <= 1.0 and loop.unsafe == 4
 
 
 def test_distance_is_from_the_gaze_frame_at_the_commanded_head_pose(sawyer):
@@ -127,3 +135,15 @@ def test_big_gaze_shifts_bring_blinks_and_the_blink_stream_is_seeded(sawyer):
     assert a == b and max(a) == 1.0
     hit = sum(any(abs(bt - k) < 0.05 for bt in times) for k in range(1, 5))
     assert hit >= 2  # shift_probability 0.9: most jumps blink at once
+
+
+def test_the_loop_fills_the_engines_command_without_copying_its_fields_by_hand(sawyer):
+    engine = _Engine(sawyer)
+    loop = GazeLoop(engine)
+    engine.next = _cmd({"head_pan": 0.2})
+    cmd = loop.tick(TrackingFrame(t=1.0))
+    assert type(cmd) is GazeCommand and cmd.head == {"head_pan": 0.2}
+    assert engine.next.blink == 0.0 and engine.next.distance is None  # the engine's is untouched
+    assert cmd.replaced(blink=0.5).blink == 0.5
+    with pytest.raises(TypeError, match="no fields"):
+        cmd.replaced(blinks=0.5)
