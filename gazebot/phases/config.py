@@ -104,7 +104,9 @@ class PhaseConfig(BaseModel):
             receiver's hand, faster than ``reach_onset_speed``, still accelerating ...
         predict_cos: ... within ``acos`` of this of the line to the receiver's hand ...
         predict_sigmas: ... and each of distance, speed and acceleration above this many
-            standard errors of the fit (the measured noise floor).
+            standard errors of the fit (the measured noise floor) ...
+        predict_horizon: ... and the model, extrapolated this far ahead (s), closes ...
+        predict_gap_share: ... this share of the gap the hands started from.
         trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
             the distances its rules need (loose: it fires before the rule can).
         trigger_speed_baseline: ... speeds from mean positions this far apart (s).
@@ -173,9 +175,11 @@ class PhaseConfig(BaseModel):
     predict_rest_window: float = Field(0.2, gt=0)
     predict_gap_factor: float = Field(3.0, ge=1)
     predict_noise_window: float = Field(1.0, gt=0)
-    predict_distance: float = Field(0.012, gt=0)
+    predict_distance: float = Field(0.016, gt=0)
     predict_cos: float = Field(0.3, ge=-1, le=1)
     predict_sigmas: float = Field(3.0, ge=0)
+    predict_horizon: float = Field(0.3, ge=0)
+    predict_gap_share: float = Field(0.15, ge=0, lt=1)
     trigger_distance_factor: float = Field(0.5, gt=0, le=1)
     trigger_speed_baseline: float = Field(0.1, gt=0)
     trigger_deep_fraction: float = Field(0.8, gt=0, le=1)

@@ -6,17 +6,20 @@ model is the local one of a hand starting to move: constant acceleration along t
 the giver's hand to the receiver's hand, ``x(t) = x0 + v t + a t^2 / 2``, fitted to the raw
 samples of the last ``predict_window`` (at least ``predict_min_samples`` of them, so the window
 widens at low rates; the newest sample seen, no gap in the window longer than
-``predict_gap_factor`` sampling intervals). The noise floor is measured on the samples of the ``predict_noise_window``
-before (:func:`noise_floor`), or is the fit's own residual if that is larger; the fit's
-covariance turns it into standard errors of ``x``, ``v`` and ``a`` (more noise or fewer samples
-raise them); every bar below is at least ``predict_sigmas`` of them.
+``predict_gap_factor`` sampling intervals). The noise floor is measured on the samples of the
+``predict_noise_window`` before (:func:`noise_floor`), or is the fit's own residual if that is
+larger; the fit's covariance turns it into standard errors of ``x``, ``v`` and ``a`` (more
+noise or fewer samples raise them); every bar below is at least ``predict_sigmas`` of them.
 
 A reach is confirmed when, along that line, the hand
 
-- has moved ``predict_distance`` from where it rested before the window (the mean over the
-  ``predict_rest_window`` before it),
-- moves faster than ``reach_onset_speed``, within ``acos(predict_cos)`` of the line, and
-- is still accelerating.
+- has moved ``predict_distance`` within the window (the travel of this motion alone, not of a
+  fidget before it),
+- moves faster than ``reach_onset_speed``, within ``acos(predict_cos)`` of the line,
+- is still accelerating, and
+- the hands' gap closes faster than ``reach_onset_speed`` (as the smoothed rule asks), and
+  the model, extrapolated ``predict_horizon`` ahead, closes ``predict_gap_share`` of the gap
+  the hands started from (the seed's use of eq. 4.5: where the hand goes next).
 
 A minimum-jerk motion accelerates only during the first half of its travel, so such a hand will
 go on to cover more than ``2 x predict_distance``: more than any fidget (a fidget of 1-2 cm
@@ -37,9 +40,9 @@ from gazebot.phases.trajectory import Trajectory
 
 def _fit(t: np.ndarray, x: np.ndarray, noise: float) -> tuple[np.ndarray, np.ndarray] | None:
     """Least-squares ``x ~ c0 + c1 t + c2 t^2`` (``t`` relative to the newest sample): ``(x, v,
-    a)`` at ``t = 0`` and their standard errors, from the larger of the noise floor ``noise``
-    (m) and the fit's own residuals (a motion the model does not follow); ``None`` if
-    singular."""
+    a)`` at ``t = 0`` and the travel ``x(0) - x(t[0])`` over the window, with their standard
+    errors from the larger of the noise floor ``noise`` (m) and the fit's own residuals (a
+    motion the model does not follow); ``None`` if singular."""
     n = t.shape[0]
     m = np.stack([np.ones(n), t, t * t], axis=1)
     coef, _, rank, _ = np.linalg.lstsq(m, x, rcond=None)
@@ -48,8 +51,10 @@ def _fit(t: np.ndarray, x: np.ndarray, noise: float) -> tuple[np.ndarray, np.nda
     res = x - m @ coef
     var = max(noise * noise, float(res @ res) / max(n - 3, 1))
     cov = var * np.linalg.inv(m.T @ m)
-    se = np.sqrt(np.maximum(np.diag(cov), 0.0)) * np.array([1.0, 1.0, 2.0])
-    return coef * np.array([1.0, 1.0, 2.0]), se
+    # (x, v, a) at t = 0, and x(0) - x(t[0]): the travel within the window
+    lin = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0], [0.0, -t[0], -t[0] ** 2]])
+    se = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", lin, cov, lin), 0.0))
+    return lin @ coef, se
 
 
 def noise_floor(x: np.ndarray) -> float:
@@ -72,7 +77,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
         return None
     g, r = traj.giver_hand, traj.receiver_hand
     now = float(t_all[-1])
-    ok = np.isfinite(g).all(axis=1) & (t_all > after)
+    ok = np.isfinite(g).all(axis=1) & np.isfinite(r).all(axis=1) & (t_all > after)
     idx = np.flatnonzero(ok)
     if idx.size < c.predict_min_samples + 2 or not ok[-1] or not np.isfinite(r[-1]).all():
         return None  # both hands seen now: the model is not extrapolated across a dropout
@@ -99,12 +104,24 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     along = _fit(tf, (g[fit] - g_rest) @ u, noise)
     if along is None:
         return None
-    (x, v, a), (sx, sv, sa) = along
+    (_, v, a, x), (_, sv, sa, sx) = along
     k = c.predict_sigmas
     if not (x >= max(c.predict_distance, k * sx) and v >= max(c.reach_onset_speed, k * sv)):
         return None
     if not a >= k * sa:
         return None  # past its speed peak (or not known to be before it): a fidget may stop
+    # ... and the hands' gap closing at a reach's speed (the receiver moving away, or a hand
+    # adjusted sideways at arm's length, closes it slower than the hand moves)
+    gap_fit = _fit(tf, -np.linalg.norm(r[fit] - g[fit], axis=1), noise)
+    if gap_fit is None or not gap_fit[0][1] >= max(c.reach_onset_speed, k * gap_fit[1][1]):
+        return None
+    # The model's prediction: over the next predict_horizon the hands close a share of the gap
+    # they started from (a hand adjusted at arm's length closes a few cm of a metre).
+    (d_now, v_c, a_c, closed), _ = gap_fit
+    h = c.predict_horizon
+    ahead = closed + v_c * h + 0.5 * max(a_c, 0.0) * h * h
+    if not ahead >= c.predict_gap_share * (closed - d_now):
+        return None
     # Within acos(predict_cos) of the line: the velocity's other components, fitted alike.
     across = [_fit(tf, g[fit, j], noise) for j in range(3)]
     if any(f is None for f in across):
