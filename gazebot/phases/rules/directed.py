@@ -52,7 +52,7 @@ def _fit(t: np.ndarray, x: np.ndarray, noise: float) -> tuple[np.ndarray, np.nda
     var = max(noise * noise, float(res @ res) / max(n - 3, 1))
     cov = var * np.linalg.inv(m.T @ m)
     # (x, v, a) at t = 0, and x(0) - x(t[0]): the travel within the window
-    lin = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0], [0.0, -t[0], -t[0] ** 2]])
+    lin = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0], [0.0, -t[0], -(t[0] ** 2)]])
     se = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", lin, cov, lin), 0.0))
     return lin @ coef, se
 
