@@ -79,7 +79,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     now = float(t_all[-1])
     ok = np.isfinite(g).all(axis=1) & np.isfinite(r).all(axis=1) & (t_all > after)
     idx = np.flatnonzero(ok)
-    if idx.size < c.predict_min_samples + 2 or not ok[-1] or not np.isfinite(r[-1]).all():
+    if idx.size < c.predict_min_samples + 2 or not ok[-1]:
         return None  # both hands seen now: the model is not extrapolated across a dropout
     tv = t_all[idx]
     # The fit window: predict_window, widened to predict_min_samples at low rates.
@@ -117,10 +117,10 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
         return None
     # The model's prediction: over the next predict_horizon the hands close a share of the gap
     # they started from (a hand adjusted at arm's length closes a few cm of a metre).
-    (d_now, v_c, a_c, closed), _ = gap_fit
+    (minus_d, v_c, a_c, closed), _ = gap_fit  # (the fit is of minus the distance)
     h = c.predict_horizon
     ahead = closed + v_c * h + 0.5 * max(a_c, 0.0) * h * h
-    if not ahead >= c.predict_gap_share * (closed - d_now):
+    if not ahead >= c.predict_gap_share * (closed - minus_d):
         return None
     # Within acos(predict_cos) of the line: the velocity's other components, fitted alike.
     across = [_fit(tf, g[fit, j], noise) for j in range(3)]
