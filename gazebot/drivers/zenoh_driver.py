@@ -25,7 +25,7 @@ from gazebot.drivers.payloads import (
 from gazebot.drivers.rmw.names import Names
 from gazebot.drivers.rmw.node import Received
 from gazebot.drivers.tracking_assembly import SampleAssembler
-from gazebot.drivers.zenoh_node import ZenohNode
+from gazebot.drivers.zenoh_node import HISTORY_BYTES, ZenohNode
 from gazebot.ros2 import convert, topics
 from gazebot.ros2.errors import MessageError
 from gazebot.types import Phase
@@ -69,9 +69,11 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         assemble_timeout: float = 0.05,
         clock: Callable[[], float] = time.monotonic,
         max_bytes: dict[str, int] | None = None,
+        history_bytes: int = HISTORY_BYTES,
     ) -> None:
         super().__init__(session, names, node, owns_session=owns_session,
-                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes)
+                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes,
+                         history_bytes=history_bytes)
         self._cond = threading.Condition(threading.Lock())
         self._queue: deque[TrackingMsg] = deque()
         self.tracking_backlog = tracking_backlog

@@ -21,7 +21,7 @@ from gazebot.drivers.payloads import (
 )
 from gazebot.drivers.rmw.names import Names
 from gazebot.drivers.rmw.node import Received
-from gazebot.drivers.zenoh_node import ZenohNode, checked, seq_stamp
+from gazebot.drivers.zenoh_node import HISTORY_BYTES, ZenohNode, checked, seq_stamp
 from gazebot.ros2 import convert, topics
 from gazebot.ros2.errors import MessageError
 from gazebot.types import Event, TrackingFrame
@@ -83,9 +83,11 @@ class ZenohRobotEndpoint(ZenohNode):
         peer_timeout: float = 2.0,
         clock: Callable[[], float] = time.monotonic,
         max_bytes: dict[str, int] | None = None,
+        history_bytes: int = HISTORY_BYTES,
     ) -> None:
         super().__init__(session, names, node, owns_session=owns_session,
-                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes)
+                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes,
+                         history_bytes=history_bytes)
         self._tracking_seq = 0
         self._joint_seq = 0
         self.head: Latest[HeadCommandMsg] = Latest()
