@@ -76,13 +76,15 @@ def test_what_gazebot_sends_fits_its_topics_cap():
         return len(Codec.for_type(store, topic.type).encode(msg))
 
     p = [1.0, 0.2, 1.5]
-    assert size(topics.GIVER_HAND, convert.point_stamped(1.0, p, "world")) < topics.GIVER_HAND.max_bytes
+    hand = convert.point_stamped(1.0, p, "world")
+    assert size(topics.GIVER_HAND, hand) < topics.GIVER_HAND.max_bytes
     # an event with the largest info the history keeps
     ev = event(0, info_bytes=16 * 1024 - 200)
     ros = convert.handover_event(ev.source, ev.category, ev.kind, ev.t, ev.t, ev.stamp, ev.info)
     assert size(topics.EVENTS, ros) < topics.EVENTS.max_bytes
     joints = {f"joint_{i}": 0.1 * i for i in range(60)}  # a humanoid's joint state
-    assert size(topics.JOINT_STATES, convert.joint_state(1.0, joints)) < topics.JOINT_STATES.max_bytes
+    state = convert.joint_state(1.0, joints)
+    assert size(topics.JOINT_STATES, state) < topics.JOINT_STATES.max_bytes
 
 
 @pytest.mark.zenoh
