@@ -27,6 +27,10 @@ Faults (each pinned by ``tests/drivers``):
   the driver, counted by topic in the status' ``dropped``.
 * a robot speaking another message type (or another version of it) on a topic: dropped, and
   reported at once as ``type_mismatch`` (topic, expected and received type with their hashes).
+* anything a sample, an event or a peer's message makes fail (in the loop, the engine or a
+  subscription callback): caught, counted (status ``info.faults``), reported as a ``node_fault``
+  event (``info.stage``, ``info.error``; the first three, then every 100th) and the status is
+  ``degraded`` for ``fault_hold`` s; the node goes on with the next sample.
 """
 
 from __future__ import annotations
@@ -76,6 +80,7 @@ class EngineNodeConfig:
             clock restarted: the engine is reset and resynchronised.
         no_robot_warning: Warn once when no tracking sample or joint state arrived this long
             (s) after the start.
+        fault_hold: The status stays ``degraded`` this long (s) after a caught fault.
     """
 
     silence_after: float = 0.15
@@ -86,10 +91,11 @@ class EngineNodeConfig:
     eye_frame_rate: float = 30.0
     clock_reset: float = 0.5
     no_robot_warning: float = 3.0
+    fault_hold: float = 5.0
 
     def __post_init__(self) -> None:
-        for name in ("silence_after", "silence_rate", "heartbeat_period",
-                     "resync_timeout", "eye_frame_rate", "clock_reset", "no_robot_warning"):
+        for name in ("silence_after", "silence_rate", "heartbeat_period", "resync_timeout",
+                     "eye_frame_rate", "clock_reset", "no_robot_warning", "fault_hold"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(
@@ -176,6 +182,10 @@ class EngineNode:
         self._phase_sent: tuple[str, float] | None = None
         self._peers: dict[str, bool] = {}
         self._skip_events: set[tuple[str, str, int, int]] = set()
+        self.faults = 0
+        self.last_fault: str | None = None
+        self._last_fault_at = -math.inf
+        self._callback_faults: dict[str, int] = {}
         self.ready = threading.Event()  # set once started (and resynchronised)
 
     @classmethod
@@ -232,7 +242,13 @@ class EngineNode:
         Returns the number of events replayed."""
         self._run_started = self.clock()  # the no-robot delay counts from here
         self.emit("node_started", category="node", robot=getattr(self.engine.robot, "name", ""))
-        replayed = self.resync() if self.config.resync else 0
+        replayed = 0
+        if self.config.resync:
+            try:
+                replayed = self.resync()
+            except Exception as exc:  # a history the engine cannot replay: start afresh
+                self.fault("resync", exc)
+                self.loop.reset(None)
         self.ready.set()
         return replayed
 
@@ -295,22 +311,60 @@ class EngineNode:
         return budget
 
     def tick(self) -> None:
-        """Wait briefly for a tracking sample and answer it, or handle the silence."""
+        """Wait briefly for a tracking sample and answer it, or handle the silence. Nothing a
+        sample, an event or a peer causes stops the node: each stage's failure is a
+        :meth:`fault` and the next stage runs."""
         msg = self.driver.wait_tracking(self._wait_budget())
         for ev in self.driver.poll_events():
             if ev.identity in self._skip_events:
                 continue
             if ev.category == "robot" and (event := ev.to_event()) is not None:
-                self.loop.notify([event])
+                self._guarded("event", self.loop.notify, [event])
         if msg is not None:
-            self.on_tracking(msg)
+            self._guarded("tracking", self.on_tracking, msg)
         else:
-            self.on_silence()
+            self._guarded("silence", self.on_silence)
+        self._guarded("checks", self._checks)
+        if self.clock() - self._last_beat >= self.config.heartbeat_period:
+            self._guarded("heartbeat", self._heartbeat)
+
+    def _checks(self) -> None:
         self._check_peers()
         self._check_mismatches()
         self._check_robot_seen()
-        if self.clock() - self._last_beat >= self.config.heartbeat_period:
-            self._heartbeat()
+        self._check_callback_faults()
+
+    def _guarded(self, stage: str, fn: Callable[..., Any], *args: Any) -> None:
+        try:
+            fn(*args)
+        except Exception as exc:
+            self.fault(stage, exc)
+
+    def fault(self, stage: str, exc: BaseException | str) -> None:
+        """Count and report a failure the node survives: a ``node_fault`` event (the first
+        three, then every 100th), ``degraded`` status for ``fault_hold`` s."""
+        self.faults += 1
+        self._last_fault_at = self.clock()
+        text = exc if isinstance(exc, str) else f"{type(exc).__name__}: {exc}"
+        text = " ".join(str(text).split())[:300]
+        self.last_fault = f"{stage}: {text}"
+        if self.faults <= 3 or self.faults % 100 == 0:
+            if isinstance(exc, BaseException):
+                log.error("engine node fault #%d in %s", self.faults, stage, exc_info=exc)
+            try:
+                self.emit("node_fault", stage=stage, error=text, faults=self.faults)
+            except Exception:  # the bus itself failing: the count and the status remain
+                log.debug("could not report a fault", exc_info=True)
+
+    def _check_callback_faults(self) -> None:
+        """Report handler failures in the driver's subscription callbacks (Zenoh's threads)."""
+        counts = getattr(self.driver, "callback_faults", dict)()
+        for topic, n in sorted(counts.items()):
+            new = n - self._callback_faults.get(topic, 0)
+            if new > 0:
+                self._callback_faults[topic] = n
+                reason = getattr(self.driver, "callback_fault_reasons", dict)().get(topic, "")
+                self.fault(f"callback {topic}", f"{new} failed: {reason}")
 
     def on_tracking(self, msg: TrackingMsg) -> None:
         """Tick the loop with one sample and send the command."""
@@ -473,7 +527,9 @@ class EngineNode:
             self._send_phase(self._now_t(), again=True)
         peers = self.driver.peers()
         no_robot = self._no_robot_warned and not self.robot_seen
-        degraded = not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
+        faulty = self.clock() - self._last_fault_at < self.config.fault_hold
+        degraded = (not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
+                    or faulty)
         msg = StatusMsg(
             node=self.driver.node,
             seq=self._next("status"),
@@ -492,6 +548,8 @@ class EngineNode:
                 "target": self._target,
                 "robot_seen": self.robot_seen,
                 "warnings": list(self.warnings),
+                "faults": self.faults,
+                "last_fault": self.last_fault,
             },
         )
         self.driver.publish_status(msg)

@@ -290,6 +290,15 @@ class ZenohNode:
     def dropped(self) -> dict[str, int]:
         return self.drops.counts()
 
+    def callback_faults(self) -> dict[str, int]:
+        """Subscription callbacks that raised (the message is lost, the node goes on), by
+        topic."""
+        return self.ros.faults.counts()
+
+    def callback_fault_reasons(self) -> dict[str, str]:
+        """The last exception of each topic's failing callback, one line."""
+        return self.ros.faults.reasons()
+
     def type_mismatches(self) -> dict[str, TypeMismatch]:
         """Topics on which a publisher of another type (or type version) was heard."""
         return self.drops.mismatches()

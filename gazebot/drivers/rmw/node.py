@@ -205,8 +205,10 @@ class Subscription:
             self.handler(msg, Received(self.topic, codec.info.name, att))
         except MessageError as exc:  # the handler found a value it cannot use (NaN, ...)
             drops.drop(self.topic, exc.reason)
-        except Exception:  # a bug in a handler must not kill Zenoh's thread
-            log.exception("handler for %s failed", self.topic)
+        except Exception as exc:  # a bug in a handler must not kill Zenoh's thread
+            self.node.faults.drop(self.topic, f"{type(exc).__name__}: {exc}")
+            if self.node.faults.counts().get(self.topic, 0) <= self.node.faults.log_first:
+                log.exception("handler for %s failed", self.topic)
 
     def undeclare(self) -> None:
         for entity in (self._token, self._sub):
@@ -252,6 +254,8 @@ class RosNode:
         self.node_id = next(_entity_ids)
         self.graph = Graph(names.domain_id)
         self.drops = DropCounter()
+        # Handler failures (bugs or inputs a handler did not expect), by topic.
+        self.faults = DropCounter()
         self.closed = False
         self.on_graph = on_graph
         self._codecs: dict[tuple[str, int], Codec] = {}
