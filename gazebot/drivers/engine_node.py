@@ -27,6 +27,13 @@ Faults (each pinned by ``tests/drivers``):
   the driver, counted by topic in the status' ``dropped``.
 * a robot speaking another message type (or another version of it) on a topic: dropped, and
   reported at once as ``type_mismatch`` (topic, expected and received type with their hashes).
+* another engine on the same robot (:mod:`gazebot.drivers.ownership`): at start the node claims
+  the robot; if an earlier engine owns it, the node reports ``competing_engine`` (``info.role``
+  ``refused``) and stops with :class:`EngineRefused`, or with ``standby`` waits (``info.role``
+  ``standby``, no commands) until the owner's claim vanishes, then takes over
+  (``engine_took_over``, resynchronised). The owner reports each rival as ``competing_engine``
+  (``info.role`` ``owner``); the status carries ``info.role`` and ``info.rivals`` and is
+  ``degraded`` while rivals exist.
 * anything a sample, an event or a peer's message makes fail (in the loop, the engine or a
   subscription callback): caught, counted (status ``info.faults``), reported as a ``node_fault``
   event (``info.stage``, ``info.error``; the first three, then every 100th) and the status is
@@ -61,6 +68,12 @@ from gazebot.types import Event, EventKind
 log = logging.getLogger("gazebot.drivers")
 
 TrackingState = Literal["waiting", "ok", "hold", "lost"]
+Role = Literal["owner", "standby", "refused"]
+
+
+class EngineRefused(RuntimeError):
+    """Another engine owns the robot and this one does not wait: it must stop (``gazebot run``
+    exits with status 3 and this one-line message)."""
 
 
 @dataclass(frozen=True)
@@ -81,6 +94,8 @@ class EngineNodeConfig:
         no_robot_warning: Warn once when no tracking sample or joint state arrived this long
             (s) after the start.
         fault_hold: The status stays ``degraded`` this long (s) after a caught fault.
+        standby: When another engine owns the robot, wait as standby instead of stopping.
+        claim_timeout: How long (s) the claim at start waits to learn the other engines'.
     """
 
     silence_after: float = 0.15
@@ -92,10 +107,13 @@ class EngineNodeConfig:
     clock_reset: float = 0.5
     no_robot_warning: float = 3.0
     fault_hold: float = 5.0
+    standby: bool = False
+    claim_timeout: float = 0.5
 
     def __post_init__(self) -> None:
         for name in ("silence_after", "silence_rate", "heartbeat_period", "resync_timeout",
-                     "eye_frame_rate", "clock_reset", "no_robot_warning", "fault_hold"):
+                     "eye_frame_rate", "clock_reset", "no_robot_warning", "fault_hold",
+                     "claim_timeout"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(
@@ -182,6 +200,8 @@ class EngineNode:
         self._phase_sent: tuple[str, float] | None = None
         self._peers: dict[str, bool] = {}
         self._skip_events: set[tuple[str, str, int, int]] = set()
+        self.role: Role = "owner"
+        self._rivals_reported: set[str] = set()
         self.faults = 0
         self.last_fault: str | None = None
         self._last_fault_at = -math.inf
@@ -238,10 +258,22 @@ class EngineNode:
 
     # -- start -----------------------------------------------------------------------------
     def start(self) -> int:
-        """Announce the node and, if configured, resynchronise with a handover under way.
-        Returns the number of events replayed."""
+        """Announce the node, claim the robot and, if configured, resynchronise with a
+        handover under way. Returns the number of events replayed.
+
+        Raises:
+            EngineRefused: Another engine owns the robot and ``standby`` is off.
+        """
         self._run_started = self.clock()  # the no-robot delay counts from here
         self.emit("node_started", category="node", robot=getattr(self.engine.robot, "name", ""))
+        self.driver.claim(self.config.claim_timeout)
+        if not self.driver.owns_robot():
+            self._yield_robot()
+        replayed = self._catch_up() if self.role == "owner" else 0
+        self.ready.set()
+        return replayed
+
+    def _catch_up(self) -> int:
         replayed = 0
         if self.config.resync:
             try:
@@ -249,8 +281,50 @@ class EngineNode:
             except Exception as exc:  # a history the engine cannot replay: start afresh
                 self.fault("resync", exc)
                 self.loop.reset(None)
-        self.ready.set()
         return replayed
+
+    # -- ownership -------------------------------------------------------------------------
+    def _yield_robot(self) -> None:
+        """An earlier engine owns the robot: wait as standby, or stop."""
+        rivals = self.driver.rival_engines()
+        owner = rivals[0] if rivals else "another engine"
+        self.role = "standby" if self.config.standby else "refused"
+        self._report_rivals(rivals)
+        if self.role == "refused":
+            raise EngineRefused(
+                f"another engine, {owner}, already commands the robot under "
+                f"{getattr(getattr(self.driver, 'names', None), 'namespace', '?')}: stop it "
+                "first, or start this one with --standby to take over when it stops")
+
+    def _report_rivals(self, rivals: Sequence[str]) -> None:
+        new = [r for r in rivals if r not in self._rivals_reported]
+        if not new and self.role == "owner":
+            return
+        self._rivals_reported.update(new)
+        text = {"owner": f"another engine ({', '.join(new)}) claims this robot: it is "
+                         "refused or waits as standby",
+                "standby": f"another engine ({', '.join(rivals)}) commands this robot: "
+                           "standing by until it stops"}
+        info = {"role": self.role, "rivals": list(rivals), "new": new}
+        if self.role == "refused":  # the node stops and says why itself
+            self.emit("competing_engine", **info)
+        else:
+            self._warn("competing_engine", text[self.role], **info)
+
+    def _check_ownership(self) -> None:
+        """Report rivals; yield to an earlier engine; take over when the owner went away."""
+        rivals = self.driver.rival_engines()
+        owns = self.driver.owns_robot()
+        if self.role == "owner":
+            if any(r not in self._rivals_reported for r in rivals):
+                self._report_rivals(rivals)
+            if not owns and rivals:
+                self._yield_robot()
+        elif self.role == "standby" and owns:
+            self.role = "owner"
+            self.emit("engine_took_over", category="node", rivals=rivals)
+            self._catch_up()
+        self._rivals_reported.intersection_update(rivals)
 
     def resync(self) -> int:
         """Take the head pose from the joint state and replay the current handover's events
@@ -284,10 +358,14 @@ class EngineNode:
 
     # -- loop ------------------------------------------------------------------------------
     def run(self, duration: float | None = None, stop: threading.Event | None = None) -> None:
-        """:meth:`start`, then :meth:`tick` until ``stop`` is set or ``duration`` s passed."""
-        self.start()
-        end = math.inf if duration is None else self.clock() + duration
+        """:meth:`start`, then :meth:`tick` until ``stop`` is set or ``duration`` s passed.
+
+        Raises:
+            EngineRefused: Another engine owns the robot (and ``standby`` is off).
+        """
         try:
+            self.start()
+            end = math.inf if duration is None else self.clock() + duration
             while not (stop is not None and stop.is_set()) and self.clock() < end:
                 self.tick()
         finally:
@@ -314,7 +392,13 @@ class EngineNode:
         """Wait briefly for a tracking sample and answer it, or handle the silence. Nothing a
         sample, an event or a peer causes stops the node: each stage's failure is a
         :meth:`fault` and the next stage runs."""
+        self._check_ownership()
         msg = self.driver.wait_tracking(self._wait_budget())
+        if self.role != "owner":  # standby: nothing is commanded; the resync catches up later
+            self.driver.poll_events()
+            if self.clock() - self._last_beat >= self.config.heartbeat_period:
+                self._guarded("heartbeat", self._heartbeat)
+            return
         for ev in self.driver.poll_events():
             if ev.identity in self._skip_events:
                 continue
@@ -528,8 +612,9 @@ class EngineNode:
         peers = self.driver.peers()
         no_robot = self._no_robot_warned and not self.robot_seen
         faulty = self.clock() - self._last_fault_at < self.config.fault_hold
+        rivals = self.driver.rival_engines()
         degraded = (not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
-                    or faulty)
+                    or faulty or bool(rivals) or self.role != "owner")
         msg = StatusMsg(
             node=self.driver.node,
             seq=self._next("status"),
@@ -548,6 +633,8 @@ class EngineNode:
                 "target": self._target,
                 "robot_seen": self.robot_seen,
                 "warnings": list(self.warnings),
+                "role": self.role,
+                "rivals": rivals,
                 "faults": self.faults,
                 "last_fault": self.last_fault,
             },

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from gazebot.drivers.base import RobotDriver
+from gazebot.drivers.ownership import Ownership
 from gazebot.drivers.payloads import (
     ArmCommandMsg,
     EyeFrameMsg,
@@ -80,6 +81,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self.tracking_received = 0
         self.tracking_skipped = 0
         self._joints: JointStateMsg | None = None
+        self._ownership: Ownership | None = None
         self._assembler = SampleAssembler(self._expected_parts, assemble_timeout, clock=clock)
         ros = self.ros
         self._head_pub = ros.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
@@ -162,6 +164,18 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
     def tracking_late(self) -> int:
         """Tracking parts that arrived after their sample was complete (dropped)."""
         return self._assembler.late
+
+    # -- ownership -------------------------------------------------------------------------
+    def claim(self, timeout: float = 0.5) -> None:
+        if self._ownership is None and not self.closed:
+            self._ownership = self.ros.declare(Ownership(self.session, self.names, self.node))
+            self._ownership.declare(timeout)
+
+    def owns_robot(self) -> bool:
+        return self._ownership is not None and self._ownership.is_owner()
+
+    def rival_engines(self) -> list[str]:
+        return [] if self._ownership is None else [str(c) for c in self._ownership.rivals()]
 
     # -- RobotDriver -----------------------------------------------------------------------
     def wait_tracking(self, timeout: float) -> TrackingMsg | None:

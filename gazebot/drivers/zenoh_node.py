@@ -309,11 +309,12 @@ class ZenohNode:
         phase: str | None = None,
         info: dict[str, Any] | None = None,
         stopping: bool = False,
+        degraded: bool = False,
     ) -> StatusMsg:
         """Publish and return this node's heartbeat; ``state`` is ``degraded`` when a peer is
-        lost or tracking is not flowing."""
+        lost, tracking is not flowing or the caller says so."""
         peers = self.peers()
-        degraded = not all(peers.values()) or tracking in ("hold", "lost")
+        degraded = degraded or not all(peers.values()) or tracking in ("hold", "lost")
         with self._lock:
             seq = self._status_seq
             self._status_seq += 1
