@@ -47,6 +47,17 @@ class RobotDriver(ABC):
         """The other engines claiming the robot, the earliest first."""
         return []
 
+    # -- tracking sources --------------------------------------------------------------------
+    def tracking_sources(self) -> dict[str, str]:
+        """Tracking group -> the source whose samples are used (see
+        :mod:`gazebot.drivers.tracking_source`); empty when the driver has one source."""
+        return {}
+
+    def tracking_rivals(self, new_only: bool = False) -> list[Any]:
+        """Sources whose tracking is ignored (:class:`~gazebot.drivers.tracking_source.Rival`;
+        ``new_only``: those not returned before)."""
+        return []
+
     # -- commands --------------------------------------------------------------------------
     @abstractmethod
     def send_head(self, msg: HeadCommandMsg) -> None:

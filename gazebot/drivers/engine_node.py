@@ -34,6 +34,11 @@ Faults (each pinned by ``tests/drivers``):
   (``engine_took_over``, resynchronised). The owner reports each rival as ``competing_engine``
   (``info.role`` ``owner``); the status carries ``info.role`` and ``info.rivals`` and is
   ``degraded`` while rivals exist.
+* a second tracking source (another tracker, with its own clock): its samples are ignored by
+  the driver (:mod:`gazebot.drivers.tracking_source`; counted by topic) while the first one keeps
+  publishing; reported once per rival as ``competing_tracking`` (``info.source``,
+  ``info.owner``, ``info.group``), the status carries ``info.tracking_sources`` and
+  ``info.tracking_rivals`` and is ``degraded`` while a rival publishes. No clock reset follows.
 * anything a sample, an event or a peer's message makes fail (in the loop, the engine or a
   subscription callback): caught, counted (status ``info.faults``), reported as a ``node_fault``
   event (``info.stage``, ``info.error``; the first three, then every 100th) and the status is
@@ -417,6 +422,13 @@ class EngineNode:
         self._check_mismatches()
         self._check_robot_seen()
         self._check_callback_faults()
+        self._check_tracking_sources()
+
+    def _check_tracking_sources(self) -> None:
+        for r in self.driver.tracking_rivals(new_only=True):
+            self._warn("competing_tracking", f"a second tracking source, {r.source}, publishes "
+                       f"the {r.group} beside {r.owner}: ignored while {r.owner} publishes",
+                       source=r.source, owner=r.owner, group=r.group)
 
     def _guarded(self, stage: str, fn: Callable[..., Any], *args: Any) -> None:
         try:
@@ -613,8 +625,9 @@ class EngineNode:
         no_robot = self._no_robot_warned and not self.robot_seen
         faulty = self.clock() - self._last_fault_at < self.config.fault_hold
         rivals = self.driver.rival_engines()
+        tracking_rivals = sorted({r.source for r in self.driver.tracking_rivals()})
         degraded = (not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
-                    or faulty or bool(rivals) or self.role != "owner")
+                    or faulty or bool(rivals) or self.role != "owner" or bool(tracking_rivals))
         msg = StatusMsg(
             node=self.driver.node,
             seq=self._next("status"),
@@ -635,6 +648,8 @@ class EngineNode:
                 "warnings": list(self.warnings),
                 "role": self.role,
                 "rivals": rivals,
+                "tracking_sources": self.driver.tracking_sources(),
+                "tracking_rivals": tracking_rivals,
                 "faults": self.faults,
                 "last_fault": self.last_fault,
             },

@@ -88,7 +88,7 @@ def test_a_standby_engine_commands_nothing_until_the_owner_stops_then_takes_over
                                                       resync=False, standby=True))
     stop2 = threading.Event()
     th2 = threading.Thread(target=node2.run, kwargs={"stop": stop2}, daemon=True)
-    bus.closers.append(lambda: (stop2.set(), th2.join(timeout=5)))
+    bus.closers.append(lambda: (stop2.set(), th2.is_alive() and th2.join(timeout=5)))
     th2.start()
     assert node2.ready.wait(30) and node2.role == "standby"
     ep.publish_tracking(frame(0.0))
