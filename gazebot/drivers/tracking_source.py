@@ -4,10 +4,12 @@ reported, so its stamps never reach the sample assembly (where a clock going bac
 restart).
 
 Sources are told apart by the publisher GID in each sample's attachment, resolved to the
-publishing node through the ROS graph (so the hands and the face of one tracker are one
-source). Parts are arbitrated in groups: the tracked points (hands, face, from their topics or
-``/tf``) are one group, the gripper and the load share one each, since a robot bridge may
-publish those while a motion-capture node publishes the points.
+publishing node (name and Zenoh session) through the ROS graph, so the hands and the face of one
+tracker are one source. An implementation whose GIDs are not rmw_zenoh's hash of the token
+(e.g. random ones) is identified by the topic's only publisher; failing that, its samples count
+as one unidentified source. Parts are arbitrated in groups: the tracked points (hands, face,
+from their topics or ``/tf``) are one group, the gripper and the load share one each, since a
+robot bridge may publish those while a motion-capture node publishes the points.
 """
 
 from __future__ import annotations

@@ -132,21 +132,23 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         return out
 
     def _source(self, rx: Received) -> str:
-        """The node that published a received part (by the GID of its attachment)."""
-        if rx.attachment is None:
-            return "unknown publisher"
-        gid = rx.attachment.gid
-        label = self._gid_labels.get(gid)
-        if label is None:
-            for e in self.ros.graph.endpoints(rx.topic, "MP"):
-                if gid_of(e.token()) == gid:
-                    if len(self._gid_labels) > 1000:  # publishers come and go: stay bounded
-                        self._gid_labels.clear()
-                    label = self._gid_labels[gid] = source_label(e)
-                    break
-            else:
-                return f"publisher {gid.hex()}"
-        return label
+        """The node that published a received part: the publisher whose token hashes to the
+        GID of the attachment (as rmw_zenoh computes GIDs), else the topic's only publisher
+        (implementations with random GIDs), else one unidentified source."""
+        gid = rx.attachment.gid if rx.attachment is not None else None
+        label = self._gid_labels.get(gid) if gid is not None else None
+        if label is not None:
+            return label
+        publishers = self.ros.graph.endpoints(rx.topic, "MP")
+        for e in publishers:
+            if gid is not None and gid_of(e.token()) == gid:
+                if len(self._gid_labels) > 1000:  # publishers come and go: stay bounded
+                    self._gid_labels.clear()
+                label = self._gid_labels[gid] = source_label(e)
+                return label
+        if len({source_label(e) for e in publishers}) == 1:
+            return source_label(publishers[0])
+        return "unidentified publisher"
 
     def tracking_sources(self) -> dict[str, str]:
         """Tracking group (``points``, ``gripper``, ``load_share``) -> its source now."""
@@ -288,8 +290,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
 
 
 def source_label(entity: Entity) -> str:
-    """A tracking source's name: its node and where it runs (session and node id)."""
-    return f"{entity.node} ({entity.zid}:{entity.node_id})"
+    """A tracking source's name: its node's name and its session."""
+    return f"{entity.node} (session {entity.zid})"
 
 
 class _EyeCommand:
