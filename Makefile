@@ -1,14 +1,17 @@
 # The two commands a new user runs: `make demo` and `make test`. Each sets up .venv itself.
 # pyproject.toml declares version ranges; make installs the exact versions of the lock
-# constraints.txt. `make test-lowest` runs the suite on the lowest allowed versions
-# (constraints-lowest.txt) in a venv of its own, on Python 3.10 when one is installed.
+# constraints.txt (resolved on Python 3.11; on Python 3.10, where NumPy 2.4 and SciPy 1.17 do not
+# install, the lowest allowed versions that CI tests there). `make test-lowest` runs the suite on
+# the lowest allowed versions (constraints-lowest.txt) in a venv of its own, on Python 3.10 when
+# one is installed.
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
-LOCK := constraints.txt
 LOWEST := constraints-lowest.txt
+LOCK := $(if $(filter 3.10,$(shell $(PYTHON) -c 'import sys; print("%d.%d" % sys.version_info[:2])' \
+	2>/dev/null)),$(LOWEST),constraints.txt)
 LOW_VENV := .venv-lowest
 LOW_STAMP := $(LOW_VENV)/.installed-test
 # The lowest supported Python: python3.10 on PATH, else pyenv's 3.10, else $(PYTHON).
@@ -38,13 +41,15 @@ $(LOW_STAMP): pyproject.toml $(LOWEST)
 # Rewrite the lock from a scratch venv: `lock` keeps every locked version and resolves only what
 # is new in pyproject.toml; `lock-upgrade` takes the newest versions the ranges allow.
 lock lock-upgrade:
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' \
+		|| { echo "make lock: the lock is resolved on Python >= 3.11 (PYTHON=python3.11)"; exit 1; }
 	rm -rf .venv-lock
 	$(PYTHON) -m venv .venv-lock
 	.venv-lock/bin/python -m pip install --quiet --upgrade pip
-	.venv-lock/bin/python -m pip install --quiet $(if $(filter lock,$@),-c $(LOCK)) ".[test]"
-	{ sed -n '/^#/p;/^#/!q' $(LOCK); .venv-lock/bin/python -m pip freeze --exclude-editable \
-		| grep -v '^gazebot'; } > $(LOCK).new
-	mv $(LOCK).new $(LOCK)
+	.venv-lock/bin/python -m pip install --quiet $(if $(filter lock,$@),-c constraints.txt) ".[test]"
+	{ sed -n '/^#/p;/^#/!q' constraints.txt; .venv-lock/bin/python -m pip freeze --exclude-editable \
+		| grep -v '^gazebot'; } > constraints.txt.new
+	mv constraints.txt.new constraints.txt
 	rm -rf .venv-lock
 
 check-gl: $(STAMP)
