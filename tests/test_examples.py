@@ -43,13 +43,15 @@ def test_robot_bridge_example_is_driven_by_the_engine_node_over_zenoh(capsys):
     result: dict = {}
 
     def robot():
-        result["rc"] = bridge.main(["--id", "example", "--listen", endpoint, "--duration", "4"])
+        result["rc"] = bridge.main(["--namespace", "/example", "--listen", endpoint,
+                                    "--duration", "4"])
 
     thread = threading.Thread(target=robot)
     thread.start()
     from gazebot.cli import main
 
-    rc = main(["run", "--robot", "sawyer", "--behavior", "face-hand-face", "--id", "example",
+    rc = main(["run", "--robot", "sawyer", "--behavior", "face-hand-face",
+                 "--namespace", "/example",
                "--connect", endpoint, "--duration", "3", "--json"])
     thread.join(timeout=10)
     out = capsys.readouterr().out

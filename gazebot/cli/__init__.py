@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "reach_plan",
     "run",
     "display",
+    "router",
     "study",
 )
 

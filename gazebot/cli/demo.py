@@ -1,6 +1,7 @@
 """``gazebot demo``: the main job. Simulates a human-to-robot handover in MuJoCo with the gaze
-engine driving the robot's head and eyes, and writes ``handover.mp4``, ``timeline.csv`` and
-``timeline.png`` into the output folder."""
+engine driving the robot's head and eyes, and writes ``handover.mp4``, ``timeline.csv``,
+``timeline.png`` and ``handover.mcap`` (every ROS 2 topic of the run, log time = simulation time)
+into the output folder."""
 
 from __future__ import annotations
 
@@ -9,8 +10,13 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode, seed_value
+
+if TYPE_CHECKING:
+    from gazebot.kinematics.config import RobotConfig
+    from gazebot.ros2.handover_log import HandoverMcap
 
 # The scene's controller fields the command line sets, for error messages.
 _OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
@@ -174,6 +180,7 @@ def run_demo(args: argparse.Namespace) -> int:
     png_path = plot_timeline(rec.ticks, out / "timeline.png", title=title)
     summary = {
         "video": str(rec.video),
+        "mcap": str(out / "handover.mcap"),
         "timeline_csv": str(csv_path),
         "timeline_png": str(png_path),
         "frames": rec.frames,
@@ -200,7 +207,7 @@ def run_demo(args: argparse.Namespace) -> int:
         )
         rob = ", ".join(f"{k} {v:+.3f}" for k, v in summary["stl_robustness"].items())
         print(f"STL robustness (Table 4.2, positive = met): {rob}")
-        for path in (rec.video, csv_path, png_path):
+        for path in (rec.video, csv_path, png_path, out / "handover.mcap"):
             print(f"wrote {path}")
     if not rec.completed:
         print("gazebot: warning: the handover did not finish in time; the video is cut")
@@ -219,15 +226,42 @@ def _last_reach_start_time(ticks) -> float | None:
 def _record(args: argparse.Namespace, out: Path, monitor=None):
     from gazebot.sim.record import record_handover
 
-    return record_handover(
-        robot=robot_with_gaze_mode(args.robot, args.gaze_mode),
-        behavior=args.behavior,
-        scene=scene_with_overrides(args),
-        on_tick=None if monitor is None else monitor.on_tick,
-        out_path=out / "handover.mp4",
-        seed=args.seed,
-        width=args.width,
-        height=args.height,
-        progress=not args.no_progress,
-        giver_factory=giver_factory(args),
+    robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
+    log = handover_mcap(robot, out / "handover.mcap")
+    try:
+        rec = record_handover(
+            robot=robot,
+            behavior=args.behavior,
+            scene=scene_with_overrides(args),
+            on_tick=None if monitor is None else monitor.on_tick,
+            out_path=out / "handover.mp4",
+            seed=args.seed,
+            width=args.width,
+            height=args.height,
+            progress=not args.no_progress,
+            giver_factory=giver_factory(args),
+            on_step=log.tick,
+        )
+    except BaseException:
+        log.abort()
+        raise
+    log.close()
+    return rec
+
+
+def handover_mcap(robot: str | Path | RobotConfig, path: Path) -> HandoverMcap:
+    """The MCAP log of a demo run on ``robot`` (name, YAML or config): every topic, eye images
+    at 5 Hz from the robot's own eye renderer (JPEG at the display's size costs milliseconds)."""
+    from gazebot.kinematics.config import RobotConfig, load_robot_config
+    from gazebot.render import EyeRenderer
+    from gazebot.ros2.handover_log import HandoverMcap
+    from gazebot.sim.record import CONTROL_HZ
+
+    config = robot if isinstance(robot, RobotConfig) else load_robot_config(robot)[0]
+    eyes = EyeRenderer.for_robot(config)
+    return HandoverMcap(
+        path, config.base_frame, config.gaze_site, 1.0 / CONTROL_HZ,
+        eye_image=lambda yaw, pitch, blink, distance: eyes.render(
+            yaw, pitch, blink=blink, distance=distance),
+        eye_image_period=0.2,
     )

@@ -56,12 +56,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         description=(
             "Segment a recording into handover phases. Formats: CSV (t + NAME_x,NAME_y,NAME_z "
             "columns; s and m unless --unit; empty/NaN = missing), C3D (labels; its own unit), "
-            "ROS 1/2 bags (PoseStamped, PointStamped, TransformStamped topics, /tf child "
-            "frames), a folder of per-body pose CSVs (--rate). Offline by default (whole "
+            "ROS 1/2 bags and MCAP files (PoseStamped, PointStamped, TransformStamped topics, "
+            "/tf child frames; gazebot's own tracking topics by default), a folder of per-body "
+            "pose CSVs (--rate). Offline by default (whole "
             "recording); --online replays it through the causal detector the engine runs."
         ),
     )
-    p.add_argument("file", metavar="FILE", help="recording: .csv, .c3d, .bag, ROS 2 bag, folder")
+    p.add_argument(
+        "file", metavar="FILE", help="recording: .csv, .c3d, .mcap, .bag, ROS 2 bag, folder"
+    )
     p.add_argument(
         "--method",
         default=None,
@@ -91,6 +94,8 @@ def handle(args: argparse.Namespace) -> int:
     names = PointNames(args.giver_hand, args.receiver_hand, args.giver_face)
     rec = load_recording(args.file, names, unit=args.unit, rate=args.rate)
     traj = rec.trajectory
+    for note in rec.notes:
+        print(f"gazebot phases: warning: {rec.source}: {note}", file=sys.stderr)
     _, reordered, dropped = traj.cleaned()
     if reordered or dropped:
         print(

@@ -67,6 +67,9 @@ class RobotConfig(BaseModel):
 
     name: str = Field(min_length=1)
     mjcf: str = Field(min_length=1)
+    # The ROS frame name of the base frame every point is in (the MJCF world frame); what
+    # gaze targets and tracking on the ROS 2 wire carry as ``header.frame_id``.
+    base_frame: str = Field(default="world", min_length=1)
     gaze_site: str = "gaze"
     gripper_site: str = "gripper"
     gripper_actuator: str = "gripper"

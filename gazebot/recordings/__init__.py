@@ -1,7 +1,8 @@
 """Recording readers: the formats labs record, into a :class:`~gazebot.phases.Trajectory` in SI.
 
 :func:`load_recording` picks the reader from the file: ``.csv`` (:mod:`.csv_table`), ``.c3d``
-(:mod:`.c3d_file`), ROS 1 ``.bag`` / ROS 2 bag folders, ``.db3`` and ``.mcap`` (:mod:`.rosbag`),
+(:mod:`.c3d_file`), ``.mcap`` files of ROS 2 messages (:mod:`.mcap_file`), ROS 1 ``.bag`` / ROS 2
+bag folders and ``.db3`` (:mod:`.rosbag`),
 and folders of per-body pose CSVs (:mod:`.pose_folder`). Point names choose the giver's hand,
 the receiver's hand and (optionally) the giver's face; a name the file lacks is an error that
 lists the names it has.
@@ -14,6 +15,7 @@ from pathlib import Path
 from gazebot.recordings.base import PointNames, Recording, RecordingError, median_rate
 from gazebot.recordings.c3d_file import read_c3d
 from gazebot.recordings.csv_table import read_csv
+from gazebot.recordings.mcap_file import read_mcap
 from gazebot.recordings.pose_folder import read_pose_folder
 from gazebot.recordings.rosbag import read_bag
 
@@ -54,12 +56,14 @@ def load_recording(
         if unit is not None:
             raise RecordingError(path, "a C3D file states its own unit (POINT:UNITS): drop --unit")
         return read_c3d(path, names)
-    if suffix in (".bag", ".db3", ".mcap"):
+    if suffix == ".mcap":
+        return read_mcap(path, names)
+    if suffix in (".bag", ".db3"):
         return read_bag(path, names)
     raise RecordingError(
         path,
         f"unknown format {suffix or '(no extension)'}: expected .csv, "
-        ".c3d, .bag, a ROS 2 bag folder or a folder of pose CSVs",
+        ".c3d, .mcap, .bag, a ROS 2 bag folder or a folder of pose CSVs",
     )
 
 
@@ -72,5 +76,6 @@ __all__ = [
     "read_bag",
     "read_c3d",
     "read_csv",
+    "read_mcap",
     "read_pose_folder",
 ]

@@ -42,11 +42,12 @@ class Recording:
     Attributes:
         trajectory: The samples (s, m).
         source: The file read.
-        format: ``csv``, ``c3d``, ``rosbag`` or ``pose-folder``.
+        format: ``csv``, ``c3d``, ``rosbag``, ``mcap`` or ``pose-folder``.
         names: The names used for giver hand, receiver hand and giver face.
         available: Every point name the file has.
         unit: The file's length unit (converted to m).
         rate: Median sampling rate found (Hz; NaN with fewer than two samples).
+        notes: What the reader had to work around (e.g. a file cut short), one line each.
     """
 
     trajectory: Trajectory
@@ -56,6 +57,7 @@ class Recording:
     available: tuple[str, ...]
     unit: str
     rate: float
+    notes: tuple[str, ...] = ()
 
     def describe(self) -> str:
         """One line: format, names, units and rate (what the CLI prints)."""
@@ -121,9 +123,10 @@ def build(
     unit: str,
     defaults: tuple[str | None, str | None, str | None],
     extra: dict[str, np.ndarray] | None = None,
+    notes: tuple[str, ...] = (),
 ) -> Recording:
     """Pick the three points from ``points`` (name -> (N, 3) in the file's unit) and build the
-    recording in metres."""
+    recording in metres (``notes``: see :attr:`Recording.notes`)."""
     available = sorted(points)
     scale = unit_scale(source, unit)
     g = pick(source, "giver_hand", names.giver_hand, available, defaults[0])
@@ -148,4 +151,40 @@ def build(
         tuple(available),
         unit,  # type: ignore[arg-type]
         median_rate(t),
+        notes,
     )
+
+
+def sample_streams(
+    series: dict[str, list[tuple[float, float, float, float]]], max_gap: float
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Points sampled on the union of all stamps: ``(t, {name: (N, 3)})`` from per-name
+    ``(t, x, y, z)`` rows (any order). Each name is linearly interpolated between its own
+    samples, missing (NaN) outside them and across gaps longer than ``max_gap`` (s)."""
+    t = np.unique(np.concatenate([[s[0] for s in v] for v in series.values()]))
+    points: dict[str, np.ndarray] = {}
+    for name, rows in series.items():
+        a = np.array(sorted(rows))
+        _, keep = np.unique(a[:, 0], return_index=True)
+        a = a[keep]
+        p = np.stack([np.interp(t, a[:, 0], a[:, k]) for k in (1, 2, 3)], axis=1)
+        j = np.searchsorted(a[:, 0], t, side="right")
+        exact = np.isin(t, a[:, 0])
+        inside = (j > 0) & (j < a.shape[0])
+        gap = np.full(t.shape[0], np.inf)
+        gap[inside] = a[j[inside], 0] - a[j[inside] - 1, 0]
+        p[~exact & (gap > max_gap)] = np.nan
+        points[name] = p
+    return t, points
+
+
+def hold_values(t: np.ndarray, rows: list[tuple[float, float]]) -> np.ndarray:
+    """The last of ``(stamp, value)`` ``rows`` at or before each time in ``t`` (NaN before the
+    first; an empty ``rows`` gives an empty array: the value is not recorded)."""
+    if not rows:
+        return np.zeros(0)
+    a = np.array(sorted(rows), dtype=float)
+    j = np.searchsorted(a[:, 0], t, side="right") - 1
+    out = np.full(t.shape[0], np.nan)
+    out[j >= 0] = a[j[j >= 0], 1]
+    return out

@@ -23,7 +23,13 @@ from gazebot.runtime import GazeLoop
 from gazebot.types import Event, Phase
 
 if TYPE_CHECKING:
+    from typing import Any
+
     from gazebot.sim.simulation import HandoverSimulation
+    from gazebot.types import TrackingFrame
+
+    # t, tracking frame, measured joints, robot events, the loop's command (None: unsafe).
+    StepObserver = Callable[[float, TrackingFrame, dict[str, float], list[Event], Any], None]
 
 CONTROL_HZ = 120.0  # tracking rate of the seed's motion capture setup
 MAX_DURATION_S = 30.0  # a handover that has not finished by then is cut (and reported)
@@ -83,6 +89,7 @@ def record_handover(
     progress: bool = True,
     on_tick: Callable[[HandoverSimulation, TickRecord], None] | None = None,
     loop: GazeLoop | None = None,
+    on_step: StepObserver | None = None,
     giver_factory=None,
 ) -> HandoverRecording:
     """Run one handover with the gaze engine in the loop; record the video when ``out_path``.
@@ -93,7 +100,9 @@ def record_handover(
     inspect or render it); it must not step the simulation. ``loop`` replaces the default
     :class:`~gazebot.runtime.GazeLoop` (``behavior`` and ``seed`` for its engine and blinks); it
     must be built for the same robot. ``giver_factory`` replaces the simulated giver (see
-    :class:`HandoverSimulation`; e.g. recorded motion, ``--giver-motion``).
+    :class:`HandoverSimulation`; e.g. recorded motion, ``--giver-motion``). ``on_step(t,
+    frame, joints, robot_events, cmd)``, when given, sees every control tick's input and the
+    loop's command (``None`` when none was safe to send), e.g. to record them as ROS 2 messages.
 
     Returns the per-tick timeline, the frame count and the robot's events.
     """
@@ -163,6 +172,8 @@ def record_handover(
                             ),
                         )
                     )
+                if on_step is not None:  # the tick's input and answer (the sim has not moved)
+                    on_step(frame.t, frame, sim.joint_state(), robot_events, cmd)
                 if on_tick is not None and ticks:
                     on_tick(sim, ticks[-1])
                 # Frame k shows the first tick at or after k / fps.
