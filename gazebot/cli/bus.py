@@ -131,3 +131,33 @@ def positive(value: str) -> float:
     if not x > 0 or x != x:
         raise argparse.ArgumentTypeError(f"expected a positive number, got {value!r}")
     return x
+
+
+def bus_failure(exc: BaseException) -> str | None:
+    """The one-line message for a node that could not join the Zenoh bus (``None``: ``exc``
+    is something else). Found by the ``zenoh.ZError`` in the exception's chain, so it holds
+    whatever the driver wraps it in; the endpoint already in use (a second ``gazebot sim``)
+    gets its own advice."""
+    import re
+    import sys
+
+    zenoh = sys.modules.get("zenoh")
+    z_error = getattr(zenoh, "ZError", None) if zenoh is not None else None
+    if z_error is None:
+        return None
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen and not isinstance(cause, z_error):
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    if cause is None or not isinstance(cause, z_error):
+        return None
+    text = re.sub(r"\s+at /\S+\.rs:\d+\.?", "", str(cause)).strip()  # Zenoh's Rust sources
+    taken = re.search(r"bound to (\S+?):\s*\[", text)
+    if "Address already in use" in text and taken:
+        return (
+            f"cannot listen on {taken.group(1)}: the address is already in use (another gazebot "
+            "sim on this port?); stop it, or pass --listen with another port and --connect "
+            "to it from the other nodes"
+        )
+    return f"could not join the Zenoh bus: {text}"

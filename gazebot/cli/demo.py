@@ -18,11 +18,15 @@ if TYPE_CHECKING:
     from gazebot.kinematics.config import RobotConfig
     from gazebot.ros2.handover_log import HandoverMcap
 
+EXIT_INFEASIBLE = 3  # the reach controller found no feasible reach and the robot stopped
+
 # The scene's controller fields the command line sets, for error messages.
 _OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from gazebot.sim.scene_config import reach_controller_names
+
     parser = sub.add_parser(
         "demo",
         help="simulate a handover with gaze and write a video, a timeline CSV and a plot",
@@ -54,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", action="store_true", help="print a JSON summary to stdout")
     parser.add_argument(
         "--controller",
-        choices=["joint", "pv", "mcj", "mce", "stl"],
+        choices=reach_controller_names(),
         help="the robot's reach controller (default: the scene's; seed chapters 3-4)",
     )
     parser.add_argument(
@@ -120,19 +124,27 @@ def scene_with_overrides(args: argparse.Namespace):
     if not overrides:
         return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
-    from gazebot.sim.scene_config import Direction, ReachControllerName, SceneConfig, load_scene
+    from gazebot.sim.scene_config import (
+        JOINT_REACH,
+        Direction,
+        SceneConfig,
+        load_scene,
+        reach_controller_names,
+    )
 
     data = load_scene(base).model_dump()
     data["controller"].update(overrides)
-    controller = ReachControllerName(data["controller"]["reach_controller"]).value
+    controller = str(data["controller"]["reach_controller"])
     timed = "reach_time_s" in overrides or "stall_time_s" in overrides
     if timed and controller == "joint":
-        raise UsageError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+        *others, last = (n for n in reach_controller_names() if n != JOINT_REACH)
+        need = f"{', '.join(others)} or {last}"
+        raise UsageError(f"--reach-time/--stall-time need --controller {need}")
     if "stall_time_s" in overrides and controller != "mce":
         raise UsageError("--stall-time ('Don't move until') is the mce controller's")
     try:
         scene = SceneConfig.model_validate(data)
-        if scene.controller.reach_controller is not ReachControllerName.JOINT:
+        if scene.controller.reach_controller != JOINT_REACH:
             # The reach and stall times against the controllers YAML, as the simulation will.
             scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field
@@ -186,7 +198,7 @@ def run_demo(args: argparse.Namespace) -> int:
         "frames": rec.frames,
         "fps": rec.fps,
         "duration_s": round(rec.ticks[-1].t, 4),
-        "completed": rec.completed,
+        "completed": rec.completed and not infeasible,
         "phases": [
             {"phase": p, "start": round(a, 3), "end": round(b, 3)}
             for p, a, b in phase_spans(rec.ticks)
@@ -209,6 +221,15 @@ def run_demo(args: argparse.Namespace) -> int:
         print(f"STL robustness (Table 4.2, positive = met): {rob}")
         for path in (rec.video, csv_path, png_path, out / "handover.mcap"):
             print(f"wrote {path}")
+    if infeasible:
+        # The robot stopped and said so: a run that ended as the seed says it should, but no
+        # handover happened.
+        print(
+            f"gazebot: the reach was infeasible at {infeasible[0].t:.2f} s: the robot stopped "
+            f"(exit {EXIT_INFEASIBLE})",
+            file=sys.stderr,
+        )
+        return EXIT_INFEASIBLE
     if not rec.completed:
         print("gazebot: warning: the handover did not finish in time; the video is cut")
         return 1

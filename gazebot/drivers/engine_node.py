@@ -301,7 +301,7 @@ class EngineNode:
             if ev.identity in self._skip_events:
                 continue
             if ev.category == "robot" and (event := ev.to_event()) is not None:
-                self.loop.notify([event])
+                self.loop.notify(event)
         if msg is not None:
             self.on_tracking(msg)
         else:
@@ -325,7 +325,7 @@ class EngineNode:
         self._last_t = msg.t
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
-        cmd = self.loop.tick(msg.t, msg.to_frame(),
+        cmd = self.loop.tick(msg.to_frame(),
                              joints=joints.position if joints is not None else None)
         self.frames_processed += 1
         if cmd is not None:
@@ -341,7 +341,7 @@ class EngineNode:
                 or now - self._last_silence_tick < 1 / self.config.silence_rate):
             return
         self._last_silence_tick = now
-        cmd = self.loop.tick(self._now_t())
+        cmd = self.loop.tick(None, t=self._now_t())
         if cmd is not None:
             self._send(cmd)
 

@@ -23,7 +23,14 @@ from pydantic import (
     model_validator,
 )
 
-from gazebot.types import Event, EventKind, GazeCommand, TrackingFrame, is_valid_point
+from gazebot.types import (
+    PHASE_OF_EVENT,
+    Event,
+    EventKind,
+    GazeCommand,
+    TrackingFrame,
+    is_valid_point,
+)
 
 if TYPE_CHECKING:
     from gazebot.runtime import LoopCommand
@@ -35,14 +42,7 @@ Seq = Annotated[int, Field(ge=0)]
 Name = Annotated[str, Field(min_length=1, max_length=64)]
 
 PHASE_KINDS = frozenset(
-    {
-        EventKind.REACH_STARTED,
-        EventKind.TRANSFER_STARTED,
-        EventKind.RETREAT_STARTED,
-        EventKind.HANDOVER_DONE,
-        EventKind.TRACKING_LOST,
-        EventKind.TRACKING_RESTORED,
-    }
+    {*PHASE_OF_EVENT, EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED}
 )
 
 
@@ -267,10 +267,13 @@ EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]
 
 
 def category_of(kind: str) -> EventCategory:
-    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` else."""
+    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` for the
+    engine's ``fault`` and any other kind."""
     try:
         ek = EventKind(kind)
     except ValueError:
+        return "fault"
+    if ek is EventKind.FAULT:
         return "fault"
     return "phase" if ek in PHASE_KINDS else "robot"
 

@@ -85,6 +85,9 @@ class RobotConfig(BaseModel):
     shifts: GazeShiftConfig = Field(default_factory=GazeShiftConfig)
     gaze_mode: GazeMode = "head-and-eyes"
     points: dict[str, Point]
+    # Tracked points farther than this from the robot base are implausible (a tracker's glitch,
+    # a unit error): the engine treats them as missing samples (counted).
+    workspace_radius_m: float = Field(default=4.0, gt=0.0, allow_inf_nan=False)
 
     @model_validator(mode="after")
     def _consistent(self) -> RobotConfig:

@@ -15,14 +15,10 @@ The defaults here and in the YAML are the same; the YAML says each one's unit an
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from gazebot.config import configs_dir, load_model
-
-Method = Literal["gazebot", "seed-7.2.5", "seed-4.4.3"]
-METHODS: tuple[str, ...] = ("gazebot", "seed-7.2.5", "seed-4.4.3")
 
 
 class PhaseConfig(BaseModel):
@@ -93,7 +89,7 @@ class PhaseConfig(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
-    method: Method = "gazebot"
+    method: str = "gazebot"  # a registered phase method (gazebot.phases.methods.PHASE_METHODS)
     transfer_distance_margin: float = Field(0.20, gt=0)
     transfer_speed_max: float = Field(0.15, gt=0)
     seed_speed_half_window: float = Field(0.05, gt=0)
@@ -133,6 +129,13 @@ class PhaseConfig(BaseModel):
     transfer_duration: float = Field(0.59, gt=0)
     retreat_duration: float = Field(1.05, gt=0)
     peak_passed_fraction: float = Field(0.8, gt=0, lt=1)
+
+    @field_validator("method")
+    @classmethod
+    def _registered_method(cls, value: str) -> str:
+        from gazebot.phases.methods import PHASE_METHODS  # (it imports this module)
+
+        return PHASE_METHODS.check(value)
 
     @model_validator(mode="after")
     def _consistent(self) -> PhaseConfig:

@@ -53,15 +53,10 @@ from gazebot.phases.rules.retreat import retreat_done
 from gazebot.phases.rules.transfer import TransferCore
 from gazebot.phases.segment import Segment, segments_from_events
 from gazebot.phases.trajectory import Trajectory
+from gazebot.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
+from gazebot.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
 
-_PHASE_OF_EVENT = {
-    EventKind.REACH_STARTED: Phase.REACH,
-    EventKind.TRANSFER_STARTED: Phase.TRANSFER,
-    EventKind.RETREAT_STARTED: Phase.RETREAT,
-    EventKind.HANDOVER_DONE: Phase.DONE,
-}
-_EVENT_OF_PHASE = {v: k for k, v in _PHASE_OF_EVENT.items()}
 # What one online period runs (gazebot's cheap trigger): the whole method, only the end
 # prediction, or nothing.
 _FULL, _REFRESH, _SKIP = "full", "refresh", "skip"
@@ -181,6 +176,21 @@ class PhaseDetector:
         self._enter(phase, event.t)
         self._joined_late = True
         self._queue.clear()
+
+    def adopt(self, phase: Phase, t0: float) -> None:
+        """Enter ``phase`` at ``t0`` because other evidence showed it (the handover state's:
+        the robot grasped or released), live: no event is emitted, queued events stay, and the
+        handover is counted as if the detector had started the phase itself. A phase that does
+        not move forward (or a time before the current phase's start) is ignored."""
+        order = (Phase.IDLE, Phase.REACH, Phase.TRANSFER, Phase.RETREAT, Phase.DONE)
+        current = Phase.IDLE if self.phase is Phase.DONE else self.phase
+        if order.index(phase) <= order.index(current) or not math.isfinite(t0):
+            return
+        if math.isfinite(self.phase_start) and t0 < self.phase_start:
+            return
+        if self.phase in (Phase.IDLE, Phase.DONE) and phase is not Phase.DONE:
+            self.handover += 1
+        self._enter(phase, t0)
 
     # ----------------------------------------------------------------- internals
     def _enter(self, phase: Phase, t0: float) -> None:

@@ -12,7 +12,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gazebot.recordings.base import PointNames, Recording, RecordingError, median_rate
+from gazebot.recordings.base import (
+    PointNames,
+    Recording,
+    RecordingError,
+    RecordingLimits,
+    median_rate,
+)
 from gazebot.recordings.c3d_file import read_c3d
 from gazebot.recordings.csv_table import read_csv
 from gazebot.recordings.mcap_file import read_mcap
@@ -25,6 +31,7 @@ def load_recording(
     names: PointNames | None = None,
     unit: str | None = None,
     rate: float | None = None,
+    limits: RecordingLimits | None = None,
 ) -> Recording:
     """Read any supported recording (see the module docstring).
 
@@ -34,9 +41,11 @@ def load_recording(
         unit: Length unit of CSV and pose-folder coordinates (m, cm, mm; default m). C3D files
             and bags carry their own.
         rate: Sampling rate of a pose folder (Hz).
+        limits: Largest time gap and coordinate magnitude (:class:`RecordingLimits`).
 
     Raises:
-        RecordingError: Missing or unreadable file, unknown format or unit, a wrong name.
+        RecordingError: Missing or unreadable file, unknown format or unit, a wrong name, times
+            not finite and increasing or a gap beyond ``limits.max_gap_s``.
     """
     path = Path(path)
     if not path.exists():
@@ -48,18 +57,18 @@ def load_recording(
             or any(path.glob("*.db3"))
             or any(path.glob("*.mcap"))
         ):
-            return read_bag(path, names)
-        return read_pose_folder(path, names, rate, unit or "m")
+            return read_bag(path, names, limits=limits)
+        return read_pose_folder(path, names, rate, unit or "m", limits)
     if suffix == ".csv":
-        return read_csv(path, names, unit or "m")
+        return read_csv(path, names, unit or "m", limits)
     if suffix == ".c3d":
         if unit is not None:
             raise RecordingError(path, "a C3D file states its own unit (POINT:UNITS): drop --unit")
-        return read_c3d(path, names)
+        return read_c3d(path, names, limits)
     if suffix == ".mcap":
-        return read_mcap(path, names)
+        return read_mcap(path, names, limits=limits)
     if suffix in (".bag", ".db3"):
-        return read_bag(path, names)
+        return read_bag(path, names, limits=limits)
     raise RecordingError(
         path,
         f"unknown format {suffix or '(no extension)'}: expected .csv, "
@@ -71,6 +80,7 @@ __all__ = [
     "PointNames",
     "Recording",
     "RecordingError",
+    "RecordingLimits",
     "load_recording",
     "median_rate",
     "read_bag",

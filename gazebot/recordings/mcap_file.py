@@ -12,7 +12,7 @@ as in :mod:`.rosbag`. A coordinate that is NaN or infinite is a missing sample.
 
 from __future__ import annotations
 
-import math
+import os
 import struct
 from collections.abc import Iterator
 from pathlib import Path
@@ -22,6 +22,8 @@ from gazebot.recordings.base import (
     PointNames,
     Recording,
     RecordingError,
+    RecordingLimits,
+    bound_streams,
     build,
     hold_values,
     sample_streams,
@@ -53,18 +55,20 @@ def _default(topics: list[str], suffix: str) -> str | None:
 
 
 def read_mcap(
-    path: str | Path, names: PointNames | None = None, max_gap: float = 0.25
+    path: str | Path,
+    names: PointNames | None = None,
+    max_gap: float = 0.25,
+    limits: RecordingLimits | None = None,
 ) -> Recording:
-    """Read the point streams (and gripper / load share) of an MCAP file of ROS 2 messages.
+    """Read the point streams (and gripper / load share) of an MCAP file of ROS 2 messages;
+    ``limits``: see :class:`~gazebot.recordings.base.RecordingLimits` (stamps, workspace).
 
     Raises:
         RecordingError: Not a readable MCAP file, a message that does not decode as its schema
             (naming topic and log time), no usable topic, or a name the file lacks.
     """
-    from mcap.exceptions import McapError
     from rosbags.typesys import Stores, get_typestore
 
-    from gazebot.ros2.errors import MessageError
     from gazebot.ros2.typestore import definition_types
 
     path = Path(path)
@@ -75,14 +79,15 @@ def read_mcap(
     load: list[tuple[float, float]] = []
 
     def add(name: str, t: float, p: object) -> None:
+        # Every row is kept here: bound_streams checks stamps and bounds coordinates (counted).
         xyz = (float(p.x), float(p.y), float(p.z))  # type: ignore[attr-defined]
-        if math.isfinite(t) and all(math.isfinite(v) for v in xyz):
-            series.setdefault(name, []).append((t, *xyz))
+        series.setdefault(name, []).append((t, *xyz))
 
     notes: list[str] = []
     try:
-        with open(path, "rb") as f:
-            for schema, channel, message in _messages(f, notes):
+        with open(path, "rb") as raw:
+            f = _CappedReads(raw)
+            for schema, channel, message in _messages(f, notes):  # type: ignore[arg-type]
                 if schema is None or schema.encoding != "ros2msg":
                     continue
                 if channel.message_encoding != "cdr":
@@ -117,18 +122,41 @@ def read_mcap(
                     load.append((_stamp(msg.header), float(msg.share)))
     except (RecordingError, FileNotFoundError):
         raise
-    except (McapError, MessageError, OSError, ValueError, KeyError) as exc:
+    except Exception as exc:  # mcap, its decompressors (zstd, lz4), struct: a damaged file
+        # McapError, MessageError, OSError, ValueError, KeyError, struct.error, ZstdError...
         raise RecordingError(path, f"not a readable MCAP file of ROS 2 messages ({exc})") from None
     if not series:
         raise RecordingError(path, "no PoseStamped, PointStamped, TransformStamped or /tf data")
+    limits = limits or RecordingLimits()
+    series, beyond, namer = bound_streams(path, series, limits)
     t, points = sample_streams(series, max_gap)
     topics = sorted(points)
     defaults = tuple(_default(topics, s) for s in _DEFAULT_SUFFIX)
     extra = {"gripper_closed": hold_values(t, grip), "load_share": hold_values(t, load)}
-    return build(
+    rec = build(
         path, "mcap", t, points, names or PointNames(), "m", defaults,  # type: ignore[arg-type]
-        extra, tuple(notes),
+        extra, tuple(notes), limits=limits, where=namer(t),
     )
+    rec.out_of_workspace += sum(beyond[n] for n in set(rec.names) - {None})
+    return rec
+
+
+class _CappedReads:
+    """A binary file whose ``read(n)`` never asks for more than is left in it: the mcap reader
+    reads a record's length field and then that many bytes, so one damaged length in a 1 kB
+    file would otherwise allocate up to gigabytes before finding the file too short."""
+
+    def __init__(self, f: BinaryIO) -> None:
+        self._f = f
+        self._size = os.fstat(f.fileno()).st_size
+
+    def read(self, n: int | None = -1) -> bytes:
+        if n is None or n < 0:
+            return self._f.read()
+        return self._f.read(max(0, min(n, self._size - self._f.tell())))
+
+    def __getattr__(self, name: str) -> Any:  # seek, tell, seekable, ... of the file
+        return getattr(self._f, name)
 
 
 def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
@@ -140,7 +168,7 @@ def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
     try:
         reader = make_reader(f)
         reader.get_summary()  # a finished file has its footer
-    except McapError:
+    except (McapError, struct.error):  # struct.error: shorter than the magic and a record
         f.seek(0)
         count, last = 0, None
         try:

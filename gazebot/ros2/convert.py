@@ -21,14 +21,14 @@ import json
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 import numpy as np
 from rosbags.typesys.store import Typestore
 
 from gazebot.ros2.errors import MessageError
 from gazebot.ros2.typestore import typestore
-from gazebot.types import Event, EventKind, Phase, TrackingFrame
+from gazebot.types import PHASE_OF_EVENT, Event, EventKind, Phase, PhaseSource, TrackingFrame
 
 POINT_STAMPED = "geometry_msgs/msg/PointStamped"
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
@@ -47,22 +47,13 @@ LOAD_SHARE = "gazebot_msgs/msg/LoadShare"
 #: The tracked bodies of a :class:`~gazebot.types.TrackingFrame`, one topic (or TF frame) each.
 BODIES = ("giver_hand", "receiver_hand", "giver_face")
 
-#: Events of the engine's phase detector (category ``phase``); other EventKinds are ``robot``.
-PHASE_KINDS = frozenset(
-    {
-        EventKind.REACH_STARTED,
-        EventKind.TRANSFER_STARTED,
-        EventKind.RETREAT_STARTED,
-        EventKind.HANDOVER_DONE,
-        EventKind.TRACKING_LOST,
-        EventKind.TRACKING_RESTORED,
-    }
-)
+#: Events of the engine's phase stream (category ``phase``); the engine's ``fault`` is a fault;
+#: other EventKinds are ``robot``.
+PHASE_KINDS = frozenset({*PHASE_OF_EVENT, EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED})
 
 EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]
-PhaseSource = Literal["tracking", "robot", "gripper"]
 _CATEGORIES = ("phase", "robot", "behavior", "fault", "node")
-_SOURCES = ("tracking", "robot", "gripper")
+_SOURCES = get_args(PhaseSource)
 _INT32 = 2**31
 _TIME_TYPES = {"Time": "builtin_interfaces/msg/Time", "Duration": "builtin_interfaces/msg/Duration"}
 
@@ -462,10 +453,13 @@ def phase_of(msg: Any) -> PhaseState:
 
 
 def category_of(kind: str) -> EventCategory:
-    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` else."""
+    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` for the
+    engine's ``fault`` and any other kind."""
     try:
         ek = EventKind(kind)
     except ValueError:
+        return "fault"
+    if ek is EventKind.FAULT:
         return "fault"
     return "phase" if ek in PHASE_KINDS else "robot"
 

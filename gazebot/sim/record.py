@@ -109,8 +109,7 @@ def record_handover(
     from gazebot.sim.gl_check import ensure_gl_backend
 
     ensure_gl_backend()
-    from tqdm import tqdm
-
+    from gazebot.render.progress import FrameProgress
     from gazebot.render.video import open_h264_writer
     from gazebot.sim.robot import load_sim_robot
     from gazebot.sim.simulation import HandoverSimulation
@@ -135,12 +134,8 @@ def record_handover(
         )
         with (
             writer_ctx as writer,
-            tqdm(
-                total=int(expected_duration(sim) * fps) + 1 if writer is not None else None,
-                unit="frame",
-                desc=label,
-                disable=not progress,
-                leave=False,
+            FrameProgress(
+                fps, expected_duration(sim), desc=label, enabled=progress and writer is not None
             ) as bar,
         ):
             while True:
@@ -149,7 +144,7 @@ def record_handover(
                 events.extend(robot_events)
                 loop.notify(robot_events)
                 # The measured arm pose: on Sawyer the head rides on right_j0.
-                cmd = loop.tick(frame.t, frame, joints=sim.joint_state())
+                cmd = loop.tick(frame, joints=sim.joint_state())
                 if cmd is not None:  # None: an unsafe command, never applied
                     sim.apply_head(cmd.head)
                     sim.apply_eyes(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)
@@ -180,7 +175,7 @@ def record_handover(
                 if writer is not None and sim.t >= frames / fps - 1e-9:
                     writer.append(sim.render(width=width, height=height))
                     frames += 1
-                    bar.update(1)
+                    bar.advance(done_at + tail if done_at is not None else None)
                 if cmd is not None:
                     phase = cmd.phase
                 if sim_done_at is None and sim.done:
@@ -194,9 +189,7 @@ def record_handover(
                 if (done_at is not None and sim.t >= done_at + tail) or sim.t >= MAX_DURATION_S:
                     break
                 sim.step(dt)
-            if bar.total is not None and bar.n != bar.total:
-                bar.total = bar.n  # the estimate was off: end the bar where the video ended
-                bar.refresh()
+            bar.finish()
     finally:
         sim.close()
     return HandoverRecording(

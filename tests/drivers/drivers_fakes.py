@@ -161,7 +161,7 @@ class FakeEngine:
         st = self.gaze.update(frame.t, self._face)
         return GazeCommand(
             t=frame.t, phase=self.phase, target="face", target_point=self._face, head=st.head,
-            eye_yaw=0.0, eye_pitch=0.0, events=tuple(events),
+            eye_yaw=0.0, eye_pitch=0.0, events=tuple(events), tracking=self.tracking,
         )
 
     def notify(self, event: Event) -> None:

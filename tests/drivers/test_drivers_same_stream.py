@@ -59,7 +59,7 @@ def in_process(ticks):
     for frame, events, joints in ticks:
         loop.notify([wire_event(e) for e in events])
         t = on_wire(frame.t)
-        c = loop.tick(t, dataclasses.replace(frame, t=t), joints=joints)
+        c = loop.tick(dataclasses.replace(frame, t=t), joints=joints)
         point = tuple(float(v) for v in c.target_point)
         out.append(_key(c.head, c.eye_yaw, c.eye_pitch, c.blink, c.distance, point))
         if not phases or phases[-1] != c.phase.value:

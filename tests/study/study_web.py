@@ -3,7 +3,9 @@ the study server as a real subprocess that a test can SIGKILL and restart."""
 
 from __future__ import annotations
 
+import csv
 import functools
+import html
 import os
 import re
 import signal
@@ -45,19 +47,34 @@ def timed_synthetic_video(robot, behavior, scene, out_path, **kw):
 
 
 class StudyServer:
-    """``python -m gazebot study serve DIR --port 0`` in a subprocess; ``base`` is its URL once
-    it listens. ``kill()`` sends SIGKILL (no shutdown code runs)."""
+    """``python -m gazebot study serve DIR --port 0`` in a subprocess (run in ``cwd``, so
+    ``study_dir`` may be relative to it, as the README shows); ``base`` is its URL once it
+    listens, ``links[N]`` participant N's link. ``kill()`` sends SIGKILL (no shutdown code
+    runs). The admin token comes from the environment, never the command line."""
 
-    def __init__(self, study_dir: Path, token: str = "test-token", port: int = 0) -> None:
+    def __init__(
+        self,
+        study_dir: Path,
+        token: str = "test-admin-token",
+        port: int = 0,
+        cwd: Path | None = None,
+    ) -> None:
         self.study_dir = study_dir
         self.token = token
         self.port = port
+        self.cwd = cwd
         self.proc: subprocess.Popen | None = None
         self.base = ""
+        self.links: dict[int, str] = {}
 
     def start(self, timeout_s: float = 30.0) -> StudyServer:
         """Start the server (on the port of the last start, if any) and wait until it listens."""
-        env = {**os.environ, "PYTHONPATH": str(REPO), "PYTHONUNBUFFERED": "1"}
+        env = {
+            **os.environ,
+            "PYTHONPATH": str(REPO),
+            "PYTHONUNBUFFERED": "1",
+            "GAZEBOT_STUDY_ADMIN_TOKEN": self.token,
+        }
         self.proc = subprocess.Popen(
             [
                 sys.executable,
@@ -68,13 +85,12 @@ class StudyServer:
                 str(self.study_dir),
                 "--port",
                 str(self.port),
-                "--admin-token",
-                self.token,
             ],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
             env=env,
+            cwd=self.cwd,
         )
         deadline = time.monotonic() + timeout_s
         lines = []
@@ -84,11 +100,12 @@ class StudyServer:
             if not line:
                 break
             lines.append(line)
-            m = re.search(r"at (http://\S+)/p/N", line)
+            m = re.search(r"at (http://\S+)/p/TOKEN", line)
             if m:
                 self.base = m.group(1)
                 self.port = int(self.base.rsplit(":", 1)[1])
                 self.proc.stdout.readline()  # the experimenter line
+                self.links = read_links(Path(self.cwd or ".") / self.study_dir)
                 return self
         self.stop()
         raise RuntimeError("study server did not start:\n" + "".join(lines))
@@ -133,3 +150,17 @@ def http(method: str, url: str, data: dict | None = None, headers: dict | None =
             return resp.status, dict(resp.headers), resp.read()
     except urllib.error.HTTPError as err:
         return err.code, dict(err.headers), err.read()
+
+
+def read_links(study_dir: Path) -> dict[int, str]:
+    """``participant-links.csv`` that ``study serve`` wrote: participant -> URL."""
+    with (study_dir / "participant-links.csv").open(newline="") as fh:
+        return {int(r["participant"]): r["url"] for r in csv.DictReader(fh)}
+
+
+def form_token(page: bytes | str) -> str:
+    """The CSRF token of a page's form (as a browser would send it back)."""
+    text = page.decode() if isinstance(page, bytes) else page
+    m = re.search(r'name="csrf_token" value="([^"]+)"', text)
+    assert m, "the page has no form with a CSRF token"
+    return html.unescape(m.group(1))

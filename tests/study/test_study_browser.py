@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 import pytest
-from study_web import REPO, StudyServer, http, render_tiny_study
+from study_web import REPO, StudyServer, form_token, http, render_tiny_study
 
 from gazebot.study.folder import load_study
 
@@ -184,11 +184,14 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
     sessions = study.sessions_of(1)
     rng = np.random.default_rng(14)
     clicked: dict[int, dict[str, int]] = {}
-    server = StudyServer(study_dir).start()
+    # `gazebot study serve study/` with a relative folder, exactly as the README shows it.
+    server = StudyServer("study", cwd=tmp_path).start()
     try:
         d = driver
-        d.get(f"{server.base}/p/1")
+        link = server.links[1]  # participant 1's own link, from participant-links.csv
+        d.get(link)
         _at(d, "Consent")
+        csrf = form_token(d.page_source)  # this participant's forms' token, for a resent form
         d.find_element(By.ID, "consent").click()
         _submit(d)
         _at(d, "Instructions")
@@ -228,7 +231,7 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
                 # A closed tab: a new one opens the same session.
                 old = d.current_window_handle
                 d.switch_to.new_window("tab")
-                d.get(f"{server.base}/p/1")
+                d.get(link)
                 _at(d, f"Session {s.session} of {len(sessions)}")
                 d.close()
                 d.switch_to.window(old)
@@ -243,12 +246,12 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
         _at(d, "Thank you")
         # A resent form after the end (browser back + resubmit) changes nothing.
         last = sessions[-1].session
-        status, _, _ = http("POST", f"{server.base}/p/1/session/{last}", {"q1": "2"})
+        status, _, _ = http("POST", f"{link}/session/{last}", {"q1": "2", "csrf_token": csrf})
         assert status == 303
-        d.get(f"{server.base}/p/1")
+        d.get(link)
         assert "completed all" in d.find_element(By.ID, "message").text
-        d.get(f"{server.base}/p/77")
-        assert "Participant 77 is not in this study's plan." in d.page_source
+        d.get(f"{server.base}/p/1")  # a participant number is no link
+        assert "No such participant link" in d.page_source
     finally:
         server.stop()
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import sqlite3
 
 import numpy as np
@@ -37,11 +38,33 @@ def fresh(study_dir, tmp_path):
     return study_dir
 
 
-def client(study_dir, remote="127.0.0.1"):
-    app = create_app(str(study_dir), admin_token="tok")
-    c = app.test_client()
-    c.environ_base["REMOTE_ADDR"] = remote
-    return c
+class Client:
+    """Flask's test client used as a participant's browser would: ``/p/N...`` in a test stands
+    for participant N's own link ``/p/TOKEN...``, and every POST carries its form's CSRF token."""
+
+    def __init__(self, study_dir, remote="127.0.0.1", **kw):
+        self.app = create_app(str(study_dir), admin_token="admin-token-1234", **kw)
+        self.web = self.app.extensions["gazebot_study"]
+        self.c = self.app.test_client()
+        self.c.environ_base["REMOTE_ADDR"] = remote
+
+    def url(self, path: str) -> str:
+        m = re.fullmatch(r"/p/(\d+)(.*)", path)
+        return self.web.link_path(int(m.group(1))) + m.group(2) if m else path
+
+    def scope(self, path: str) -> str:
+        return "p:" + self.url(path).split("/")[2] if path.startswith("/p/") else "admin"
+
+    def get(self, path, **kw):
+        return self.c.get(self.url(path), **kw)
+
+    def post(self, path, data=None, **kw):
+        data = {"csrf_token": self.web.csrf(self.scope(path)), **(data or {})}
+        return self.c.post(self.url(path), data=data, **kw)
+
+
+def client(study_dir, remote="127.0.0.1", **kw):
+    return Client(study_dir, remote, **kw)
 
 
 def start(c, pid=1):
@@ -54,7 +77,8 @@ def test_participant_steps_in_order_consent_instructions_practice_sessions_done(
     page = c.get("/p/1")
     assert page.status_code == 200 and b"Consent" in page.data
     assert c.post("/p/1/consent", data={}).status_code == 400  # the box must be ticked
-    assert c.post("/p/1/consent", data={"consent": "yes"}).headers["Location"].endswith("/p/1")
+    resp = c.post("/p/1/consent", data={"consent": "yes"})
+    assert resp.headers["Location"].endswith(c.url("/p/1"))
     page = c.get("/p/1").get_data(as_text=True)
     assert "Instructions" in page and "robot&#39;s head movement" in page  # the plan's head-only
     c.post("/p/1/instructions")
@@ -64,7 +88,7 @@ def test_participant_steps_in_order_consent_instructions_practice_sessions_done(
     for k in range(1, n + 1):
         page = c.get("/p/1").get_data(as_text=True)
         assert f"Session {k} of {n}" in page
-        assert f'action="/p/1/session/{k}"' in page
+        assert f'action="{c.url("/p/1")}/session/{k}"' in page
         assert c.post(f"/p/1/session/{k}", data={**ANSWERS, "comment": f"c{k}"}).status_code == 303
     page = c.get("/p/1")
     assert page.status_code == 200 and b"You have completed all 6 sessions" in page.data
@@ -121,22 +145,47 @@ def test_a_new_app_on_the_same_folder_resumes_where_the_participant_was(fresh):
     assert "Session 3 of 6" in resumed.get("/p/1").get_data(as_text=True)
 
 
-@pytest.mark.parametrize("path", ["/p/99", "/p/0", "/p/abc", "/p/-1", "/nowhere"])
-def test_unknown_participant_or_page_gets_a_clear_page_not_a_traceback(fresh, path):
-    resp = client(fresh).get(path)
+@pytest.mark.parametrize(
+    "path", ["/p/99", "/p/0", "/p/abc", "/p/-1", "/p/AAAAAAAAAAAAAAAAAAAAAAAA", "/nowhere"]
+)
+def test_unknown_participant_link_or_page_gets_a_clear_page_not_a_traceback(fresh, path):
+    resp = client(fresh).c.get(path)  # the path as typed, not a participant's link
     assert resp.status_code == 404
     text = resp.get_data(as_text=True)
     assert "Traceback" not in text
-    if path in ("/p/99", "/p/0"):
-        assert f"Participant {path[3:]} is not in this study&#39;s plan." in text
+    if path.startswith("/p/"):
+        assert "No such participant link: check the link you were given." in text
     else:
         assert "no such page" in text
 
 
-def test_index_sends_a_participant_number_to_their_page(fresh):
+def test_participant_links_are_random_tokens_not_their_numbers(fresh):
     c = client(fresh)
-    assert c.get("/?participant=2").headers["Location"].endswith("/p/2")
+    links = c.web.links
+    assert sorted(links) == load_study(fresh).participants
+    assert len(set(links.values())) == len(links)
+    for p, token in links.items():
+        assert re.fullmatch(r"[A-Za-z0-9_-]{24}", token) and str(p) != token
+    # Participant 1's page by number does not open, and its forms refuse another's token.
+    assert c.c.get("/p/1").status_code == 404
+    other = {"consent": "yes", "csrf_token": c.web.csrf(c.scope("/p/2"))}
+    assert c.c.post(c.url("/p/1") + "/consent", data=other).status_code == 403
+    assert load_study(fresh).store().progress(1).mode is None
+    # A restarted server keeps the links handed out.
+    assert client(fresh).web.links == links
+
+
+def test_index_sends_a_participant_code_to_their_page(fresh):
+    c = client(fresh)
+    token = c.web.links[2]
+    assert c.get(f"/?participant={token}").headers["Location"].endswith(f"/p/{token}")
     assert c.get("/?participant=x1").status_code == 400
+    # A digit that is not ASCII (int() would take "²" apart) is a clear 400, not a 500.
+    for code in ("²", "١٢", "3²", "%00", " "):
+        resp = c.get("/", query_string={"participant": code})
+        assert resp.status_code in (200, 400), code
+        assert b"Something went wrong" not in resp.data
+    assert c.get("/", query_string={"participant": "²"}).status_code == 400
 
 
 def test_videos_are_served_with_range_requests_and_without_their_file_name(fresh):
@@ -153,13 +202,26 @@ def test_videos_are_served_with_range_requests_and_without_their_file_name(fresh
     assert c.get("/p/1/video/99/1.mp4").status_code == 404
 
 
-def test_admin_needs_loopback_or_the_token(fresh):
-    assert client(fresh, remote="192.0.2.7").get("/admin").status_code == 403
+def test_admin_needs_loopback_or_the_token_signed_in_by_a_form_not_a_url(fresh):
     remote = client(fresh, remote="192.0.2.7")
-    assert remote.get("/admin?token=tok").status_code == 200
-    assert remote.get("/admin").status_code == 200  # the token is kept in a cookie
-    assert client(fresh, remote="192.0.2.7").get("/admin?token=bad").status_code == 403
+    page = remote.get("/admin")
+    assert page.status_code == 403 and b'action="/admin/login"' in page.data
+    # A token in the URL (which logs and browser histories keep) opens nothing.
+    assert remote.get("/admin?token=admin-token-1234").status_code == 403
+    assert remote.post("/admin/login", data={"token": "bad"}).status_code == 403
+    resp = remote.post("/admin/login", data={"token": "admin-token-1234"})
+    assert resp.status_code == 303 and resp.headers["Location"].endswith("/admin")
+    cookie = resp.headers["Set-Cookie"]
+    assert "admin-token-1234" not in cookie and "HttpOnly" in cookie and "SameSite=Strict" in cookie
+    assert remote.get("/admin").status_code == 200  # the sign-in is kept in a cookie
     assert client(fresh).get("/admin").status_code == 200
+
+
+def test_admin_page_lists_each_participants_link(fresh):
+    c = client(fresh)
+    page = c.get("/admin").get_data(as_text=True)
+    for token in c.web.links.values():
+        assert f"http://localhost/p/{token}</code>" in page
 
 
 def test_admin_shows_each_participants_progress(fresh):
@@ -283,11 +345,10 @@ def test_table_6_1_reproduced_through_the_served_6_3_study(tmp_path):
 
 
 def test_token_only_admin_refuses_loopback_without_the_token(fresh):
-    app = create_app(str(fresh), admin_token="tok", local_admin=False)
-    c = app.test_client()
-    c.environ_base["REMOTE_ADDR"] = "127.0.0.1"
+    c = client(fresh, local_admin=False)
     assert c.get("/admin").status_code == 403
-    assert c.get("/admin?token=tok").status_code == 200
+    assert c.post("/admin/login", data={"token": "admin-token-1234"}).status_code == 303
+    assert c.get("/admin").status_code == 200
 
 
 def test_export_names_the_mode_as_group_when_a_study_has_both(fresh, tmp_path):

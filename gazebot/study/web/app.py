@@ -1,27 +1,26 @@
 """The study's web pages (Flask): one step per page for a participant, an experimenter's view.
 
-Participant ``N`` opens ``/p/N`` and is shown the step they are at, derived from the stored
-answers (:mod:`gazebot.study.store`): consent, instructions, the practice session, then the plan's
-sessions in order, then a closing page. Every form posts to its step and is answered with a
-redirect back to ``/p/N`` (post/redirect/get), so a reload never resubmits and a double submit of
-a session stores it once.
+Participant ``N`` opens their own link ``/p/TOKEN`` (a random token per participant, see
+:mod:`gazebot.study.web.security`; ``study serve`` writes them to ``participant-links.csv``) and
+is shown the step they are at, derived from the stored answers (:mod:`gazebot.study.store`):
+consent, instructions, the practice session, then the plan's sessions in order, then a closing
+page. Every form posts to its step and is answered with a redirect back to ``/p/TOKEN``
+(post/redirect/get), so a reload never resubmits and a double submit of a session stores it once.
 
 A session page plays the first handover video, then the second (each with the caption naming the
 head or the eyes, as the seed's captions did); the five questions are enabled once both have
 played to the end, and all five are required (the comment is optional, as the seed's question 6
 says).
 
-The experimenter's pages under ``/admin`` (from the loopback interface, or anywhere with the
-token printed at start) show every participant's progress and let the experimenter enter an
-in-person participant's answers after each live pair, the plan telling which behavior comes
-first.
+The experimenter's pages under ``/admin`` (from the loopback interface, or anywhere after
+signing in with the admin token) show every participant's progress and link and let the
+experimenter enter an in-person participant's answers after each live pair, the plan telling
+which behavior comes first.
 """
 
 from __future__ import annotations
 
-import hmac
 import ipaddress
-import secrets
 import time
 from dataclasses import dataclass
 from datetime import datetime, timezone
@@ -30,6 +29,7 @@ from functools import wraps
 from flask import (
     Flask,
     abort,
+    g,
     make_response,
     redirect,
     render_template,
@@ -47,6 +47,15 @@ from gazebot.study.questionnaire import (
     questions,
 )
 from gazebot.study.store import Progress, ResponseStore
+from gazebot.study.web.security import (
+    MAX_BODY_BYTES,
+    cross_site_reason,
+    csrf_token,
+    is_link_token,
+    new_token,
+    security_headers,
+    tokens_equal,
+)
 
 ADMIN_COOKIE = "gazebot_admin"
 CONSENT_FILE = "consent.txt"  # the study's own consent text, in the study folder
@@ -110,18 +119,43 @@ def _step_label(prog: Progress, step: Step) -> str:
     return step.kind
 
 
+@dataclass(frozen=True)
+class StudyWeb:
+    """What the app knows of its study (``app.extensions["gazebot_study"]``): the folder, its
+    answers, each participant's link token and the CSRF key."""
+
+    study: StudyFolder
+    store: ResponseStore
+    links: dict[int, str]
+    csrf_key: bytes
+
+    def link_path(self, participant: int) -> str:
+        """``/p/TOKEN`` of a participant."""
+        return f"/p/{self.links[participant]}"
+
+    def csrf(self, scope: str) -> str:
+        """The CSRF token of the forms of ``scope`` (``p:TOKEN`` or ``admin``)."""
+        return csrf_token(self.csrf_key, scope)
+
+
 def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool = True) -> Flask:
     """The Flask app of the rendered study in ``study_dir`` (answers in
-    ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` (default: a
-    random one, in ``app.config["ADMIN_TOKEN"]``); ``local_admin``: also open it without the token
-    to requests from the loopback interface (turn off behind a reverse proxy on the same
-    machine, where every request comes from there)."""
+    ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` from other
+    hosts (default: a random one, in ``app.config["ADMIN_TOKEN"]``); ``local_admin``: also open
+    it without the token to requests from the loopback interface (turn off behind a reverse
+    proxy on the same machine, where every request comes from there)."""
     study = load_study(study_dir)
     store = study.store()
+    web = StudyWeb(study, store, store.links(study.participants), store.secret("csrf"))
+    by_token = {t: p for p, t in web.links.items()}
     app = Flask(__name__)
-    app.config["ADMIN_TOKEN"] = admin_token or secrets.token_urlsafe(16)
+    app.config["ADMIN_TOKEN"] = admin_token or new_token(16)
     app.config["STUDY"] = study
     app.config["STORE"] = store
+    # Flask refuses a larger form with 413 too (waitress already does before reading it).
+    app.config["MAX_CONTENT_LENGTH"] = MAX_BODY_BYTES
+    app.config["MAX_FORM_MEMORY_SIZE"] = MAX_BODY_BYTES
+    app.extensions["gazebot_study"] = web
     consent_file = study.root / CONSENT_FILE
     # The ethics board's text replaces ours: paragraphs separated by blank lines.
     consent_text = (
@@ -130,15 +164,50 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
     consent_paragraphs = [p.strip() for p in consent_text.split("\n\n") if p.strip()]
     n_sessions = {p: len(study.sessions_of(p)) for p in study.participants}
     last_session = {p: max(s.session for s in study.sessions_of(p)) for p in study.participants}
+    # The admin cookie holds a MAC of the token, not the token.
+    admin_cookie = csrf_token(web.csrf_key, "admin-cookie:" + app.config["ADMIN_TOKEN"])
+
+    def form_scope() -> str:
+        """The CSRF scope of this request's forms: its participant link, else the admin's."""
+        token = (request.view_args or {}).get("token")
+        return f"p:{token}" if isinstance(token, str) else "admin"
+
+    @app.context_processor
+    def template_globals():
+        return {"csrf_token": lambda: web.csrf(form_scope()), "csp_nonce": lambda: g.csp_nonce}
+
+    @app.before_request
+    def guard():
+        g.csp_nonce = new_token(12)
+        if request.method != "POST" or request.url_rule is None:
+            return None
+        reason = cross_site_reason(request.headers, request.host)
+        if reason is not None:
+            abort(403, description=f"Refused: {reason}.")
+        # Reading the form here is bounded by MAX_CONTENT_LENGTH (413 beyond it).
+        given = request.form.get("csrf_token", "")
+        if not tokens_equal(given, web.csrf(form_scope())):
+            abort(403, description="This form has expired: go back, reload the page and retry.")
+        return None
+
+    @app.after_request
+    def headers(resp):
+        resp.headers.update(security_headers(getattr(g, "csp_nonce", new_token(12))))
+        return resp
 
     def page(template: str, status: int = 200, **kw: object):
         resp = make_response(render_template(template, **kw), status)
         resp.headers["Cache-Control"] = "no-store"  # a step page must never come from a cache
         return resp
 
-    def participant_or_404(participant: int) -> None:
-        if participant not in n_sessions:
-            abort(404, description=f"Participant {participant} is not in this study's plan.")
+    def participant_of(token: str) -> int:
+        participant = by_token.get(token) if is_link_token(token) else None
+        if participant is None:
+            abort(404, description="No such participant link: check the link you were given.")
+        return participant
+
+    def to_page(token: str):
+        return redirect(url_for("participant_page", token=token), 303)
 
     def in_person_page(participant: int):
         return page(
@@ -151,13 +220,15 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
             ),
         )
 
-    def session_page(participant: int, k: int, errors: list[str] | None = None, values=None):
+    def session_page(
+        participant: int, token: str, k: int, errors: list[str] | None = None, values=None
+    ):
         sessions = study.sessions_of(participant)
         store.mark_shown(participant, k)
         return page(
             "session.html",
             400 if errors else 200,
-            participant=participant,
+            link=f"/p/{token}",
             session=k,
             practice=k == PRACTICE,
             position=0 if k == PRACTICE else [s.session for s in sessions].index(k) + 1,
@@ -171,32 +242,33 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
 
     @app.get("/")
     def index():
-        pid = request.args.get("participant", "").strip()
-        if pid:
-            if not pid.isdigit():
+        code = request.args.get("participant", "").strip()
+        if code:
+            if not is_link_token(code):
                 return page(
-                    "index.html", 400, error=f"{pid!r} is not a participant number.", value=pid
+                    "index.html", 400, error=f"{code!r} is not a participant code.", value=""
                 )
-            return redirect(url_for("participant_page", participant=int(pid)), 303)
+            return redirect(url_for("participant_page", token=code), 303)
         return page("index.html", error=None, value="")
 
     @app.get("/healthz")
     def healthz():
         return {"ok": True, "participants": len(n_sessions)}
 
-    @app.get("/p/<int:participant>")
-    def participant_page(participant: int):
-        participant_or_404(participant)
+    @app.get("/p/<token>")
+    def participant_page(token: str):
+        participant = participant_of(token)
         prog = store.progress(participant)
         if prog.mode == "in-person":
             return in_person_page(participant)
         step = current_step(study, store, participant, prog)
+        link = f"/p/{token}"
         if step.kind == "consent":
-            return page("consent.html", participant=participant, paragraphs=consent_paragraphs)
+            return page("consent.html", link=link, paragraphs=consent_paragraphs)
         if step.kind == "instructions":
             return page(
                 "instructions.html",
-                participant=participant,
+                link=link,
                 text=instructions(study.gaze_mode),
                 total=n_sessions[participant],
             )
@@ -209,23 +281,28 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
                     "are saved. You can close this page."
                 ),
             )
-        return session_page(participant, step.session)
+        return session_page(participant, token, step.session)
 
-    @app.post("/p/<int:participant>/consent")
-    def consent(participant: int):
-        participant_or_404(participant)
+    @app.post("/p/<token>/consent")
+    def consent(token: str):
+        participant = participant_of(token)
         if request.form.get("consent") != "yes":
-            return page("consent.html", 400, participant=participant, error="Please tick the box.")
+            return page(
+                "consent.html",
+                400,
+                link=f"/p/{token}",
+                paragraphs=consent_paragraphs,
+                error="Please tick the box.",
+            )
         if store.progress(participant).mode == "in-person":
             return in_person_page(participant)
         store.give_consent(participant, "video")
-        return redirect(url_for("participant_page", participant=participant), 303)
+        return to_page(token)
 
-    @app.post("/p/<int:participant>/instructions")
-    def instructions_read(participant: int):
-        participant_or_404(participant)
-        store.read_instructions(participant)
-        return redirect(url_for("participant_page", participant=participant), 303)
+    @app.post("/p/<token>/instructions")
+    def instructions_read(token: str):
+        store.read_instructions(participant_of(token))
+        return to_page(token)
 
     def parse_answers(mode: str) -> tuple[dict[str, int], str, list[str]]:
         answers, errors = {}, []
@@ -238,14 +315,17 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
         comment = request.form.get("comment", "").strip()[:MAX_COMMENT]
         return answers, comment, errors
 
-    @app.post("/p/<int:participant>/session/<int:k>")
-    def submit(participant: int, k: int):
-        participant_or_404(participant)
+    def form_values() -> dict[str, str]:
+        return {k: v for k, v in request.form.items() if k != "csrf_token"}
+
+    @app.post("/p/<token>/session/<int:k>")
+    def submit(token: str, k: int):
+        participant = participant_of(token)
         prog = store.progress(participant)
         if prog.mode == "in-person":
             return in_person_page(participant)
         if k in prog.answered:  # a double submit or a resent form: already stored, go on
-            return redirect(url_for("participant_page", participant=participant), 303)
+            return to_page(token)
         step = current_step(study, store, participant, prog)
         if step.kind != "session" or step.session != k:
             return page(
@@ -253,17 +333,17 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
                 409,
                 title="Not this session yet",
                 message="This is not your current step.",
-                link=url_for("participant_page", participant=participant),
+                link=url_for("participant_page", token=token),
             )
         answers, comment, errors = parse_answers("video")
         if errors:
-            return session_page(participant, k, errors, dict(request.form))
+            return session_page(participant, token, k, errors, form_values())
         store.submit(participant, k, answers, comment, "video", last_session[participant])
-        return redirect(url_for("participant_page", participant=participant), 303)
+        return to_page(token)
 
-    @app.get("/p/<int:participant>/video/<int:k>/<int:which>.mp4")
-    def video(participant: int, k: int, which: int):
-        participant_or_404(participant)
+    @app.get("/p/<token>/video/<int:k>/<int:which>.mp4")
+    def video(token: str, k: int, which: int):
+        participant = participant_of(token)
         try:
             path = study.video_path(participant, k, which)
         except KeyError:
@@ -277,19 +357,29 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
 
     # ---- experimenter ----
 
+    def is_admin() -> bool:
+        cookie = request.cookies.get(ADMIN_COOKIE, "")
+        return tokens_equal(cookie, admin_cookie) or (
+            local_admin and _is_loopback(request.remote_addr)
+        )
+
     def admin_only(view):
         @wraps(view)
         def wrapped(*args, **kwargs):
-            token = request.args.get("token") or request.cookies.get(ADMIN_COOKIE) or ""
-            good = hmac.compare_digest(token.encode(), app.config["ADMIN_TOKEN"].encode())
-            if not (good or (local_admin and _is_loopback(request.remote_addr))):
-                abort(403, description="The experimenter's pages need the token printed at start.")
-            resp = make_response(view(*args, **kwargs))
-            if good and request.args.get("token"):
-                resp.set_cookie(ADMIN_COOKIE, token, httponly=True, samesite="Strict")
-            return resp
+            if not is_admin():
+                return page("admin_login.html", 403, error=None)
+            return view(*args, **kwargs)
 
         return wrapped
+
+    @app.post("/admin/login")
+    def admin_login():
+        # The token comes in a form, never in a URL a log or a browser history keeps.
+        if not tokens_equal(request.form.get("token", ""), app.config["ADMIN_TOKEN"]):
+            return page("admin_login.html", 403, error="That is not the admin token.")
+        resp = redirect(url_for("admin"), 303)
+        resp.set_cookie(ADMIN_COOKIE, admin_cookie, httponly=True, samesite="Strict")
+        return resp
 
     @app.get("/admin")
     @admin_only
@@ -305,6 +395,7 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
                     "total": n_sessions[p],
                     "step": _step_label(prog, current_step(study, store, p, prog)),
                     "last": _utc(prog.last_activity),
+                    "link": request.host_url.rstrip("/") + web.link_path(p),
                 }
             )
         return page(
@@ -314,6 +405,10 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
             finished=sum(r["step"] == "finished" for r in rows),
             gaze_mode=study.gaze_mode,
         )
+
+    def participant_or_404(participant: int) -> None:
+        if participant not in n_sessions:
+            abort(404, description=f"Participant {participant} is not in this study's plan.")
 
     def next_in_person(participant: int) -> Session | None:
         done = set(store.progress(participant).answered)
@@ -352,14 +447,14 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
         if prog.mode == "video":
             return in_person_form(participant, ["This participant answers online."], status=409)
         k = request.form.get("session", "")
-        if k.isdigit() and int(k) in prog.answered:
+        if k.isascii() and k.isdigit() and int(k) in prog.answered:
             return redirect(url_for("in_person", participant=participant), 303)
         nxt = next_in_person(participant)
-        if nxt is None or not k.isdigit() or int(k) != nxt.session:
+        if nxt is None or not (k.isascii() and k.isdigit()) or int(k) != nxt.session:
             return redirect(url_for("in_person", participant=participant), 303)
         answers, comment, errors = parse_answers("in-person")
         if errors:
-            return in_person_form(participant, errors, dict(request.form), status=400)
+            return in_person_form(participant, errors, form_values(), status=400)
         now = time.time()
         if prog.mode is None:
             store.give_consent(participant, "in-person", now)
@@ -388,6 +483,15 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
     @app.errorhandler(405)
     def not_allowed(err):
         return page("message.html", 405, title="Not allowed", message="Use the study's pages.")
+
+    @app.errorhandler(413)
+    def too_large(err):
+        return page(
+            "message.html",
+            413,
+            title="Too large",
+            message=f"A form is at most {MAX_BODY_BYTES // 1024} kB: shorten the comment.",
+        )
 
     @app.errorhandler(500)
     def server_error(err):
