@@ -6,7 +6,8 @@ node keeps the graph the other tokens describe.
 Subscriptions listen to their topic whatever the type (``<domain>/<topic>/*/*``) so that a
 publisher of another type or another version of the type is reported, not silently unheard.
 Zenoh runs callbacks on its own threads: a subscription callback never raises; anything
-malformed is counted by topic (:class:`DropCounter`) and dropped.
+malformed is counted by topic (:class:`DropCounter`) and dropped, and so is a message whose
+handler fails in any other way (one rate-limited log line, never a traceback per message).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from gazebot.drivers.rmw.graph import ADMIN_SPACE, Entity, Graph, Kind
 from gazebot.drivers.rmw.names import Names, check_namespace, check_node_name
 from gazebot.drivers.rmw.qos import DEFAULT, QosProfile
 from gazebot.ros2.codec import MAX_PAYLOAD_BYTES, Codec
-from gazebot.ros2.errors import MessageError
+from gazebot.ros2.errors import MessageError, one_line
 from gazebot.ros2.names import ros_type_name
 
 if TYPE_CHECKING:
@@ -64,6 +65,7 @@ class DropCounter:
         self._lock = threading.Lock()
 
     def drop(self, topic: str, reason: str, mismatch: TypeMismatch | None = None) -> None:
+        reason = one_line(reason)
         with self._lock:
             n = self._counts[topic] = self._counts.get(topic, 0) + 1
             self._reasons[topic] = reason
@@ -204,8 +206,10 @@ class Subscription:
             self.handler(msg, Received(self.topic, codec.info.name, att))
         except MessageError as exc:  # the handler found a value it cannot use (NaN, ...)
             drops.drop(self.topic, exc.reason)
-        except Exception:  # a bug in a handler must not kill Zenoh's thread
-            log.exception("handler for %s failed", self.topic)
+        except Exception as exc:  # noqa: BLE001 - whatever a message causes, it is a drop
+            # A crafted message must not kill Zenoh's thread nor flood the log with a
+            # traceback per message: counted and logged (rate-limited) like malformed CDR.
+            drops.drop(self.topic, f"handler failed: {type(exc).__name__}: {exc}")
 
     def undeclare(self) -> None:
         for entity in (self._token, self._sub):
