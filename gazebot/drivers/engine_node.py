@@ -475,8 +475,11 @@ class EngineNode:
         self._last_t = msg.t
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
+        faults = self.loop.faults
         cmd = self.loop.tick(msg.to_frame(),
                              joints=joints.position if joints is not None else None)
+        if self.loop.faults > faults:  # the loop survived the engine failing: report it
+            self.fault("tracking", self.loop.last_fault or "the engine failed on a sample")
         self.frames_processed += 1
         if cmd is not None:
             self._send(cmd)
@@ -491,7 +494,10 @@ class EngineNode:
                 or now - self._last_silence_tick < 1 / self.config.silence_rate):
             return
         self._last_silence_tick = now
+        faults = self.loop.faults
         cmd = self.loop.tick(None, t=self._now_t())
+        if self.loop.faults > faults:
+            self.fault("silence", self.loop.last_fault or "the engine failed on silence")
         if cmd is not None:
             self._send(cmd)
 

@@ -45,15 +45,62 @@ def test_an_untracked_part_completes_the_sample_once_its_topic_moves_on():
     assert [m.t for m in out] == [0.1] and out[0].giver_face is None
 
 
-def test_a_stalled_sample_is_flushed_after_the_timeout_and_late_parts_dropped():
+def test_a_sender_stalling_between_its_puts_does_not_split_a_sample():
+    # a busy machine pauses the sender for 0.2 s after its first put: the clock says nothing
+    # about completeness, only the stamps do
     clock = FakeClock(10.0)
-    asm = SampleAssembler(lambda: ALL, timeout=0.05, clock=clock)
-    assert asm.add("giver_hand", 1.0, [1, 0, 1]) == []
+    asm = SampleAssembler(lambda: ALL, clock=clock)
+    first, *rest = parts(1.0)
+    assert asm.add(*first) == []
+    clock.now += 0.2
     assert asm.flush_stale() == []
-    clock.now += 0.06
+    out = [m for p in rest for m in asm.add(*p)]
+    assert [m.t for m in out] == [1.0] and out[0].giver_face == (1.2, 0.0, 1.6)
+    assert asm.late == 0
+
+
+def test_an_untracked_part_counts_as_missing_once_the_reorder_window_of_samples_passed():
+    # the face has a publisher but is not seen: the sender never sends it; the clock stands still
+    clock = FakeClock(10.0)
+    asm = SampleAssembler(lambda: ALL, reorder=3, clock=clock)
+    out = []
+    for k in range(6):
+        out += [m for p in parts(k / 10) if p[0] != "giver_face" for m in asm.add(*p)]
+        # sample k is answered as soon as 3 newer samples arrived, not before
+        assert [round(m.t, 9) for m in out] == [j / 10 for j in range(k - 2)]
+    assert all(m.giver_face is None and m.giver_hand is not None for m in out)
+    assert asm.late == 0
+
+
+def test_a_part_the_source_published_before_is_awaited_even_before_the_graph_lists_it():
+    # the graph lags: it knows only the hand's publisher, but the face came with sample 0.1
+    asm = SampleAssembler(lambda: {"giver_hand"})
+    assert asm.add("giver_face", 0.1, [1.2, 0, 1.6]) == []
+    assert [m.t for m in asm.add("giver_hand", 0.1, [1, 0, 1])] == [0.1]
+    assert asm.add("giver_hand", 0.2, [1, 0, 1]) == []  # the face of 0.2 may still come
+    [m] = asm.add("giver_face", 0.2, [1.2, 0, 1.6])
+    assert m.t == 0.2 and m.giver_face == (1.2, 0.0, 1.6) and asm.late == 0
+
+
+def test_pending_samples_are_flushed_after_the_idle_time_and_late_parts_dropped():
+    clock = FakeClock(10.0)
+    asm = SampleAssembler(lambda: ALL, idle_flush=0.5, clock=clock)
+    assert asm.add("giver_hand", 1.0, [1, 0, 1]) == []
+    assert asm.next_deadline() == 10.5
+    clock.now += 0.49
+    assert asm.flush_stale() == []
+    clock.now += 0.01
     [m] = asm.flush_stale()
     assert m.t == 1.0 and m.giver_face is None
+    assert asm.next_deadline() is None
     assert asm.add("giver_face", 1.0, [1, 0, 1]) == [] and asm.late == 1
+
+
+def test_the_assembly_refuses_a_non_positive_idle_time_or_window():
+    with pytest.raises(ValueError, match="idle_flush"):
+        SampleAssembler(lambda: ALL, idle_flush=0.0)
+    with pytest.raises(ValueError, match="reorder"):
+        SampleAssembler(lambda: ALL, reorder=0)
 
 
 def test_a_robot_clock_going_back_starts_a_new_timeline():
