@@ -202,3 +202,17 @@ def test_the_engine_survives_a_tracking_sample_at_x_1e155_from_the_bus(bus):
     assert wait_until(lambda: targets.msgs and targets.msgs[-1][0] == pytest.approx(29 / 120))
     assert th.is_alive()
     assert all(np.all(np.isfinite(p)) and np.all(np.abs(p) < 1e3) for _, p in targets.msgs)
+
+
+# -- the router ----------------------------------------------------------------------------------
+
+
+def test_the_router_listens_on_loopback_unless_told_to_open_up():
+    from gazebot.cli import build_parser
+    from gazebot.cli.router import router_config
+
+    default = router_config(build_parser().parse_args(["router"]))
+    assert default.mode == "router"
+    assert default.listen and all(ep.startswith("tcp/127.0.0.1:") for ep in default.listen)
+    opened = router_config(build_parser().parse_args(["router", "--listen", "tcp/0.0.0.0:7447"]))
+    assert opened.listen == ("tcp/0.0.0.0:7447",)
