@@ -475,11 +475,8 @@ class EngineNode:
         self._last_t = msg.t
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
-        faults = self.loop.faults
-        cmd = self.loop.tick(msg.to_frame(),
-                             joints=joints.position if joints is not None else None)
-        if self.loop.faults > faults:  # the loop survived the engine failing: report it
-            self.fault("tracking", self.loop.last_fault or "the engine failed on a sample")
+        cmd = self._tick_loop("tracking", msg.to_frame(),
+                              joints=joints.position if joints is not None else None)
         self.frames_processed += 1
         if cmd is not None:
             self._send(cmd)
@@ -494,12 +491,18 @@ class EngineNode:
                 or now - self._last_silence_tick < 1 / self.config.silence_rate):
             return
         self._last_silence_tick = now
-        faults = self.loop.faults
-        cmd = self.loop.tick(None, t=self._now_t())
-        if self.loop.faults > faults:
-            self.fault("silence", self.loop.last_fault or "the engine failed on silence")
+        cmd = self._tick_loop("silence", None, t=self._now_t())
         if cmd is not None:
             self._send(cmd)
+
+    def _tick_loop(self, stage: str, *args: Any, **kwargs: Any) -> LoopCommand | None:
+        """``loop.tick``; a tick the engine raised on (the loop answers it with nothing) is
+        reported as a fault of ``stage``."""
+        before = getattr(self.loop, "faults", 0)
+        cmd = self.loop.tick(*args, **kwargs)
+        if getattr(self.loop, "faults", 0) > before:
+            self.fault(stage, "the engine raised on this tick; nothing was sent")
+        return cmd
 
     @property
     def unsafe_commands(self) -> int:
@@ -526,7 +529,10 @@ class EngineNode:
     def _send(self, cmd: LoopCommand) -> None:
         self._track(cmd)
         for event in cmd.events:
-            if category_of(event.kind.value) == "phase":
+            if event.kind is EventKind.FAULT:  # caught inside the engine; the command is safe
+                info = event.info or {}
+                self.fault(f"engine {info.get('stage', '?')}", str(info.get("error", "")))
+            elif category_of(event.kind.value) == "phase":
                 self.driver.publish_event(
                     EventMsg.from_event(event, self.driver.node, self._next("event"), time.time())
                 )

@@ -112,6 +112,7 @@ class ZenohRobotEndpoint(ZenohNode):
         self.compete_window = float(compete_window)
         self._compete_lock = threading.Lock()
         self._head_gids: dict[bytes, float] = {}  # publisher GID -> when it last commanded
+        self._gid_publishers: dict[bytes, tuple[str, str]] = {}
         self._reported_gids: frozenset[bytes] = frozenset()
         self._reported_claims: frozenset[Claim] = frozenset()
         ros = self.ros
@@ -173,8 +174,14 @@ class ZenohRobotEndpoint(ZenohNode):
 
     def _publisher_of(self, gid: bytes) -> tuple[str, str] | None:
         """``(zid, node)`` of the head command publisher with ``gid`` (from the graph)."""
+        known = self._gid_publishers.get(gid)
+        if known is not None:
+            return known
         for e in self.ros.graph.endpoints(self._head_topic, "MP"):
             if gid_of(e.token()) == gid:
+                if len(self._gid_publishers) > 1000:  # publishers come and go: stay bounded
+                    self._gid_publishers.clear()
+                self._gid_publishers[gid] = (e.zid, e.node)
                 return e.zid, e.node
         return None
 

@@ -109,7 +109,6 @@ class GazeLoop:
         self.blinks = blink if blink is not None else BlinkModel(seed)
         self.unsafe = 0  # commands refused: non-finite, or outside the joint or eye limits
         self.faults = 0  # ticks the engine raised on (answered with None)
-        self.last_fault: Exception | None = None  # what the engine raised last
         self.ticks = 0
         self._t = -math.inf
         self._frame_key: tuple | None = None
@@ -189,9 +188,8 @@ class GazeLoop:
         self.ticks += 1
         try:
             cmd = self.engine.step(frame, arm=joints)
-        except Exception as exc:  # noqa: BLE001 - a node never dies on input; no command
+        except Exception:  # noqa: BLE001 - a node never dies on input; the tick sends nothing
             self.faults += 1
-            self.last_fault = exc
             return None
         return self._finish(cmd, answers, joints)
 

@@ -6,6 +6,7 @@ Each test has its own namespace and port; the robot side listens, the engine con
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 
 import numpy as np
@@ -437,13 +438,38 @@ def test_a_sample_that_makes_the_engine_fail_is_reported_and_the_node_goes_on(bu
     assert wait_until(lambda: events.where(kind="node_fault"))
     [fault] = events.where(kind="node_fault")
     assert fault.category == "fault" and fault.source == "engine"
-    assert fault.info["stage"] == "tracking" and "OverflowError" in fault.info["error"]
+    assert fault.info["stage"] == "tracking" and "engine raised" in fault.info["error"]
     assert wait_until(lambda: any(s.node == "engine" and s.state == "degraded"
                                   and s.values.get("faults") == 1 for s in status.msgs))
     # the node goes on: the next sample is answered
     ep.publish_tracking(frame(0.1))
     assert wait_until(lambda: ep.head.peek() is not None)
     assert th.is_alive() and node.faults == 1
+
+
+class FaultyEngine(FakeEngine):
+    """Reports a fault it caught itself (as GazeEngine does) with a safe command."""
+
+    def step(self, frame, arm=None):
+        cmd = super().step(frame, arm)
+        fault = Event(EventKind.FAULT, frame.t, frame.t,
+                      {"stage": "phases", "error": "OverflowError: too big"})
+        return dataclasses.replace(cmd, events=(*cmd.events, fault))
+
+
+def test_a_fault_the_engine_caught_is_reported_by_the_node_and_the_command_sent(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus, engine=FaultyEngine())
+    events = events_of(ep)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(30)
+    ep.publish_tracking(frame(0.0))
+    assert wait_until(lambda: events.where(kind="node_fault"))
+    fault = events.where(kind="node_fault")[0]
+    assert fault.info == {"stage": "engine phases", "error": "OverflowError: too big",
+                          "faults": 1}
+    assert wait_until(lambda: ep.head.peek() is not None) and th.is_alive()
 
 
 def test_a_failing_subscription_callback_is_counted_and_reported_as_a_fault(bus):
