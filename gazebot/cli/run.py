@@ -91,13 +91,10 @@ def handle(args: argparse.Namespace) -> int:
 
         node = (EngineNode.with_eye_frames(loop, driver, node_cfg, warn=warn)
                 if not args.no_eye_frames else EngineNode(loop, driver, node_cfg, warn=warn))
-        print(
-            f"gazebot run: {args.behavior} on {node.engine.robot.name} under {cfg.names.namespace} "
-            f"({endpoints})",
-            file=sys.stderr,
-        )
         try:
-            with _stop_on_sigterm() as stop:
+            with _stop_on_sigterm() as stop:  # before saying it runs: SIGTERM from then on
+                print(f"gazebot run: {args.behavior} on {node.engine.robot.name} under "
+                      f"{cfg.names.namespace} ({endpoints})", file=sys.stderr, flush=True)
                 node.run(duration=args.duration, stop=stop)
         except KeyboardInterrupt:
             pass
