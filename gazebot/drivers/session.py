@@ -33,6 +33,10 @@ if TYPE_CHECKING:
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 EPHEMERAL_ENDPOINT = "tcp/127.0.0.1:0"
+#: Largest message Zenoh reassembles for a gazebot node (bytes): twice the largest topic cap
+#: (eye images, 4 MiB); Zenoh's own default is 1 GiB. A larger message is dropped by Zenoh,
+#: the link stays up.
+MAX_MESSAGE_BYTES = 8 * 1024 * 1024
 #: Where ``gazebot router`` listens by default (every interface, rmw_zenohd's port).
 #: ``gazebot router``'s default: loopback only. The router has no authentication unless a
 #: ``--zenoh-config`` sets it up, so opening it to the network takes an explicit ``--listen``.
@@ -104,6 +108,9 @@ class BusConfig:
             again quickly.
         config_file: A Zenoh JSON5 configuration file, the base of the session's (TLS,
             authentication, access control); ``None``: Zenoh's defaults.
+        max_message_bytes: Largest message Zenoh reassembles for a peer or client (a router
+            forwards others' traffic and keeps Zenoh's default), unless the file sets
+            ``transport/link/rx/max_message_size``.
     """
 
     names: Names = field(default_factory=Names)
@@ -113,6 +120,7 @@ class BusConfig:
     multicast_scouting: bool = False
     retry_max_s: float = 1.0
     config_file: str | None = None
+    max_message_bytes: int = MAX_MESSAGE_BYTES
 
     def __post_init__(self) -> None:
         if not isinstance(self.names, Names):
@@ -123,6 +131,9 @@ class BusConfig:
             raise ValueError(f"mode must be 'peer', 'client' or 'router', got {self.mode!r}")
         if self.mode == "client" and not self.connect:
             raise ValueError("client mode needs a router endpoint in 'connect'")
+        if not (isinstance(self.max_message_bytes, int) and self.max_message_bytes > 0):
+            raise ValueError(
+                f"max_message_bytes must be a positive integer, got {self.max_message_bytes!r}")
         if not self.retry_max_s > 0:
             raise ValueError(f"retry_max_s must be > 0, got {self.retry_max_s!r}")
 
@@ -137,6 +148,9 @@ class BusConfig:
         cfg.insert_json5("connect/endpoints", json.dumps(list(self.connect)))
         if self.multicast_scouting or not from_file or _unset(cfg, "scouting/multicast/enabled"):
             cfg.insert_json5("scouting/multicast/enabled", json.dumps(self.multicast_scouting))
+        rx_max = "transport/link/rx/max_message_size"
+        if self.mode != "router" and (not from_file or _unset(cfg, rx_max)):
+            cfg.insert_json5(rx_max, json.dumps(int(self.max_message_bytes)))
         if from_file and not _unset(cfg, "connect/retry"):
             return cfg
         retry_max_ms = max(100, int(self.retry_max_s * 1000))

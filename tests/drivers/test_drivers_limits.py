@@ -113,3 +113,27 @@ def test_a_multi_megabyte_event_is_dropped_unread_and_the_history_stays_bounded(
     assert sum(event_bytes(m) for m in drv.history()) <= 100_000
     assert all(m.kind == "probe" and m.t > 0 for m in drv.history() if m.source != "engine")
     assert len(drv.poll_events()) <= 100_000 // 12_000
+
+
+@pytest.mark.zenoh
+def test_zenoh_drops_a_message_beyond_the_nodes_limit_before_it_is_reassembled(bus):
+    """20 MB on a subscribed topic: Zenoh (rx max_message_size 8 MiB) drops it before any
+    decoder sees it, and the link stays up for the next command."""
+    import zenoh
+
+    ep = ZenohRobotEndpoint(bus.listener(), bus.names, "sim")
+    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
+    for n in (ep, drv):
+        bus.closers.append(n.close)
+    assert wait_until(lambda: ep.peers().get("engine"))
+    head = ep.names.resolve(topics.HEAD_COMMAND.name)
+    codec = Codec.for_type(typestore(), topics.HEAD_COMMAND.type)
+    key = ep.names.key(head, codec.info.dds_name, codec.info.hash)
+    drv.session.put(key, b"\x00\x01\x00\x00" + bytes(20 * 1024 * 1024),
+                    congestion_control=zenoh.CongestionControl.BLOCK)
+    from gazebot.drivers.payloads import HeadCommandMsg
+
+    drv.send_head(HeadCommandMsg(seq=0, t=0.0, stamp=0.0, head={"head_pan": 0.3}))
+    assert wait_until(lambda: ep.head.peek() is not None)
+    assert ep.head.peek().head == {"head_pan": 0.3}
+    assert head not in ep.dropped()  # never reached the subscription

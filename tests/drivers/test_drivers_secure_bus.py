@@ -135,3 +135,56 @@ def test_simulator_and_engine_over_mutual_tls_and_a_node_without_the_certificate
         except subprocess.TimeoutExpired:
             sim.kill()
             sim.communicate()
+
+
+@pytest.mark.zenoh
+def test_user_password_authentication_from_the_config_file_keeps_out_a_node_without_it(
+        tmp_path):
+    from drivers_fakes import Recorder
+
+    from gazebot.drivers.rmw.names import Names
+    from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+    from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
+    from gazebot.ros2 import convert, topics
+    from gazebot.types import TrackingFrame
+
+    (tmp_path / "users.txt").write_text("robot:robot-secret\nengine:engine-secret\n")
+
+    def auth_file(name: str, user: str | None, password: str | None, dictionary: bool = False):
+        usrpwd = {"user": user, "password": password} if user else {}
+        if dictionary:
+            usrpwd["dictionary_file"] = str(tmp_path / "users.txt")
+        path = tmp_path / f"{name}.json5"
+        path.write_text(json.dumps({"transport": {"auth": {"usrpwd": usrpwd}}}))
+        return str(path)
+
+    names = Names(f"/auth{free_port()}")
+    robot_ep = f"tcp/127.0.0.1:{free_port()}"
+    sessions = []
+
+    def session(config, listen=(), connect=(robot_ep,)):
+        s = open_session(BusConfig(names, listen=listen, connect=connect, config_file=config))
+        sessions.append(s)
+        return s
+
+    try:
+        ep = ZenohRobotEndpoint(session(auth_file("robot", "robot", "robot-secret", True),
+                                        listen=(robot_ep,), connect=()), names, "sim")
+        drv = ZenohRobotDriver(session(auth_file("engine", "engine", "engine-secret")), names,
+                               "engine")
+        outsiders = [session(auth_file("wrong", "engine", "guess")), session(None)]
+        heard = [Recorder(drv, topics.GIVER_HAND, convert.point_of)]
+        for s in outsiders:
+            got: list = []
+            s.declare_subscriber("**", lambda sample, got=got: got.append(sample))
+            heard.append(got)
+        assert wait_until(lambda: drv.peers().get("sim"))
+        for i in range(5):
+            ep.publish_tracking(TrackingFrame.make(i / 120, giver_hand=[1.0, 0.0, 1.0]))
+        assert wait_until(lambda: len(heard[0].msgs) == 5)
+        assert heard[1] == [] and heard[2] == []
+        for n in (drv, ep):
+            n.close()
+    finally:
+        for s in sessions:
+            s.close()
