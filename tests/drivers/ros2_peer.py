@@ -115,11 +115,14 @@ def graph(port: int, ns: str, wait: float) -> dict:
         time.sleep(0.2)
     topics = {k: sorted(v) for k, v in topics.items()}
     out = {}
+    # The topics the peer records have publishers while the handover runs: a reply without
+    # one came back short (its own subscription answers first).
+    published = {f"{ns}/{t}" for t in (*TOPICS, *(f"tracking/{b}" for b in BODIES))}
     for name, types in topics.items():
         for _ in range(10):  # a liveliness query on a busy machine may come back short
             info = get_topic_info(name, router_port=port, timeout=1.0, verbose=True)
             endpoints = (info.publishers + info.subscribers) if info else []
-            if endpoints:
+            if endpoints and (name not in published or info.publishers):
                 break
         out[name] = {"types": types,
                      "hashes": sorted({e.type_hash for e in endpoints}),
