@@ -14,7 +14,7 @@ target is one of its transitions, with a named condition:
     target, ``[same handover: the gaze carries]`` (internal: reach -> transfer -> retreat keep
     the target they had);
   * ``timer`` ``[PHASE: WHEN (RULE)]`` -> a segment's target, once per segment of the behavior:
-    ``0.5 of the reach (end: latest of tracking, event, robot plan; else 0.8 s)`` or
+    ``0.5 of the reach (end: latest of tracking, event, robot plan; else 1.01 s)`` or
     ``robot_reach_ended + 0.2 s``; when several start by the same tick the latest start wins
     (:func:`gazebot.behaviors.schedule.due_segments`).
 

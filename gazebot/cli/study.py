@@ -134,14 +134,23 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=Path,
         default=None,
         metavar="FILE",
-        help="file holding the token that opens /admin from other hosts (default: the "
+        help="file holding the token that opens /admin (default: the "
         "environment variable GAZEBOT_STUDY_ADMIN_TOKEN, else a random token written to "
         "DIR/admin-token); never on the command line, where ps shows it",
     )
     sv.add_argument(
-        "--token-only",
+        "--local-admin",
         action="store_true",
-        help="ask for the token on /admin from this machine too (behind a local reverse proxy)",
+        help="open /admin without the token to requests from loopback (anyone on this machine; "
+        "never behind a reverse proxy on it)",
+    )
+    sv.add_argument(
+        "--allowed-host",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="a host name browsers use for this server besides localhost and the --host name "
+        "(repeatable; e.g. a reverse proxy's name); other names get 400 (DNS rebinding)",
     )
     sv.set_defaults(func=_input_errors(_serve))
 
@@ -460,7 +469,8 @@ def _serve(args: argparse.Namespace) -> int:
         args.port,
         args.threads,
         args.admin_token_file,
-        local_admin=not args.token_only,
+        local_admin=args.local_admin,
+        allowed_hosts=tuple(args.allowed_host),
     )
     return 0
 

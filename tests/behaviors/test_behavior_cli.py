@@ -66,7 +66,7 @@ def test_show_diagram_writes_the_machine_with_its_phase_and_gaze_states(tmp_path
     # The gaze shifts are the machine's transitions, labelled with the segment's timing and the
     # rule that picks the phase's expected end.
     assert (
-        "timer [reach: 0.5 of the reach (end: latest of tracking, event, robot plan; else 0.8 s)]"
+        "timer [reach: 0.5 of the reach (end: latest of tracking, event, robot plan; else 1.01 s)]"
         in text
     )
     assert "timer [retreat: 0.5 of the retreat (end: first known of" in text

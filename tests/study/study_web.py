@@ -15,6 +15,7 @@ import time
 import urllib.error
 import urllib.parse
 import urllib.request
+from http.cookiejar import CookieJar
 from pathlib import Path
 
 from gazebot.study.plan import make_plan
@@ -58,11 +59,13 @@ class StudyServer:
         token: str = "test-admin-token",
         port: int = 0,
         cwd: Path | None = None,
+        args: tuple[str, ...] = (),
     ) -> None:
         self.study_dir = study_dir
         self.token = token
         self.port = port
         self.cwd = cwd
+        self.args = args  # more options of `study serve`
         self.proc: subprocess.Popen | None = None
         self.base = ""
         self.links: dict[int, str] = {}
@@ -85,6 +88,7 @@ class StudyServer:
                 str(self.study_dir),
                 "--port",
                 str(self.port),
+                *self.args,
             ],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
@@ -141,15 +145,44 @@ class _NoRedirect(urllib.request.HTTPRedirectHandler):
 _opener = urllib.request.build_opener(_NoRedirect)
 
 
-def http(method: str, url: str, data: dict | None = None, headers: dict | None = None):
+def http(
+    method: str,
+    url: str,
+    data: dict | None = None,
+    headers: dict | None = None,
+    opener: urllib.request.OpenerDirector | None = None,
+):
     """(status, headers, body) of one request; redirects are not followed."""
     body = urllib.parse.urlencode(data).encode() if data is not None else None
     req = urllib.request.Request(url, data=body, method=method, headers=headers or {})
     try:
-        with _opener.open(req, timeout=30) as resp:
+        with (opener or _opener).open(req, timeout=30) as resp:
             return resp.status, dict(resp.headers), resp.read()
     except urllib.error.HTTPError as err:
         return err.code, dict(err.headers), err.read()
+
+
+class Visitor:
+    """A browser's part in a request, over urllib: it keeps the server's cookies and sends the
+    ``Origin`` of the page on its POSTs (as a browser does on a form of the site, with
+    ``Referrer-Policy: same-origin``). ``request`` answers as :func:`http` does."""
+
+    def __init__(self, base: str) -> None:
+        self.origin = base
+        self.jar = CookieJar()
+        self._opener = urllib.request.build_opener(
+            _NoRedirect, urllib.request.HTTPCookieProcessor(self.jar)
+        )
+
+    def request(self, method: str, url: str, data: dict | None = None):
+        headers = {"Origin": self.origin} if method == "POST" else {}
+        return http(method, url, data, headers, opener=self._opener)
+
+    def form_token(self, url: str) -> str:
+        """The CSRF token of the form on the page at ``url`` (fetched now)."""
+        status, _, body = self.request("GET", url)
+        assert status == 200, status
+        return form_token(body)
 
 
 def read_links(study_dir: Path) -> dict[int, str]:

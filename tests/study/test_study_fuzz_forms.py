@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from study_web import render_tiny_study
 
-from gazebot.study.web.app import create_app
+from gazebot.study.web.app import ADMIN_COOKIE, VISITOR_COOKIE, create_app
 
 FUZZ = settings(
     max_examples=60,
@@ -33,7 +33,21 @@ FORM = st.dictionaries(
 def app(tmp_path_factory):
     out = tmp_path_factory.mktemp("fuzz") / "study"
     render_tiny_study(out)
-    return create_app(str(out), admin_token="admin-token-1234")
+    # local_admin: a loopback client is the experimenter, so the fuzzed forms reach the views.
+    return create_app(str(out), admin_token="admin-token-1234", local_admin=True)
+
+
+VISITOR = "fuzz-visitor-0123456789"
+SAME_ORIGIN = {"Origin": "http://localhost"}
+
+
+def _browser(app, remote="127.0.0.1"):
+    """A test client as a browser: a visitor cookie, and the site's Origin on its POSTs."""
+    c = app.test_client()
+    c.environ_base["REMOTE_ADDR"] = remote
+    c.environ_base["HTTP_ORIGIN"] = SAME_ORIGIN["Origin"]
+    c.set_cookie(VISITOR_COOKIE, VISITOR)
+    return c
 
 
 def _check(resp) -> None:
@@ -46,10 +60,10 @@ def _check(resp) -> None:
 @given(form=FORM, k=st.integers(-3, 2**70), who=st.integers(1, 6), valid_csrf=st.booleans())
 def test_participant_forms_with_any_fields(app, form, k, who, valid_csrf):
     web = app.extensions["gazebot_study"]
-    c = app.test_client()
+    c = _browser(app)
     link = web.link_path(who)
     if valid_csrf:
-        form = {**form, "csrf_token": web.csrf("p:" + web.links[who])}
+        form = {**form, "csrf_token": web.csrf("p:" + web.links[who], VISITOR)}
     for path in (f"{link}/consent", f"{link}/instructions", f"{link}/session/{k}"):
         _check(c.post(path, data=form))
     _check(c.get(link))
@@ -62,10 +76,12 @@ def test_participant_forms_with_any_fields(app, form, k, who, valid_csrf):
 @given(form=FORM, who=st.integers(-5, 2**70), remote=st.sampled_from(["127.0.0.1", "192.0.2.9"]))
 def test_experimenter_forms_with_any_fields(app, form, who, remote):
     web = app.extensions["gazebot_study"]
-    c = app.test_client()
-    c.environ_base["REMOTE_ADDR"] = remote
-    _check(c.post(f"/admin/in-person/{who}", data={**form, "csrf_token": web.csrf("admin")}))
-    _check(c.post("/admin/login", data={**form, "csrf_token": web.csrf("admin")}))
+    c = _browser(app, remote)
+    _check(c.get("/admin"))  # from loopback: an admin session (cookie) and its forms' token
+    cookie = c.get_cookie(ADMIN_COOKIE)
+    admin_csrf = web.csrf("admin", cookie.value.split(".")[0]) if cookie else "none"
+    _check(c.post(f"/admin/in-person/{who}", data={**form, "csrf_token": admin_csrf}))
+    _check(c.post("/admin/login", data={**form, "csrf_token": web.csrf("login", VISITOR)}))
     _check(c.get(f"/admin/in-person/{who}"))
 
 

@@ -13,12 +13,13 @@ import numpy as np
 import pytest
 from study_responses import BEHAVIORS, responses_from_tables
 from study_seed_tables import TABLE_6_1
-from study_web import reach_start_time_of, render_tiny_study
+from study_web import form_token, reach_start_time_of, render_tiny_study
 
 from gazebot.study.analysis import analyze, read_responses
 from gazebot.study.export import export_responses
 from gazebot.study.folder import load_study
-from gazebot.study.web.app import create_app
+from gazebot.study.web.app import ADMIN_COOKIE, VISITOR_COOKIE, create_app
+from gazebot.study.web.security import new_token
 
 ANSWERS = {"q1": "1", "q2": "2", "q3": "1", "q4": "1", "q5": "2"}
 
@@ -40,13 +41,26 @@ def fresh(study_dir, tmp_path):
 
 class Client:
     """Flask's test client used as a participant's browser would: ``/p/N...`` in a test stands
-    for participant N's own link ``/p/TOKEN...``, and every POST carries its form's CSRF token."""
+    for participant N's own link ``/p/TOKEN...``, it holds a visitor cookie (and with ``admin``
+    signs in with the admin token), and every POST carries its form's CSRF token and the
+    ``Origin`` a browser sends on the site's own forms."""
 
-    def __init__(self, study_dir, remote="127.0.0.1", **kw):
+    def __init__(self, study_dir, remote="127.0.0.1", admin=False, **kw):
         self.app = create_app(str(study_dir), admin_token="admin-token-1234", **kw)
         self.web = self.app.extensions["gazebot_study"]
         self.c = self.app.test_client()
         self.c.environ_base["REMOTE_ADDR"] = remote
+        self.c.environ_base["HTTP_ORIGIN"] = "http://localhost"
+        self.c.set_cookie(VISITOR_COOKIE, new_token())  # as a browser that visited before
+        if admin:
+            self.sign_in()
+
+    def sign_in(self, token="admin-token-1234"):
+        """The experimenter's sign-in form, filled in as a browser would."""
+        csrf = form_token(self.c.get("/admin").data)
+        resp = self.c.post("/admin/login", data={"token": token, "csrf_token": csrf})
+        assert resp.status_code == 303, resp.status_code
+        return resp
 
     def url(self, path: str) -> str:
         m = re.fullmatch(r"/p/(\d+)(.*)", path)
@@ -55,11 +69,19 @@ class Client:
     def scope(self, path: str) -> str:
         return "p:" + self.url(path).split("/")[2] if path.startswith("/p/") else "admin"
 
+    def csrf(self, path: str) -> str:
+        """The CSRF token the form posting to ``path`` shows this browser."""
+        scope = self.scope(path)
+        if scope == "admin":
+            cookie = self.c.get_cookie(ADMIN_COOKIE)
+            return self.web.csrf(scope, cookie.value.split(".")[0]) if cookie else ""
+        return self.web.csrf(scope, self.c.get_cookie(VISITOR_COOKIE).value)
+
     def get(self, path, **kw):
         return self.c.get(self.url(path), **kw)
 
     def post(self, path, data=None, **kw):
-        data = {"csrf_token": self.web.csrf(self.scope(path)), **(data or {})}
+        data = {"csrf_token": self.csrf(path), **(data or {})}
         return self.c.post(self.url(path), data=data, **kw)
 
 
@@ -168,7 +190,7 @@ def test_participant_links_are_random_tokens_not_their_numbers(fresh):
         assert re.fullmatch(r"[A-Za-z0-9_-]{24}", token) and str(p) != token
     # Participant 1's page by number does not open, and its forms refuse another's token.
     assert c.c.get("/p/1").status_code == 404
-    other = {"consent": "yes", "csrf_token": c.web.csrf(c.scope("/p/2"))}
+    other = {"consent": "yes", "csrf_token": c.csrf("/p/2")}
     assert c.c.post(c.url("/p/1") + "/consent", data=other).status_code == 403
     assert load_study(fresh).store().progress(1).mode is None
     # A restarted server keeps the links handed out.
@@ -202,30 +224,34 @@ def test_videos_are_served_with_range_requests_and_without_their_file_name(fresh
     assert c.get("/p/1/video/99/1.mp4").status_code == 404
 
 
-def test_admin_needs_loopback_or_the_token_signed_in_by_a_form_not_a_url(fresh):
-    remote = client(fresh, remote="192.0.2.7")
+@pytest.mark.parametrize("remote", ["192.0.2.7", "127.0.0.1", "127.0.1.1"])
+def test_admin_needs_the_token_signed_in_by_a_form_not_a_url(fresh, remote):
+    """From anywhere, loopback included (on Debian a browser on the machine opening its own
+    name comes from 127.0.1.1), unless ``local_admin`` is asked for."""
+    remote = client(fresh, remote=remote)
     page = remote.get("/admin")
     assert page.status_code == 403 and b'action="/admin/login"' in page.data
     # A token in the URL (which logs and browser histories keep) opens nothing.
     assert remote.get("/admin?token=admin-token-1234").status_code == 403
-    assert remote.post("/admin/login", data={"token": "bad"}).status_code == 403
-    resp = remote.post("/admin/login", data={"token": "admin-token-1234"})
-    assert resp.status_code == 303 and resp.headers["Location"].endswith("/admin")
+    login_csrf = form_token(page.data)
+    bad = remote.c.post("/admin/login", data={"token": "bad", "csrf_token": login_csrf})
+    assert bad.status_code == 403 and b"not the admin token" in bad.data
+    resp = remote.sign_in()
+    assert resp.headers["Location"].endswith("/admin")
     cookie = resp.headers["Set-Cookie"]
     assert "admin-token-1234" not in cookie and "HttpOnly" in cookie and "SameSite=Strict" in cookie
     assert remote.get("/admin").status_code == 200  # the sign-in is kept in a cookie
-    assert client(fresh).get("/admin").status_code == 200
 
 
 def test_admin_page_lists_each_participants_link(fresh):
-    c = client(fresh)
+    c = client(fresh, admin=True)
     page = c.get("/admin").get_data(as_text=True)
     for token in c.web.links.values():
         assert f"http://localhost/p/{token}</code>" in page
 
 
 def test_admin_shows_each_participants_progress(fresh):
-    c = client(fresh)
+    c = client(fresh, admin=True)
     start(c, 2)
     c.post("/p/2/session/0", data=ANSWERS)
     c.post("/p/2/session/1", data=ANSWERS)
@@ -236,7 +262,7 @@ def test_admin_shows_each_participants_progress(fresh):
 
 def test_in_person_mode_enters_answers_in_plan_order_with_the_in_person_question_5(fresh):
     study = load_study(fresh)
-    c = client(fresh)
+    c = client(fresh, admin=True)
     sessions = study.sessions_of(3)
     for s in sessions:
         page = c.get("/admin/in-person/3").get_data(as_text=True)
@@ -258,7 +284,7 @@ def test_admin_table_shows_an_in_person_participants_next_live_pair_not_a_practi
     """In person there is no practice session: after two entered pairs the table says session
     3 (it said "practice" for as long as the participant took part)."""
     study = load_study(fresh)
-    c = client(fresh)
+    c = client(fresh, admin=True)
     for s in study.sessions_of(3)[:2]:
         resp = c.post("/admin/in-person/3", data={**ANSWERS, "session": str(s.session)})
         assert resp.status_code == 303
@@ -267,7 +293,7 @@ def test_admin_table_shows_an_in_person_participants_next_live_pair_not_a_practi
 
 
 def test_in_person_entry_for_an_online_participant_is_refused(fresh):
-    c = client(fresh)
+    c = client(fresh, admin=True)
     start(c, 4)
     resp = c.post("/admin/in-person/4", data={**ANSWERS, "session": "1"})
     assert resp.status_code == 409 and b"answers online" in resp.data
@@ -344,15 +370,19 @@ def test_table_6_1_reproduced_through_the_served_6_3_study(tmp_path):
     json.dumps(result.to_json())
 
 
-def test_token_only_admin_refuses_loopback_without_the_token(fresh):
-    c = client(fresh, local_admin=False)
-    assert c.get("/admin").status_code == 403
-    assert c.post("/admin/login", data={"token": "admin-token-1234"}).status_code == 303
+def test_local_admin_opens_admin_to_loopback_only_when_asked_for(fresh):
+    assert client(fresh).get("/admin").status_code == 403  # the default
+    c = client(fresh, local_admin=True)
     assert c.get("/admin").status_code == 200
+    # Its forms work with a session of its own (a cookie), as a signed-in one's do.
+    start(client(fresh), 5)
+    resp = c.post("/admin/in-person/5", data={**ANSWERS, "session": "1"})
+    assert resp.status_code == 409 and b"answers online" in resp.data
+    assert client(fresh, remote="192.0.2.7", local_admin=True).get("/admin").status_code == 403
 
 
 def test_export_names_the_mode_as_group_when_a_study_has_both(fresh, tmp_path):
-    c = client(fresh)
+    c = client(fresh, admin=True)
     start(c, 1)
     c.post("/p/1/session/0", data=ANSWERS)
     c.post("/p/1/session/1", data=ANSWERS)

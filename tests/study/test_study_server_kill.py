@@ -7,20 +7,28 @@ from __future__ import annotations
 import threading
 import time
 
-from study_web import StudyServer, form_token, http, render_tiny_study
+from study_web import StudyServer, Visitor, http, render_tiny_study
 
 from gazebot.study.folder import load_study
 
 ANSWERS = {"q1": "2", "q2": "1", "q3": "2", "q4": "1", "q5": "1"}
 
 
-def _post_all(link: str, pid: int, sessions: list[int], confirmed: list, stop: threading.Event):
-    csrf = form_token(http("GET", link)[2])
+def _post_all(
+    browser: Visitor,
+    link: str,
+    pid: int,
+    sessions: list[int],
+    confirmed: list,
+    stop: threading.Event,
+):
+    csrf = browser.form_token(link)
     for k in sessions:
         if stop.is_set():
             return
         try:
-            status, _, _ = http("POST", f"{link}/session/{k}", {**ANSWERS, "csrf_token": csrf})
+            data = {**ANSWERS, "csrf_token": csrf}
+            status, _, _ = browser.request("POST", f"{link}/session/{k}", data)
         except OSError:  # the server died under this request
             return
         if status == 303:
@@ -34,16 +42,20 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
     server = StudyServer(study_dir).start()
     try:
         links = server.links
-        csrf = {pid: form_token(http("GET", links[pid])[2]) for pid in study.participants}
+        browsers = {pid: Visitor(server.base) for pid in study.participants}
+        csrf = {pid: browsers[pid].form_token(links[pid]) for pid in study.participants}
         for pid in study.participants:
-            http("POST", f"{links[pid]}/consent", {"consent": "yes", "csrf_token": csrf[pid]})
-            http("POST", f"{links[pid]}/instructions", {"csrf_token": csrf[pid]})
+            b, link, token = browsers[pid], links[pid], csrf[pid]
+            consent = {"consent": "yes", "csrf_token": token}
+            assert b.request("POST", f"{link}/consent", consent)[0] == 303
+            assert b.request("POST", f"{link}/instructions", {"csrf_token": token})[0] == 303
         confirmed: list[tuple[int, int]] = []
         stop = threading.Event()
         threads = [
             threading.Thread(
                 target=_post_all,
                 args=(
+                    browsers[pid],
                     links[pid],
                     pid,
                     [0] + [s.session for s in study.sessions_of(pid)],
@@ -75,7 +87,7 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
         for pid in study.participants:
             for k in [0] + [s.session for s in study.sessions_of(pid)]:
                 data = {**ANSWERS, "csrf_token": csrf[pid]}  # a form loaded before the kill
-                status, _, _ = http("POST", f"{links[pid]}/session/{k}", data)
+                status, _, _ = browsers[pid].request("POST", f"{links[pid]}/session/{k}", data)
                 assert status == 303
         answers = study.store().answers(include_practice=True)
         keys = [(a.participant, a.session) for a in answers]

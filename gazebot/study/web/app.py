@@ -12,10 +12,10 @@ head or the eyes, as the seed's captions did); the five questions are enabled on
 played to the end, and all five are required (the comment is optional, as the seed's question 6
 says).
 
-The experimenter's pages under ``/admin`` (from the loopback interface, or anywhere after
-signing in with the admin token) show every participant's progress and link and let the
-experimenter enter an in-person participant's answers after each live pair, the plan telling
-which behavior comes first.
+The experimenter's pages under ``/admin`` (after signing in with the admin token; from the
+loopback interface without it only when ``local_admin`` is asked for) show every participant's
+progress and link and let the experimenter enter an in-person participant's answers after each
+live pair, the plan telling which behavior comes first.
 """
 
 from __future__ import annotations
@@ -48,16 +48,21 @@ from gazebot.study.questionnaire import (
 )
 from gazebot.study.store import Progress, ResponseStore
 from gazebot.study.web.security import (
+    LOOPBACK_HOSTS,
     MAX_BODY_BYTES,
+    admin_cookie,
+    admin_session_of,
     cross_site_reason,
     csrf_token,
+    host_allowed,
     is_link_token,
     new_token,
     security_headers,
     tokens_equal,
 )
 
-ADMIN_COOKIE = "gazebot_admin"
+ADMIN_COOKIE = "gazebot_admin"  # the experimenter's signed session id
+VISITOR_COOKIE = "gazebot_visitor"  # any other browser's random id, which its forms' tokens name
 CONSENT_FILE = "consent.txt"  # the study's own consent text, in the study folder
 DEFAULT_CONSENT = (
     "You are invited to take part in a study of how people perceive a robot's gaze when a person "
@@ -122,7 +127,7 @@ def _step_label(prog: Progress, step: Step) -> str:
 @dataclass(frozen=True)
 class StudyWeb:
     """What the app knows of its study (``app.extensions["gazebot_study"]``): the folder, its
-    answers, each participant's link token and the CSRF key."""
+    answers, each participant's link token and the CSRF key (also the admin cookie's)."""
 
     study: StudyFolder
     store: ResponseStore
@@ -133,17 +138,26 @@ class StudyWeb:
         """``/p/TOKEN`` of a participant."""
         return f"/p/{self.links[participant]}"
 
-    def csrf(self, scope: str) -> str:
-        """The CSRF token of the forms of ``scope`` (``p:TOKEN`` or ``admin``)."""
-        return csrf_token(self.csrf_key, scope)
+    def csrf(self, scope: str, session: str) -> str:
+        """The CSRF token of the forms of ``scope`` (``p:TOKEN``, ``login`` or ``admin``) for
+        the browser whose cookie holds the random id ``session`` (its visitor id, or for
+        ``admin`` its admin session id)."""
+        return csrf_token(self.csrf_key, scope, session)
 
 
-def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool = True) -> Flask:
+def create_app(
+    study_dir: str,
+    admin_token: str | None = None,
+    local_admin: bool = False,
+    allowed_hosts: tuple[str, ...] = LOOPBACK_HOSTS,
+) -> Flask:
     """The Flask app of the rendered study in ``study_dir`` (answers in
-    ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` from other
-    hosts (default: a random one, in ``app.config["ADMIN_TOKEN"]``); ``local_admin``: also open
-    it without the token to requests from the loopback interface (turn off behind a reverse
-    proxy on the same machine, where every request comes from there)."""
+    ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` (default:
+    a random one, in ``app.config["ADMIN_TOKEN"]``); ``local_admin``: also open it without the
+    token to requests from the loopback interface (any user or program on this machine, and on
+    Debian a browser on it that opens the machine's own name, which resolves to 127.0.1.1);
+    ``allowed_hosts``: the names a request's ``Host`` may give (an IP address is always
+    accepted, see :func:`~gazebot.study.web.security.host_allowed`), anything else is 400."""
     study = load_study(study_dir)
     store = study.store()
     web = StudyWeb(study, store, store.links(study.participants), store.secret("csrf"))
@@ -164,21 +178,62 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
     consent_paragraphs = [p.strip() for p in consent_text.split("\n\n") if p.strip()]
     n_sessions = {p: len(study.sessions_of(p)) for p in study.participants}
     last_session = {p: max(s.session for s in study.sessions_of(p)) for p in study.participants}
-    # The admin cookie holds a MAC of the token, not the token.
-    admin_cookie = csrf_token(web.csrf_key, "admin-cookie:" + app.config["ADMIN_TOKEN"])
+    admin_token = app.config["ADMIN_TOKEN"]
+    allowed = tuple(allowed_hosts)
+
+    def visitor() -> str:
+        """This browser's random visitor id (a new one, set in the response, if it has none)."""
+        if "visitor" not in g:
+            cookie = request.cookies.get(VISITOR_COOKIE, "")
+            g.visitor = cookie if is_link_token(cookie) else new_token()
+            g.new_visitor = g.visitor != cookie
+        return g.visitor
+
+    def admin_session() -> str | None:
+        """The experimenter's session id of this request (``None``: not signed in). With
+        ``local_admin`` a loopback request without one is given a new one (in a cookie), so
+        its forms' CSRF tokens are bound to a secret cookie all the same."""
+        if "admin_session" not in g:
+            cookie = request.cookies.get(ADMIN_COOKIE, "")
+            sid = admin_session_of(web.csrf_key, admin_token, cookie)
+            if sid is None and local_admin and _is_loopback(request.remote_addr):
+                sid = g.new_admin_session = new_token()
+            g.admin_session = sid
+        return g.admin_session
 
     def form_scope() -> str:
-        """The CSRF scope of this request's forms: its participant link, else the admin's."""
+        """The CSRF scope of this request's forms: its participant link, the sign-in form (on
+        the sign-in page and its POST) or the experimenter's forms."""
         token = (request.view_args or {}).get("token")
-        return f"p:{token}" if isinstance(token, str) else "admin"
+        if isinstance(token, str):
+            return f"p:{token}"
+        if g.get("login_form") or request.endpoint == "admin_login":
+            return "login"
+        return "admin"
+
+    def form_csrf() -> str | None:
+        """The CSRF token of this request's forms (``None``: an experimenter's form without
+        an admin session, which no token opens)."""
+        scope = form_scope()
+        if scope == "admin":
+            sid = admin_session()
+            return None if sid is None else web.csrf(scope, sid)
+        return web.csrf(scope, visitor())
 
     @app.context_processor
     def template_globals():
-        return {"csrf_token": lambda: web.csrf(form_scope()), "csp_nonce": lambda: g.csp_nonce}
+        return {"csrf_token": lambda: form_csrf() or "", "csp_nonce": lambda: g.csp_nonce}
 
     @app.before_request
     def guard():
         g.csp_nonce = new_token(12)
+        # DNS rebinding: a page of evil.example (resolving to this machine) must get nothing.
+        if not host_allowed(request.host, allowed):
+            abort(
+                400,
+                description=f"This server does not answer to the host name {request.host!r} "
+                "(start it with --allowed-host NAME to add one).",
+            )
         if request.method != "POST" or request.url_rule is None:
             return None
         reason = cross_site_reason(request.headers, request.host)
@@ -186,13 +241,23 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
             abort(403, description=f"Refused: {reason}.")
         # Reading the form here is bounded by MAX_CONTENT_LENGTH (413 beyond it).
         given = request.form.get("csrf_token", "")
-        if not tokens_equal(given, web.csrf(form_scope())):
-            abort(403, description="This form has expired: go back, reload the page and retry.")
+        expected = form_csrf()
+        if expected is None or not tokens_equal(given, expected):
+            abort(
+                403,
+                description="This form has expired: go back, reload the page and retry "
+                "(the study's pages need cookies).",
+            )
         return None
 
     @app.after_request
     def headers(resp):
         resp.headers.update(security_headers(getattr(g, "csp_nonce", new_token(12))))
+        if g.get("new_visitor"):
+            resp.set_cookie(VISITOR_COOKIE, g.visitor, httponly=True, samesite="Lax")
+        if g.get("new_admin_session"):
+            cookie = admin_cookie(web.csrf_key, admin_token, g.new_admin_session)
+            resp.set_cookie(ADMIN_COOKIE, cookie, httponly=True, samesite="Strict")
         return resp
 
     def page(template: str, status: int = 200, **kw: object):
@@ -357,17 +422,15 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
 
     # ---- experimenter ----
 
-    def is_admin() -> bool:
-        cookie = request.cookies.get(ADMIN_COOKIE, "")
-        return tokens_equal(cookie, admin_cookie) or (
-            local_admin and _is_loopback(request.remote_addr)
-        )
+    def login_page(error: str | None):
+        g.login_form = True  # its form gets the visitor's sign-in token, never an admin one
+        return page("admin_login.html", 403, error=error)
 
     def admin_only(view):
         @wraps(view)
         def wrapped(*args, **kwargs):
-            if not is_admin():
-                return page("admin_login.html", 403, error=None)
+            if admin_session() is None:
+                return login_page(None)
             return view(*args, **kwargs)
 
         return wrapped
@@ -375,11 +438,11 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
     @app.post("/admin/login")
     def admin_login():
         # The token comes in a form, never in a URL a log or a browser history keeps.
-        if not tokens_equal(request.form.get("token", ""), app.config["ADMIN_TOKEN"]):
-            return page("admin_login.html", 403, error="That is not the admin token.")
-        resp = redirect(url_for("admin"), 303)
-        resp.set_cookie(ADMIN_COOKIE, admin_cookie, httponly=True, samesite="Strict")
-        return resp
+        if not tokens_equal(request.form.get("token", ""), admin_token):
+            return login_page("That is not the admin token.")
+        # A new random session at each sign-in: a session id planted before it is worth nothing.
+        g.new_admin_session = new_token()
+        return redirect(url_for("admin"), 303)
 
     @app.get("/admin")
     @admin_only
@@ -475,6 +538,10 @@ def create_app(study_dir: str, admin_token: str | None = None, local_admin: bool
             message=desc if known else "There is no such page: check the link you were given.",
             link=url_for("index"),
         )
+
+    @app.errorhandler(400)
+    def bad_request(err):
+        return page("message.html", 400, title="Bad request", message=err.description)
 
     @app.errorhandler(403)
     def forbidden(err):

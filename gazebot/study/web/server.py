@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import csv
+import ipaddress
 import os
+import re
 import socket
 import sys
 from pathlib import Path
@@ -13,6 +15,7 @@ from gazebot.study.folder import load_study
 from gazebot.study.web.app import create_app
 from gazebot.study.web.security import (
     ADMIN_TOKEN_ENV,
+    LOOPBACK_HOSTS,
     MAX_BODY_BYTES,
     new_token,
     rate_limit_logs,
@@ -29,6 +32,42 @@ def base_url(host: str, port: int) -> str:
         host = socket.gethostname()
     shown = f"[{host}]" if ":" in host else host
     return f"http://{shown}:{port}"
+
+
+_LABEL = r"[A-Za-z0-9][A-Za-z0-9-]{0,62}"
+_HOST_NAME_RE = re.compile(rf"{_LABEL}(\.{_LABEL})*\.?")
+
+
+def check_host_name(name: str) -> str:
+    """``name`` if it is a host name or an IP address (what ``--allowed-host`` takes), else
+    ``ValueError`` saying what was expected."""
+    bare = name.strip("[]")
+    try:
+        ipaddress.ip_address(bare)
+        return bare
+    except ValueError:
+        pass
+    if len(name) <= 253 and _HOST_NAME_RE.fullmatch(name):
+        return name
+    raise ValueError(
+        f"--allowed-host: {name!r} is not a host name (expected a name such as "
+        "study.lab.example or an IP address: no scheme, port or path)"
+    )
+
+
+def served_host_names(host: str, extra: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The names a request's ``Host`` may give for a server bound to ``host``: the loopback
+    names, the bound name (for a wildcard address the machine's name and full name, as
+    :func:`base_url` prints it), and ``extra`` (``--allowed-host``: a reverse proxy's or a DNS
+    name of this machine). IP addresses are always accepted (see
+    :func:`~gazebot.study.web.security.host_allowed`)."""
+    names = list(LOOPBACK_HOSTS)
+    if host in ("", "0.0.0.0", "::"):
+        names += [socket.gethostname(), socket.getfqdn()]
+    else:
+        names.append(host)
+    names += extra
+    return tuple(dict.fromkeys(n.lower() for n in names if n))
 
 
 def read_admin_token(path: Path) -> str:
@@ -85,20 +124,28 @@ def serve(
     threads: int = 4,
     admin_token_file: Path | None = None,
     out: TextIO | None = None,
-    local_admin: bool = True,
+    local_admin: bool = False,
+    allowed_hosts: tuple[str, ...] = (),
 ) -> None:
     """Serve the rendered study in ``study_dir`` until interrupted. Writes each participant's
     link to ``DIR/participant-links.csv`` and prints where the links and the admin token are
     once the socket listens (never the token itself); ``port`` 0 picks a free port. The admin
     token: see :func:`admin_token_source`; ``local_admin``: see
-    :func:`~gazebot.study.web.app.create_app`."""
+    :func:`~gazebot.study.web.app.create_app`; ``allowed_hosts``: host names to answer to
+    besides :func:`served_host_names`."""
     from waitress import create_server
 
     out = out or sys.stdout
+    allowed_hosts = tuple(check_host_name(n) for n in allowed_hosts)
     root = Path(study_dir).expanduser().resolve()
     load_study(root)  # a folder that is not a study says so before a token file is written
     token, where = admin_token_source(root, admin_token_file)
-    app = create_app(str(root), admin_token=token, local_admin=local_admin)
+    app = create_app(
+        str(root),
+        admin_token=token,
+        local_admin=local_admin,
+        allowed_hosts=served_host_names(host, allowed_hosts),
+    )
     rate_limit_logs()
     server = create_server(
         app,
