@@ -688,7 +688,7 @@ def health_of(msg: Any) -> list[NodeHealth]:
 
 # -- eye frames ---------------------------------------------------------------------------------
 
-#: Largest image (width, height, pixels) :func:`decode_image` decodes by default: the eye display
+#: Largest image (width, height) :func:`decode_image` decodes by default: the eye display
 #: is 1024x600; a 4096x4096 RGB image is 48 MiB decoded. A few hundred kB of PNG can claim
 #: 20000x20000 (1.2 GB decoded): the header is read and such an image refused undecoded.
 MAX_IMAGE_SIZE = (4096, 4096)
