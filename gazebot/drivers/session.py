@@ -38,7 +38,9 @@ EPHEMERAL_ENDPOINT = "tcp/127.0.0.1:0"
 #: the link stays up.
 MAX_MESSAGE_BYTES = 8 * 1024 * 1024
 #: Where ``gazebot router`` listens by default (every interface, rmw_zenohd's port).
-ROUTER_ENDPOINT = "tcp/0.0.0.0:7447"
+#: ``gazebot router``'s default: loopback only. The router has no authentication unless a
+#: ``--zenoh-config`` sets it up, so opening it to the network takes an explicit ``--listen``.
+ROUTER_ENDPOINT = "tcp/127.0.0.1:7447"
 _ENDPOINT = re.compile(r"^(tcp|udp|tls|quic|ws|unixsock-stream|serial)/\S+$")
 
 

@@ -27,7 +27,7 @@ from gazebot.drivers.rmw.attachment import gid_of
 from gazebot.drivers.rmw.graph import Entity
 from gazebot.drivers.rmw.names import Names
 from gazebot.drivers.rmw.node import Received
-from gazebot.drivers.tracking_assembly import SampleAssembler
+from gazebot.drivers.tracking_assembly import IDLE_FLUSH, REORDER, SampleAssembler
 from gazebot.drivers.tracking_source import Rival, SourceArbiter, group_of
 from gazebot.drivers.zenoh_node import HISTORY_BYTES, ZenohNode
 from gazebot.ros2 import convert, topics
@@ -55,8 +55,11 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         peer_timeout: Heartbeat timeout (s) after which a peer counts as lost.
         tracking_backlog: Unread tracking samples kept (oldest dropped beyond, counted in
             ``tracking_skipped``): 12 = 0.1 s at 120 Hz, the most the engine may lag.
-        assemble_timeout: Wall time (s) after which a tracking sample missing a part is
-            complete anyway (see :mod:`gazebot.drivers.tracking_assembly`).
+        assemble_idle: Time (s) without any tracking part after which pending samples are
+            complete anyway; completeness is otherwise decided from the stamps (see
+            :mod:`gazebot.drivers.tracking_assembly`).
+        assemble_reorder: Newer samples after which a part missing from a sample counts as
+            not tracked at its stamp (how far one tracking topic may run ahead of another).
         source_timeout: A tracking source silent this long (s) gives way to the next one
             (see :mod:`gazebot.drivers.tracking_source`); until then another source's samples
             are dropped, counted by topic and reported as rivals.
@@ -73,7 +76,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         owns_session: bool = False,
         peer_timeout: float = 2.0,
         tracking_backlog: int = 12,
-        assemble_timeout: float = 0.05,
+        assemble_idle: float = IDLE_FLUSH,
+        assemble_reorder: int = REORDER,
         clock: Callable[[], float] = time.monotonic,
         max_bytes: dict[str, int] | None = None,
         history_bytes: int = HISTORY_BYTES,
@@ -91,7 +95,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self._ownership: Ownership | None = None
         self._sources = SourceArbiter(source_timeout, clock)
         self._gid_labels: dict[bytes, str] = {}
-        self._assembler = SampleAssembler(self._expected_parts, assemble_timeout, clock=clock)
+        self._assembler = SampleAssembler(self._expected_parts, assemble_idle,
+                                          assemble_reorder, clock=clock)
         ros = self.ros
         self._head_pub = ros.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
         self._target_pub = ros.publisher(topics.GAZE_TARGET.name, topics.GAZE_TARGET.type)
