@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "run",
     "display",
     "study",
+    "gps",
 )
 
 

@@ -67,7 +67,7 @@ FINGER_MASS_KG = 0.015
 
 
 def _fmt(values: tuple[float, ...] | list[float]) -> str:
-    return " ".join(f"{v:.9g}" for v in values)
+    return " ".join(f"{v:.17g}" for v in values)
 
 
 def _link_geom(i: int) -> str:
@@ -99,7 +99,7 @@ def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: flo
     for i, ((a, d, alpha), link) in enumerate(zip(DH, LINKS, strict=True)):
         pos = (a, -d * math.sin(alpha), d * math.cos(alpha))
         xml.append(
-            f'<body name="link{i + 1}" pos="{_fmt(pos)}" euler="{alpha:.9g} 0 0" gravcomp="1">'
+            f'<body name="link{i + 1}" pos="{_fmt(pos)}" euler="{alpha:.17g} 0 0" gravcomp="1">'
         )
         xml.append(
             f'<inertial pos="{_fmt(link.com)}" mass="{link.mass}" '
@@ -111,7 +111,7 @@ def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: flo
         )
         xml.append(_link_geom(i))
     xml.append(
-        f'<body name="hand" pos="0 0 {FLANGE_D_M}" euler="0 0 {-math.pi / 4:.9g}" '
+        f'<body name="hand" pos="0 0 {FLANGE_D_M}" euler="0 0 {-math.pi / 4:.17g}" '
         f'gravcomp="{gravcomp_hand:.9g}">'
     )
     xml.append(
