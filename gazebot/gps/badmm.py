@@ -162,10 +162,14 @@ def iterate(cfg: GPSFileConfig, scene: HandoverScene, motions: list[TesterMotion
             X = Xs[i]
             lin = _policy_linearization(st.policy, X)
             ctrl = st.controllers[i]
-            # Eq. 5.7: lambda_t += alpha nu_t (E[pi u] - E[p u]) over the sampled states.
+            # Eq. 5.7: lambda_t += alpha nu_t (E[pi u] - E[p u]) over the sampled states. The
+            # difference is in N m and N while lambda is in cost per action unit: we take alpha's
+            # units from the policy's action precision (alpha Sigma_pi^-1), which makes the shift
+            # lambda induces in eq. 5.5's target alpha times the difference instead of overshooting.
             mu_pi = st.policy.mean(X)
             mu_p = np.einsum("tux,mtx->mtu", ctrl.K, X) + ctrl.k
-            st.lam[i] += g.dual_rate * st.nu[i][:, None] * (mu_pi - mu_p).mean(axis=0)
+            gap = (mu_pi - mu_p).mean(axis=0) @ np.linalg.inv(st.policy.cov).T
+            st.lam[i] += g.dual_rate * st.nu[i][:, None] * gap
             # nu_t grows where the local controller and the policy disagree, shrinks where not.
             mu_x, sig_x = _sample_moments(X)
             kl_t = kl_per_step(mu_x, sig_x, ctrl, lin)
