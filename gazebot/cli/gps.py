@@ -1,6 +1,7 @@
 """``gazebot gps``: the seed's chapter 5, Guided Policy Search (BADMM) for the reach, in MuJoCo.
 
-  gazebot gps train --controllers 8|12 --trainer static|moving --state reduced|full|relative --out DIR
+  gazebot gps train --controllers 8|12 --trainer static|moving
+      --state reduced|full|relative --out DIR
   gazebot gps evaluate DIR --tester static|moving [--mass KG] [--grid N] [--json] [--plot PNG]
   gazebot gps figures RESULTS.json... --out DIR
 """

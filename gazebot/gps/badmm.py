@@ -99,7 +99,8 @@ def _update_policy(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, seed: int) 
     for i, ctrl in enumerate(st.controllers):
         prec = ctrl.precision  # (T, dU, dU)
         mu_p = np.einsum("tux,mtx->mtu", ctrl.K, Xs[i]) + ctrl.k
-        # nu/2 (mu - mu_p)' P (mu - mu_p) + mu' lam = nu/2 (mu - (mu_p - P^-1 lam / nu))' P (...) + c
+        # nu/2 (mu - mu_p)' P (mu - mu_p) + mu' lam
+        #   = nu/2 (mu - (mu_p - P^-1 lam / nu))' P (...) + const
         shift = np.linalg.solve(prec, st.lam[i][..., None])[..., 0] / st.nu[i][:, None]
         xs.append(Xs[i].reshape(-1, dx))
         tgts.append((mu_p - shift).reshape(-1, DU))

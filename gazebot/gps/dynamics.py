@@ -8,9 +8,8 @@ conditions, all t), as in Levine et al.'s BADMM GPS; conditioning gives the line
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 from sklearn.exceptions import ConvergenceWarning

@@ -1,4 +1,5 @@
-"""Time-varying linear-Gaussian local controllers, eq. 5.2: p_i(u_t | x_t) = N(K_t x_t + k_t, C_t)."""
+"""Time-varying linear-Gaussian local controllers, eq. 5.2:
+p_i(u_t | x_t) = N(K_t x_t + k_t, C_t)."""
 
 from __future__ import annotations
 

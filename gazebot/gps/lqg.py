@@ -27,7 +27,8 @@ class NotPositiveDefinite(np.linalg.LinAlgError):
 
 @dataclass(frozen=True)
 class PolicyLinearization:
-    """The global policy around one condition's samples: K (T, dU, dX), k (T, dU), cov (T, dU, dU)."""
+    """The global policy around one condition's samples:
+    K (T, dU, dX), k (T, dU), cov (T, dU, dU)."""
 
     K: np.ndarray
     k: np.ndarray

@@ -2,10 +2,11 @@
 5.4) and a Gaussian action noise, trained by supervised learning on the local controllers'
 samples (eq. 5.5) with JAX and optax (the optional ``gps`` extra).
 
-The network's loss on sample (x, t) of condition i is nu_t [1/2 (mu(x) - mu_i(x))' P (mu(x) - mu_i(x))
-+ mu(x)' lambda_t / nu_t], i.e. the mean part of nu_t KL(p_i || pi) plus the Lagrange term of
-eq. 5.5; P is the local controller's action precision. Its covariance is the inverse of the mean
-precision of the local controllers (as in Levine et al.'s implementation).
+The network's loss on sample (x, t) of condition i is
+nu_t [1/2 (mu(x) - mu_i(x))' P (mu(x) - mu_i(x)) + mu(x)' lambda_t / nu_t]: the mean part of
+nu_t KL(p_i || pi) plus the Lagrange term of eq. 5.5; P is the local controller's action precision.
+Its covariance is the inverse of the local controllers' mean precision (as in Levine et al.'s
+implementation).
 """
 
 from __future__ import annotations
@@ -86,7 +87,8 @@ def train_policy(params: PolicyParams, X: np.ndarray, targets: np.ndarray, weigh
     tg = jnp.asarray(targets / us, dtype=jnp.float32)
     # W acts on actions; in scaled units it is diag(us) W diag(us).
     wt = jnp.asarray(weights * us[None, :, None] * us[None, None, :], dtype=jnp.float32)
-    theta = {k: jnp.asarray(getattr(params, k), dtype=jnp.float32) for k in ("w1", "b1", "w2", "b2")}
+    theta = {k: jnp.asarray(getattr(params, k), dtype=jnp.float32)
+             for k in ("w1", "b1", "w2", "b2")}
     opt = optax.adam(learning_rate)
     n = X.shape[0]
     b = min(batch, n)

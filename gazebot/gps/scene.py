@@ -89,7 +89,7 @@ class Observation:
     g_r: float  # gripper width [m], 0 closed
     r_ee: np.ndarray  # (3, 3) gripper frame orientation
     w_ee: np.ndarray  # (3,) gripper angular velocity, world frame
-    torque: np.ndarray  # (7,) N m, joint torque applied (command + the robot's gravity compensation)
+    torque: np.ndarray  # (7,) N m applied: command + the robot's gravity compensation
 
 
 class HandoverScene:

@@ -27,7 +27,7 @@ def azimuths(cfg: ShellConfig) -> np.ndarray:
 
 
 def shell_grid(cfg: ShellConfig, grid: int | None = None) -> np.ndarray:
-    """All test locations [m] as an (n_azimuth * grid^2, 3) array (2299 for the seed's 19 x 11 x 11).
+    """All test locations [m], (n_azimuth * grid^2, 3): 2299 for the seed's 19 x 11 x 11.
 
     ``grid`` overrides the per-azimuth grid size for a coarser quick run.
     """

@@ -13,7 +13,8 @@ import yaml
 from gazebot.cli import main
 from gazebot.gps.config import default_gps_path
 
-pytest.importorskip("jax")
+pytest.importorskip("jax", reason="gazebot gps needs the optional extra gazebot[gps]")
+pytest.importorskip("sklearn", reason="gazebot gps needs the optional extra gazebot[gps]")
 
 
 @pytest.fixture(scope="module")

@@ -7,11 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gazebot.gps.cost import ReachCost
-from gazebot.gps.dynamics import GMMPrior, fit_dynamics, transitions
-from gazebot.gps.lingauss import LinearGaussian
-from gazebot.gps.lqg import PolicyLinearization, forward, kl_per_step, lqg_update
-from gazebot.gps.policy import init_policy, jacobians, train_policy
+pytest.importorskip("sklearn", reason="the GMM prior needs the optional extra gazebot[gps]")
+
+from gazebot.gps.cost import ReachCost  # noqa: E402
+from gazebot.gps.dynamics import GMMPrior, fit_dynamics, transitions  # noqa: E402
+from gazebot.gps.lingauss import LinearGaussian  # noqa: E402
+from gazebot.gps.lqg import PolicyLinearization, forward, kl_per_step, lqg_update  # noqa: E402
+from gazebot.gps.policy import init_policy, jacobians, train_policy  # noqa: E402
 
 T, DX, DU = 15, 4, 2
 

@@ -1,4 +1,4 @@
-"""The chapter-5 scene: the Panda learner built from its DH table, the tester, eq. 5.12, the shell."""
+"""The chapter-5 scene: the Panda learner from its DH table, the tester, eq. 5.12, the shell."""
 
 from __future__ import annotations
 
