@@ -29,7 +29,8 @@ None brings the eight published shares closer (sum of absolute gaps: own 45.2 po
 to the shares end two frames before the transfer (about 5 frames long), contradicting the
 published lengths. The seed's figures may come from a labelling that differs from the public
 files; lacking a window that reproduces them, the plain own-reach window stays
-(``tests/annotations/test_annotations_real_data.py`` pins its numbers).
+(``tests/annotations/test_annotations_real_data.py`` states each published figure beside
+ours, with the gap and its measured reason).
 """
 
 from __future__ import annotations

@@ -167,9 +167,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     a.add_argument(
         "--sides",
         choices=["one", "two"],
-        default="one",
-        help="p-values of the proportion difference tests: one-sided in the observed direction "
-        "(default, as the seed's Tables B.7-B.12) or two-sided",
+        default=None,
+        help="override the sidedness of every proportion difference test (default: as the "
+        "seed's tables, matched one-sided in the observed direction as B.7-B.9, unmatched "
+        "video vs in-person two-sided as B.10-B.12)",
     )
     a.set_defaults(func=_input_errors(_analyze))
 
@@ -373,7 +374,8 @@ def _analyze(args: argparse.Namespace) -> int:
         print(
             f"{c.measure} {c.behavior_i} vs {c.behavior_j} ({c.design}, n={c.n_a}/{c.n_b}): "
             f"{c.sample_a} {c.proportion_a:.2f} vs {c.sample_b} {c.proportion_b:.2f}, "
-            f"z={c.difference.z:.2f} p={c.difference.p_value:.2f} ({args.sides}-sided), "
+            f"z={c.difference.z:.2f} p={c.difference.p_value:.2f} ({c.sides}-sided"
+            f"{', as ' + c.table if c.table and args.sides is None else ''}), "
             f"equivalence p={c.equivalence.p_value:.2f}"
         )
     return 0

@@ -28,6 +28,11 @@ class ReachObservation:
         target: A predetermined handover location (STL ``predetermined`` strategies), else None.
         robot_holds_object: The object state ``o == o_r`` (STL).
         zone_center: The robot's base, the centre of the STL handover zone.
+        object_free: The object state ``o == o_g`` (on the ground: nobody holds it; STL giver
+            pick-up, Table 4.2's t_5).
+        object_position: Where the object is (``p_o``), for the pick-up; None: not sensed.
+        dropoff: The object's drop-off location (``p_d``) of a receiving robot (Table 4.2's
+            t_3); None: the task ends with the object held.
     """
 
     t: float
@@ -36,9 +41,13 @@ class ReachObservation:
     target: np.ndarray | None = None
     robot_holds_object: bool = False
     zone_center: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    object_free: bool = False
+    object_position: np.ndarray | None = None
+    dropoff: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        names = ("x", "hand") if self.target is None else ("x", "hand", "target")
+        optional = ("target", "object_position", "dropoff")
+        names = ("x", "hand") + tuple(n for n in optional if getattr(self, n) is not None)
         for name in names:
             v = np.asarray(getattr(self, name), float)
             if v.shape != (3,) or not np.all(np.isfinite(v)):

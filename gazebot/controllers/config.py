@@ -97,11 +97,31 @@ class STLConfig(_Strict):
     retreat_time_s: float = Field(
         default=2.5, gt=0, description="t_3 / t_9: at the drop-off (or home) this soon"
     )
+    release_time_s: float = Field(
+        default=1.0, gt=0, description="t_4: a receiver opens this soon at the drop-off"
+    )
+    pickup_time_s: float = Field(
+        default=3.0, gt=0, description="t_5: a giver is at the object this soon once it is free"
+    )
+    pickup_grasp_time_s: float = Field(
+        default=1.0, gt=0, description="t_6: a giver grasps this soon once at the object"
+    )
+    gripper_speed_per_s: float = Field(
+        default=4.0,
+        gt=0,
+        le=100,
+        description="|dg_r/dt| cap: gripper openness (0 closed .. 1 open) per second (eq. 4.2)",
+    )
+    gripper_margin: float = Field(
+        default=0.02, ge=0, description="synthesize the openness this far inside eps_g"
+    )
 
     @model_validator(mode="after")
     def _ordered(self) -> STLConfig:
         if self.margin_m >= self.eps_p_m:
             raise ValueError("margin_m < eps_p_m")
+        if self.gripper_margin >= self.eps_g:
+            raise ValueError("gripper_margin < eps_g")
         if self.delta_1 > self.delta_2:
             raise ValueError("delta_1 <= delta_2")
         return self

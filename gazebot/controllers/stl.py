@@ -11,6 +11,12 @@ with the trigger and target of the strategy (Table 4.3): ``proactive`` triggers 
 is not with the robot (receiver; with the robot for a giver, t_7), ``reactive`` also needs the
 human hand in the handover zone (``||p_h - c|| <= l_h``); ``towards-human`` targets the hand
 predicted by the least-squares LDS (eq. 4.5), ``predetermined`` a fixed handover location.
+The same synthesis serves Table 4.2's other position specifications, picked from the object
+state each step: a giver with the object on the ground (``o == o_g``) goes to it first
+(``[](o == o_g => <>_[0, t_5] ||p_o - p_r|| < eps_p)``, the pick-up), and a receiver holding
+the object (``o == o_r``) with a drop-off location carries it there
+(``[](o == o_r => <>_[0, t_3] ||p_r - p_d|| < eps_p)``, the retreat). The gripper's
+specifications (t_2, t_4, t_6, t_8) are :class:`~gazebot.controllers.stl_gripper.STLGripper`'s.
 The "eventually" is encoded with one binary per future step (big-M on the l1 distance); each
 triggered window, including one opened in the past and not yet met, needs a near step. Windows
 that end beyond the horizon are left to later steps (as the receding-horizon synthesis of
@@ -21,6 +27,7 @@ Raman et al. does). "If no feasible control input is found, the robot stops." So
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -30,8 +37,20 @@ from gazebot.controllers.human_model import LinearHandModel
 from gazebot.controllers.stl_milp import ReachMILP, solve_reach_milp
 
 
+@dataclass(frozen=True)
+class ActiveSpec:
+    """The Table 4.2/4.3 position specification a step synthesizes:
+    ``[](trigger => <>_[0, steps dt] ||target - p_r||_1 < eps_p)`` over the horizon."""
+
+    name: str  # its time bound: "t1", "t3", "t5" or "t7"
+    trigger: np.ndarray  # (H + 1,) bool, at x_0..x_H
+    target: np.ndarray  # (H + 1, 3)
+    steps: int
+
+
 class STLController(ReachController):
-    """Receding-horizon MILP synthesis of the Table 4.3 reach specification."""
+    """Receding-horizon MILP synthesis of the Table 4.3 reach specification and of Table 4.2's
+    pick-up (t_5) and carry to the drop-off (t_3); ``active`` names the last step's."""
 
     name = "stl"
 
@@ -44,6 +63,7 @@ class STLController(ReachController):
     def reset(self) -> None:
         self.model.reset()
         self.last_milp: ReachMILP | None = None  # the last step's problem (benchmarks, debugging)
+        self.active: ActiveSpec | None = None  # the last step's specification
         self._pending: int | None = None  # step the oldest unmet trigger fired
 
     def _triggered(self, hand: np.ndarray, holds: bool, center: np.ndarray) -> np.ndarray:
@@ -54,22 +74,38 @@ class STLController(ReachController):
             trig &= np.linalg.norm(hand - center, axis=1) <= self.stl.zone_radius_m
         return trig
 
-    def plan(self, obs: ReachObservation) -> VelocityPlan:
-        t_start = time.perf_counter()
-        H, eps = self.stl.horizon, self.stl.eps_p_m
-        k = self.steps(obs.t)
-        n1 = self.steps(self.config.reach_time_s)
-        x0 = np.asarray(obs.x, float)
-        center = np.asarray(obs.zone_center, float)
-        self.model.observe(obs.hand)
-        hand = self.model.predict(H)  # j = 0..H
+    def _spec(self, obs: ReachObservation, hand: np.ndarray) -> ActiveSpec:
+        """Which position specification binds now (the object state picks it; module doc)."""
+        H = self.stl.horizon
+        always = np.ones(H + 1, bool)
+        giver = self.stl.role is Role.GIVER
+        if giver and obs.object_free and obs.object_position is not None:
+            at = np.tile(np.asarray(obs.object_position, float), (H + 1, 1))
+            return ActiveSpec("t5", always, at, self.steps(self.stl.pickup_time_s))
+        if not giver and obs.robot_holds_object and obs.dropoff is not None:
+            at = np.tile(np.asarray(obs.dropoff, float), (H + 1, 1))
+            return ActiveSpec("t3", always, at, self.steps(self.stl.retreat_time_s))
         if self.stl.strategy.towards_human:
             target = hand
         else:
             if obs.target is None:
                 raise ValueError(f"strategy {self.stl.strategy.value} needs a handover location")
             target = np.tile(np.asarray(obs.target, float), (H + 1, 1))
-        trig = self._triggered(hand, obs.robot_holds_object, center)
+        trig = self._triggered(hand, obs.robot_holds_object, np.asarray(obs.zone_center, float))
+        name = "t7" if giver else "t1"
+        return ActiveSpec(name, trig, target, self.steps(self.config.reach_time_s))
+
+    def plan(self, obs: ReachObservation) -> VelocityPlan:
+        t_start = time.perf_counter()
+        H, eps = self.stl.horizon, self.stl.eps_p_m
+        k = self.steps(obs.t)
+        x0 = np.asarray(obs.x, float)
+        self.model.observe(obs.hand)
+        spec = self._spec(obs, self.model.predict(H))  # hand at j = 0..H
+        if self.active is not None and spec.name != self.active.name:
+            self._pending = None  # a new specification: its own windows
+        self.active = spec
+        trig, target, n1 = spec.trigger, spec.target, spec.steps
         near_now = float(np.abs(x0 - target[0]).sum()) < eps
         if near_now:
             self._pending = None

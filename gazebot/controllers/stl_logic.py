@@ -143,8 +143,9 @@ class Eventually(Formula):
 # --------------------------------------------------------------------------- handover specs
 # Signals used below (base frame, m): p_r (robot end effector), p_h (human hand), p_o (object),
 # p_star (predetermined handover location), p_d (drop-off), p_home (robot home), alpha (the
-# robot's load share 0..1), g_r (gripper openness 0 closed .. 1 open), e (1 once the handover
-# signal is given).
+# robot's load share 0..1), g_r / g_h (gripper / hand openness 0 closed .. 1 open), e (1 once
+# the handover signal is given). Orientations (q) are left out: gazebot synthesizes positions
+# only, as the seed's simulations do (4.4: "we only consider the position trajectory").
 
 
 def _l1(s: Signal, a: str, b: str) -> np.ndarray:
@@ -212,6 +213,11 @@ def reach_spec(
     return Always(implies(trigger, Eventually(goal, 0.0, reach_time_s)))
 
 
+def _gripper_at(name: str, level: float, tol: float) -> Formula:
+    """``|g_r - level| < eps_g``: the gripper's openness at ``level`` (1 open, ``g*`` holding)."""
+    return Predicate(name, lambda s: tol - np.abs(s["g_r"] - level))
+
+
 def transfer_spec(cfg: STLConfig, t_s: float, role: Role) -> Formula:
     """Table 4.2 transfer: receiver grasps (``|g_r - g*| < eps_g``) within t_2 of reaching the
     shared/held object; giver opens within t_8 once the object is shared."""
@@ -221,8 +227,33 @@ def transfer_spec(cfg: STLConfig, t_s: float, role: Role) -> Formula:
         at_obj = near("p_o", "p_r", cfg.eps_p_m)
         grasped = Predicate("g_r=g*", lambda s: tol - np.abs(s["g_r"] - width))
         return Always(implies(And(at_obj, Or(o["o_h"], o["o_s"])), Eventually(grasped, 0, t_s)))
-    opened = Predicate("g_r=1", lambda s: tol - np.abs(s["g_r"] - 1.0))
-    return Always(implies(o["o_s"], Eventually(opened, 0, t_s)))
+    return Always(implies(o["o_s"], Eventually(_gripper_at("g_r=1", 1.0, tol), 0, t_s)))
+
+
+def release_spec(cfg: STLConfig, t_s: float) -> Formula:
+    """Table 4.2, receiver retreat, second formula (t_4): at the drop-off holding the object,
+    the gripper is open (``|g_r - 1| < eps_g``) within ``t_s``:
+    ``[]((||p_r - p_d|| < eps_p and o == o_r) => <>_[0, t_4] |g_r - 1| < eps_g)``."""
+    o = object_states(cfg, cfg.eps_p_m)
+    at_dropoff = And(near("p_r", "p_d", cfg.eps_p_m), o["o_r"])
+    return Always(implies(at_dropoff, Eventually(_gripper_at("g_r=1", 1.0, cfg.eps_g), 0, t_s)))
+
+
+def pickup_reach_spec(cfg: STLConfig, t_s: float) -> Formula:
+    """Table 4.2, giver pick-up, first formula (t_5): while the object is on the ground the
+    gripper gets to it within ``t_s``: ``[](o == o_g => <>_[0, t_5] ||p_o - p_r|| < eps_p)``."""
+    o = object_states(cfg, cfg.eps_p_m)
+    return Always(implies(o["o_g"], Eventually(near("p_o", "p_r", cfg.eps_p_m), 0, t_s)))
+
+
+def pickup_grasp_spec(cfg: STLConfig, t_s: float) -> Formula:
+    """Table 4.2, giver pick-up, second formula (t_6): at the object on the ground, the gripper
+    closes to the grip width within ``t_s``:
+    ``[]((||p_o - p_r|| < eps_p and o == o_g) => <>_[0, t_6] |g_r - g*| < eps_g)``."""
+    o = object_states(cfg, cfg.eps_p_m)
+    at_object = And(near("p_o", "p_r", cfg.eps_p_m), o["o_g"])
+    grasped = _gripper_at("g_r=g*", cfg.grip_width, cfg.eps_g)
+    return Always(implies(at_object, Eventually(grasped, 0, t_s)))
 
 
 def retreat_spec(cfg: STLConfig, t_s: float, role: Role) -> Formula:
@@ -232,3 +263,25 @@ def retreat_spec(cfg: STLConfig, t_s: float, role: Role) -> Formula:
     if role is Role.RECEIVER:
         return Always(implies(o["o_r"], Eventually(near("p_r", "p_d", cfg.eps_p_m), 0, t_s)))
     return Always(implies(o["o_h"], Eventually(near("p_r", "p_home", cfg.eps_p_m), 0, t_s)))
+
+
+def table_4_2(cfg: STLConfig, reach_time_s: float, role: Role) -> dict[str, Formula]:
+    """Every Table 4.2 specification of ``role`` with ``cfg``'s times, keyed by its time bound
+    in the order of the task: receiver ``t1``-``t4``, giver ``t5``-``t9``. The reach (``t1`` /
+    ``t7``) is Table 4.3's row for ``cfg.strategy``, which "replaces the reach phase
+    specification in Table 4.2"."""
+    reach = reach_spec(cfg, reach_time_s, role=role)
+    if role is Role.RECEIVER:
+        return {
+            "t1": reach,
+            "t2": transfer_spec(cfg, cfg.transfer_time_s, role),
+            "t3": retreat_spec(cfg, cfg.retreat_time_s, role),
+            "t4": release_spec(cfg, cfg.release_time_s),
+        }
+    return {
+        "t5": pickup_reach_spec(cfg, cfg.pickup_time_s),
+        "t6": pickup_grasp_spec(cfg, cfg.pickup_grasp_time_s),
+        "t7": reach,
+        "t8": transfer_spec(cfg, cfg.transfer_time_s, role),
+        "t9": retreat_spec(cfg, cfg.retreat_time_s, role),
+    }

@@ -1,8 +1,10 @@
 """The STL reach MILP of one receding-horizon step (seed eqs. 4.1-4.4), assembled as sparse
 matrices and solved with HiGHS through ``scipy.optimize.milp``.
 
-Variables, ``H`` steps: velocities ``u`` (H x 3), their absolute values ``a`` (H x 3), the
-absolute position gaps ``d`` (H x 3) and one binary ``b_j`` per step ("near at x_j"):
+Variables, ``H`` steps of a ``D``-dimensional integrator (D = 3 for the end effector's position,
+1 for the gripper's openness; eq. 4.2 makes both ``x_dot = u``): velocities ``u`` (H x D), their
+absolute values ``a`` (H x D), the absolute gaps ``d`` (H x D) and one binary ``b_j`` per step
+("near at x_j"):
 
     min  sum a
     s.t. -u_max <= u <= u_max,  a >= |u|
@@ -27,8 +29,8 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 class ReachMILP:
     """One step's problem data (base frame, m, s)."""
 
-    x0: np.ndarray  # (3,) end effector now
-    target: np.ndarray  # (H, 3) where to be near at x_1..x_H
+    x0: np.ndarray  # (D,) the state now (end effector position, or gripper openness)
+    target: np.ndarray  # (H, D) where to be near at x_1..x_H
     windows: np.ndarray  # (R, H) 0/1: which steps each required window covers
     required: np.ndarray  # (R,) 1 where the window must hold a near step
     dt: float
@@ -39,24 +41,28 @@ class ReachMILP:
     def horizon(self) -> int:
         return len(self.target)
 
+    @property
+    def dim(self) -> int:
+        return len(np.asarray(self.x0).reshape(-1))
+
     def big_m(self) -> np.ndarray:
         """Per-step big-M: the largest l1 gap ``x_j`` can have from ``target_j`` at the speed cap
         (a tight M keeps the LP relaxation, and so the branch and bound, small)."""
         j = np.arange(1, self.horizon + 1)
         start = np.abs(np.asarray(self.target, float) - np.asarray(self.x0, float)).sum(axis=1)
-        return start + 3.0 * self.u_max * self.dt * j + self.eps
+        return start + self.dim * self.u_max * self.dt * j + self.eps
 
 
 def solve_reach_milp(p: ReachMILP, mip_gap: float = 1e-4) -> tuple[np.ndarray | None, str]:
-    """``(u (H, 3), "optimal")`` or ``(None, reason)`` when no input meets the windows."""
-    H = p.horizon
-    n3 = 3 * H
+    """``(u (H, D), "optimal")`` or ``(None, reason)`` when no input meets the windows."""
+    H, dim = p.horizon, p.dim
+    n3 = dim * H
     # Column blocks: u [0, n3), a [n3, 2 n3), d [2 n3, 3 n3), b [3 n3, 3 n3 + H)
     I3 = sparse.identity(n3, format="csr")
     Z3 = sparse.csr_matrix((n3, n3))
     ZB = sparse.csr_matrix((n3, H))
-    # x_flat = x0_tiled + S u_flat, S = kron(dt * tril(ones), I_3) (row-major (j, axis))
-    S = sparse.kron(sparse.csr_matrix(np.tril(np.ones((H, H))) * p.dt), sparse.identity(3))
+    # x_flat = x0_tiled + S u_flat, S = kron(dt * tril(ones), I_D) (row-major (j, axis))
+    S = sparse.kron(sparse.csr_matrix(np.tril(np.ones((H, H))) * p.dt), sparse.identity(dim))
     x_free = np.tile(np.asarray(p.x0, float), H) - np.asarray(p.target, float).reshape(-1)
     M = p.big_m()
     rows = [
@@ -72,7 +78,7 @@ def solve_reach_milp(p: ReachMILP, mip_gap: float = 1e-4) -> tuple[np.ndarray | 
                 [
                     sparse.csr_matrix((H, n3)),
                     sparse.csr_matrix((H, n3)),
-                    sparse.kron(sparse.identity(H), np.ones((1, 3))),
+                    sparse.kron(sparse.identity(H), np.ones((1, dim))),
                     sparse.diags(M),
                 ]
             ),
@@ -126,20 +132,20 @@ def solve_reach_milp(p: ReachMILP, mip_gap: float = 1e-4) -> tuple[np.ndarray | 
     )
     if res.status != 0 or res.x is None:
         return None, "infeasible" if res.status == 2 else f"status {res.status}: {res.message}"
-    return np.asarray(res.x[:n3], float).reshape(H, 3), "optimal"
+    return np.asarray(res.x[:n3], float).reshape(H, dim), "optimal"
 
 
 def solve_reach_milp_cvxpy(p: ReachMILP, solver: str = "SCIPY") -> tuple[np.ndarray | None, str]:
     """The same MILP built and solved through cvxpy (default solver: SciPy's HiGHS)."""
     import cvxpy as cp
 
-    H = p.horizon
-    U = cp.Variable((H, 3))
+    H, dim = p.horizon, p.dim
+    U = cp.Variable((H, dim))
     b = cp.Variable(H, boolean=True)
-    Au = cp.Variable((H, 3))
-    D = cp.Variable((H, 3))
+    Au = cp.Variable((H, dim))
+    D = cp.Variable((H, dim))
     X = (
-        np.ones((H, 1)) @ np.asarray(p.x0, float).reshape(1, 3)
+        np.ones((H, 1)) @ np.asarray(p.x0, float).reshape(1, dim)
         + (np.tril(np.ones((H, H))) * p.dt) @ U
     )
     cons = [

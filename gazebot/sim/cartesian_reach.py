@@ -92,9 +92,14 @@ class CartesianReach:
         hand: np.ndarray,
         target: np.ndarray | None = None,
         robot_holds_object: bool = False,
+        object_free: bool = False,
+        object_position: np.ndarray | None = None,
+        dropoff: np.ndarray | None = None,
     ) -> ReachStep:
         """Advance to ``t`` (``dt`` since the last call) toward ``hand`` (the point to take the
-        object at); plans when a control period has passed."""
+        object at); plans when a control period has passed. The object state and places
+        (``object_free``, ``object_position``, ``dropoff``) go to the controller as
+        :class:`~gazebot.controllers.base.ReachObservation` describes them."""
         assert self._q_cmd is not None, "start() first"
         plan = None
         if t + 1e-9 >= self._next_plan:
@@ -107,6 +112,9 @@ class CartesianReach:
                     target=target,
                     robot_holds_object=robot_holds_object,
                     zone_center=self.zone_center,
+                    object_free=object_free,
+                    object_position=object_position,
+                    dropoff=dropoff,
                 )
             )
             self._u = plan.command.copy()

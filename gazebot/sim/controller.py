@@ -4,7 +4,14 @@ lets go (or right after grasping). The reach is a joint-space minimum-jerk move 
 pose (the gaze studies' robot) or, given a :class:`~gazebot.sim.cartesian_reach.CartesianReach`,
 one of the seed's Cartesian controllers (pv, mcj, mce, stl) toward the object in the giver's hand;
 the retreat is a joint-space minimum-jerk move home (the seed's STL robot, 4.4.4: "the retreat
-motion of the robot [was] commanded by another controller")."""
+motion of the robot [was] commanded by another controller").
+
+Table 4.2's whole task (the ``stl`` reach with an :class:`~gazebot.controllers.stl_gripper.
+STLGripper`): a giving robot given a ``pickup`` point starts with an open, empty gripper, goes to
+the object (t_5) and grasps it (t_6) before its handover starts; a receiving robot given a
+``dropoff`` point carries the object there (t_3), opens its gripper (t_4), leaves the object and
+returns home. In these scenes the transfer's grasp (t_2) and release (t_8) are synthesized by the
+same gripper; elsewhere the gripper closes or opens over ``gripper_close_s``."""
 
 from __future__ import annotations
 
@@ -13,6 +20,7 @@ from enum import Enum
 
 import numpy as np
 
+from gazebot.controllers.stl_gripper import STLGripper
 from gazebot.sim.cartesian_reach import CartesianReach
 from gazebot.sim.motion import PEAK_RATE, MinJerkSegment
 from gazebot.sim.scene_config import ControllerConfig, RetreatTrigger
@@ -20,12 +28,16 @@ from gazebot.types import Event, EventKind
 
 
 class ControllerState(str, Enum):
+    PICKING_UP = "picking_up"  # giver with a pick-up: going to the object (t_5)
+    PICK_GRASPING = "pick_grasping"  # closing on the object at the pick-up (t_6)
     WAITING = "waiting"  # at home, watching for the giver to start
     REACHING = "reaching"
     AT_HANDOVER = "at_handover"  # waiting for the object to come close
     GRASPING = "grasping"  # closing the gripper
     RELEASING = "releasing"  # robot-to-human: opening the gripper
     HOLDING = "holding"  # grasped; waiting for the giver to let go
+    CARRYING = "carrying"  # receiver with a drop-off: taking the object there (t_3)
+    DROPPING = "dropping"  # opening the gripper at the drop-off (t_4)
     RETREATING = "retreating"
     DONE = "done"
 
@@ -43,6 +55,9 @@ class Sensed:
     object_gap: float
     hand_object_gap: float
     object_pos: np.ndarray | None = None  # where to take the object (Cartesian reaches)
+    #: The robot's load share alpha_r (0..1), a gripper force sensor's reading (seed Table 4.1);
+    #: None: not sensed. A receiver with a drop-off carries the object once it holds it alone.
+    load_share: float | None = None
 
 
 @dataclass(frozen=True)
@@ -67,6 +82,12 @@ class HandoverController:
             released the vial if the human's hand was within a certain distance from the robot's
             gripper") and retreats once it has let go. ``Sensed.object_gap`` is then the
             distance from the object to the person's hand.
+        pickup: A giver's pick-up point (m): the object starts there, the robot picks it up
+            first (needs ``reach`` and ``gripper``).
+        dropoff: A receiver's drop-off point (m): the robot carries the object there and lets
+            go of it (needs ``reach`` and ``gripper``).
+        gripper: The synthesized gripper of Table 4.2's grasp and release at the pick-up and
+            the drop-off.
     """
 
     def __init__(
@@ -78,6 +99,9 @@ class HandoverController:
         start_at: float | None = None,
         target: np.ndarray | None = None,
         giver: bool = False,
+        pickup: np.ndarray | None = None,
+        dropoff: np.ndarray | None = None,
+        gripper: STLGripper | None = None,
     ) -> None:
         self.home = np.asarray(home, float)
         self.handover = np.asarray(handover, float)
@@ -99,6 +123,26 @@ class HandoverController:
         self.infeasible_at: float | None = None
         self._last_t: float | None = None
         self._last_q = self.home.copy()
+        self.pickup = None if pickup is None else np.asarray(pickup, float)
+        self.dropoff = None if dropoff is None else np.asarray(dropoff, float)
+        if (self.pickup is not None or self.dropoff is not None) and (
+            reach is None or gripper is None
+        ):
+            raise ValueError("a pick-up or drop-off needs a Cartesian reach and a gripper")
+        if self.pickup is not None and not self.giver:
+            raise ValueError("only a giving robot picks the object up")
+        if self.dropoff is not None and self.giver:
+            raise ValueError("only a receiving robot has a drop-off")
+        self.gripper_synth = gripper
+        self._g_t0: float | None = None  # when the current gripper specification started
+        self._g_next = -np.inf
+        self._g_u = 0.0
+        self.gripper_infeasible_at: float | None = None
+        self.dropped = False  # the object was left at the drop-off
+        self._last_tick_dt: float | None = None
+        if self.pickup is not None:
+            self.state = ControllerState.PICKING_UP
+            self._gripper = 0.0  # open, empty
 
     def planned_duration(self, start: np.ndarray, goal: np.ndarray, minimum: float) -> float:
         """Duration of a minimum-jerk move whose fastest joint peaks at the speed limit."""
@@ -157,8 +201,14 @@ class HandoverController:
             self._grasp_t0 = t
             s = ControllerState.RELEASING
         if s is ControllerState.RELEASING:
-            self._gripper = max(0.0, 1.0 - (t - self._grasp_t0) / cfg.gripper_close_s)
-            if self._gripper <= 0.0:
+            if self._gripper_synthesized(t, release=True):  # t_8
+                released = True
+            elif self.gripper_synth is not None:
+                released = False
+            else:
+                self._gripper = max(0.0, 1.0 - (t - self._grasp_t0) / cfg.gripper_close_s)
+                released = self._gripper <= 0.0
+            if released:
                 self._emit(EventKind.ROBOT_RELEASED, t)
                 start = self.reach.hold() if self.reach is not None else self._last_q
                 duration = self._move(t, start, self.home, cfg.retreat_min_duration_s)
@@ -166,15 +216,100 @@ class HandoverController:
                 s = ControllerState.RETREATING
         return s
 
+    def _gripper_tick(self, t: float, dt: float, goal: float, within_s: float) -> bool:
+        """One tick of the synthesized gripper toward openness ``goal`` within ``within_s`` of
+        this specification's start; True once ``|g_r - goal| < eps_g``."""
+        g = self.gripper_synth
+        assert g is not None
+        if self._g_t0 is None:
+            g.reset()
+            self._g_t0, self._g_next = t, t
+        if t + 1e-9 >= self._g_next:
+            plan = g.plan(t - self._g_t0, 1.0 - self._gripper, goal, True, within_s)
+            self._g_u = plan.command
+            if not plan.feasible and self.gripper_infeasible_at is None:
+                self.gripper_infeasible_at = t  # it stops ("the robot stops", 4.4.1)
+            self._g_next += g.dt
+        self._gripper = float(np.clip(self._gripper - self._g_u * dt, 0.0, 1.0))
+        return abs((1.0 - self._gripper) - goal) < g.stl.eps_g
+
+    def _gripper_synthesized(self, t: float, release: bool) -> bool:
+        """With the STL gripper: one tick of the transfer's grasp (t_2, to ``g*``) or release
+        (t_8, open); True once met. Without it: False (the ramp of ``gripper_close_s`` runs)."""
+        if self.gripper_synth is None:
+            return False
+        assert self.reach is not None and self._last_tick_dt is not None
+        stl = self.reach.controller.config.stl
+        goal = 1.0 if release else stl.grip_width
+        if self._gripper_tick(t, self._last_tick_dt, goal, stl.transfer_time_s):
+            self._gripper_done()
+            return True
+        return False
+
+    def _gripper_done(self) -> None:
+        self._g_t0, self._g_u = None, 0.0
+
+    def _holds_alone(self, sensed: Sensed) -> bool:
+        """``o == o_r`` from the load share (Table 4.1 with a force sensor: ``alpha_r >
+        delta_2``): the t_3 carry starts when its specification's trigger holds."""
+        assert self.reach is not None and sensed.load_share is not None
+        return sensed.load_share > self.reach.controller.config.stl.delta_2
+
+    def _gap_to(self, q: np.ndarray, point: np.ndarray) -> float:
+        """Gripper-site distance (m) to ``point`` at arm joints ``q``."""
+        assert self.reach is not None
+        return float(np.linalg.norm(self.reach.ik.pose(q).translation - point))
+
+    def _pick_up(self, t: float, dt: float, q: np.ndarray, s: ControllerState):
+        """Giver with a pick-up: to the object (t_5), then grasp it (t_6); returns the state
+        and the arm goal."""
+        assert self.reach is not None and self.pickup is not None
+        stl = self.reach.controller.config.stl
+        if not self.reach.started:
+            self.reach.start(t, q)
+        if s is ControllerState.PICKING_UP:
+            step = self.reach.update(
+                t, dt, self.pickup, object_free=True, object_position=self.pickup
+            )
+            if self._gap_to(q, self.pickup) <= self.config.grasp_distance_m:
+                s = ControllerState.PICK_GRASPING
+            return s, step.q
+        if self._gripper_tick(t, dt, stl.grip_width, stl.pickup_grasp_time_s):
+            self._gripper_done()
+            s = ControllerState.WAITING  # holds it: the handover can start
+        return s, self.reach.hold()
+
+    def _drop_off(self, t: float, dt: float, q: np.ndarray, s: ControllerState):
+        """Receiver with a drop-off: carry the object there (t_3), open (t_4), go home."""
+        assert self.reach is not None and self.dropoff is not None
+        stl = self.reach.controller.config.stl
+        if s is ControllerState.CARRYING:
+            step = self.reach.update(
+                t, dt, self.dropoff, robot_holds_object=True, dropoff=self.dropoff
+            )
+            if self._gap_to(q, self.dropoff) <= self.config.grasp_distance_m:
+                s = ControllerState.DROPPING
+            return s, step.q
+        if self._gripper_tick(t, dt, 1.0, stl.release_time_s):
+            self._gripper_done()
+            self.dropped = True
+            self._emit(EventKind.ROBOT_RELEASED, t)
+            self._move(t, self.reach.hold(), self.home, self.config.retreat_min_duration_s)
+            return ControllerState.RETREATING, None
+        return s, self.reach.hold()
+
     def update(self, t: float, q: np.ndarray, sensed: Sensed) -> ArmCommand:
         """Advance to time ``t`` (s) with the measured arm joints ``q`` (rad)."""
         cfg, s = self.config, self.state
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
         self._last_t = t
+        self._last_tick_dt = dt
         self._last_q = np.asarray(q, float)
         arm_goal: np.ndarray | None = None
         if self._hand0 is None and np.all(np.isfinite(sensed.giver_hand)):
             self._hand0 = sensed.giver_hand.copy()
+        if s in (ControllerState.PICKING_UP, ControllerState.PICK_GRASPING):
+            s, arm_goal = self._pick_up(t, dt, self._last_q, s)
         if s is ControllerState.WAITING and self._started(t, sensed):
             self.handover_start = t
             s = ControllerState.REACHING
@@ -202,8 +337,14 @@ class HandoverController:
             self._grasp_t0 = t
             s = ControllerState.GRASPING
         if s is ControllerState.GRASPING:
-            self._gripper = min(1.0, (t - self._grasp_t0) / cfg.gripper_close_s)
-            if self._gripper >= 1.0:
+            if self._gripper_synthesized(t, release=False):  # t_2
+                grasped = True
+            elif self.gripper_synth is not None:
+                grasped = False
+            else:
+                self._gripper = min(1.0, (t - self._grasp_t0) / cfg.gripper_close_s)
+                grasped = self._gripper >= 1.0
+            if grasped:
                 self._emit(EventKind.ROBOT_GRASPED, t)
                 s = ControllerState.HOLDING
         retreat_now = (
@@ -211,14 +352,23 @@ class HandoverController:
             and not self.giver
             and (
                 cfg.retreat is RetreatTrigger.AFTER_GRASP
-                or sensed.hand_object_gap >= cfg.release_trigger_m
+                or (
+                    self._holds_alone(sensed)
+                    if self.dropoff is not None and sensed.load_share is not None
+                    else sensed.hand_object_gap >= cfg.release_trigger_m
+                )
             )
         )
-        if retreat_now:
+        if retreat_now and self.dropoff is not None:
+            self._emit(EventKind.ROBOT_RETREAT_STARTED, t, planned_duration=0.0)
+            s = ControllerState.CARRYING
+        elif retreat_now:
             start = self.reach.hold() if self.reach is not None else q
             duration = self._move(t, start, self.home, cfg.retreat_min_duration_s)
             self._emit(EventKind.ROBOT_RETREAT_STARTED, t, planned_duration=duration)
             s = ControllerState.RETREATING
+        if s in (ControllerState.CARRYING, ControllerState.DROPPING):
+            s, arm_goal = self._drop_off(t, dt, self._last_q, s)
         if s is ControllerState.RETREATING and self._segment is not None and self._segment.done(t):
             self._emit(EventKind.ROBOT_RETREAT_ENDED, t)
             s = ControllerState.DONE
@@ -235,6 +385,8 @@ class HandoverController:
     @property
     def grasped(self) -> bool:
         """Whether the robot's gripper holds the object."""
+        if self.dropped:
+            return False
         if self.giver:
             return self.state in (
                 ControllerState.WAITING,
@@ -244,6 +396,13 @@ class HandoverController:
             )
         return self.state in (
             ControllerState.HOLDING,
+            ControllerState.CARRYING,
+            ControllerState.DROPPING,
             ControllerState.RETREATING,
             ControllerState.DONE,
         )
+
+    @property
+    def picking_up(self) -> bool:
+        """A giver before it has grasped the object at the pick-up."""
+        return self.state in (ControllerState.PICKING_UP, ControllerState.PICK_GRASPING)

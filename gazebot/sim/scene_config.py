@@ -143,6 +143,16 @@ class ControllerConfig(_Strict):
     grasp_distance_m: float = Field(default=0.05, gt=0, description="object-gripper distance")
     gripper_close_s: float = Field(default=0.35, gt=0)
     release_trigger_m: float = Field(default=0.04, gt=0, description="hand-object gap = let go")
+    pickup_m: tuple[float, float, float] | None = Field(
+        default=None,
+        description="robot-to-human, stl: the object starts here (robot base frame, m) and the "
+        "robot picks it up first (seed Table 4.2, t_5 and t_6)",
+    )
+    dropoff_m: tuple[float, float, float] | None = Field(
+        default=None,
+        description="human-to-robot, stl: the robot carries the object here (robot base frame, "
+        "m) and lets go of it (seed Table 4.2, t_3 and t_4)",
+    )
 
 
 class TrackingNoiseConfig(_Strict):
@@ -216,6 +226,21 @@ class SceneConfig(_Strict):
     giver_motion: GiverMotionConfig | None = Field(
         default=None, description="replay a recorded giver instead of the simulated one"
     )
+
+    @model_validator(mode="after")
+    def _whole_task(self) -> SceneConfig:
+        ctrl = self.controller
+        for field, direction in (
+            ("pickup_m", Direction.ROBOT_TO_HUMAN),
+            ("dropoff_m", Direction.HUMAN_TO_ROBOT),
+        ):
+            if getattr(ctrl, field) is None:
+                continue
+            if ctrl.reach_controller is not ReachControllerName.STL:
+                raise ValueError(f"controller.{field} needs reach_controller: stl (Table 4.2)")
+            if self.direction is not direction:
+                raise ValueError(f"controller.{field} needs direction: {direction.value}")
+        return self
 
     @property
     def has_table(self) -> bool:

@@ -180,19 +180,22 @@ class HandoverSimulation:
             self.layout.rest_hand, self.layout.offer_hand, plan, cued=self.robot_initiated
         )
         ctrl = self.config.controller
+        self._reach_for_gripper = self._cartesian_reach(ctrl)
         self.controller = HandoverController(
             self.home,
             self.robot.handover,
             ctrl,
-            reach=self._cartesian_reach(ctrl),
+            reach=self._reach_for_gripper,
             start_at=ctrl.robot_start_s if self.robot_initiated else None,
             target=np.asarray(self.robot.config.points["handover_location"], float)
             if "handover_location" in self.robot.config.points
             else None,
             giver=self.robot_to_human,
+            **self._whole_task(ctrl),
         )
-        if self.robot_to_human:
-            self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, 1.0)
+        self.data.ctrl[self._gripper_act] = self._clip_ctrl(
+            self._gripper_act, self.controller._gripper
+        )
         self._noise = TrackingNoise(
             tracking_noise or self.config.tracking, np.random.default_rng([self.seed, 1])
         )
@@ -235,6 +238,22 @@ class HandoverSimulation:
         base = self.data.xpos[m.jnt_bodyid[m.joint(self.robot.arm_joints[0]).id]].copy()
         return CartesianReach(make_controller(ctrl.reach_controller.value, cfg), ik, base)
 
+    def _whole_task(self, ctrl: ControllerConfig) -> dict:
+        """The pick-up / drop-off of Table 4.2's whole task, with the STL gripper (scene
+        validation makes sure the reach is ``stl``)."""
+        if ctrl.pickup_m is None and ctrl.dropoff_m is None:
+            return {}
+        from gazebot.controllers.stl_gripper import STLGripper
+
+        reach = self._reach_for_gripper
+        assert reach is not None
+        timing = reach.controller.config
+        return {
+            "pickup": None if ctrl.pickup_m is None else np.asarray(ctrl.pickup_m, float),
+            "dropoff": None if ctrl.dropoff_m is None else np.asarray(ctrl.dropoff_m, float),
+            "gripper": STLGripper(timing.stl, timing.dt_s),
+        }
+
     def _actuator(self, name: str) -> int:
         act = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
         if act < 0:
@@ -270,6 +289,8 @@ class HandoverSimulation:
         if self.robot_to_human:
             self._place_object_robot_giver(hand)
             return
+        if self.controller.dropped:
+            return  # left at the drop-off
         if self.giver.holds_object or not self.controller.grasped:
             self.data.mocap_pos[mocap] = hand + self.layout.object_offset
             self.data.mocap_quat[mocap] = [1.0, 0.0, 0.0, 0.0]
@@ -296,18 +317,25 @@ class HandoverSimulation:
         """Robot-to-human: the object rides in the gripper until the robot lets go, then in the
         person's hand (keeping where it was in the hand when taken)."""
         mocap = self.scene.object_mocap
+        if self.controller.picking_up:  # on the table at the pick-up, upright
+            self.data.mocap_pos[mocap] = self.controller.pickup
+            self.data.mocap_quat[mocap] = [1.0, 0.0, 0.0, 0.0]
+            return
         if not self.controller.grasped:
             if self._object_in_hand is None:
                 self._object_in_hand = self.data.mocap_pos[mocap] - hand
             self.data.mocap_pos[mocap] = hand + self._object_in_hand
             return
         g_pos, g_quat = self._gripper_pose()
-        if self._object_rel is None:  # the start: the object sits in the gripper, upright
+        if self._object_rel is None:  # the start (or the pick-up): in the gripper, upright
             inv = np.zeros(4)
             mujoco.mju_negQuat(inv, g_quat)
             rel_quat = np.zeros(4)
             mujoco.mju_mulQuat(rel_quat, inv, np.array([1.0, 0.0, 0.0, 0.0]))
-            self._object_rel = (np.zeros(3), rel_quat)
+            rel_pos = np.zeros(3)
+            if self.controller.pickup is not None:  # it stays where the gripper closed on it
+                mujoco.mju_rotVecQuat(rel_pos, self.data.mocap_pos[mocap] - g_pos, inv)
+            self._object_rel = (rel_pos, rel_quat)
         rel_pos, rel_quat = self._object_rel
         world = np.zeros(3)
         mujoco.mju_rotVecQuat(world, rel_pos, g_quat)
@@ -375,8 +403,17 @@ class HandoverSimulation:
             object_pos=into_hand,
         )
 
+    @property
+    def robot_load_share(self) -> float:
+        """The robot's share of the object's weight, ``alpha_r`` (seed 4.3): 0 while it does not
+        grip it, 0.5 while the person grips it too, 1 alone."""
+        if not self.controller.grasped:
+            return 0.0
+        return 0.5 if self.giver.holds_object else 1.0
+
     def _sense_robot_receiver(self, obj: np.ndarray, gripper: np.ndarray) -> Sensed:
         return Sensed(
+            load_share=self.robot_load_share,
             giver_hand=self.giver.hand.copy(),
             object_gap=float(np.linalg.norm(obj - gripper)),
             hand_object_gap=float(

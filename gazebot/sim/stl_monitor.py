@@ -2,11 +2,14 @@
 reach ("within t_1 seconds after the handover signal e"), the transfer (grasp within t_2 of the
 object reaching the gripper; a giver robot releases within t_8 of sharing it) and the retreat (at
 the drop-off within t_3 of holding the object; a giver robot home within t_9 of the person
-holding it). Positive robustness: the run met the spec.
+holding it). With a scene's drop-off (``controller.dropoff_m``) the receiver's release there
+(t_4) is monitored too, with a pick-up (``controller.pickup_m``) the giver's pick-up (t_5, t_6).
+Positive robustness: the run met the spec.
 
 In the simulation "near" is the grasp distance (the controller grasps or releases there, seed
 3.3.4), taken as an l1 bound (``sqrt(3)`` times the Euclidean grasp distance); the drop-off of a
-receiving robot is its home gripper position (it retreats home with the object)."""
+receiving robot is the scene's drop-off, else its home gripper position (it retreats home with
+the object)."""
 
 from __future__ import annotations
 
@@ -24,6 +27,9 @@ from gazebot.controllers.stl_logic import (
     Signal,
     implies,
     near,
+    pickup_grasp_spec,
+    pickup_reach_spec,
+    release_spec,
     retreat_spec,
     transfer_spec,
 )
@@ -41,6 +47,8 @@ class HandoverMonitor:
     eps: float = 0.05 * math.sqrt(3)
     home: np.ndarray | None = None
     dt: float | None = None
+    dropoff: np.ndarray | None = None
+    pickup: bool = False
     _last_t: float | None = None
 
     def on_tick(self, sim, _tick=None) -> None:
@@ -56,14 +64,17 @@ class HandoverMonitor:
         gripper = sim.data.site_xpos[sim._gripper_site].copy()
         if self.home is None:
             self.home = gripper.copy()
+        whole = sim.config.controller
+        if whole.dropoff_m is not None:
+            self.dropoff = np.asarray(whole.dropoff_m, float)
+        self.pickup = whole.pickup_m is not None
         if self.start_t is None and ctrl.handover_start is not None:
             self.start_t = float(ctrl.handover_start)
         if self._last_t is not None and self.dt is None:
             self.dt = sim.t - self._last_t
         self._last_t = sim.t
-        grasped = ctrl.grasped
         person = sim.giver.holds_object
-        alpha = 0.0 if not grasped else (0.5 if person else 1.0)
+        alpha = sim.robot_load_share
         obj = sim.data.mocap_pos[sim.scene.object_mocap].copy()
         row = {
             "t": sim.t,
@@ -74,7 +85,7 @@ class HandoverMonitor:
             "g_r": 1.0 - float(ctrl._gripper),
             # The person's hand: closed on the object (g*) while holding it, else open.
             "g_h": self.config.stl.grip_width if person else 1.0,
-            "p_d": self.home,
+            "p_d": self.home if self.dropoff is None else self.dropoff,
             "p_home": self.home,
         }
         for k in _KEYS:
@@ -99,11 +110,17 @@ class HandoverMonitor:
         reach = Always(
             implies(e, Eventually(near("p_h", "p_r", self.eps), 0, self.config.reach_time_s))
         )
-        return {
+        specs = {
             "reach": reach,
             "transfer": transfer_spec(stl, stl.transfer_time_s, self.role),
             "retreat": retreat_spec(stl, stl.retreat_time_s, self.role),
         }
+        if self.role is Role.RECEIVER and self.dropoff is not None:
+            specs["release"] = release_spec(stl, stl.release_time_s)  # t_4
+        if self.role is Role.GIVER and self.pickup:
+            specs["pickup"] = pickup_reach_spec(stl, stl.pickup_time_s)  # t_5
+            specs["pickup_grasp"] = pickup_grasp_spec(stl, stl.pickup_grasp_time_s)  # t_6
+        return specs
 
     def robustness(self) -> dict[str, float]:
         """Each spec's robustness over the run (positive: met)."""

@@ -58,6 +58,8 @@ from gazebot.study.stats import (
     matched_equivalence,
     matched_proportion_difference,
     position_bias_test,
+    seed_sides,
+    seed_table,
     unmatched_equivalence,
     unmatched_proportion_difference,
 )
@@ -238,6 +240,10 @@ class LevelComparison:
     group_b: str = ""
     n_a: int = 0
     n_b: int = 0
+    #: "one" or "two": the sidedness of ``difference.p_value``.
+    sides: str = "one"
+    #: The seed's Appendix B table that reports this test ("B.7".."B.12"), else "".
+    table: str = ""
 
     @property
     def sample_a(self) -> str:
@@ -261,7 +267,8 @@ class StudyAnalysis:
     #: questions), as the seed reports each study's (6.4.4 video, 6.4.5 in person).
     bias_by_group: dict[str, dict[str, BiasTest]] = field(default_factory=dict)
     comparisons: list[LevelComparison] = field(default_factory=list)
-    sides: str = "one"
+    #: "seed" (each difference test as the seed's table for its design) or the override.
+    sides: str = "seed"
 
     def to_json(self) -> dict:
         """A JSON-ready dict."""
@@ -325,6 +332,8 @@ class StudyAnalysis:
                     "difference": c.difference.difference,
                     "z": c.difference.z,
                     "p_value": c.difference.p_value,
+                    "sides": c.sides,
+                    "table": c.table,
                     "equivalence_margin": c.equivalence.margin,
                     "equivalence_p_value": c.equivalence.p_value,
                 }
@@ -356,7 +365,7 @@ def analyze(
     margin: float = 0.1,
     behaviors: list[str] | None = None,
     bias_unit: str = "participant",
-    sides: str = "one",
+    sides: str | None = None,
 ) -> StudyAnalysis:
     """Bradley-Terry P_i with the likelihood-ratio chi-square (= eqs 6.1-6.2 for a complete
     design) per sample (level, or ``group:level``) and measure, the first/second bias test per
@@ -365,11 +374,12 @@ def analyze(
     unmatched as the module doc explains. ``behaviors`` fixes the order of the conditions
     (default: :func:`behaviors_of`). The bias test is run per measure and per question (the seed
     reports it per measure in 6.3 and per question in 6.4), over all participants and, with
-    several groups, per group. ``sides``: p-values of the difference
-    tests, ``"one"`` (one-sided in the observed direction, as the seed's Tables B.7-B.12) or
-    ``"two"``."""
-    if sides not in ("one", "two"):
-        raise ValueError(f"sides must be 'one' or 'two', got {sides!r}")
+    several groups, per group. ``sides``: None (default) gives each difference test the seed's
+    sidedness for its design (:data:`~gazebot.study.stats.SEED_SIDES`: matched one-sided in the
+    observed direction as Tables B.7-B.9, unmatched two-sided as Tables B.10-B.12); ``"one"`` or
+    ``"two"`` overrides it for every test."""
+    if sides not in (None, "one", "two"):
+        raise ValueError(f"sides must be 'one', 'two' or None (the seed's), got {sides!r}")
     if not (isinstance(margin, int | float) and math.isfinite(margin) and 0 < margin < 1):
         raise ValueError(f"equivalence margin must be a finite proportion in (0, 1), got {margin}")
     found = behaviors_of(responses)
@@ -379,7 +389,7 @@ def analyze(
         raise ValueError(f"responses compare behaviors {found}, not {list(behaviors)}")
     behaviors = list(behaviors)
     samples = list(dict.fromkeys(r.sample for r in responses))
-    result = StudyAnalysis(behaviors=behaviors, levels=samples, sides=sides)
+    result = StudyAnalysis(behaviors=behaviors, levels=samples, sides=sides or "seed")
     for sample in samples:
         rows = [r for r in responses if r.sample == sample]
         result.per_level[sample] = {}
@@ -444,9 +454,10 @@ def _compare(
     rows_b: list[Response],
     behaviors: list[str],
     margin: float,
-    sides: str = "one",
+    sides: str | None = None,
 ) -> list[LevelComparison]:
-    """Matched tests if the samples share participants (on the shared ones), else unmatched."""
+    """Matched tests if the samples share participants (on the shared ones), else unmatched;
+    ``sides`` None: the seed's sidedness for the design (see :func:`analyze`)."""
     ra, rb = rows_a[0], rows_b[0]
     out = []
     for measure, questions in MEASURES.items():
@@ -462,7 +473,8 @@ def _compare(
                 if xa.size == 0:
                     continue
                 design = "matched"
-                difference = matched_proportion_difference(xa, xb, sides)
+                used = sides or seed_sides(design)
+                difference = matched_proportion_difference(xa, xb, used)
                 equivalence = matched_equivalence(xa, xb, margin)
             else:
                 xa = np.array([v[i, j] for v in pa.values() if np.isfinite(v[i, j])])
@@ -470,8 +482,9 @@ def _compare(
                 if xa.size == 0 or xb.size == 0:
                     continue
                 design = "unmatched"
+                used = sides or seed_sides(design)
                 counts = (float(xa.sum()), xa.size, float(xb.sum()), xb.size)
-                difference = unmatched_proportion_difference(*counts, sides=sides)
+                difference = unmatched_proportion_difference(*counts, sides=used)
                 equivalence = unmatched_equivalence(*counts, margin=margin)
             out.append(
                 LevelComparison(
@@ -489,9 +502,21 @@ def _compare(
                     group_b=rb.group,
                     n_a=int(xa.size),
                     n_b=int(xb.size),
+                    sides=used,
+                    table=_table_of(design, ra, rb),
                 )
             )
     return out
+
+
+def _table_of(design: str, ra: Response, rb: Response) -> str:
+    """The seed's table for a comparison: B.7-B.9 for two levels of a condition answered by the
+    same participants, B.10-B.12 for one level answered by two groups (video, in person)."""
+    across_groups = ra.group != rb.group
+    if (design == "unmatched") != across_groups:
+        return ""  # e.g. a between-subject condition: no table of the seed's
+    table = seed_table(design, ra.condition)
+    return table.name if table is not None else ""
 
 
 def read_win_matrix(path: str | Path) -> tuple[list[str], np.ndarray]:

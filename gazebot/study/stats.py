@@ -132,10 +132,56 @@ class ProportionTest:
 SIDES = ("one", "two")
 
 
+@dataclass(frozen=True)
+class SeedTable:
+    """One of the seed's Appendix B tables of binary proportion difference tests: the design of
+    its test (``matched``: the same participants in two levels, eqs 6.3-6.4; ``unmatched``: the
+    video against the in-person participants, eqs 6.5-6.6), the condition it compares and the
+    sidedness of its p-values."""
+
+    name: str
+    design: str
+    condition: str
+    sides: str
+
+
+# The sidedness of the seed's difference tests, one fact per design: the matched tests of H2-H4
+# (Tables B.7-B.9) one-sided in the observed direction, the unmatched video-against-in-person
+# tests of H5 (Tables B.10-B.12) two-sided, as issue 22 reads the dissertation's Appendix B (the
+# tables are not in the seed excerpt; its H5, "Observers of a handover and participants in a
+# handover have different preference ratings", names no direction).
+SEED_SIDES: dict[str, str] = {"matched": "one", "unmatched": "two"}
+
+SEED_TABLES: tuple[SeedTable, ...] = tuple(
+    SeedTable(name, design, condition, SEED_SIDES[design])
+    for name, design, condition in (
+        ("B.7", "matched", "object-size"),
+        ("B.8", "matched", "fragility"),
+        ("B.9", "matched", "posture"),
+        ("B.10", "unmatched", "object-size"),
+        ("B.11", "unmatched", "fragility"),
+        ("B.12", "unmatched", "posture"),
+    )
+)
+
+
+def seed_sides(design: str) -> str:
+    """The sidedness the seed's tables use for a ``matched`` or ``unmatched`` difference test."""
+    if design not in SEED_SIDES:
+        raise ValueError(f"design must be one of {sorted(SEED_SIDES)}, got {design!r}")
+    return SEED_SIDES[design]
+
+
+def seed_table(design: str, condition: str) -> SeedTable | None:
+    """The Appendix B table that reports a ``design`` test between the levels of ``condition``
+    (None: the seed has no such table, e.g. a between-subject condition of our own)."""
+    return next((t for t in SEED_TABLES if (t.design, t.condition) == (design, condition)), None)
+
+
 def _z_test(diff: float, se: float, sides: str = "two") -> ProportionTest:
     """z = diff / se; ``sides="two"``: p = 2 P(Z > |z|); ``"one"``: p = P(Z > |z|), one-sided in
-    the direction observed (the seed's Tables B.7-B.12 report the preferred condition in bold
-    with such a p)."""
+    the direction observed (the seed's matched Tables B.7-B.9 report the preferred condition in
+    bold with such a p; :data:`SEED_SIDES` holds which design is which)."""
     if sides not in SIDES:
         raise ValueError(f"sides must be 'one' or 'two', got {sides!r}")
     if se <= 0:

@@ -157,3 +157,105 @@ def test_object_states_without_a_force_sensor_follow_table_4_1():
     # a gripper at the object but open does not hold it
     open_gripper = Signal(0.1, {**sig.values, "g_r": np.ones(4)})
     assert states["o_r"].rho(open_gripper)[0] < 0
+
+
+# ------------------------------------------------------------ Table 4.2: t4, t5, t6
+def _cfg(force_sensor: bool):
+    return load_controllers_config().stl.model_copy(update={"force_sensor": force_sensor})
+
+
+def _pickup_trace(n: int = 16, arrive: int = 6, close: int = 8) -> Signal:
+    """A giver robot: the object on the table at P (nobody holds it: o_g), the gripper there at
+    sample ``arrive``, closed on it (g_r = g* = 0) from ``close``, holding it (load share 1) from
+    the next sample. 0.1 s per sample; the person's hand far away and open."""
+    P = np.array([0.5, 0.0, 0.0])
+    k = np.arange(n)
+    return Signal(
+        0.1,
+        {
+            "p_r": np.outer(np.minimum(k / arrive, 1.0), P),
+            "p_o": np.tile(P, (n, 1)),
+            "p_h": np.tile([1.0, 1.0, 0.0], (n, 1)),
+            "g_r": np.where(k < close, 1.0, 0.0),
+            "g_h": np.ones(n),
+            "alpha": np.where(k <= close, 0.0, 1.0),
+        },
+    )
+
+
+def _dropoff_trace(D, n: int = 16, arrive: int = 5, open_at: int | None = 8) -> Signal:
+    """A receiver robot holding the object (g_r = g*, load share 1) carries it from H0 to the
+    drop-off D at sample ``arrive`` and opens (g_r = 1, load share 0) at ``open_at`` (None:
+    never); the object stays where the gripper left it."""
+    H0, D = np.array([0.3, 0.3, 0.3]), np.asarray(D, float)
+    k = np.arange(n)
+    p_r = H0 + np.outer(np.minimum(k / arrive, 1.0), D - H0)
+    opened = np.zeros(n, bool) if open_at is None else k >= open_at
+    return Signal(
+        0.1,
+        {
+            "p_r": p_r,
+            "p_o": p_r.copy(),
+            "p_d": np.tile([0.6, 0.0, 0.2], (n, 1)),
+            "p_h": np.tile([1.0, 1.0, 0.0], (n, 1)),
+            "g_r": np.where(opened, 1.0, 0.0),
+            "g_h": np.ones(n),
+            "alpha": np.where(opened, 0.0, 1.0),
+        },
+    )
+
+
+@pytest.mark.parametrize("force_sensor", [True, False])
+def test_t4_release_at_the_dropoff_robustness_sign(force_sensor):
+    from gazebot.controllers.stl_logic import release_spec
+
+    cfg = _cfg(force_sensor)
+    at_d = _dropoff_trace([0.6, 0.0, 0.2])  # at the drop-off at 0.5 s, open at 0.8 s
+    assert release_spec(cfg, 0.4).robustness(at_d) > 0
+    assert release_spec(cfg, 0.2).robustness(at_d) < 0  # opened 0.3 s after arriving
+    never = _dropoff_trace([0.6, 0.0, 0.2], open_at=None)
+    assert release_spec(cfg, 1.0).robustness(never) < 0
+    # carried elsewhere: never at the drop-off with the object, so t_4 does not bind
+    elsewhere = _dropoff_trace([0.6, 0.2, 0.2], open_at=None)
+    assert release_spec(cfg, 0.2).robustness(elsewhere) > 0
+
+
+@pytest.mark.parametrize("force_sensor", [True, False])
+def test_t5_reach_the_free_object_robustness_sign(force_sensor):
+    from gazebot.controllers.stl_logic import pickup_reach_spec
+
+    cfg = _cfg(force_sensor)
+    trace = _pickup_trace()  # at the object 0.6 s after the start
+    assert pickup_reach_spec(cfg, 0.8).robustness(trace) > 0
+    assert pickup_reach_spec(cfg, 0.4).robustness(trace) < 0
+    # the same motion with the person holding the object (o_h, not o_g): t_5 does not bind
+    held = Signal(
+        trace.dt,
+        {**trace.values, "p_h": trace["p_o"], "g_h": np.zeros(trace.n), "g_r": np.ones(trace.n)},
+    )
+    assert pickup_reach_spec(cfg, 0.4).robustness(held) > 0
+
+
+@pytest.mark.parametrize("force_sensor", [True, False])
+def test_t6_grasp_at_the_object_robustness_sign(force_sensor):
+    from gazebot.controllers.stl_logic import pickup_grasp_spec
+
+    cfg = _cfg(force_sensor)
+    trace = _pickup_trace()  # at the object at 0.6 s, closed at 0.8 s
+    assert pickup_grasp_spec(cfg, 0.3).robustness(trace) > 0
+    assert pickup_grasp_spec(cfg, 0.1).robustness(trace) < 0
+    never = _pickup_trace(close=99)
+    never = Signal(never.dt, {**never.values, "alpha": np.zeros(never.n)})
+    assert pickup_grasp_spec(cfg, 0.5).robustness(never) < 0
+
+
+def test_table_4_2_lists_each_roles_specs_in_task_order():
+    from gazebot.controllers.stl_logic import table_4_2
+
+    cfg = load_controllers_config()
+    assert list(table_4_2(cfg.stl, 3.0, Role.RECEIVER)) == ["t1", "t2", "t3", "t4"]
+    assert list(table_4_2(cfg.stl, 3.0, Role.GIVER)) == ["t5", "t6", "t7", "t8", "t9"]
+    # a whole giver task: picked up in time, so t_5 and t_6 hold
+    giver = table_4_2(cfg.stl.model_copy(update={"pickup_time_s": 0.8}), 3.0, Role.GIVER)
+    trace = _pickup_trace()
+    assert giver["t5"].robustness(trace) > 0 and giver["t6"].robustness(trace) > 0

@@ -238,18 +238,85 @@ def test_levels_of_different_conditions_are_not_compared(tmp_path):
     assert pairs == {("small-box", "large-box", "matched"), ("sitting", "standing", "matched")}
 
 
-def test_bias_is_tested_per_question_as_in_6_4_and_sides_default_to_one(two_level_csv):
+def test_bias_is_tested_per_question_as_in_6_4_and_sides_can_be_overridden(two_level_csv):
     responses = read_responses(two_level_csv)
-    one = analyze(responses, behaviors=BEHAVIORS)
+    seed = analyze(responses, behaviors=BEHAVIORS)
+    one = analyze(responses, behaviors=BEHAVIORS, sides="one")
     two = analyze(responses, behaviors=BEHAVIORS, sides="two")
-    assert list(one.bias_per_question) == ["q1", "q2", "q3", "q4", "q5"]
-    assert one.sides == "one" and one.to_json()["bias_per_question"]["q5"]["z"] == (
-        one.bias_per_question["q5"].z
-    )
-    assert one.to_json()["bias_per_question"]["q5"]["p_z"] == one.bias_per_question["q5"].p_z
+    assert list(seed.bias_per_question) == ["q1", "q2", "q3", "q4", "q5"]
+    assert seed.to_json()["bias_per_question"]["q5"]["z"] == seed.bias_per_question["q5"].z
+    assert seed.to_json()["bias_per_question"]["q5"]["p_z"] == seed.bias_per_question["q5"].p_z
+    assert (seed.sides, one.sides, two.sides) == ("seed", "one", "two")
+    # two levels answered by the same participants: matched, one-sided as the seed's B.7
+    assert {(c.sides, c.table) for c in seed.comparisons} == {("one", "B.7")}
+    assert {c.sides for c in two.comparisons} == {"two"}
     for c1, c2 in zip(one.comparisons, two.comparisons, strict=True):
         assert c1.difference.z == c2.difference.z
         assert c1.difference.p_value == pytest.approx(c2.difference.p_value / 2)
+
+
+_CONDITIONS = {
+    "object-size": ("small-box", "large-box"),
+    "fragility": ("plastic-bottle", "glass-bottle"),
+    "posture": ("sitting", "standing"),
+}
+
+
+@pytest.fixture(scope="module")
+def video_and_in_person(tmp_path_factory):
+    """The seed's section 6.4 design: per condition, 24 video and 24 in-person participants
+    (numbered from 1 in each group) each answer both levels; the groups answer differently."""
+    rows = []
+    for k, (condition, (a, b)) in enumerate(_CONDITIONS.items()):
+        for group, (ta, tb) in (
+            ("video", (TABLE_6_1, TABLE_6_2)),
+            ("in-person", (TABLE_6_2, TABLE_6_1)),
+        ):
+            for level, table in ((a, ta), (b, tb)):
+                rows += _rows(level, table, offset=24 * k, group=group, condition=condition)
+    path = write_responses(rows, tmp_path_factory.mktemp("resp") / "responses.csv")
+    return read_responses(path)
+
+
+@pytest.mark.parametrize(
+    ("table", "design", "condition", "sides"),
+    [
+        ("B.7", "matched", "object-size", "one"),
+        ("B.8", "matched", "fragility", "one"),
+        ("B.9", "matched", "posture", "one"),
+        ("B.10", "unmatched", "object-size", "two"),
+        ("B.11", "unmatched", "fragility", "two"),
+        ("B.12", "unmatched", "posture", "two"),
+    ],
+)
+def test_each_b_table_test_has_the_seeds_sidedness(
+    video_and_in_person, table, design, condition, sides
+):
+    """Matched level tests (B.7-B.9) one-sided, unmatched video vs in-person (B.10-B.12)
+    two-sided; the p-value is recomputed here from z with that sidedness."""
+    from scipy.stats import norm
+
+    result = analyze(video_and_in_person, behaviors=BEHAVIORS)
+    levels = set(_CONDITIONS[condition])
+    tests = [c for c in result.comparisons if c.table == table]
+    # matched: one test per group; unmatched: one per level; each x 3 measures x 6 pairs
+    assert len(tests) == 2 * 3 * 6
+    for c in tests:
+        assert c.design == design and c.sides == sides and {c.level_a, c.level_b} <= levels
+        tail = norm.sf(abs(c.difference.z))
+        assert c.difference.p_value == pytest.approx(tail if sides == "one" else 2 * tail)
+    doc = [d for d in result.to_json()["level_comparisons"] if d["table"] == table]
+    assert {d["sides"] for d in doc} == {sides}
+    # --sides overrides the seed's for every test
+    for override in ("one", "two"):
+        forced = analyze(video_and_in_person, behaviors=BEHAVIORS, sides=override)
+        assert {c.sides for c in forced.comparisons if c.table == table} == {override}
+
+
+def test_unmatched_levels_of_one_group_have_no_seed_table_but_the_seed_sidedness(tmp_path):
+    rows = _rows("small-box", TABLE_6_1) + _rows("large-box", TABLE_6_2, offset=24)
+    result = analyze(read_responses(write_responses(rows, tmp_path / "r.csv")), behaviors=BEHAVIORS)
+    assert {(c.design, c.table, c.sides) for c in result.comparisons} == {("unmatched", "", "two")}
 
 
 def test_a_sample_without_a_finite_fit_is_named_in_the_error(tmp_path):
