@@ -3,7 +3,8 @@
   gazebot gps train --controllers 8|12 --trainer static|moving
       --state reduced|full|relative --out DIR
   gazebot gps evaluate DIR --tester static|moving [--mass KG] [--grid N] [--json] [--plot PNG]
-  gazebot gps figures RESULTS.json... --out DIR
+  gazebot gps demo DIR [--out VIDEO.mp4] [--tester static|moving] [--target X Y Z]
+  gazebot gps figures LABEL=RESULT.npz... --out PNG
 """
 
 from __future__ import annotations
@@ -85,6 +86,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=_evaluate)
 
+    d = gsub.add_parser("demo", help="render the learned reach to a video")
+    d.add_argument("policy", help="directory written by `gazebot gps train`")
+    d.add_argument("--out", default="out/gps-demo.mp4", help="output MP4")
+    d.add_argument("--tester", choices=("static", "moving"), default="moving")
+    d.add_argument("--target", type=float, nargs=3, metavar=("X", "Y", "Z"), default=None,
+                   help="the tester hand's final position, m in the learner's base frame "
+                   "(default: the middle of the test shell)")
+    d.add_argument("--json", action="store_true", help="print a JSON summary")
+    d.set_defaults(func=_demo)
+
     f = gsub.add_parser("figures", help="plot Figs. 5.3-5.5 from saved evaluations")
     f.add_argument("results", nargs="+", help="LABEL=PATH.npz entries written by evaluate --save")
     f.add_argument("--kind", choices=("distributions", "mass"), default="distributions",
@@ -137,6 +148,20 @@ def _evaluate(args: argparse.Namespace) -> int:
         for k, v in summary.items():
             print(f"{k}: {v:.4f}" if isinstance(v, float) else f"{k}: {v}")
     sys.stdout.flush()
+    return 0
+
+
+def _demo(args: argparse.Namespace) -> int:
+    from gazebot.gps.demo import run_demo
+    from gazebot.gps.tester import UnreachableTarget
+
+    try:
+        res = run_demo(args.policy, args.out, args.tester == "moving", args.target)
+    except UnreachableTarget as exc:
+        raise UsageError(f"--target: {exc}") from exc
+    summary = {"video": str(res.video), "frames": res.frames, "target_m": res.target_m,
+               "error_m": res.error_m}
+    print(json.dumps(summary) if args.json else f"wrote {res.video} (error {res.error_m:.3f} m)")
     return 0
 
 

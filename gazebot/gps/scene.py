@@ -38,6 +38,7 @@ def scene_mjcf(cfg: SceneConfig, ee_mass_kg: float | None = None) -> str:
   </default>
   <worldbody>
     <light pos="0 0 3" dir="0 0 -1"/>
+    <camera name="side" pos="0.55 -1.9 0.9" xyaxes="1 0 0 0 0.25 1"/>
     <geom type="plane" size="3 3 0.1" rgba="0.3 0.3 0.3 1" contype="0" conaffinity="0"/>
     {panda.panda_mjcf(mass, cfg.joint_damping, gravcomp_hand)}
     <body name="tester_base" gravcomp="1">

@@ -70,3 +70,19 @@ def test_evaluate_rejects_a_non_positive_mass(trained, capsys):
     with pytest.raises(SystemExit):
         main(["gps", "evaluate", str(trained), "--mass", "-1"])
     assert "expected a finite number > 0" in capsys.readouterr().err
+
+
+def test_demo_renders_one_frame_per_control_step(trained, tmp_path, capsys):
+    from gazebot.sim.gl_check import ensure_gl_backend
+
+    try:
+        ensure_gl_backend()
+    except Exception as exc:  # no EGL/OSMesa on this machine
+        pytest.skip(f"no off-screen GL: {exc}")
+    capsys.readouterr()
+    video = tmp_path / "reach.mp4"
+    assert main(["gps", "demo", str(trained), "--out", str(video), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert video.stat().st_size > 0
+    assert summary["frames"] == 1 + 20  # 1 s trials at 20 Hz in the tiny configuration
+    assert summary["error_m"] >= 0
