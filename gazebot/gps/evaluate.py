@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import spearmanr
 
 from gazebot.gps.badmm import policy_act
 from gazebot.gps.rollout import run_trial
@@ -26,6 +27,7 @@ class Evaluation:
     train_errors: np.ndarray
     moving: bool
     mass_kg: float
+    distances: np.ndarray  # each test location's distance to the nearest training target [m]
 
     def summary(self) -> dict:
         return {
@@ -35,11 +37,15 @@ class Evaluation:
             "test_error_max_m": float(self.errors.max()),
             "n": int(self.errors.size),
             "mean_torque_nm": float(self.torques.mean()),
+            # Fig. 5.2's "error increases as the target location is shifted away from the
+            # training locations": rank correlation of error with that distance.
+            "error_distance_spearman": float(spearmanr(self.errors, self.distances)[0]),
         }
 
     def save(self, path) -> None:
         np.savez(path, points=self.points, errors=self.errors, torques=self.torques,
-                 train_errors=self.train_errors, moving=self.moving, mass_kg=self.mass_kg)
+                 train_errors=self.train_errors, moving=self.moving, mass_kg=self.mass_kg,
+                 distances=self.distances)
 
 
 def evaluate(trained: TrainedPolicy, moving: bool, mass_kg: float | None = None,
@@ -64,5 +70,6 @@ def evaluate(trained: TrainedPolicy, moving: bool, mass_kg: float | None = None,
         finals.append(trial.p_h[-1])
         errors.append(trial.final_error())
         torques.append(trial.torque_norm[1:].mean())
+    dist = np.min(np.linalg.norm(pts[:, None] - trained.targets[None], axis=2), axis=1)
     return Evaluation(np.array(finals), np.array(errors), np.array(torques), train, moving,
-                      cfg.scene.ee_mass_kg if mass_kg is None else mass_kg)
+                      cfg.scene.ee_mass_kg if mass_kg is None else mass_kg, dist)
