@@ -155,3 +155,15 @@ def test_state_dimensions_and_gap_to_the_hand(scene, kind):
     assert np.linalg.norm(gap) == pytest.approx(np.linalg.norm(obs.p_r - obs.p_h))
     np.testing.assert_allclose(x[:7], obs.theta_r)
     assert x[-1] == pytest.approx(obs.g_r)
+
+
+def test_trial_error_is_the_mean_gap_over_the_last_half_second():
+    from gazebot.gps.rollout import Trial
+
+    n = 41  # 2 s at 20 Hz, both ends included
+    p_h = np.zeros((n, 3))
+    p_r = np.zeros((n, 3))
+    p_r[:, 0] = np.linspace(1.0, 0.0, n)  # gap shrinks linearly from 1 m to 0
+    trial = Trial(np.zeros((40, 1)), np.zeros((40, 1)), p_r, p_h, np.zeros(n), 0.05)
+    # t = 1.5 .. 2.0 s: gaps 0.25, 0.225, ..., 0 (11 samples), mean 0.125 m.
+    assert trial.final_error() == pytest.approx(0.125)
