@@ -135,7 +135,8 @@ def test_shell_has_the_seeds_2299_locations_and_training_targets_at_its_corners(
     assert pts.shape == (2299, 3)
     assert shell_grid(CFG.shell, 3).shape == (19 * 9, 3)
     r = np.linalg.norm(pts, axis=1)
-    assert r.min() == pytest.approx(0.5) and r.max() == pytest.approx(0.7)
+    assert r.min() == pytest.approx(CFG.shell.radius_m[0])
+    assert r.max() == pytest.approx(CFG.shell.radius_m[1])
     t8, t12 = training_targets(CFG.shell, 8), training_targets(CFG.shell, 12)
     assert len(t8) == 8 and len(t12) == 12
     assert np.all(np.min(np.linalg.norm(pts[:, None] - t8[None], axis=2), axis=0) < 1e-12)
