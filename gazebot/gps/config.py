@@ -27,6 +27,7 @@ class TesterConfig(_Strict):
     hand_mass_kg: float = Field(gt=0)
     hand_radius_m: float = Field(gt=0)
     hand_length_m: float = Field(gt=0)
+    rest_deg: tuple[float, float]
     a: float
     b: float = Field(gt=0)
     c: float = Field(gt=0)

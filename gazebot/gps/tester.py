@@ -3,7 +3,9 @@ for the human (seed 5.4), and its human-like joint trajectory (eq. 5.12).
 
 The arm moves in the vertical plane through the learner's base axis at the tester's azimuth: its
 shoulder stands ``shoulder_distance_m`` from that axis at ``shoulder_height_m``; at zero joint
-angles the arm hangs straight down, positive angles swing it towards the learner.
+angles the arm hangs straight down, positive angles swing it towards the learner. The seed's
+theta_0 = 0 of eq. 5.12 is the tester's rest posture ``rest_deg`` (ours: upper arm down, forearm
+level, as a person holding an object in front of them); the seed does not give its arm's zero.
 """
 
 from __future__ import annotations
@@ -94,4 +96,5 @@ def motion_to(point: np.ndarray, moving: bool, cfg: TesterConfig) -> TesterMotio
     azimuth = math.atan2(y, x)
     rho = math.hypot(x, y)
     shoulder, elbow = planar_ik(cfg.shoulder_distance_m - rho, z - cfg.shoulder_height_m, cfg)
-    return TesterMotion(azimuth, (0.0, 0.0), (shoulder, elbow), moving)
+    rest = tuple(math.radians(v) for v in cfg.rest_deg)
+    return TesterMotion(azimuth, (rest[0], rest[1]), (shoulder, elbow), moving)

@@ -121,10 +121,14 @@ def test_scene_places_the_tester_hand_where_the_ik_says(scene):
     p = training_targets(CFG.shell, 8)[3]
     obs = scene.reset(motion_to(p, False, CFG.scene.tester))
     np.testing.assert_allclose(obs.p_h, p, atol=1e-9)
-    # Moving tester: starts hanging down, ends near the target (eq. 5.12 settles 1.6% beyond).
+    # Moving tester: starts at its rest posture (eq. 5.12's theta_0), ends near the target
+    # (eq. 5.12 settles 1.6% beyond theta_f).
     m = motion_to(p, True, CFG.scene.tester)
     obs = scene.reset(m)
-    assert np.linalg.norm(obs.p_h - p) > 0.3
+    rest = np.radians(CFG.scene.tester.rest_deg)
+    np.testing.assert_allclose(obs.p_h, hand_position(m.azimuth, *rest, CFG.scene.tester),
+                               atol=0.002)  # eq. 5.12 has moved 0.09% of the way at t = 0
+    assert np.linalg.norm(obs.p_h - p) > 0.1
     for _ in range(CFG.scene.horizon):
         obs = scene.step(np.zeros(8))
     assert np.linalg.norm(obs.p_h - p) < 0.03
