@@ -72,6 +72,13 @@ def init_policy(dx: int, du: int, hidden: int, u_scale: np.ndarray, seed: int) -
     )
 
 
+def input_scale(std: np.ndarray) -> np.ndarray:
+    """Per-feature input scale from the training spread. A feature constant in training (the
+    hand's velocity under a static trainer) gets 1 SI unit: its weights never learn, and dividing
+    by a tiny floor would amplify an unseen value (a moving tester's hand) a thousandfold."""
+    return np.where(std < 1e-9, 1.0, np.maximum(std, 1e-3))
+
+
 def train_policy(params: PolicyParams, X: np.ndarray, targets: np.ndarray, weights: np.ndarray,
                  steps: int, batch: int, learning_rate: float, seed: int) -> PolicyParams:
     """Fit the network to ``targets`` (N, dU) at states ``X`` (N, dX) under the weighted Euclidean
@@ -81,7 +88,7 @@ def train_policy(params: PolicyParams, X: np.ndarray, targets: np.ndarray, weigh
     """
     jax, jnp, optax = _jax()
     x_mean = X.mean(axis=0)
-    x_scale = np.maximum(X.std(axis=0), 1e-3)
+    x_scale = input_scale(X.std(axis=0))
     xn = jnp.asarray((X - x_mean) / x_scale, dtype=jnp.float32)
     us = params.u_scale
     tg = jnp.asarray(targets / us, dtype=jnp.float32)
