@@ -156,3 +156,10 @@ def test_policy_network_imitates_a_linear_controller_and_its_jacobian_is_exact()
         fd = np.array([(trained.mean(X[i] + eps * e) - trained.mean(X[i] - eps * e)) / (2 * eps)
                        for e in np.eye(dx)]).T
         np.testing.assert_allclose(J[i], fd, atol=1e-5)
+
+
+def test_a_feature_constant_in_training_is_not_amplified_when_it_moves():
+    from gazebot.gps.policy import input_scale
+
+    scale = input_scale(np.array([0.0, 1e-4, 0.2]))
+    np.testing.assert_allclose(scale, [1.0, 1e-3, 0.2])
