@@ -133,11 +133,13 @@ def _evaluate(args: argparse.Namespace) -> int:
                   progress=not args.quiet)
     summary = ev.summary()
     if args.save:
+        # Append the suffixes: a stem like "run_m0.5" must not lose its ".5".
         base = Path(args.save)
+        stem = base.name[:-4] if base.suffix in (".npz", ".json") else base.name
         base.parent.mkdir(parents=True, exist_ok=True)
-        ev.save(base.with_suffix(".npz"))
-        base.with_suffix(".json").write_text(json.dumps(summary, indent=2) + "\n",
-                                             encoding="utf-8")
+        ev.save(base.parent / f"{stem}.npz")
+        (base.parent / f"{stem}.json").write_text(json.dumps(summary, indent=2) + "\n",
+                                                  encoding="utf-8")
     if args.plot:
         from gazebot.gps.plots import shell_plot
 
