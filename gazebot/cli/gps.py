@@ -135,7 +135,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     if args.save:
         # Append the suffixes: a stem like "run_m0.5" must not lose its ".5".
         base = Path(args.save)
-        stem = base.name[:-4] if base.suffix in (".npz", ".json") else base.name
+        stem = base.stem if base.suffix in (".npz", ".json") else base.name
         base.parent.mkdir(parents=True, exist_ok=True)
         ev.save(base.parent / f"{stem}.npz")
         (base.parent / f"{stem}.json").write_text(json.dumps(summary, indent=2) + "\n",
