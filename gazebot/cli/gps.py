@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from gazebot.cli.errors import UsageError
+from gazebot.gps.tester import UnreachableTarget
 
 
 def _positive_float(value: str) -> float:
@@ -115,8 +116,11 @@ def _train(args: argparse.Namespace) -> int:
         raise UsageError(f"--out: {out} exists and is not a directory")
     cfg = load_gps_config(args.config)
     start = time.monotonic()
-    result = train(cfg, args.controllers, args.trainer == "moving", StateKind(args.state),
-                   iterations=args.iterations, progress=not args.quiet)
+    try:
+        result = train(cfg, args.controllers, args.trainer == "moving", StateKind(args.state),
+                       iterations=args.iterations, progress=not args.quiet)
+    except UnreachableTarget as exc:
+        raise UsageError(f"the configuration's shell is out of the tester's reach: {exc}") from exc
     seconds = time.monotonic() - start
     save(result, cfg, out, seconds)
     print(json.dumps({"out": str(out), "train_error_m": float(result.train_errors_m.mean()),
@@ -129,8 +133,11 @@ def _evaluate(args: argparse.Namespace) -> int:
     from gazebot.gps.store import load
 
     trained = load(args.policy)
-    ev = evaluate(trained, args.tester == "moving", args.mass, args.grid,
-                  progress=not args.quiet)
+    try:
+        ev = evaluate(trained, args.tester == "moving", args.mass, args.grid,
+                      progress=not args.quiet)
+    except UnreachableTarget as exc:
+        raise UsageError(f"the policy's shell is out of the tester's reach: {exc}") from exc
     summary = ev.summary()
     if args.save:
         # Append the suffixes: a stem like "run_m0.5" must not lose its ".5".
@@ -155,7 +162,6 @@ def _evaluate(args: argparse.Namespace) -> int:
 
 def _demo(args: argparse.Namespace) -> int:
     from gazebot.gps.demo import run_demo
-    from gazebot.gps.tester import UnreachableTarget
 
     try:
         res = run_demo(args.policy, args.out, args.tester == "moving", args.target)

@@ -11,6 +11,7 @@ implementation).
 
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -79,6 +80,34 @@ def input_scale(std: np.ndarray) -> np.ndarray:
     return np.where(std < 1e-9, 1.0, np.maximum(std, 1e-3))
 
 
+@functools.lru_cache(maxsize=8)
+def _fitter(batch: int, learning_rate: float):
+    """The jitted Adam loop; compiled once per data shape, not once per call."""
+    jax, jnp, optax = _jax()
+    opt = optax.adam(learning_rate)
+
+    def loss(th, xb, tb, wb):
+        h = jax.nn.relu(xb @ th["w1"] + th["b1"])
+        diff = h @ th["w2"] + th["b2"] - tb
+        return 0.5 * jnp.mean(jnp.einsum("bi,bij,bj->b", diff, wb, diff))
+
+    def run(theta, xn, tg, wt, keys):
+        n = xn.shape[0]
+        b = min(batch, n)
+
+        def step(carry, key):
+            th, state = carry
+            idx = jax.random.randint(key, (b,), 0, n)
+            g = jax.grad(loss)(th, xn[idx], tg[idx], wt[idx])
+            upd, state = opt.update(g, state, th)
+            return (optax.apply_updates(th, upd), state), None
+
+        (theta, _), _ = jax.lax.scan(step, (theta, opt.init(theta)), keys)
+        return theta
+
+    return jax.jit(run)
+
+
 def train_policy(params: PolicyParams, X: np.ndarray, targets: np.ndarray, weights: np.ndarray,
                  steps: int, batch: int, learning_rate: float, seed: int) -> PolicyParams:
     """Fit the network to ``targets`` (N, dU) at states ``X`` (N, dX) under the weighted Euclidean
@@ -86,7 +115,7 @@ def train_policy(params: PolicyParams, X: np.ndarray, targets: np.ndarray, weigh
 
     The input normalisation is refitted to X; the weights continue from ``params``.
     """
-    jax, jnp, optax = _jax()
+    jax, jnp, _ = _jax()
     x_mean = X.mean(axis=0)
     x_scale = input_scale(X.std(axis=0))
     xn = jnp.asarray((X - x_mean) / x_scale, dtype=jnp.float32)
@@ -96,24 +125,8 @@ def train_policy(params: PolicyParams, X: np.ndarray, targets: np.ndarray, weigh
     wt = jnp.asarray(weights * us[None, :, None] * us[None, None, :], dtype=jnp.float32)
     theta = {k: jnp.asarray(getattr(params, k), dtype=jnp.float32)
              for k in ("w1", "b1", "w2", "b2")}
-    opt = optax.adam(learning_rate)
-    n = X.shape[0]
-    b = min(batch, n)
-
-    def loss(th, xb, tb, wb):
-        h = jax.nn.relu(xb @ th["w1"] + th["b1"])
-        diff = h @ th["w2"] + th["b2"] - tb
-        return 0.5 * jnp.mean(jnp.einsum("bi,bij,bj->b", diff, wb, diff))
-
-    def step(carry, key):
-        th, state = carry
-        idx = jax.random.randint(key, (b,), 0, n)
-        g = jax.grad(loss)(th, xn[idx], tg[idx], wt[idx])
-        upd, state = opt.update(g, state, th)
-        return (optax.apply_updates(th, upd), state), None
-
     keys = jax.random.split(jax.random.PRNGKey(seed), steps)
-    (theta, _), _ = jax.jit(lambda c, k: jax.lax.scan(step, c, k))((theta, opt.init(theta)), keys)
+    theta = _fitter(batch, learning_rate)(theta, xn, tg, wt, keys)
     out = {k: np.asarray(v, dtype=float) for k, v in theta.items()}
     return PolicyParams(**out, x_mean=x_mean, x_scale=x_scale, u_scale=us, cov=params.cov)
 

@@ -86,3 +86,13 @@ def test_demo_renders_one_frame_per_control_step(trained, tmp_path, capsys):
     assert video.stat().st_size > 0
     assert summary["frames"] == 1 + 20  # 1 s trials at 20 Hz in the tiny configuration
     assert summary["error_m"] >= 0
+
+
+def test_train_names_a_shell_the_tester_cannot_reach(tiny_config, tmp_path, capsys):
+    data = yaml.safe_load(tiny_config.read_text(encoding="utf-8"))
+    data["scene"]["tester"]["forearm_m"] = 0.1  # reach 0.6 m: the shell is beyond it
+    bad = tmp_path / "gps.yaml"
+    bad.write_text(yaml.safe_dump(data), encoding="utf-8")
+    assert main(["gps", "train", "--config", str(bad), "--out", str(tmp_path / "p"),
+                 "--quiet"]) == 2
+    assert "out of the tester's reach" in capsys.readouterr().err
