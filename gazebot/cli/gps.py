@@ -161,6 +161,9 @@ def _evaluate(args: argparse.Namespace) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
+    from gazebot.sim.gl_check import ensure_gl_backend
+
+    ensure_gl_backend()  # before MuJoCo loads: off-screen EGL or OSMesa
     from gazebot.gps.demo import run_demo
 
     try:

@@ -95,7 +95,8 @@ def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: flo
         ee_mass_kg * (w * w + h * h) / 12,
     )
     xml = ['<body name="link0" childclass="learner">',
-           '<geom type="cylinder" size="0.09 0.07" pos="0 0 0.07" class="learner"/>']
+           '<geom type="cylinder" size="0.09 0.07" pos="0 0 0.07" class="learner"/>',
+           f'<geom type="capsule" fromto="0 0 0 0 0 {DH[0][1]}" size="0.06" class="learner"/>']
     for i, ((a, d, alpha), link) in enumerate(zip(DH, LINKS, strict=True)):
         pos = (a, -d * math.sin(alpha), d * math.cos(alpha))
         xml.append(
