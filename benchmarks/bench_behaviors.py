@@ -44,10 +44,10 @@ def _contexts() -> list[GazeContext]:
     out = []
     for i in range(300):
         t = i / 100.0
-        phase, start, end = Phase.DONE, 2.6, math.nan
-        for p, a, b in _PHASES:
+        end = math.nan  # the tracking's prediction of the current phase's end (exact here)
+        for _, a, b in _PHASES:
             if a <= t < b:
-                phase, start, end = p, a, b
+                end = b
         hand = np.array([1.0 - 0.2 * t, 0.0, 1.0])
         points = {
             "face": np.array([1.0, 0.0, 1.6]),
@@ -56,7 +56,7 @@ def _contexts() -> list[GazeContext]:
             "handover_location": np.array([0.6, 0.0, 1.0]),
             "rest": np.array([0.4, 0.0, 0.8]),
         }
-        out.append(GazeContext(t, phase, start, end, points))
+        out.append(GazeContext(t, points, tracking_end=end))
     return out
 
 
@@ -66,6 +66,7 @@ class PlainFaceHandFace:
     def __init__(self, reach_s: float = 0.8, retreat_s: float = 1.05) -> None:
         self.defaults = {Phase.REACH: reach_s, Phase.RETREAT: retreat_s}
         self.phase = Phase.IDLE
+        self.start = 0.0
         self.shifted = False
 
     def handle(self, event: Event) -> None:
@@ -76,19 +77,20 @@ class PlainFaceHandFace:
             EventKind.HANDOVER_DONE: Phase.DONE,
         }.get(event.kind)
         if new is not None and new is not self.phase:
-            self.phase, self.shifted = new, False
+            self.phase, self.start, self.shifted = new, event.t, False
 
     def target(self, ctx: GazeContext) -> GazeTarget:
-        if ctx.phase in (Phase.REACH, Phase.RETREAT) and not self.shifted:
-            end = ctx.expected_phase_end
-            if not math.isfinite(end) or end <= ctx.phase_start:
-                end = ctx.phase_start + self.defaults[ctx.phase]
-            self.shifted = ctx.t >= ctx.phase_start + 0.5 * (end - ctx.phase_start)
-        if ctx.phase is Phase.REACH:
+        phase, start = self.phase, self.start
+        if phase in (Phase.REACH, Phase.RETREAT) and not self.shifted:
+            end = ctx.tracking_end
+            if not math.isfinite(end) or end <= start:
+                end = start + self.defaults[phase]
+            self.shifted = ctx.t >= start + 0.5 * (end - start)
+        if phase is Phase.REACH:
             kind = "hand" if self.shifted else "face"
-        elif ctx.phase is Phase.TRANSFER:
+        elif phase is Phase.TRANSFER:
             kind = "hand"
-        elif ctx.phase is Phase.RETREAT:
+        elif phase is Phase.RETREAT:
             kind = "face" if self.shifted else "hand"
         else:
             kind = "face"

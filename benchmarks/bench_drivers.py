@@ -1,11 +1,13 @@
 """Bus latency and simulator speed.
 
-* tracking-in to head-command-out: a tracking sample published on ``gazebot/<id>/tracking``
+* tracking-in to head-command-out: a tracking sample (its ROS 2 messages on the rmw_zenoh wire:
+  three ``PointStamped``, ``GripperState``, ``LoadShare``, CDR with rmw_zenoh's attachment)
   crosses Zenoh to a real engine node (``GazeEngine`` sawyer / face-hand-face), which answers with
-  a head command back across Zenoh. Peer: a raw Zenoh echo between the same two sessions with a
-  payload of the same size (publish -> subscriber -> re-publish -> subscriber), measured
-  interleaved with ours in the same run. Samples come from a simulated handover, so the engine's
-  phases and behavior do their real work.
+  a ``JointTrajectory`` head command back across Zenoh. Peer: a raw Zenoh echo between the same
+  two sessions of the same bytes (the same five payloads on five keys; when all five arrived, a
+  payload of the head command's size back), measured interleaved with ours in the same run.
+  Samples come from a simulated handover, so the engine's phases and behavior do their real
+  work.
 * the simulator node's real-time factor without rendering (tracking and joint states published
   on the bus, no pacing) against the bare simulation stepping loop.
 """
@@ -47,72 +49,104 @@ def _record_frames(seconds: float) -> list:
 
 
 def _latency() -> list[Result]:
-    from gazebot.drivers.engine_node import EngineNode
-    from gazebot.drivers.payloads import HeadCommandMsg, TrackingMsg
+    from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
+    from gazebot.drivers.rmw.names import Names
     from gazebot.drivers.session import EPHEMERAL_ENDPOINT, BusConfig, open_session
     from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+    from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
     from gazebot.engine import GazeEngine
+    from gazebot.ros2 import convert, topics
     from gazebot.runtime import GazeLoop
 
     frames = _record_frames(N_SAMPLES / 120)
+    names = Names("/bench")
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
-    robot = open_session(BusConfig("bench", listen=(endpoint,)))
+    robot = ZenohRobotEndpoint(open_session(BusConfig(names, listen=(endpoint,))), names,
+                               "sim", owns_session=True)
     engine_session = open_session(
-        BusConfig("bench", listen=(EPHEMERAL_ENDPOINT,), connect=(endpoint,)))
-    driver = ZenohRobotDriver(engine_session, BusConfig("bench").keys, "engine")
-    keys = driver.keys
-    node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face")), driver)
+        BusConfig(names, listen=(EPHEMERAL_ENDPOINT,), connect=(endpoint,)))
+    driver = ZenohRobotDriver(engine_session, names, "engine")
+    # Every answer is a sample's: no silence ticks, so the n-th head command answers sample n.
+    node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face")), driver,
+                      EngineNodeConfig(silence_after=1e3, resync=False))
     stop = threading.Event()
     engine_thread = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
     entities = []
     try:
         answered = threading.Event()
-        answer: dict[str, float] = {}
+        state = {"heads": 0, "want": 0, "pings": 0, "expect": 0, "at": 0.0}
+        head_key = robot.ros.names.key(
+            names.resolve(topics.HEAD_COMMAND.name),
+            *(lambda c: (c.info.dds_name, c.info.hash))(robot.ros.codec(topics.HEAD_COMMAND.type)))
 
         def on_head(sample) -> None:
-            msg = HeadCommandMsg.decode(sample.payload.to_bytes())
-            if msg.answers == answer.get("want"):
-                answer["at"] = time.perf_counter()
+            state["heads"] += 1
+            if state["heads"] == state["want"]:
+                state["at"] = time.perf_counter()
                 answered.set()
 
         def on_pong(sample) -> None:
-            answer["at"] = time.perf_counter()
+            state["at"] = time.perf_counter()
             answered.set()
 
-        # Raw echo in the engine's session: same sessions, same links, same payload size.
-        echo_pub = engine_session.declare_publisher(f"{keys.root}/bench/pong")
+        pubs = {body: robot._point_pubs[body] for body in convert.BODIES}
+        parts = [*pubs.values(), robot._gripper_pub, robot._share_pub]
+        # Raw echo in the engine's session: same sessions, same links, same payloads.
+        echo_pub = engine_session.declare_publisher("bench/raw/pong")
+        pong = {"size": 0}
+
+        def on_ping(sample) -> None:
+            state["pings"] += 1
+            if state["pings"] == state["expect"]:
+                state["pings"] = 0
+                echo_pub.put(bytes(pong["size"]))
+
         entities += [
             echo_pub,
-            engine_session.declare_subscriber(
-                f"{keys.root}/bench/ping", lambda s: echo_pub.put(s.payload.to_bytes())),
-            robot.declare_subscriber(keys.head_command, on_head),
-            robot.declare_subscriber(f"{keys.root}/bench/pong", on_pong),
+            engine_session.declare_subscriber("bench/raw/ping/*", on_ping),
+            robot.session.declare_subscriber(head_key, on_head),
+            robot.session.declare_subscriber("bench/raw/pong", on_pong),
         ]
-        tracking_pub = robot.declare_publisher(keys.tracking)
-        ping_pub = robot.declare_publisher(f"{keys.root}/bench/ping")
-        entities += [tracking_pub, ping_pub]
+        ping_pubs = [robot.session.declare_publisher(f"bench/raw/ping/{i}")
+                     for i in range(len(parts))]
+        entities += ping_pubs
         deadline = time.monotonic() + 5
-        while not driver.peers() and time.monotonic() < deadline:
+        while not driver.peers().get("sim") and time.monotonic() < deadline:
             time.sleep(0.01)
         engine_thread.start()
         node.ready.wait(5)
+        pong["size"] = len(robot.ros.codec(topics.HEAD_COMMAND.type).encode(
+            convert.head_trajectory(GazeEngine.from_config("sawyer", "face-hand-face")
+                                    .step(frames[0]), 1 / 120)))
 
         ours: list[float] = []
         raw: list[float] = []
         sizes = []
+        base = names.base_frame
         for seq, frame in enumerate(frames):
-            payload = TrackingMsg.from_frame(frame, seq, time.time()).encode()
-            sizes.append(len(payload))
+            tracked = convert.tracking_points(frame)  # an untracked body is not sent
+            sample = [(pubs[b], pubs[b].codec.encode(convert.point_stamped(frame.t, p, base)))
+                      for b, p in tracked.items()]
+            sample.append((robot._gripper_pub, robot._gripper_pub.codec.encode(
+                convert.gripper_state(frame.t, bool(frame.gripper_closed)))))
+            sample.append((robot._share_pub, robot._share_pub.codec.encode(
+                convert.load_share(frame.t, float(frame.load_share)))))
+            sizes.append(sum(len(data) for _, data in sample))
+            state["expect"] = len(sample)
             for kind in ("ours", "raw"):  # interleaved: both see the same conditions
                 answered.clear()
-                answer["want"] = seq
+                state["want"] = seq + 1
                 t0 = time.perf_counter()
                 if kind == "ours":
-                    tracking_pub.put(payload)
+                    for pub, data in sample:
+                        pub.publish_raw(data)
                 else:
-                    ping_pub.put(payload)
+                    for pub, (_, data) in zip(ping_pubs, sample, strict=False):
+                        pub.put(data)
                 if answered.wait(1.0):
-                    (ours if kind == "ours" else raw).append(answer["at"] - t0)
+                    (ours if kind == "ours" else raw).append(state["at"] - t0)
+                elif kind == "ours":
+                    state["heads"] = state["want"]  # a lost answer: count it as given
             time.sleep(0.001)  # let the engine's loop settle between samples
         lost = len(frames) - len(ours)
     finally:
@@ -126,7 +160,8 @@ def _latency() -> list[Result]:
         robot.close()
 
     size = int(statistics.median(sizes))
-    note = f"{len(ours)} samples, {size} B JSON, round trip A->B->A, {lost} unanswered"
+    note = (f"{len(ours)} samples, 5 CDR messages = {size} B in (median), {pong['size']} B back, "
+            f"round trip A->B->A, {lost} unanswered")
     ms = 1e3
     return [
         Result("tracking in -> head command out, p50", statistics.median(ours) * ms,
@@ -155,8 +190,10 @@ def _real_time_factor(repeat: int = 3) -> list[Result]:
         with HandoverSimulation("sawyer", "default", seed=0) as sim:
             return SimNode(sim, endpoint, SimNodeConfig(speed=float("inf"))).run(SIM_SECONDS)
 
+    from gazebot.drivers.rmw.names import Names
+
     endpoint = ZenohRobotEndpoint.open(
-        BusConfig("benchrtf", listen=(f"tcp/127.0.0.1:{_free_port()}",)), "sim")
+        BusConfig(Names("/benchrtf"), listen=(f"tcp/127.0.0.1:{_free_port()}",)), "sim")
     ours, peer = [], []
     try:
         bare()  # warm-up (imports, MuJoCo model compilation caches)

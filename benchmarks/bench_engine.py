@@ -70,7 +70,7 @@ def run() -> list[Result]:
             if i % len(frames) == 0:
                 loop.reset()
             f = frames[i % len(frames)]
-            loop.tick(f.t, f)
+            loop.tick(f)
             state["i"] = i + 1
 
         def bare_step(engine=bare, state=step_state):

@@ -5,6 +5,11 @@ rule (``seed-7.2.5``, dissertation section 7.2.5) measured in the same run.
   through GAZEBOT_KTH_DATA or /work/data/kth, skipped when absent): every method's transfer
   start and end against the force truth (both grips loaded / the giver's grip lets go), and
   the online detection latency of the transfer.
+- Online reach onset (issue 20): how long after the giver's true onset the reach is confirmed
+  (median and p90 over a varied synthetic set, 8-240 Hz), and the false reaches on recordings
+  with no handover (resting and fidgeting hands under 2 and 5 mm of noise, 8-240 Hz).
+- Issue 20's hold kinds (joint carry, still hold, quick 30 Hz / 5 mm): transfer start and end
+  errors against the generator's truth.
 - Offline throughput: recordings segmented per second over a synthetic set (100 Hz, ~8 s).
 - Online cost: median time of one ``PhaseDetector.update`` per sample.
 """
@@ -17,8 +22,9 @@ import numpy as np
 
 from benchmarks.common import Result
 from benchmarks.kth_data import RATE, force_truth, kth_dir
-from gazebot.phases import METHODS, PhaseConfig, PhaseDetector, Trajectory, run_online, segment
-from gazebot.phases.synthetic import synthetic_set
+from gazebot.phases import PhaseConfig, PhaseDetector, Trajectory, run_online, segment
+from gazebot.phases.methods import PHASE_METHODS
+from gazebot.phases.synthetic import CASE_KINDS, case_set, rest_recording, synthetic_set
 from gazebot.types import EventKind, Phase
 
 SEED = "seed-7.2.5"
@@ -57,7 +63,7 @@ def _kth_results() -> list[Result]:
     traj, t0, t1 = found
     out = []
     errs = {}
-    for m in METHODS:
+    for m in PHASE_METHODS.names():
         c = PhaseConfig(method=m)
         tr = [s for s in segment(traj, c) if s.phase is Phase.TRANSFER]
         ev = [e for e in run_online(traj, c).events if e.kind is EventKind.TRANSFER_STARTED]
@@ -83,12 +89,86 @@ def _kth_results() -> list[Result]:
     return out
 
 
+def _reach_onset(method: str) -> tuple[float, float, int, int]:
+    """(median, p90 latency in ms, false reaches, recordings without a handover)."""
+    cfg = PhaseConfig(method=method)
+    lat = []
+    for case in synthetic_set(40, seed=7):
+        ev = [
+            e for e in run_online(case.trajectory, cfg).events if e.kind is EventKind.REACH_STARTED
+        ]
+        for e, h in zip(ev, case.truth, strict=False):
+            lat.append((e.detected_at - h.reach_start) * 1e3)
+    rests = [
+        rest_recording(rate, noise, 20.0, seed=k, fidget=fidget)
+        for k, rate in enumerate((8.0, 30.0, 120.0, 240.0))
+        for noise in (0.002, 0.005)
+        for fidget in (False, True)
+    ]
+    false = sum(
+        e.kind is EventKind.REACH_STARTED for tr in rests for e in run_online(tr, cfg).events
+    )
+    return float(np.median(lat)), float(np.percentile(lat, 90)), false, len(rests)
+
+
+def _reach_results() -> list[Result]:
+    med, p90, false, n = _reach_onset("gazebot")
+    pmed, pp90, pfalse, _ = _reach_onset(SEED)
+    return [
+        Result(
+            "online reach onset, median after the true onset",
+            med,
+            pmed,
+            "ms",
+            f"{SEED} run online",
+            note=(
+                f"p90 {p90:.0f} ms (peer {pp90:.0f}); false reaches {false} in {n} recordings "
+                f"without a handover (peer {pfalse}); 40 synthetic recordings, 8-240 Hz"
+            ),
+        )
+    ]
+
+
+def _hold_kind_results() -> list[Result]:
+    out = []
+    for kind in CASE_KINDS:
+        cases = case_set(kind, 12, seed=3)
+        errs = {}
+        for m in ("gazebot", SEED):
+            cfg = PhaseConfig(method=m)
+            e = []
+            for c in cases:
+                tr = [s for s in segment(c.trajectory, cfg) if s.phase is Phase.TRANSFER]
+                if len(tr) != 1:
+                    e.append(float("inf"))
+                    continue
+                h = c.truth[0]
+                e.append(max(abs(tr[0].start - h.transfer_start), abs(tr[0].end - h.transfer_end)))
+            errs[m] = 1e3 * np.array(e)
+        ours, peer = errs["gazebot"], errs[SEED]
+        out.append(
+            Result(
+                f"transfer ends, {kind} hold",
+                float(np.median(ours)),
+                float(np.median(peer)),
+                "ms",
+                SEED,
+                note=(
+                    f"worse end of start/end per recording, median over 12; max {ours.max():.0f} "
+                    f"ms (peer {peer.max():.0f}); within 0.3 s: {np.sum(ours <= 300)}/12 "
+                    f"(peer {np.sum(peer <= 300)}/12)"
+                ),
+            )
+        )
+    return out
+
+
 def run() -> list[Result]:
-    results = _kth_results()
+    results = _kth_results() + _reach_results() + _hold_kind_results()
     cases = synthetic_set(12, seed=7, rate=100.0, handovers=1)
     trajs = [c.trajectory for c in cases]
     seed_cfg = PhaseConfig(method=SEED)
-    for m in METHODS:
+    for m in PHASE_METHODS.names():
         if m == SEED:
             continue
         cfg = PhaseConfig(method=m)

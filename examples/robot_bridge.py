@@ -1,8 +1,12 @@
 """A robot bridge on the Zenoh bus: what a real robot's driver does to be driven by `gazebot run`.
 
-It publishes tracking (from your motion capture) and joint states, and applies the head and eye
-commands the engine sends. Here the "robot" is a stand-in that applies head goals instantly and
-the "motion capture" replays a synthetic handover; swap both for your hardware interfaces.
+It publishes tracking (from your motion capture) and joint states as ROS 2 messages on the
+rmw_zenoh wire (``/gazebot/tracking/*`` PointStamped, ``/joint_states``), and applies the head
+commands (``/gazebot/head/command``, JointTrajectory) the engine sends. A ROS 2 robot running
+rmw_zenoh needs no bridge at all: its own nodes publish and subscribe to these topics.
+
+Here the "robot" is a stand-in that applies head goals instantly and the "motion capture"
+replays a synthetic handover; swap both for your hardware interfaces.
 
 Terminal 1:  python examples/robot_bridge.py --duration 10
 Terminal 2:  gazebot run --robot sawyer --behavior face-hand-face --duration 10
@@ -13,13 +17,13 @@ from __future__ import annotations
 import argparse
 import time
 
-from gazebot.drivers import BusConfig, ZenohRobotEndpoint
+from gazebot.drivers import BusConfig, Names, ZenohRobotEndpoint
 from gazebot.phases.synthetic import SyntheticOptions, generate
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--id", default="sim", help="robot id: keys are gazebot/<id>/...")
+    parser.add_argument("--namespace", default="/gazebot", help="ROS namespace of the topics")
     parser.add_argument("--listen", default="tcp/127.0.0.1:7447")
     parser.add_argument("--duration", type=float, default=10.0, help="wall seconds")
     args = parser.parse_args(argv)
@@ -27,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
     frames = generate(seed=2, options=SyntheticOptions(rate=120.0)).trajectory.frames()
     head = {"head_pan": 0.0}
     applied = 0
-    bus = BusConfig(robot_id=args.id, listen=(args.listen,))
+    bus = BusConfig(names=Names(args.namespace), listen=(args.listen,))
     robot = ZenohRobotEndpoint.open(bus, node="sim")
     try:
         start = time.monotonic()

@@ -28,7 +28,7 @@ class ConfigError(ValueError):
         msg = f"{self.source}: field '{field}': expected {expected}"
         if got is not None:
             msg += f", got {got!r}"
-        super().__init__(msg)
+        super().__init__(" ".join(msg.splitlines()))  # one line, whatever a library said
 
 
 def configs_dir() -> Path:
@@ -40,13 +40,58 @@ def configs_dir() -> Path:
     raise FileNotFoundError("gazebot's configs/ directory was not found beside the package")
 
 
-def read_yaml(path: str | Path) -> Any:
-    """Parse a YAML file; a syntax error becomes a :class:`ConfigError` naming line and column."""
+MAX_YAML_BYTES = 1_000_000  # the largest shipped config is 7 kB
+MAX_YAML_DEPTH = 64  # nesting levels; PyYAML's composer recurses once per level
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """PyYAML's safe loader without aliases and with bounded nesting: a 1 kB file of nested
+    aliases ("billion laughs") expands to gigabytes, and thousands of ``[`` exhaust the stack.
+    gazebot's configs use neither."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent, index):  # noqa: ANN001, ANN201 (PyYAML's signature)
+        if self.check_event(yaml.AliasEvent):
+            raise yaml.composer.ComposerError(
+                None,
+                None,
+                "an alias (*name): aliases and merge keys are not accepted in gazebot configs",
+                self.peek_event().start_mark,
+            )
+        self._depth += 1
+        try:
+            if self._depth > MAX_YAML_DEPTH:
+                raise yaml.composer.ComposerError(
+                    None,
+                    None,
+                    f"more than {MAX_YAML_DEPTH} levels of nesting",
+                    self.peek_event().start_mark,
+                )
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+
+def read_yaml(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> Any:
+    """Parse a YAML file (every gazebot config, behavior, scene and robot file is read here).
+
+    A file over ``max_bytes``, an alias, nesting deeper than :data:`MAX_YAML_DEPTH` or a syntax
+    error becomes a :class:`ConfigError` naming the file (and line and column)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as fh:
+            raw = fh.read(max_bytes + 1)  # never more than the cap, whatever the file is
     except OSError as exc:
         raise ConfigError(path, "<file>", "a readable YAML file", str(exc)) from exc
+    if len(raw) > max_bytes:
+        raise ConfigError(
+            path, "<file>", f"a YAML file of at most {max_bytes} bytes", "a larger file"
+        )
+    try:
+        text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(
             path,
@@ -54,13 +99,20 @@ def read_yaml(path: str | Path) -> Any:
             "UTF-8 text",
             f"byte 0x{exc.object[exc.start]:02x} at offset {exc.start}",
         ) from exc
+    loader = None
     try:
-        return yaml.safe_load(text)
+        loader = _BoundedLoader(text)  # checks the characters: a control character is an error
+        return loader.get_single_data()
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "<document>"
         problem = getattr(exc, "problem", None) or str(exc)
         raise ConfigError(path, where, "valid YAML", problem) from exc
+    except RecursionError:  # a nesting PyYAML's scanner recursed on before the composer
+        raise ConfigError(path, "<document>", "valid YAML", "too deeply nested") from None
+    finally:
+        if loader is not None:
+            loader.dispose()
 
 
 def validate(model: type[M], data: Any, source: str | Path = "<config>") -> M:

@@ -1,46 +1,76 @@
-"""The gaze engine: composes phases -> behavior -> gaze target -> kinematics, one tick at a time.
+"""The gaze engine: composes phases -> handover state -> behavior -> gaze target -> kinematics,
+one tick at a time.
 
 The engine owns no transport and no simulator; a robot stack calls :meth:`GazeEngine.step` with each
 tracking frame and sends the returned :class:`~gazebot.types.GazeCommand` wherever it likes.
+
+One handover state (:class:`~gazebot.handover.HandoverState`) merges the phase detector's events
+and the robot's (:meth:`GazeEngine.notify`); the behavior reads its phase, and the command
+reports it with its source. The engine never dies on input: a tracked point beyond the robot's
+``workspace_radius_m`` is a missing sample (counted in :attr:`GazeEngine.stats`), and whatever a
+sample or an event makes a stage raise is caught, reported as a ``fault`` event and the command's
+``status: degraded``, and the tick still answers with a safe command.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
 from gazebot.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
 from gazebot.config import ConfigError
+from gazebot.handover import HandoverState, PhaseChange
 from gazebot.kinematics import GazeController, GazeShiftConfig, RobotConfig, RobotModel
 from gazebot.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.types import (
+    EVENT_OF_PHASE,
+    NAN3,
+    PHASE_OF_EVENT,
     Event,
+    EventKind,
     GazeCommand,
     GazeContext,
     Phase,
+    PhaseSource,
+    Status,
     TrackingFrame,
-    is_valid_point,
+    TrackingState,
 )
 
 # Targets the engine fills from tracking each tick; all others come from the robot config.
 _TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
+# Robot events whose phase change the phase detector adopts (it cannot see a grasp).
+_DETECTOR_ADOPTS = frozenset({EventKind.ROBOT_GRASPED, EventKind.ROBOT_RELEASED})
+
+
+class PhaseDetectorLike(Protocol):
+    """What the engine needs of a phase detector (:class:`gazebot.phases.PhaseDetector`)."""
+
+    phase: Phase
+    expected_phase_end: float
+
+    def update_all(self, frame: TrackingFrame) -> list[Event]: ...
+
+    def resync(self, event: Event) -> None: ...
+
+    def adopt(self, phase: Phase, t0: float) -> None: ...
 
 
 @dataclass
-class _PointMemory:
-    """Last valid position of each tracked point, so a dropout does not move the gaze target."""
+class EngineStats:
+    """What the engine bridged or survived (counts since the last reset)."""
 
-    last: dict[str, np.ndarray] = field(default_factory=dict)
+    implausible: int = 0  # tracked points beyond the workspace, treated as missing
+    faults: int = 0  # exceptions a sample or an event caused, caught and reported
 
-    def update(self, name: str, value: np.ndarray, fallback: np.ndarray) -> np.ndarray:
-        if is_valid_point(value):
-            self.last[name] = value
-            return value
-        return self.last.get(name, fallback)
+
+def _events(events: Event | Iterable[Event]) -> list[Event]:
+    return [events] if isinstance(events, Event) else list(events)
 
 
 class GazeEngine:
@@ -73,13 +103,20 @@ class GazeEngine:
             )
         self.robot = robot
         self.behavior_spec = behavior
-        self.detector = make_detector(phases or PhaseConfig())
-        self.behavior = BehaviorMachine(behavior, seed=seed)
+        self._phase_config = phases or PhaseConfig()
         self.gaze = GazeController(robot, shifts)
-        self._memory = _PointMemory()
-        self._pending: list[Event] = []
-        self._last_t = -math.inf
         self._fixed_points = {k: np.asarray(v, float) for k, v in robot.points.items()}
+        fixed = self._fixed_points
+        # A tracked point never seen yet: the robot's default for it.
+        self._defaults = {
+            "face": fixed["face"],
+            "hand": fixed["handover_location"],
+            "object": fixed["handover_location"],
+            "receiver_hand": fixed["rest"],
+        }
+        self._radius = float(robot.config.workspace_radius_m)
+        self._seed = seed
+        self.reset()
 
     @classmethod
     def from_config(
@@ -104,22 +141,27 @@ class GazeEngine:
 
     @property
     def phase(self) -> Phase:
-        return self.detector.phase
+        """The handover state's phase (the one the behavior runs and commands report)."""
+        return self.handover.phase
 
-    def notify(self, event: Event) -> None:
-        """Queue a robot event (e.g. ``robot_reach_started`` with ``planned_duration``) for the
-        next :meth:`step`."""
-        self._pending.append(event)
+    @property
+    def phase_source(self) -> PhaseSource:
+        """What decided the current phase: ``tracking``, ``robot`` or ``gripper``."""
+        return self.handover.source
 
-    def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
-        fixed = self._fixed_points
-        face = self._memory.update("face", frame.giver_face, fixed["face"])
-        hand = self._memory.update("hand", frame.giver_hand, fixed["handover_location"])
-        receiver = self._memory.update("receiver_hand", frame.receiver_hand, fixed["rest"])
-        points = dict(fixed)
-        points.update(face=face, hand=hand, object=hand, receiver_hand=receiver)
-        return points
+    @property
+    def tracking(self) -> TrackingState:
+        """The behavior's tracking state after the last step: ``ok``; ``hold`` while tracking is
+        lost and the behavior holds the gaze (its ``tracking_lost.hold_s``); ``lost`` once it
+        looks at its ``tracking_lost`` target."""
+        return self.behavior.tracking  # type: ignore[return-value]
 
+    def notify(self, events: Event | Iterable[Event]) -> None:
+        """Queue one robot event or several (e.g. ``robot_reach_started`` with
+        ``planned_duration``) for the next :meth:`step`."""
+        self._pending.extend(_events(events))
+
+    # ----------------------------------------------------------------- the tick
     def step(self, frame: TrackingFrame, arm: Mapping[str, float] | None = None) -> GazeCommand:
         """Advance one tick with ``frame`` and return the command for the head and the eyes.
 
@@ -127,46 +169,40 @@ class GazeEngine:
         carries the head (Sawyer's head sits on ``right_j0``) so the head goals compensate.
 
         Out-of-order frames are handed to the phase detector (which ignores them) and answered
-        with the previous command's goals, so the output never jumps back in time.
+        with the previous command's goals, so the output never jumps back in time. Never raises
+        for what a sample or an event holds (see the module docstring).
         """
-        # Every event this sample reveals (a gripper closing can reveal a reach and a transfer).
-        events = self.detector.update_all(frame)
+        faults: list[Event] = []
+        t = self._time(frame)
+        frame = self._plausible(frame)
+        try:
+            # Every event this sample reveals (a gripper closing can reveal a reach and a
+            # transfer).
+            events = self.detector.update_all(frame)
+        except Exception as err:  # noqa: BLE001 - a sample must never kill the engine
+            events = []
+            faults.append(self._fault(t, "phases", err))
         events.extend(self._pending)
         self._pending.clear()
+        stream: list[Event] = []  # the tick's events, phase events as the handover state's
         for event in events:
-            self.behavior.handle(event)
-
-        if math.isfinite(frame.t):
-            t = self._last_t = max(frame.t, self._last_t)
-        else:  # a frame without a usable time: answer at the last known time
-            t = self._last_t if math.isfinite(self._last_t) else 0.0
-        ctx = GazeContext(
-            t=t,
-            phase=self.detector.phase,
-            phase_start=self.detector.phase_start,
-            expected_phase_end=self.detector.expected_phase_end,
-            points=self._points(frame),
+            try:
+                stream.extend(self._apply(event))
+            except Exception as err:  # noqa: BLE001 - an event must never kill the engine
+                faults.append(self._fault(t, f"event {getattr(event, 'kind', event)!r}", err))
+        detector = self.detector
+        state = self.handover
+        tracking_end = (
+            detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
-        target = self.behavior.target(ctx)
-        state = self.gaze.update(t, target.point, arm=arm)
-        return GazeCommand(
-            t=t,
-            phase=ctx.phase,
-            target=target.kind,
-            target_point=target.point,
-            head=state.head,
-            eye_yaw=state.eye_yaw,
-            eye_pitch=state.eye_pitch,
-            residual=state.residual,
-            events=tuple(events),
-        )
-
-    @property
-    def tracking(self) -> str:
-        """The behavior's tracking state after the last step: ``ok``; ``hold`` while tracking is
-        lost and the behavior holds the gaze (its ``tracking_lost.hold_s``); ``lost`` once it
-        looks at its ``tracking_lost`` target."""
-        return self.behavior.tracking
+        ctx = GazeContext(t=t, points=self._points(frame), tracking_end=tracking_end)
+        try:
+            target = self.behavior.target(ctx)
+            kind, point = target.kind, target.point
+        except Exception as err:  # noqa: BLE001
+            faults.append(self._fault(t, "behavior", err))
+            kind, point = self._last_target
+        return self._command(t, kind, point, arm, tuple(stream) + tuple(faults), faults)
 
     def look_at(
         self,
@@ -180,34 +216,165 @@ class GazeEngine:
         A fallback for a robot stack, e.g. the last face position while tracking is lost; the
         gaze shift timing and limits still apply. The phase is left as it is.
         """
-        if math.isfinite(t):
-            t = self._last_t = max(t, self._last_t)
-        else:
-            t = self._last_t if math.isfinite(self._last_t) else 0.0
-        state = self.gaze.update(t, point, arm=arm)
-        return GazeCommand(
-            t=t,
-            phase=self.detector.phase,
-            target=target,
-            target_point=np.asarray(point, float),
-            head=state.head,
-            eye_yaw=state.eye_yaw,
-            eye_pitch=state.eye_pitch,
-            residual=state.residual,
-        )
+        t = self._time(TrackingFrame(t=t))
+        return self._command(t, target, np.asarray(point, float), arm, (), [])
 
-    def resync(self, events: list[Event]) -> None:
+    def resync(self, events: Iterable[Event]) -> None:
         """Catch up with a handover already under way (e.g. after an engine restart): replay the
         phase and robot events published before the restart, oldest first."""
-        for event in sorted(events, key=lambda e: e.t):
+        for event in sorted(_events(events), key=lambda e: e.t):
             self.detector.resync(event)
             self.behavior.handle(event)
 
     def reset(self, head: Mapping[str, float] | None = None) -> None:
         """Forget the current handover (e.g. after a restart) and optionally the head pose."""
-        self.detector = make_detector(self.detector.config)
-        self.behavior = BehaviorMachine(self.behavior_spec, seed=self.behavior.seed)
+        self.detector: PhaseDetectorLike = make_detector(self._phase_config)
+        if hasattr(self, "behavior"):  # reuse the machine: building one costs milliseconds
+            self.handover.reset()
+            self.behavior.reset()
+        else:
+            self.handover = HandoverState()
+            self.behavior = BehaviorMachine(
+                self.behavior_spec, seed=self._seed, handover=self.handover,
+                defaults=self._defaults,
+            )
         self.gaze.reset(head)
-        self._memory = _PointMemory()
-        self._pending.clear()
+        self.stats = EngineStats()
+        self._pending: list[Event] = []
         self._last_t = -math.inf
+        self._last_target: tuple[str, np.ndarray] = (
+            self.behavior_spec.before,
+            self._defaults["face"],
+        )
+        self._last_safe: GazeCommand | None = None
+
+    # ----------------------------------------------------------------- internals
+    def _time(self, frame: TrackingFrame) -> float:
+        """The tick's time: the frame's, never earlier than the last one; a frame without a
+        usable time is answered at the last known time."""
+        try:
+            t = float(frame.t)
+        except (TypeError, ValueError, OverflowError):
+            t = math.nan
+        if math.isfinite(t):
+            self._last_t = max(t, self._last_t)
+        return self._last_t if math.isfinite(self._last_t) else 0.0
+
+    def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
+        """``frame`` with every point beyond the workspace (or not a numeric 3-vector) missing."""
+        changed = {}
+        r = self._radius
+        for name in ("giver_hand", "receiver_hand", "giver_face"):
+            p = getattr(frame, name)
+            if type(p) is np.ndarray and p.shape == (3,) and p.dtype.kind == "f":
+                x, y, z = p.tolist()  # plain floats: numpy per-call overhead is microseconds
+            else:
+                try:
+                    x, y, z = (float(v) for v in np.asarray(p, dtype=float).reshape(3))
+                except (TypeError, ValueError, OverflowError):
+                    changed[name] = NAN3.copy()
+                    continue
+                changed[name] = np.array([x, y, z])
+            if x != x or y != y or z != z:
+                continue  # already missing (NaN)
+            # Per coordinate first: a huge finite value must not overflow x * x.
+            if not (-r <= x <= r and -r <= y <= r and -r <= z <= r
+                    and x * x + y * y + z * z <= r * r):
+                self.stats.implausible += 1
+                changed[name] = NAN3.copy()
+        if not changed:
+            return frame
+        return TrackingFrame(
+            t=frame.t,
+            giver_hand=changed.get("giver_hand", frame.giver_hand),
+            receiver_hand=changed.get("receiver_hand", frame.receiver_hand),
+            giver_face=changed.get("giver_face", frame.giver_face),
+            gripper_closed=frame.gripper_closed,
+            load_share=frame.load_share,
+        )
+
+    def _apply(self, event: Event) -> list[Event]:
+        """One event through the behavior (and so the handover state); returns what it adds
+        to the tick's events. A phase event is passed on only when it changed the handover's
+        phase (the stream published is the one phase stream); a robot event that changed it
+        is followed by that phase's event (``info.source`` ``robot`` or ``gripper``,
+        ``info.evidence`` the robot event). A grasp or a release the detector cannot see moves
+        its phase too."""
+        change: PhaseChange | None = self.behavior.handle(event)
+        kind = getattr(event, "kind", None)
+        if kind in PHASE_OF_EVENT:
+            return [event] if change is not None else []
+        out = [event]
+        if change is not None:
+            if change.rule.trigger in _DETECTOR_ADOPTS:
+                self.detector.adopt(change.phase, change.t)
+            info = {
+                "handover": self.handover.handover,
+                "source": change.source,
+                "evidence": change.rule.trigger.value,
+            }
+            detected = getattr(event, "detected_at", change.t)
+            out.append(Event(EVENT_OF_PHASE[change.phase], change.t, detected, info))
+        return out
+
+    def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
+        points = dict(self._fixed_points)
+        points.update(
+            face=frame.giver_face,
+            hand=frame.giver_hand,
+            object=frame.giver_hand,
+            receiver_hand=frame.receiver_hand,
+        )
+        return points
+
+    def _fault(self, t: float, stage: str, err: BaseException) -> Event:
+        self.stats.faults += 1
+        info = {"stage": stage, "error": f"{type(err).__name__}: {err}"[:200]}
+        return Event(EventKind.FAULT, t, t, info)
+
+    def _command(
+        self,
+        t: float,
+        kind: str,
+        point: np.ndarray,
+        arm: Mapping[str, float] | None,
+        events: tuple[Event, ...],
+        faults: list[Event],
+    ) -> GazeCommand:
+        """The command for ``kind`` at ``point``; the last safe one (or rest) if the kinematics
+        fail or give a non-finite value."""
+        try:
+            state = self.gaze.update(t, point, arm=arm)
+            head, yaw, pitch = state.head, state.eye_yaw, state.eye_pitch
+            residual, shift = state.residual, state.shift_amplitude
+            ok = all(math.isfinite(v) for v in (yaw, pitch, residual, shift, *head.values()))
+        except Exception as err:  # noqa: BLE001 - e.g. a joint reading that is no number
+            faults.append(self._fault(t, "kinematics", err))
+            events = (*events, faults[-1])
+            ok = False
+        if not ok:
+            last = self._last_safe
+            head = dict(last.head) if last is not None else self.robot.head_dict(self.robot.rest)
+            yaw, pitch = (last.eye_yaw, last.eye_pitch) if last is not None else (0.0, 0.0)
+            residual = last.residual if last is not None else 0.0
+            shift = 0.0
+        self._last_target = (kind, point)
+        status: Status = "degraded" if faults or not ok else "ok"
+        cmd = GazeCommand(
+            t=t,
+            phase=self.handover.phase,
+            phase_source=self.handover.source,
+            target=kind,
+            target_point=np.asarray(point, float),
+            head=head,
+            eye_yaw=yaw,
+            eye_pitch=pitch,
+            residual=residual,
+            gaze_shift=shift,
+            tracking=self.behavior.tracking,  # type: ignore[arg-type]
+            status=status,
+            events=events,
+        )
+        if ok:
+            self._last_safe = cmd
+        return cmd

@@ -8,9 +8,9 @@ frame unless a name says otherwise.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from enum import Enum
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -73,6 +73,30 @@ class EventKind(str, Enum):
     ROBOT_RETREAT_ENDED = "robot_retreat_ended"
     ROBOT_REACH_INFEASIBLE = "robot_reach_infeasible"  # no reach meets the timing (seed 3.2)
     ROBOT_RELEASED = "robot_released"  # robot-to-human: the robot let go of the object
+    FAULT = "fault"  # a sample or event raised inside the engine; info names it and the error
+
+
+#: The phase each phase event starts (the one event -> phase mapping; detector, handover state,
+#: behaviors and the bus all read it).
+PHASE_OF_EVENT: dict[EventKind, Phase] = {
+    EventKind.REACH_STARTED: Phase.REACH,
+    EventKind.TRANSFER_STARTED: Phase.TRANSFER,
+    EventKind.RETREAT_STARTED: Phase.RETREAT,
+    EventKind.HANDOVER_DONE: Phase.DONE,
+}
+#: The event that starts each phase (the inverse of :data:`PHASE_OF_EVENT`).
+EVENT_OF_PHASE: dict[Phase, EventKind] = {p: k for k, p in PHASE_OF_EVENT.items()}
+
+#: What the current phase was last decided by: the tracked hands (the phase detector), the
+#: robot's own motion events, or its gripper / load-share sensors.
+PhaseSource = Literal["tracking", "robot", "gripper"]
+#: The behavior's tracking state: ``ok``, ``hold`` (tracking lost, the gaze held for the
+#: behavior's ``tracking_lost.hold_s``) or ``lost`` (looking at its ``tracking_lost`` target);
+#: ``waiting`` before the first sample.
+TrackingState = Literal["waiting", "ok", "hold", "lost"]
+#: ``ok``, or ``degraded`` when a sample or event of this tick raised inside the engine (reported
+#: as a ``fault`` event; the command is still safe).
+Status = Literal["ok", "degraded"]
 
 
 @dataclass(frozen=True)
@@ -148,37 +172,51 @@ class GazeTarget:
 
 @dataclass(frozen=True)
 class GazeContext:
-    """What a behavior sees at one tick: the phase, its timing and the points it may look at.
+    """What a behavior sees at one tick besides the handover state: the time and the points.
+
+    The phase is not here: the behavior reads it from the one
+    :class:`~gazebot.handover.HandoverState` it is given.
 
     Attributes:
         t: Current time (s).
-        phase: Current handover phase.
-        phase_start: When the current phase started (s).
-        expected_phase_end: Predicted end of the current phase (s); NaN when unknown.
         points: Current 3D points by target name (base frame, m): at least ``face``, ``hand``,
             ``object``, ``handover_location`` and ``rest``; NaN where unknown.
+        tracking_end: The phase detector's prediction of the current phase's end (s); NaN when
+            unknown (or when the detector is not in the handover's phase).
     """
 
     t: float
-    phase: Phase
-    phase_start: float
-    expected_phase_end: float
     points: dict[str, np.ndarray]
+    tracking_end: float = math.nan
 
 
 @dataclass(frozen=True)
 class GazeCommand:
-    """The engine's output for one tick.
+    """The one command value, from the engine through the runtime loop to the wire (the bus
+    payloads map it; nothing else copies its fields).
+
+    The engine fills everything but the lids and the vergence; the runtime loop adds ``blink``,
+    ``distance`` and ``answers_sample`` with :meth:`replaced`.
 
     Attributes:
         t: Time of the tracking frame this answers (s).
-        phase: Current handover phase.
+        phase: The handover state's phase (the one the behavior runs).
+        phase_source: What decided that phase: ``tracking``, ``robot`` or ``gripper``.
         target: Gaze target kind (``face``, ``hand``, ...).
         target_point: The 3D point looked at (base frame, m).
-        head: Head joint goals by joint name (rad), always finite and within limits.
-        eye_yaw: Eye yaw on the display (rad, + = robot's left).
-        eye_pitch: Eye pitch on the display (rad, + = down).
+        head: Head joint goals by joint name (rad), finite and within the joint limits.
+        eye_yaw: Eye yaw on the display (rad, + = robot's left), within the eye range.
+        eye_pitch: Eye pitch on the display (rad, + = down), within the eye range.
         residual: Angle between the final line of sight (head + eyes) and the target (rad).
+        gaze_shift: Angle (rad) the line of sight to the target turned since the previous tick
+            (from the head's ``gaze`` frame); drives the blink model.
+        tracking: The behavior's tracking state (see :data:`TrackingState`).
+        status: ``ok`` or ``degraded`` (see :data:`Status`).
+        blink: Lid closure, 0 open .. 1 closed (the runtime loop's blink model; 0 from the
+            engine alone).
+        distance: Distance (m) from the ``gaze`` frame to the target, for vergence; ``None``
+            when unknown.
+        answers_sample: Whether the tick answered a tracking sample (``False``: silence).
         events: Events that fired during this tick.
     """
 
@@ -190,8 +228,31 @@ class GazeCommand:
     eye_yaw: float
     eye_pitch: float
     residual: float = 0.0
+    phase_source: PhaseSource = "tracking"
+    gaze_shift: float = 0.0
+    tracking: TrackingState = "ok"
+    status: Status = "ok"
+    blink: float = 0.0
+    distance: float | None = None
+    answers_sample: bool = True
     events: tuple[Event, ...] = ()
 
+    def replaced(self, **changes: Any) -> GazeCommand:
+        """This command with ``changes`` (field names) applied: what
+        :func:`dataclasses.replace` does, without its per-call field inspection (the runtime loop
+        calls this every tick; ``replace`` would cost more than the rest of the loop)."""
+        unknown = changes.keys() - _COMMAND_FIELDS
+        if unknown:
+            raise TypeError(f"GazeCommand has no fields {sorted(unknown)}")
+        new = object.__new__(GazeCommand)
+        new.__dict__.update(self.__dict__)
+        new.__dict__.update(changes)
+        return new
+
     def is_finite(self) -> bool:
-        vals = [self.eye_yaw, self.eye_pitch, *self.head.values()]
+        """True when every joint and eye value (and the time) is finite."""
+        vals = [self.t, self.eye_yaw, self.eye_pitch, self.blink, *self.head.values()]
         return all(math.isfinite(v) for v in vals)
+
+
+_COMMAND_FIELDS = frozenset(f.name for f in fields(GazeCommand))

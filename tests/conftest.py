@@ -39,3 +39,24 @@ def seed_text() -> str:
     if not path.is_file():
         pytest.skip(f"seed text not present at {path}")
     return path.read_text(encoding="utf-8")
+
+
+@pytest.fixture(scope="session")
+def bounded_memory():
+    """``with bounded_memory(limit_bytes): ...`` fails the test if the block's peak of traced
+    allocations (Python objects and numpy arrays) exceeds the limit: a parser fed hostile input
+    must not allocate without bound."""
+    import tracemalloc
+    from contextlib import contextmanager
+
+    @contextmanager
+    def limit(limit_bytes: float = 100e6):
+        tracemalloc.start()
+        try:
+            yield
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert peak < limit_bytes, f"peak {peak / 1e6:.0f} MB over {limit_bytes / 1e6:.0f} MB"
+
+    return limit

@@ -79,3 +79,75 @@ def test_nan_and_infinity_in_yaml_are_rejected_with_the_field(tmp_path, name, te
     with pytest.raises(ConfigError) as err:
         loader(path)
     assert str(path) in str(err.value) and "finite" in str(err.value)
+
+
+# ---- hostile YAML: bounded memory and a one-line error naming the file ----
+
+BILLION_LAUGHS = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{n}: &{n} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+    for p, n in zip("abcdefgh", "bcdefghi", strict=True)
+)  # under 1 kB; expanded, 9**9 strings
+
+
+def _loaders():
+    from gazebot.behaviors.registry import load_behavior
+    from gazebot.controllers.config import load_controllers_config
+    from gazebot.kinematics.config import load_robot_config
+    from gazebot.phases.config import load_phase_config
+    from gazebot.render.eye_style import load_eye_style
+    from gazebot.sim.scene_config import load_scene
+
+    return {
+        "behavior": load_behavior,
+        "robot": load_robot_config,
+        "scene": load_scene,
+        "phases": load_phase_config,
+        "controllers": load_controllers_config,
+        "eye style": load_eye_style,
+    }
+
+
+@pytest.mark.parametrize("kind", list(_loaders()))
+def test_every_config_loader_refuses_an_alias_bomb_in_bounded_memory(tmp_path, kind):
+    import tracemalloc
+
+    path = tmp_path / "bomb.yaml"
+    path.write_text(BILLION_LAUGHS)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ConfigError) as err:
+            _loaders()[kind](path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 20e6, peak
+    msg = str(err.value)
+    assert msg.startswith(str(path)) and "line 2, column 8" in msg and "alias" in msg
+    assert len(msg) < 300 and "\n" not in msg
+
+
+def test_an_anchor_without_alias_still_loads(tmp_path):
+    path = tmp_path / "ok.yaml"
+    path.write_text("rate_hz: &r 5\n")
+    assert load_model(_Model, path).rate_hz == 5
+
+
+def test_a_file_over_the_size_cap_is_refused_unread(tmp_path):
+    from gazebot.config import MAX_YAML_BYTES
+
+    path = tmp_path / "big.yaml"
+    path.write_text("rate_hz: 1\n" + "#" * MAX_YAML_BYTES + "\n")
+    with pytest.raises(ConfigError, match=f"at most {MAX_YAML_BYTES} bytes") as err:
+        load_model(_Model, path)
+    assert str(err.value).startswith(str(path))
+
+
+@pytest.mark.parametrize(
+    "text", ["[" * 100_000, "a:\n" + "".join(" " * i + "b:\n" for i in range(1, 400))]
+)
+def test_deep_nesting_is_a_config_error_not_a_recursion_crash(tmp_path, text):
+    path = tmp_path / "deep.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_model(_Model, path)
+    assert str(err.value).startswith(str(path))

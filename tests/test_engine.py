@@ -233,3 +233,34 @@ def test_look_at_points_the_real_head_and_eyes_at_a_fixed_point_keeping_the_phas
     # a time going back is answered at the last time, never earlier
     assert engine.look_at(t0, point).t == last.t
     assert engine.look_at(math.nan, point).t == last.t
+
+
+@pytest.mark.parametrize("behavior", ["face-hand-face", "short-face-hand"])
+def test_a_robot_first_reach_is_reported_as_the_reach_from_the_first_look_at_the_hand(behavior):
+    # Issue 19: robot_reach_started at 0.5 s, the giver's hand still. The phase the command
+    # reports is the phase the behavior runs: reach (decided by the robot) from the first
+    # command that looks at the hand (was: idle with target hand from 1.00 to 1.74 s).
+    eng = GazeEngine.from_config(robot="sawyer", behavior=behavior)
+    hand, grip, face = [1.0, -0.35, 0.85], [0.35, 0.0, 0.9], [1.15, 0.0, 1.6]
+    commands = []
+    for t in np.arange(0.0, 3.0, 1 / 120):
+        if abs(t - 0.5) < 1e-9:
+            eng.notify(Event(EventKind.ROBOT_REACH_STARTED, t, t, {"planned_duration": 1.0}))
+        commands.append(
+            eng.step(TrackingFrame.make(t, giver_hand=hand, receiver_hand=grip, giver_face=face))
+        )
+    on_hand = [c for c in commands if c.target == "hand"]
+    assert on_hand and on_hand[0].t >= 0.5, "the behavior looks at the hand before the reach"
+    assert all(c.phase is Phase.REACH and c.phase_source == "robot" for c in on_hand)
+    assert all(c.phase is Phase.IDLE for c in commands if c.t < 0.5)
+    assert all(c.phase is Phase.REACH for c in commands if c.t >= 0.5)
+
+
+def test_the_command_reports_the_gripper_as_the_source_of_a_grasped_transfer():
+    eng = GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
+    eng.notify(Event(EventKind.ROBOT_REACH_STARTED, 0.1, 0.1, {"planned_duration": 1.0}))
+    eng.step(TrackingFrame.make(0.1))
+    eng.notify([Event(EventKind.ROBOT_GRASPED, 0.2, 0.2)])  # one event or many
+    cmd = eng.step(TrackingFrame.make(0.2))
+    assert (cmd.phase, cmd.phase_source) == (Phase.TRANSFER, "gripper")
+    assert eng.detector.phase is Phase.TRANSFER  # the detector adopted what it cannot see

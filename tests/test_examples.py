@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+import importlib
 import importlib.util
 import json
 import socket
@@ -43,13 +45,15 @@ def test_robot_bridge_example_is_driven_by_the_engine_node_over_zenoh(capsys):
     result: dict = {}
 
     def robot():
-        result["rc"] = bridge.main(["--id", "example", "--listen", endpoint, "--duration", "4"])
+        result["rc"] = bridge.main(["--namespace", "/example", "--listen", endpoint,
+                                    "--duration", "4"])
 
     thread = threading.Thread(target=robot)
     thread.start()
     from gazebot.cli import main
 
-    rc = main(["run", "--robot", "sawyer", "--behavior", "face-hand-face", "--id", "example",
+    rc = main(["run", "--robot", "sawyer", "--behavior", "face-hand-face",
+                 "--namespace", "/example",
                "--connect", endpoint, "--duration", "3", "--json"])
     thread.join(timeout=10)
     out = capsys.readouterr().out
@@ -58,3 +62,51 @@ def test_robot_bridge_example_is_driven_by_the_engine_node_over_zenoh(capsys):
     assert summary["frames"] > 100 and summary["commands"] > 100
     applied = int(out.rsplit("applied", 1)[1].split()[0])
     assert applied > 100
+
+
+def test_shipped_sample_recording_is_what_the_generator_writes():
+    lines, truth = _load("make_sample_recording").rows()
+    assert (EXAMPLES / "sample-handover.csv").read_text().splitlines() == lines
+    assert json.loads((EXAMPLES / "sample-handover.truth.json").read_text()) == truth
+
+
+def test_gazebot_phases_runs_on_the_sample_recording_and_finds_its_handover(capsys):
+    from gazebot.cli import main
+
+    assert main(["phases", str(EXAMPLES / "sample-handover.csv"), "--json"]) == 0
+    segments = json.loads(capsys.readouterr().out)["segments"]
+    truth = json.loads((EXAMPLES / "sample-handover.truth.json").read_text())["handovers"][0]
+    assert [s["phase"] for s in segments] == ["reach", "transfer", "retreat"]
+    reach, transfer, _ = segments
+    assert abs(reach["start"] - truth["reach_start"]) < 0.1
+    assert abs(transfer["start"] - truth["transfer_start"]) < 0.1
+    assert abs(transfer["end"] - truth["transfer_end"]) < 0.1
+
+
+def test_register_extensions_example_adds_a_phase_method_and_a_controller_from_outside():
+    from gazebot.controllers import CONTROLLERS
+    from gazebot.phases.methods import PHASE_METHODS
+    from gazebot.sim.scene_config import SceneConfig
+
+    example = _load("register_extensions")
+    try:
+        lines = example.main()
+        online = [line.split()[1] for line in lines if line.startswith("online")]
+        assert online == ["reach_started", "transfer_started", "retreat_started"]
+        starts = {line.split()[0]: float(line.split()[1]) for line in lines[1:4]}
+        truth = float(lines[0].split("transfer")[1].split()[0])
+        assert starts["reach"] < starts["transfer"] < starts["retreat"]
+        assert abs(starts["transfer"] - truth) < 0.4
+        assert lines[-1] == "straight: [1.0, 0.0, 0.0] m/s"
+        # Registered names are accepted wherever the built-ins are: configs and the CLI.
+        scene = SceneConfig.model_validate({"controller": {"reach_controller": "straight"}})
+        assert scene.controller.reach_controller == "straight"
+        parser = argparse.ArgumentParser()
+        sub = parser.add_subparsers()
+        importlib.import_module("gazebot.cli.reach_plan").register(sub)
+        importlib.import_module("gazebot.cli.phases").register(sub)
+        args = parser.parse_args(["phases", "x.csv", "--method", "closest-approach"])
+        assert args.method == "closest-approach"
+    finally:
+        PHASE_METHODS.unregister("closest-approach")
+        CONTROLLERS.unregister("straight")

@@ -30,13 +30,9 @@ from gazebot.annotations.rules import DEFAULT_RULE, GazeRule
 from gazebot.annotations.three_phase import HANDOVER_PHASES
 from gazebot.behaviors.machine import BehaviorMachine
 from gazebot.behaviors.spec import BehaviorSpec
-from gazebot.types import Event, EventKind, GazeContext, Phase
+from gazebot.types import EVENT_OF_PHASE, Event, EventKind, GazeContext, Phase
 
-_START_EVENT = {
-    "reach": EventKind.REACH_STARTED,
-    "transfer": EventKind.TRANSFER_STARTED,
-    "retreat": EventKind.RETREAT_STARTED,
-}
+_START_EVENT = {p.value: k for p, k in EVENT_OF_PHASE.items() if p is not Phase.DONE}
 _AS_HAND = {"hand": "hand", "object": "hand", "face": "face"}
 # Stand-in positions: only the target kind matters for the comparison.
 _POINTS = {
@@ -125,12 +121,6 @@ def handover_events(phases: tuple[str, ...]) -> dict[int, list[Event]]:
     return events
 
 
-def _phase_of(label: str, after_handover: bool) -> Phase:
-    if label in _START_EVENT:
-        return Phase(label)
-    return Phase.DONE if after_handover else Phase.IDLE
-
-
 def replay_handover(
     handover: AnnotatedHandover,
     spec: BehaviorSpec,
@@ -146,13 +136,12 @@ def replay_handover(
     phases = handover.phase(role)
     gaze = handover.gaze(role)
     events = handover_events(phases)
-    # Phase start/end of every frame (the true end stands in for the detector's prediction).
-    bounds: list[tuple[float, float]] = [(0.0, math.nan)] * len(phases)
-    done = False
+    # The phase end of every frame (the true end stands in for the detector's prediction).
+    ends: list[float] = [math.nan] * len(phases)
     for label, start, n in phase_runs(phases):
         end = (start + n) / FPS if label in _START_EVENT else math.nan
         for i in range(start, start + n):
-            bounds[i] = (start / FPS, end)
+            ends[i] = end
     if machine is None or machine.spec is not spec:
         machine = BehaviorMachine(spec, seed=seed)
     else:
@@ -161,12 +150,7 @@ def replay_handover(
     for i, label in enumerate(phases):
         for event in events.get(i, ()):
             machine.handle(event)
-        if label == "retreat":
-            done = True
-        elif label == "reach":
-            done = False
-        start, end = bounds[i]
-        ctx = GazeContext(i / FPS, _phase_of(label, done), start, end, _POINTS)
+        ctx = GazeContext(i / FPS, _POINTS, tracking_end=ends[i])
         kind = machine.target(ctx).kind
         human = rule.target(gaze[i])
         if label not in by_phase or human is None:

@@ -20,19 +20,14 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from gazebot.types import EventKind, Phase
+from gazebot.types import EVENT_OF_PHASE, EventKind, Phase
 
 #: Targets every robot provides (``GazeContext.points``); other names are robot-named points.
 STANDARD_TARGETS = ("face", "hand", "object", "handover_location", "rest")
 #: Phases a segment can belong to (idle and done use ``before`` and ``after``).
 SEGMENT_PHASES = (Phase.REACH, Phase.TRANSFER, Phase.RETREAT)
 #: The event that starts each phase; ``{after: <that event>}`` is measured from the phase start.
-PHASE_START_EVENT = {
-    Phase.REACH: EventKind.REACH_STARTED,
-    Phase.TRANSFER: EventKind.TRANSFER_STARTED,
-    Phase.RETREAT: EventKind.RETREAT_STARTED,
-    Phase.DONE: EventKind.HANDOVER_DONE,
-}
+PHASE_START_EVENT = EVENT_OF_PHASE
 
 _TARGET_CHARS = set("abcdefghijklmnopqrstuvwxyz0123456789_-")
 

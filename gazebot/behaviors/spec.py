@@ -44,6 +44,7 @@ from gazebot.behaviors.segment import (
     check_target_name,
     parse_at,
 )
+from gazebot.phases.durations import REACH_S, RETREAT_S, TRANSFER_S
 from gazebot.types import Phase
 
 __all__ = [
@@ -86,14 +87,13 @@ class TrackingLostPolicy(_Strict):
 class PhaseDurations(_Strict):
     """Fallback phase durations (s) for fraction timings when no online estimate exists.
 
-    Defaults are the human receivers' mean phase lengths in the published annotations, measured
-    by ``gazebot annotations summarize``: reach 6.43, transfer 4.68, retreat 8.40 frames at 8 fps
-    (the seed's figure 6.1 gives 7.53 frames for the receivers' reach).
+    Defaults: the typical durations of the phase stream the engine reports (the giver's), from
+    :mod:`gazebot.phases.durations`, the one place the detector's prediction reads too.
     """
 
-    reach: float = Field(default=0.80, gt=0.0, allow_inf_nan=False)
-    transfer: float = Field(default=0.59, gt=0.0, allow_inf_nan=False)
-    retreat: float = Field(default=1.05, gt=0.0, allow_inf_nan=False)
+    reach: float = Field(default=REACH_S, gt=0.0, allow_inf_nan=False)
+    transfer: float = Field(default=TRANSFER_S, gt=0.0, allow_inf_nan=False)
+    retreat: float = Field(default=RETREAT_S, gt=0.0, allow_inf_nan=False)
 
     def of(self, phase: Phase) -> float:
         return float(getattr(self, phase.value, self.reach))

@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "reach_plan",
     "run",
     "display",
+    "router",
     "study",
     "gps",
 )
@@ -42,7 +43,25 @@ def build_parser() -> argparse.ArgumentParser:
     for name in COMMAND_MODULES:
         module = importlib.import_module(f"gazebot.cli.{name}")
         module.register(sub)
+    _plain_help(parser)
     return parser
+
+
+def _plain_help(parser: argparse.ArgumentParser) -> None:
+    """Strip the reST literal markup (````x````) that module docstrings used as descriptions
+    carry: ``--help`` is read in a terminal. In place, for every sub-command."""
+    parser.description = _plain(parser.description)
+    for action in parser._actions:
+        action.help = _plain(action.help)
+        if isinstance(action, argparse._SubParsersAction):
+            for choice in action._choices_actions:
+                choice.help = _plain(choice.help)
+            for sub in set(action.choices.values()):
+                _plain_help(sub)
+
+
+def _plain(text: str | None) -> str | None:
+    return None if text is None else text.replace("``", "")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -59,10 +78,21 @@ def main(argv: list[str] | None = None) -> int:
     except (ConfigError, TrajectoryFormatError, RecordingError, UsageError, OSError) as exc:
         # Input errors only: a malformed file, a wrong option, a missing file, a directory where
         # a file was expected, permissions. Any other exception is a bug: it keeps its traceback.
-        print(f"gazebot: error: {exc}", file=sys.stderr)
+        # A file name that is not UTF-8 is kept as surrogates: shown escaped, not a crash.
+        text = str(exc).encode("utf-8", "backslashreplace").decode("utf-8")
+        print(f"gazebot: error: {text}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130
+    except Exception as exc:
+        # A node that cannot join the bus (its port taken, a bad endpoint) is not a bug.
+        from gazebot.cli.bus import bus_failure
+
+        message = bus_failure(exc)
+        if message is None:
+            raise
+        print(f"gazebot: error: {message}", file=sys.stderr)
+        return 2
     return int(result or 0)
 
 

@@ -32,7 +32,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         required=True,
         help="behavior name or YAML file (repeatable; 'all' = every available behavior)",
     )
-    p.add_argument("--role", choices=("receiver", "giver"), default="receiver")
+    p.add_argument(
+        "--role",
+        choices=("receiver", "giver"),
+        default="receiver",
+        help="whose gaze: the receiver's (default, the robot's part) or the giver's",
+    )
     p.add_argument("--seed", type=seed_value, default=0, help="seed of data-driven behaviors")
     p.add_argument("--json", action="store_true", help="print one JSON document")
     p.set_defaults(func=_replay)
@@ -41,7 +46,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "fit-human", help="fit the data-driven behavior (patterns and shift timings) to a role"
     )
     p.add_argument("dir", type=Path, help="folder of the annotations")
-    p.add_argument("--role", choices=("receiver", "giver"), default="receiver")
+    p.add_argument(
+        "--role",
+        choices=("receiver", "giver"),
+        default="receiver",
+        help="whose gaze: the receiver's (default, the robot's part) or the giver's",
+    )
     p.add_argument("--min-count", type=int, default=3, help="keep patterns seen this often")
     p.add_argument("-o", "--output", type=Path, help="write the behavior YAML here")
     p.set_defaults(func=_fit)

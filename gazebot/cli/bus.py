@@ -1,23 +1,66 @@
 """Command-line options shared by the bus nodes (``gazebot sim``, ``gazebot run``, ``gazebot
-display``): how a node joins the Zenoh bus, and positive numbers."""
+display``): how a node joins the Zenoh bus and names its ROS 2 topics, and positive numbers."""
 
 from __future__ import annotations
 
 import argparse
+import os
 
+from gazebot.cli.errors import UsageError
+from gazebot.drivers.rmw.names import Names, parse_remap
 from gazebot.drivers.session import DEFAULT_ENDPOINT, EPHEMERAL_ENDPOINT, BusConfig
+from gazebot.ros2.convert import BODIES
+
+
+def _tf_frame(value: str) -> tuple[str, str]:
+    body, sep, frame = value.partition("=")
+    if not sep or body not in BODIES or not frame:
+        raise argparse.ArgumentTypeError(
+            f"expected BODY=FRAME with BODY one of {', '.join(BODIES)}, got {value!r}")
+    return body, frame
+
+
+def _remap(value: str) -> tuple[str, str]:
+    try:
+        return parse_remap(value)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _domain_id(value: str) -> int:
+    try:
+        d = int(value)
+    except ValueError:
+        d = -1
+    if not 0 <= d <= 232:
+        raise argparse.ArgumentTypeError(f"expected a ROS domain id 0..232, got {value!r}")
+    return d
 
 
 def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool) -> None:
-    """``--id``, ``--listen``, ``--connect``, ``--multicast``: how the node joins the bus.
+    """``--namespace``, ``--remap``, ``--domain-id``, ``--base-frame``, ``--tf-frame``,
+    ``--listen``, ``--connect``, ``--multicast``: how the node joins the bus.
 
     By default the robot side (``gazebot sim``) listens on ``tcp/127.0.0.1:7447`` and engine
     nodes (``gazebot run``) connect to it, listening on an ephemeral port so that other
-    connected nodes reach them too.
+    connected nodes reach them too. ``--connect tcp/HOST:7447`` joins a Zenoh router instead.
     """
     listen_default = DEFAULT_ENDPOINT if listens_by_default else EPHEMERAL_ENDPOINT
     connect_default = "none" if listens_by_default else DEFAULT_ENDPOINT
-    parser.add_argument("--id", default="sim", help="robot id: keys live under gazebot/<id>/")
+    parser.add_argument("--namespace", default="/gazebot", metavar="NS",
+                        help="ROS namespace of the nodes and their relative topics "
+                        "(default /gazebot)")
+    parser.add_argument("--remap", action="append", type=_remap, default=[],
+                        metavar="FROM:=TO", help="rename a topic, repeatable "
+                        "(e.g. gaze_target:=/robot/look_at)")
+    parser.add_argument("--domain-id", type=_domain_id, default=None, metavar="N",
+                        help="ROS domain id (default: $ROS_DOMAIN_ID, else 0)")
+    parser.add_argument("--base-frame", default=None, metavar="FRAME",
+                        help="TF name of the robot base frame: frame_id of the points sent "
+                        "and accepted (default: the robot YAML's base_frame)")
+    parser.add_argument("--tf-frame", action="append", type=_tf_frame, default=[],
+                        metavar="BODY=FRAME", help="also take BODY (giver_hand, receiver_hand, "
+                        "giver_face) from /tf: FRAME's transform from the base frame; repeatable")
     parser.add_argument(
         "--listen",
         action="append",
@@ -28,25 +71,56 @@ def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool)
         "--connect",
         action="append",
         metavar="EP",
-        help=f"peer or router endpoint to connect to, repeatable (default: {connect_default})",
+        help=f"peer or router endpoint to connect to, e.g. tcp/HOST:7447, repeatable "
+        f"(default: {connect_default})",
     )
     parser.add_argument(
         "--multicast", action="store_true", help="enable multicast scouting (off by default)"
     )
 
 
-def bus_config(args: argparse.Namespace, listens_by_default: bool) -> BusConfig:
-    """The :class:`BusConfig` of parsed ``add_bus_arguments`` options."""
+def add_record_argument(parser: argparse.ArgumentParser) -> None:
+    """``--record FILE.mcap``: record the bus to MCAP while the node runs."""
+    parser.add_argument("--record", metavar="FILE.mcap", default=None,
+                        help="record every gazebot topic on the bus (ROS 2 schemas embedded, "
+                        "log time = receive time) to this MCAP file, as ros2 bag record does")
+
+
+def bus_names(args: argparse.Namespace, base_frame: str = "world") -> Names:
+    """The :class:`Names` of parsed ``add_bus_arguments`` options (``ValueError`` if bad);
+    ``base_frame``: the robot's, unless ``--base-frame`` names another."""
+    domain = args.domain_id
+    if domain is None:
+        env = os.environ.get("ROS_DOMAIN_ID", "").strip()
+        domain = _domain_id(env) if env else 0
+    return Names(args.namespace, dict(args.remap), domain,
+                 base_frame=args.base_frame or base_frame, tf_frames=dict(args.tf_frame))
+
+
+def robot_base_frame(robot: str) -> str:
+    """The base frame of robot ``robot`` (name or YAML file) as its YAML names it."""
+    from gazebot.kinematics.config import load_robot_config
+
+    return load_robot_config(robot)[0].base_frame
+
+
+def bus_config(args: argparse.Namespace, listens_by_default: bool,
+               base_frame: str = "world") -> BusConfig:
+    """The :class:`BusConfig` of parsed ``add_bus_arguments`` options (``base_frame``: the
+    robot's, see :func:`bus_names`)."""
     listen = args.listen if args.listen is not None else (
         [DEFAULT_ENDPOINT] if listens_by_default else [EPHEMERAL_ENDPOINT])
     connect = args.connect if args.connect is not None else (
         [] if listens_by_default else [DEFAULT_ENDPOINT])
-    return BusConfig(
-        robot_id=args.id,
-        listen=tuple(listen),
-        connect=tuple(connect),
-        multicast_scouting=args.multicast,
-    )
+    try:
+        return BusConfig(
+            names=bus_names(args, base_frame),
+            listen=tuple(listen),
+            connect=tuple(connect),
+            multicast_scouting=args.multicast,
+        )
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
 
 
 def positive(value: str) -> float:
@@ -57,3 +131,33 @@ def positive(value: str) -> float:
     if not x > 0 or x != x:
         raise argparse.ArgumentTypeError(f"expected a positive number, got {value!r}")
     return x
+
+
+def bus_failure(exc: BaseException) -> str | None:
+    """The one-line message for a node that could not join the Zenoh bus (``None``: ``exc``
+    is something else). Found by the ``zenoh.ZError`` in the exception's chain, so it holds
+    whatever the driver wraps it in; the endpoint already in use (a second ``gazebot sim``)
+    gets its own advice."""
+    import re
+    import sys
+
+    zenoh = sys.modules.get("zenoh")
+    z_error = getattr(zenoh, "ZError", None) if zenoh is not None else None
+    if z_error is None:
+        return None
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen and not isinstance(cause, z_error):
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    if cause is None or not isinstance(cause, z_error):
+        return None
+    text = re.sub(r"\s+at /\S+\.rs:\d+\.?", "", str(cause)).strip()  # Zenoh's Rust sources
+    taken = re.search(r"bound to (\S+?):\s*\[", text)
+    if "Address already in use" in text and taken:
+        return (
+            f"cannot listen on {taken.group(1)}: the address is already in use (another gazebot "
+            "sim on this port?); stop it, or pass --listen with another port and --connect "
+            "to it from the other nodes"
+        )
+    return f"could not join the Zenoh bus: {text}"

@@ -1,6 +1,7 @@
 """``gazebot demo``: the main job. Simulates a human-to-robot handover in MuJoCo with the gaze
-engine driving the robot's head and eyes, and writes ``handover.mp4``, ``timeline.csv`` and
-``timeline.png`` into the output folder."""
+engine driving the robot's head and eyes, and writes ``handover.mp4``, ``timeline.csv``,
+``timeline.png`` and ``handover.mcap`` (every ROS 2 topic of the run, log time = simulation time)
+into the output folder."""
 
 from __future__ import annotations
 
@@ -9,14 +10,23 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode, seed_value
+
+if TYPE_CHECKING:
+    from gazebot.kinematics.config import RobotConfig
+    from gazebot.ros2.handover_log import HandoverMcap
+
+EXIT_INFEASIBLE = 3  # the reach controller found no feasible reach and the robot stopped
 
 # The scene's controller fields the command line sets, for error messages.
 _OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from gazebot.sim.scene_config import reach_controller_names
+
     parser = sub.add_parser(
         "demo",
         help="simulate a handover with gaze and write a video, a timeline CSV and a plot",
@@ -48,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", action="store_true", help="print a JSON summary to stdout")
     parser.add_argument(
         "--controller",
-        choices=["joint", "pv", "mcj", "mce", "stl"],
+        choices=reach_controller_names(),
         help="the robot's reach controller (default: the scene's; seed chapters 3-4)",
     )
     parser.add_argument(
@@ -114,19 +124,27 @@ def scene_with_overrides(args: argparse.Namespace):
     if not overrides:
         return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
-    from gazebot.sim.scene_config import Direction, ReachControllerName, SceneConfig, load_scene
+    from gazebot.sim.scene_config import (
+        JOINT_REACH,
+        Direction,
+        SceneConfig,
+        load_scene,
+        reach_controller_names,
+    )
 
     data = load_scene(base).model_dump()
     data["controller"].update(overrides)
-    controller = ReachControllerName(data["controller"]["reach_controller"]).value
+    controller = str(data["controller"]["reach_controller"])
     timed = "reach_time_s" in overrides or "stall_time_s" in overrides
     if timed and controller == "joint":
-        raise UsageError("--reach-time/--stall-time need --controller pv, mcj, mce or stl")
+        *others, last = (n for n in reach_controller_names() if n != JOINT_REACH)
+        need = f"{', '.join(others)} or {last}"
+        raise UsageError(f"--reach-time/--stall-time need --controller {need}")
     if "stall_time_s" in overrides and controller != "mce":
         raise UsageError("--stall-time ('Don't move until') is the mce controller's")
     try:
         scene = SceneConfig.model_validate(data)
-        if scene.controller.reach_controller is not ReachControllerName.JOINT:
+        if scene.controller.reach_controller != JOINT_REACH:
             # The reach and stall times against the controllers YAML, as the simulation will.
             scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field
@@ -174,12 +192,13 @@ def run_demo(args: argparse.Namespace) -> int:
     png_path = plot_timeline(rec.ticks, out / "timeline.png", title=title)
     summary = {
         "video": str(rec.video),
+        "mcap": str(out / "handover.mcap"),
         "timeline_csv": str(csv_path),
         "timeline_png": str(png_path),
         "frames": rec.frames,
         "fps": rec.fps,
         "duration_s": round(rec.ticks[-1].t, 4),
-        "completed": rec.completed,
+        "completed": rec.completed and not infeasible,
         "phases": [
             {"phase": p, "start": round(a, 3), "end": round(b, 3)}
             for p, a, b in phase_spans(rec.ticks)
@@ -200,8 +219,17 @@ def run_demo(args: argparse.Namespace) -> int:
         )
         rob = ", ".join(f"{k} {v:+.3f}" for k, v in summary["stl_robustness"].items())
         print(f"STL robustness (Table 4.2, positive = met): {rob}")
-        for path in (rec.video, csv_path, png_path):
+        for path in (rec.video, csv_path, png_path, out / "handover.mcap"):
             print(f"wrote {path}")
+    if infeasible:
+        # The robot stopped and said so: a run that ended as the seed says it should, but no
+        # handover happened.
+        print(
+            f"gazebot: the reach was infeasible at {infeasible[0].t:.2f} s: the robot stopped "
+            f"(exit {EXIT_INFEASIBLE})",
+            file=sys.stderr,
+        )
+        return EXIT_INFEASIBLE
     if not rec.completed:
         print("gazebot: warning: the handover did not finish in time; the video is cut")
         return 1
@@ -219,15 +247,42 @@ def _last_reach_start_time(ticks) -> float | None:
 def _record(args: argparse.Namespace, out: Path, monitor=None):
     from gazebot.sim.record import record_handover
 
-    return record_handover(
-        robot=robot_with_gaze_mode(args.robot, args.gaze_mode),
-        behavior=args.behavior,
-        scene=scene_with_overrides(args),
-        on_tick=None if monitor is None else monitor.on_tick,
-        out_path=out / "handover.mp4",
-        seed=args.seed,
-        width=args.width,
-        height=args.height,
-        progress=not args.no_progress,
-        giver_factory=giver_factory(args),
+    robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
+    log = handover_mcap(robot, out / "handover.mcap")
+    try:
+        rec = record_handover(
+            robot=robot,
+            behavior=args.behavior,
+            scene=scene_with_overrides(args),
+            on_tick=None if monitor is None else monitor.on_tick,
+            out_path=out / "handover.mp4",
+            seed=args.seed,
+            width=args.width,
+            height=args.height,
+            progress=not args.no_progress,
+            giver_factory=giver_factory(args),
+            on_step=log.tick,
+        )
+    except BaseException:
+        log.abort()
+        raise
+    log.close()
+    return rec
+
+
+def handover_mcap(robot: str | Path | RobotConfig, path: Path) -> HandoverMcap:
+    """The MCAP log of a demo run on ``robot`` (name, YAML or config): every topic, eye images
+    at 5 Hz from the robot's own eye renderer (JPEG at the display's size costs milliseconds)."""
+    from gazebot.kinematics.config import RobotConfig, load_robot_config
+    from gazebot.render import EyeRenderer
+    from gazebot.ros2.handover_log import HandoverMcap
+    from gazebot.sim.record import CONTROL_HZ
+
+    config = robot if isinstance(robot, RobotConfig) else load_robot_config(robot)[0]
+    eyes = EyeRenderer.for_robot(config)
+    return HandoverMcap(
+        path, config.base_frame, config.gaze_site, 1.0 / CONTROL_HZ,
+        eye_image=lambda yaw, pitch, blink, distance: eyes.render(
+            yaw, pitch, blink=blink, distance=distance),
+        eye_image_period=0.2,
     )

@@ -13,16 +13,17 @@ from typing import Any
 
 from gazebot.cli.bus import add_bus_arguments, bus_config, positive
 from gazebot.cli.errors import UsageError, seed_value
+from gazebot.ros2 import topics
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "display",
         help="show the robot's eyes on its head screen, driven by the engine over the bus",
-        description="Subscribe to gazebot/<id>/eyes (yaw, pitch, blink, distance) and draw the "
-        "robot's eyes at the screen rate; between updates the eyes drift slightly; when the "
-        "engine goes silent they return to a neutral pose, blink on their own and the status "
-        "line says so. Headless with SDL_VIDEODRIVER=dummy (e.g. with --record).",
+        description="Subscribe to the engine's eyes/state (yaw, pitch, blink, distance) and "
+        "draw the robot's eyes at the screen rate; between updates the eyes drift slightly; "
+        "when the engine goes silent they return to a neutral pose, blink on their own and the "
+        "status line says so. Headless with SDL_VIDEODRIVER=dummy (e.g. with --record).",
     )
     p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
     p.add_argument("--style", default=None, help="eye style name or YAML (default: the robot's)")
@@ -64,10 +65,10 @@ def handle(args: argparse.Namespace) -> int:
                             caption=f"gazebot display: {renderer.style.name}")
         if args.record is not None:
             writer = open_h264_writer(args.record, fps, screen.size)
-        print(f"gazebot display: {args.robot} eyes from {cfg.keys.eyes} "
+        print(f"gazebot display: {args.robot} eyes from {cfg.names.resolve(topics.EYES.name)} "
               f"(connect {list(cfg.connect)}) at {fps:g} frames/s", file=sys.stderr)
         summary = run_display(node, screen, animator, fps, args.duration, writer,
-                              key=cfg.keys.eyes, robot=args.robot)
+                              key=cfg.names.resolve(topics.EYES.name), robot=args.robot)
         if writer is not None:
             writer.close()
             summary["video"] = str(args.record)

@@ -1,5 +1,6 @@
 """``gazebot phases FILE [--method M] [--online] [--json] [--config FILE] [--giver-hand NAME]
-[--receiver-hand NAME] [--giver-face NAME] [--unit U] [--rate HZ]``: segment a recording."""
+[--receiver-hand NAME] [--giver-face NAME] [--unit U] [--rate HZ] [--max-gap S]
+[--workspace M]``: segment a recording."""
 
 from __future__ import annotations
 
@@ -56,16 +57,21 @@ def register(sub: argparse._SubParsersAction) -> None:
         description=(
             "Segment a recording into handover phases. Formats: CSV (t + NAME_x,NAME_y,NAME_z "
             "columns; s and m unless --unit; empty/NaN = missing), C3D (labels; its own unit), "
-            "ROS 1/2 bags (PoseStamped, PointStamped, TransformStamped topics, /tf child "
-            "frames), a folder of per-body pose CSVs (--rate). Offline by default (whole "
+            "ROS 1/2 bags and MCAP files (PoseStamped, PointStamped, TransformStamped topics, "
+            "/tf child frames; gazebot's own tracking topics by default), a folder of per-body "
+            "pose CSVs (--rate). Offline by default (whole "
             "recording); --online replays it through the causal detector the engine runs."
         ),
     )
-    p.add_argument("file", metavar="FILE", help="recording: .csv, .c3d, .bag, ROS 2 bag, folder")
+    from gazebot.phases.methods import PHASE_METHODS
+
+    p.add_argument(
+        "file", metavar="FILE", help="recording: .csv, .c3d, .mcap, .bag, ROS 2 bag, folder"
+    )
     p.add_argument(
         "--method",
         default=None,
-        choices=("gazebot", "seed-7.2.5", "seed-4.4.3"),
+        choices=PHASE_METHODS.names(),
         help="phase rules (default: method in the config, gazebot)",
     )
     p.add_argument("--online", action="store_true", help="replay through the online detector")
@@ -74,7 +80,46 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--config", default=None, help="phase settings YAML (default: configs/phases.yaml)"
     )
     add_recording_options(p)
+    p.add_argument(
+        "--max-gap",
+        type=float,
+        default=None,
+        metavar="S",
+        help="largest time step between two samples, s (default: 60); a larger gap is an error "
+        "naming the line",
+    )
+    p.add_argument(
+        "--workspace",
+        type=float,
+        default=None,
+        metavar="M",
+        help="largest plausible coordinate magnitude, m (default: 50); a point beyond it is a "
+        "missing sample, counted",
+    )
     p.set_defaults(func=handle)
+
+
+# Rules that split one recorded handover after the fact: online they see every pause as a
+# handover (4.4.3) or a transfer from the first stop (7.2.5).
+OFFLINE_METHODS = {
+    "seed-4.4.3": "the seed's split of single giving motions (4.4.3)",
+    "seed-7.2.5": "the seed's annotation rule (7.2.5)",
+}
+
+
+def _limits(args: argparse.Namespace):
+    from gazebot.cli.errors import UsageError
+    from gazebot.recordings import RecordingLimits
+
+    kw = {}
+    for option, field in (("max_gap", "max_gap_s"), ("workspace", "workspace_m")):
+        value = getattr(args, option)
+        if value is not None:
+            if not (math.isfinite(value) and value > 0):
+                flag = "--" + option.replace("_", "-")
+                raise UsageError(f"{flag} must be a finite number > 0, got {value}")
+            kw[field] = value
+    return RecordingLimits(**kw)
 
 
 def _fmt(x: float | None) -> str:
@@ -89,8 +134,23 @@ def handle(args: argparse.Namespace) -> int:
     if args.method is not None:
         config = config.model_copy(update={"method": args.method})
     names = PointNames(args.giver_hand, args.receiver_hand, args.giver_face)
-    rec = load_recording(args.file, names, unit=args.unit, rate=args.rate)
+    rec = load_recording(args.file, names, unit=args.unit, rate=args.rate, limits=_limits(args))
+    if args.online and config.method in OFFLINE_METHODS:
+        print(
+            f"gazebot phases: warning: --method {config.method} is "
+            f"{OFFLINE_METHODS[config.method]}, meant offline on a recording of one handover; "
+            "online it may report spurious or early phases (use --method gazebot online)",
+            file=sys.stderr,
+        )
+    if rec.out_of_workspace:
+        print(
+            f"gazebot phases: warning: {args.file}: {rec.out_of_workspace} point sample(s) "
+            f"beyond the workspace bound made missing",
+            file=sys.stderr,
+        )
     traj = rec.trajectory
+    for note in rec.notes:
+        print(f"gazebot phases: warning: {rec.source}: {note}", file=sys.stderr)
     _, reordered, dropped = traj.cleaned()
     if reordered or dropped:
         print(

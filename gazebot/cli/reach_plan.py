@@ -28,13 +28,19 @@ MAX_DURATION_S = 120.0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from gazebot.controllers import CONTROLLER_NAMES
+    from gazebot.controllers import CONTROLLERS
     from gazebot.controllers.config import Role, Strategy
 
     p = sub.add_parser(
-        "reach-plan", help="plan a timed reach (pv, mcj, mce, stl)", description=__doc__
+        "reach-plan", help=f"plan a timed reach ({', '.join(CONTROLLERS.names())})",
+        description=__doc__,
     )
-    p.add_argument("--controller", required=True, choices=CONTROLLER_NAMES)
+    p.add_argument(
+        "--controller",
+        required=True,
+        choices=CONTROLLERS.names(),
+        help="; ".join(f"{n}: {CONTROLLERS.entry(n).description}" for n in CONTROLLERS.names()),
+    )
     p.add_argument(
         "--start",
         nargs=3,

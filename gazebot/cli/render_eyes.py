@@ -70,12 +70,17 @@ def handler(args: argparse.Namespace) -> int:
         raise
     except ValueError as exc:  # the renderer rejects the given size or distance
         raise UsageError(str(exc)) from None
+    shown = _printable(out)
     if out.parent and not out.parent.is_dir():
-        raise FileNotFoundError(f"output folder does not exist: {out.parent}")
-    if not cv2.imwrite(str(out), img[..., ::-1]):
-        raise UsageError(f"could not write the image {out}")
+        raise FileNotFoundError(f"output folder does not exist: {_printable(out.parent)}")
+    # Encoded here and written by Python: cv2.imwrite takes the name as UTF-8 and crashes on
+    # a file name that is not (bytes a shell passes through as they are).
+    ok, data = cv2.imencode(out.suffix.lower(), img[..., ::-1])
+    if not ok:
+        raise UsageError(f"could not encode the image {shown}")
+    out.write_bytes(data.tobytes())
     summary = {
-        "out": str(out),
+        "out": shown,
         "robot": args.robot,
         "style": renderer.style.name,
         "width": renderer.width,
@@ -85,5 +90,13 @@ def handler(args: argparse.Namespace) -> int:
         "blink": args.blink,
         "distance_m": args.distance,
     }
-    print(json.dumps(summary) if args.json else f"wrote {out} ({renderer.width}x{renderer.height})")
+    print(
+        json.dumps(summary) if args.json else f"wrote {shown} ({renderer.width}x{renderer.height})"
+    )
     return 0
+
+
+def _printable(path: Path) -> str:
+    """``path`` as text a terminal can print: bytes that are not UTF-8 (kept by Python as
+    surrogates) shown as ``\\udcXX`` escapes."""
+    return str(path).encode("utf-8", "backslashreplace").decode("utf-8")

@@ -1,5 +1,5 @@
-"""``gazebot run``: the gaze engine node alone, driving any robot that speaks gazebot's keys on
-the Zenoh bus (the simulator of ``gazebot sim`` or a real robot's bridge)."""
+"""``gazebot run``: the gaze engine node alone, driving any robot that speaks gazebot's ROS 2
+topics on the Zenoh bus (the simulator of ``gazebot sim`` or a real robot's bridge)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,13 @@ import argparse
 import json
 import sys
 
-from gazebot.cli.bus import add_bus_arguments, bus_config, positive
+from gazebot.cli.bus import (
+    add_bus_arguments,
+    add_record_argument,
+    bus_config,
+    positive,
+    robot_base_frame,
+)
 from gazebot.cli.errors import robot_with_gaze_mode, seed_value
 
 
@@ -42,6 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="never render eye frames (eye state is always published)")
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
     add_bus_arguments(p, listens_by_default=False)
+    add_record_argument(p)
     p.set_defaults(func=handle)
 
 
@@ -49,7 +56,7 @@ def handle(args: argparse.Namespace) -> int:
     from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
     from gazebot.drivers.zenoh_driver import ZenohRobotDriver
 
-    cfg = bus_config(args, listens_by_default=False)
+    cfg = bus_config(args, listens_by_default=False, base_frame=robot_base_frame(args.robot))
     node_cfg = EngineNodeConfig(
         silence_after=args.silence_after,
         resync=not args.no_resync,
@@ -61,7 +68,12 @@ def handle(args: argparse.Namespace) -> int:
     robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
     loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
     driver = ZenohRobotDriver.open(cfg, "engine")
+    recorder = None
     try:
+        if args.record:
+            from gazebot.drivers.recorder import BusRecorder
+
+            recorder = BusRecorder(driver.session, cfg.names, args.record)
         endpoints = f"listen {list(cfg.listen)}, connect {list(cfg.connect)}"
 
         def warn(text: str) -> None:
@@ -70,7 +82,7 @@ def handle(args: argparse.Namespace) -> int:
         node = (EngineNode.with_eye_frames(loop, driver, node_cfg, warn=warn)
                 if not args.no_eye_frames else EngineNode(loop, driver, node_cfg, warn=warn))
         print(
-            f"gazebot run: {args.behavior} on {node.engine.robot.name} at gazebot/{cfg.robot_id}/ "
+            f"gazebot run: {args.behavior} on {node.engine.robot.name} under {cfg.names.namespace} "
             f"({endpoints})",
             file=sys.stderr,
         )
@@ -88,8 +100,13 @@ def handle(args: argparse.Namespace) -> int:
             "warnings": node.warnings,
             "dropped": driver.dropped(),
             "tracking_skipped": driver.tracking_skipped,
+            "type_mismatches": {k: str(v) for k, v in driver.type_mismatches().items()},
         }
+        if recorder is not None:
+            summary["recorded"] = {"file": str(recorder.close()), "messages": recorder.messages}
     finally:
+        if recorder is not None:
+            recorder.close()
         driver.close()
     print(json.dumps(summary) if args.json else "\n".join(f"{k}: {v}" for k, v in summary.items()))
     return 0

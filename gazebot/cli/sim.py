@@ -9,7 +9,13 @@ import sys
 import threading
 from typing import Any
 
-from gazebot.cli.bus import add_bus_arguments, bus_config, positive
+from gazebot.cli.bus import (
+    add_bus_arguments,
+    add_record_argument,
+    bus_config,
+    positive,
+    robot_base_frame,
+)
 from gazebot.cli.errors import UsageError, robot_with_gaze_mode, seed_value
 
 
@@ -37,7 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--eye-frames",
         action="store_true",
-        help="show the engine's rendered eye frames on the display (gazebot/<id>/eyes/frame) "
+        help="show the engine's rendered eye frames on the display (eyes/image/compressed) "
         "instead of drawing the eyes from the eye state",
     )
     p.add_argument("--duration", type=positive, default=None,
@@ -46,6 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="simulated seconds per real second (default 1: real time)")
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
     add_bus_arguments(p, listens_by_default=True)
+    add_record_argument(p)
     p.set_defaults(func=handle)
 
 
@@ -90,14 +97,18 @@ def handle(args: argparse.Namespace) -> int:
     from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
     from gazebot.sim import HandoverSimulation
 
-    cfg = bus_config(args, listens_by_default=True)
-    view = sim = endpoint = driver = engine_node = thread = None
+    cfg = bus_config(args, listens_by_default=True, base_frame=robot_base_frame(args.robot))
+    view = sim = endpoint = driver = engine_node = thread = recorder = None
     stop = threading.Event()
     summary: dict[str, Any] = {}
     try:
         view = None if args.headless else PygameView()
         sim = HandoverSimulation(args.robot, args.scene, seed=args.seed)
         endpoint = ZenohRobotEndpoint.open(cfg, "sim", eye_frames=args.eye_frames)
+        if args.record:
+            from gazebot.drivers.recorder import BusRecorder
+
+            recorder = BusRecorder(endpoint.session, cfg.names, args.record)
         node = SimNode(sim, endpoint, SimNodeConfig(speed=args.speed), view=view)
         node.publish_state()
         if args.with_engine:
@@ -105,7 +116,7 @@ def handle(args: argparse.Namespace) -> int:
             from gazebot.drivers.zenoh_driver import ZenohRobotDriver
             from gazebot.runtime import GazeLoop
 
-            driver = ZenohRobotDriver(endpoint.session, cfg.keys, "engine")
+            driver = ZenohRobotDriver(endpoint.session, cfg.names, "engine")
 
             robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
             loop = GazeLoop.from_config(robot, args.behavior, seed=args.seed)
@@ -117,7 +128,8 @@ def handle(args: argparse.Namespace) -> int:
             if not engine_node.ready.wait(60.0):
                 raise TimeoutError("the in-process engine node did not start within 60 s")
         print(
-            f"gazebot sim: robot {sim.robot.name} scene {args.scene} on gazebot/{cfg.robot_id}/ "
+            f"gazebot sim: robot {sim.robot.name} scene {args.scene} under {cfg.names.namespace} "
+            f"(ROS domain {cfg.names.domain_id}) "
             f"(listen {list(cfg.listen)}, connect {list(cfg.connect)})"
             + (f", engine '{args.behavior}' in-process" if args.with_engine else ""),
             file=sys.stderr,
@@ -141,6 +153,10 @@ def handle(args: argparse.Namespace) -> int:
         stop.set()
         if thread is not None:
             thread.join(timeout=5)
+        if recorder is not None:
+            path = recorder.close()  # before the session closes
+            if summary:
+                summary["recorded"] = {"file": str(path), "messages": recorder.messages}
         if engine_node is not None and summary:
             summary["engine"] = {
                 "frames": engine_node.frames_processed,

@@ -97,11 +97,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_input_errors(_plan))
 
     r = study.add_parser("render", help="render a plan's videos, pair videos and questionnaires")
-    r.add_argument("plan", type=Path)
-    r.add_argument("--out", required=True, type=Path)
-    r.add_argument("--width", type=int, default=640)
-    r.add_argument("--height", type=int, default=480)
-    r.add_argument("--fps", type=int, default=30)
+    r.add_argument("plan", type=Path, help="plan CSV written by `gazebot study plan`")
+    r.add_argument(
+        "--out",
+        required=True,
+        type=Path,
+        help="study folder to write (videos/, pairs/, participants/, manifest.json; reused "
+        "videos come from its cache)",
+    )
+    r.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
+    r.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
+    r.add_argument("--fps", type=int, default=30, help="frames per second (default: 30)")
     r.add_argument("--workers", type=int, default=None, help="processes (default: CPU cores)")
     r.add_argument("--card-seconds", type=float, default=1.5, help="title card duration (s)")
     r.add_argument(
@@ -115,7 +121,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="pin the cache key's code version (default: a hash of gazebot's sources and configs)",
     )
-    r.add_argument("--no-progress", action="store_true")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     r.set_defaults(func=_input_errors(_render))
 
     sv = study.add_parser("serve", help="run a rendered study in the browser (answers in SQLite)")
@@ -124,17 +130,32 @@ def register(sub: argparse._SubParsersAction) -> None:
     sv.add_argument("--port", type=int, default=8000, help="port (0: any free port)")
     sv.add_argument("--threads", type=int, default=4, help="server worker threads")
     sv.add_argument(
-        "--admin-token", default=None, help="token for /admin from other hosts (default: random)"
+        "--admin-token-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="file holding the token that opens /admin (default: the "
+        "environment variable GAZEBOT_STUDY_ADMIN_TOKEN, else a random token written to "
+        "DIR/admin-token); never on the command line, where ps shows it",
     )
     sv.add_argument(
-        "--token-only",
+        "--local-admin",
         action="store_true",
-        help="ask for the token on /admin from this machine too (behind a local reverse proxy)",
+        help="open /admin without the token to requests from loopback (anyone on this machine; "
+        "never behind a reverse proxy on it)",
+    )
+    sv.add_argument(
+        "--allowed-host",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="a host name browsers use for this server besides localhost and the --host name "
+        "(repeatable; e.g. a reverse proxy's name); other names get 400 (DNS rebinding)",
     )
     sv.set_defaults(func=_input_errors(_serve))
 
     ex = study.add_parser("export", help="write the answers of a served study as a responses CSV")
-    ex.add_argument("dir", type=Path)
+    ex.add_argument("dir", type=Path, help="a study folder served by `gazebot study serve`")
     ex.add_argument("--out", required=True, type=Path, help="CSV file for `gazebot study analyze`")
     ex.add_argument(
         "--include-practice",
@@ -144,8 +165,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     ex.set_defaults(func=_input_errors(_export))
 
     a = study.add_parser("analyze", help="Bradley-Terry analysis of a responses CSV")
-    a.add_argument("responses", type=Path)
-    a.add_argument("--json", action="store_true")
+    a.add_argument(
+        "responses", type=Path, help="responses CSV (from `gazebot study export`, or by hand)"
+    )
+    a.add_argument("--json", action="store_true", help="print one JSON document")
     a.add_argument(
         "--plot",
         type=Path,
@@ -175,7 +198,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     a.set_defaults(func=_input_errors(_analyze))
 
     f = study.add_parser("fit-wins", help="Bradley-Terry fit of a win-count matrix CSV")
-    f.add_argument("wins", type=Path)
+    f.add_argument(
+        "wins",
+        type=Path,
+        help="CSV matrix: conditions in the header row and first column, cell (i, j) = wins "
+        "of i over j",
+    )
     f.add_argument(
         "--participants",
         type=float,
@@ -183,7 +211,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="n: every pair compared n times (cell(i,j) + cell(j,i) = n); a pair with another "
         "total is fitted with its own total, with a warning",
     )
-    f.add_argument("--json", action="store_true")
+    f.add_argument("--json", action="store_true", help="print one JSON document")
     f.set_defaults(func=_input_errors(_fit_wins))
 
 
@@ -440,8 +468,9 @@ def _serve(args: argparse.Namespace) -> int:
         args.host,
         args.port,
         args.threads,
-        args.admin_token,
-        local_admin=not args.token_only,
+        args.admin_token_file,
+        local_admin=args.local_admin,
+        allowed_hosts=tuple(args.allowed_host),
     )
     return 0
 

@@ -7,7 +7,7 @@ differential IK (:mod:`gazebot.controllers.arm_ik`).
 - ``mce``: minimum cumulative error with stall and reach times (eqs. 3.4-3.5)
 - ``stl``: STL specification synthesized as a MILP in receding horizon (eqs. 4.1-4.5)
 
-Entry point: :func:`make_controller`.
+Entry point: :func:`make_controller`; the registry :data:`CONTROLLERS` (one line per controller).
 """
 
 from __future__ import annotations
@@ -19,43 +19,57 @@ from gazebot.controllers.base import (
     VelocityPlan,
 )
 from gazebot.controllers.config import ControllersConfig, load_controllers_config
+from gazebot.registry import Registry
 
-CONTROLLER_NAMES = ("pv", "mcj", "mce", "stl")
+#: The reach controllers by name: CLI choices, scene validation and the README's table come from
+#: here. A new controller is one file plus one line (imported on first use).
+CONTROLLERS: Registry[ReachController] = Registry("controller")
+CONTROLLERS.register(
+    "pv", "gazebot.controllers.pv:PVController", "proportional velocity baseline (eq. 3.6)"
+)
+CONTROLLERS.register(
+    "mcj", "gazebot.controllers.mcj:MCJController",
+    "minimum cumulative jerk with a reach time (eqs. 3.2-3.3)",
+)
+CONTROLLERS.register(
+    "mce", "gazebot.controllers.mce:MCEController",
+    "minimum cumulative error with stall and reach times (eqs. 3.4-3.5)",
+)
+CONTROLLERS.register(
+    "stl", "gazebot.controllers.stl:STLController",
+    "STL specification as a MILP in receding horizon (eqs. 4.1-4.5)",
+)
+
+
+def controller_names() -> tuple[str, ...]:
+    """The registered controllers' names (the built-ins and any registered since)."""
+    return CONTROLLERS.names()
+
+
+#: The built-in controllers' names (for code written before the registry; prefer
+#: :func:`controller_names`, which includes registered ones).
+CONTROLLER_NAMES = controller_names()
 
 __all__ = [
+    "CONTROLLERS",
     "CONTROLLER_NAMES",
     "INFEASIBLE_MESSAGE",
     "ControllersConfig",
     "ReachController",
     "ReachObservation",
     "VelocityPlan",
+    "controller_names",
     "load_controllers_config",
     "make_controller",
 ]
 
 
 def make_controller(name: str, config: ControllersConfig | None = None) -> ReachController:
-    """The controller called ``name`` (one of :data:`CONTROLLER_NAMES`) with ``config``
-    (default: ``configs/controllers.yaml``).
+    """The controller registered as ``name`` with ``config`` (default:
+    ``configs/controllers.yaml``).
 
     Raises:
-        ValueError: an unknown name.
+        ValueError: an unknown name (the message lists the registered ones).
     """
-    config = config or load_controllers_config()
-    if name == "pv":
-        from gazebot.controllers.pv import PVController
-
-        return PVController(config)
-    if name == "mcj":
-        from gazebot.controllers.mcj import MCJController
-
-        return MCJController(config)
-    if name == "mce":
-        from gazebot.controllers.mce import MCEController
-
-        return MCEController(config)
-    if name == "stl":
-        from gazebot.controllers.stl import STLController
-
-        return STLController(config)
-    raise ValueError(f"unknown controller {name!r} (known: {', '.join(CONTROLLER_NAMES)})")
+    CONTROLLERS.check(name)
+    return CONTROLLERS.make(name, config or load_controllers_config())

@@ -1,5 +1,7 @@
-"""Robot drivers and the Zenoh bus: the gaze engine drives a robot (simulated or real) over
-versioned JSON topics under ``gazebot/<robot id>/`` (see :mod:`gazebot.drivers.keys`).
+"""Robot drivers and the bus: the gaze engine drives a robot (simulated or real) over ROS 2
+messages on Zenoh, exactly as rmw_zenoh puts them on the network (:mod:`gazebot.drivers.rmw`;
+topics and types in :mod:`gazebot.ros2.topics`), so ROS 2 nodes, ``ros2 topic echo``, rosbag2
+and Foxglove see gazebot as one of theirs.
 
 * :class:`RobotDriver` (``base.py``): the engine's view of a robot.
   :class:`ZenohRobotDriver` speaks the bus; :class:`SimRobotDriver` wraps an in-process
@@ -8,7 +10,8 @@ versioned JSON topics under ``gazebot/<robot id>/`` (see :mod:`gazebot.drivers.k
 * :class:`EngineNode` / :class:`SimNode`: the two node loops behind ``gazebot run`` and
   ``gazebot sim``; the engine node runs :class:`gazebot.runtime.GazeLoop`.
 * :class:`ZenohDisplayNode`: the head screen's side of the bus (``gazebot display``).
-* :class:`BusConfig` / :func:`open_session`: peer mode, ``tcp/127.0.0.1:7447``, no multicast.
+* :class:`BusConfig` / :func:`open_session`: peer mode, ``tcp/127.0.0.1:7447``, no multicast;
+  ``--connect tcp/HOST:7447`` joins a Zenoh router.
 
 Zenoh and MuJoCo are imported only when a session is opened or a simulation built.
 """
@@ -17,20 +20,18 @@ from __future__ import annotations
 
 from gazebot.drivers.base import RobotDriver
 from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig, current_handover
-from gazebot.drivers.keys import KeyLayout
 from gazebot.drivers.payloads import (
     ArmCommandMsg,
-    EventHistoryMsg,
     EventMsg,
     EyeFrameMsg,
     EyeStateMsg,
     HeadCommandMsg,
     JointStateMsg,
     PayloadError,
-    PayloadVersionError,
     StatusMsg,
     TrackingMsg,
 )
+from gazebot.drivers.rmw.names import Names
 from gazebot.drivers.session import DEFAULT_ENDPOINT, EPHEMERAL_ENDPOINT, BusConfig, open_session
 from gazebot.drivers.sim_driver import SimRobotDriver, apply_arm_command
 from gazebot.drivers.sim_node import SimNode, SimNodeConfig
@@ -45,15 +46,13 @@ __all__ = [
     "BusConfig",
     "EngineNode",
     "EngineNodeConfig",
-    "EventHistoryMsg",
     "EventMsg",
     "EyeFrameMsg",
     "EyeStateMsg",
     "HeadCommandMsg",
     "JointStateMsg",
-    "KeyLayout",
+    "Names",
     "PayloadError",
-    "PayloadVersionError",
     "RobotDriver",
     "SimNode",
     "SimNodeConfig",

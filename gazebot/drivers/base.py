@@ -1,10 +1,10 @@
 """The ``RobotDriver`` interface: the engine's view of one robot, whatever carries the data.
 
-A driver sends head commands, eye state or eye frames and arm commands, and reads the robot's
-joint state, the tracking samples and the events of the other nodes. Concrete kinds:
-:class:`~gazebot.drivers.zenoh_driver.ZenohRobotDriver` (any robot bridge that speaks the keys
-of :mod:`gazebot.drivers.keys`) and :class:`~gazebot.drivers.sim_driver.SimRobotDriver`
-(an in-process :class:`gazebot.sim.HandoverSimulation`, no bus).
+A driver sends head commands, the gaze target, eye state or eye frames, the phase and arm
+commands, and reads the robot's joint state, the tracking samples and the events of the other
+nodes. Concrete kinds: :class:`~gazebot.drivers.zenoh_driver.ZenohRobotDriver` (any robot
+bridge that speaks the ROS 2 topics of :mod:`gazebot.ros2.topics`) and
+:class:`~gazebot.drivers.sim_driver.SimRobotDriver` (an in-process simulation, no bus).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from gazebot.drivers.payloads import (
     EyeStateMsg,
     HeadCommandMsg,
     JointStateMsg,
+    Point,
     StatusMsg,
     TrackingMsg,
 )
@@ -37,6 +38,12 @@ class RobotDriver(ABC):
     @abstractmethod
     def send_head(self, msg: HeadCommandMsg) -> None:
         """Send head joint goals (rad)."""
+
+    def send_gaze_target(self, t: float, point: Point) -> None:  # noqa: B027 - optional
+        """Send the point looked at (m, robot base frame) at robot time ``t``."""
+
+    def send_phase(self, t: float, phase: str, phase_start: float) -> None:  # noqa: B027
+        """Send the handover phase (``idle`` ... ``done``), started at ``phase_start`` (s)."""
 
     @abstractmethod
     def send_eyes(self, msg: EyeStateMsg) -> None:
@@ -85,11 +92,13 @@ class RobotDriver(ABC):
         return {}
 
     def dropped(self) -> dict[str, int]:
-        """Malformed payloads dropped so far, by key."""
+        """Malformed messages dropped so far, by topic."""
         return {}
 
-    def foreign_versions(self) -> dict[str, Any]:
-        """Keys on which the robot spoke another payload version (dropped), with that version."""
+    def type_mismatches(self) -> dict[str, Any]:
+        """Topics on which a publisher of another message type (or type version) was heard,
+        each with what was expected and received (:class:`~gazebot.drivers.rmw.node.
+        TypeMismatch`)."""
         return {}
 
     def close(self) -> None:  # noqa: B027 - nothing to release by default

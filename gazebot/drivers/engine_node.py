@@ -8,9 +8,10 @@ Faults (each pinned by ``tests/drivers``):
   bridges ``max_gap_hold``, then the behavior holds the gaze for its ``tracking_lost.hold_s``:
   event ``tracking_stale``, status ``tracking: hold``; then it looks at its ``tracking_lost``
   target, by default the last known face: event ``tracking_timeout`` with ``info.face``, status
-  ``tracking: lost``). Head commands meanwhile say ``mode: tracking_lost``; when samples return,
-  ``tracking_resumed``. A sample older than a silence tick already answered is too late and
-  is dropped by the phase detector (its time is the robot clock estimated from the wall clock).
+  ``tracking: lost``). The status' ``tracking`` says which policy commands the head; when
+  samples return, ``tracking_resumed``. A sample older than a silence tick already answered is
+  too late and is dropped by the phase detector (its time is the robot clock estimated from the
+  wall clock).
 * engine restart: at start the node takes the head pose from the joint state and replays the
   current handover's phase and robot events from the other nodes' event history
   (``GazeEngine.resync``), then reports ``engine_resynced``.
@@ -22,7 +23,10 @@ Faults (each pinned by ``tests/drivers``):
   ``info.robot_seen: false`` until the robot shows up.
 * robot clock restart (a sample older than the last by ``clock_reset``): event
   ``tracking_clock_reset``, then the same resynchronisation as at start.
-* malformed payloads: dropped by the driver, counted in the status' ``dropped``.
+* malformed messages (garbage, truncated CDR, oversized, NaN or infinite values): dropped by
+  the driver, counted by topic in the status' ``dropped``.
+* a robot speaking another message type (or another version of it) on a topic: dropped, and
+  reported at once as ``type_mismatch`` (topic, expected and received type with their hashes).
 """
 
 from __future__ import annotations
@@ -36,7 +40,6 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from gazebot.drivers.base import RobotDriver
-from gazebot.drivers.payloads import VERSION as PAYLOAD_VERSION
 from gazebot.drivers.payloads import (
     EventMsg,
     EyeFrameMsg,
@@ -167,9 +170,12 @@ class EngineNode:
         self._last_eye_frame = -math.inf
         self._behavior_state: str | None = None
         self._target: str | None = None
-        self._version_warned = False
+        self._mismatch_warned: set[str] = set()
+        self._no_robot_warned = False
+        self._last_head: HeadCommandMsg | None = None
+        self._phase_sent: tuple[str, float] | None = None
         self._peers: dict[str, bool] = {}
-        self._skip_events: set[tuple[str, int, float]] = set()
+        self._skip_events: set[tuple[str, str, int, int]] = set()
         self.ready = threading.Event()  # set once started (and resynchronised)
 
     @classmethod
@@ -243,7 +249,7 @@ class EngineNode:
             names = list(getattr(self.engine.robot, "head_joints", []))
             head = {n: joints.position[n] for n in names if n in joints.position} or None
         history = self.driver.event_history(timeout=max(0.05, deadline - self.clock()))
-        self._skip_events = {(m.source, m.seq, m.stamp) for m in history}
+        self._skip_events = {m.identity for m in history}
         events = [e for m in history if m.category in ("phase", "robot")
                   if (e := m.to_event()) is not None]
         replay = current_handover(events)
@@ -292,15 +298,16 @@ class EngineNode:
         """Wait briefly for a tracking sample and answer it, or handle the silence."""
         msg = self.driver.wait_tracking(self._wait_budget())
         for ev in self.driver.poll_events():
-            if (ev.source, ev.seq, ev.stamp) in self._skip_events:
+            if ev.identity in self._skip_events:
                 continue
             if ev.category == "robot" and (event := ev.to_event()) is not None:
-                self.loop.notify([event])
+                self.loop.notify(event)
         if msg is not None:
             self.on_tracking(msg)
         else:
             self.on_silence()
         self._check_peers()
+        self._check_mismatches()
         self._check_robot_seen()
         if self.clock() - self._last_beat >= self.config.heartbeat_period:
             self._heartbeat()
@@ -318,11 +325,11 @@ class EngineNode:
         self._last_t = msg.t
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
-        cmd = self.loop.tick(msg.t, msg.to_frame(),
+        cmd = self.loop.tick(msg.to_frame(),
                              joints=joints.position if joints is not None else None)
         self.frames_processed += 1
         if cmd is not None:
-            self._send(cmd, answers=msg.seq)
+            self._send(cmd)
 
     def on_silence(self) -> None:
         """No sample arrived: after ``silence_after``, tick the loop without one (its
@@ -334,9 +341,9 @@ class EngineNode:
                 or now - self._last_silence_tick < 1 / self.config.silence_rate):
             return
         self._last_silence_tick = now
-        cmd = self.loop.tick(self._now_t())
+        cmd = self.loop.tick(None, t=self._now_t())
         if cmd is not None:
-            self._send(cmd, answers=None)
+            self._send(cmd)
 
     @property
     def unsafe_commands(self) -> int:
@@ -360,7 +367,7 @@ class EngineNode:
             self.emit("tracking_timeout", t=cmd.t, silence=silence, target=cmd.target,
                       face=point_or_none(cmd.target_point))
 
-    def _send(self, cmd: LoopCommand, answers: int | None) -> None:
+    def _send(self, cmd: LoopCommand) -> None:
         self._track(cmd)
         for event in cmd.events:
             if category_of(event.kind.value) == "phase":
@@ -368,10 +375,12 @@ class EngineNode:
                     EventMsg.from_event(event, self.driver.node, self._next("event"), time.time())
                 )
         stamp = time.time()
-        mode = "behavior" if cmd.tracking == "ok" else "tracking_lost"
-        self.driver.send_head(
-            HeadCommandMsg.from_command(cmd, self._next("head"), stamp, answers, mode)
-        )
+        head = HeadCommandMsg.from_command(cmd, self._next("head"), stamp, self._last_head)
+        self._last_head = head
+        self.driver.send_head(head)
+        if (point := point_or_none(cmd.target_point)) is not None:
+            self.driver.send_gaze_target(cmd.t, point)
+        self._send_phase(cmd.t)
         self.driver.send_eyes(
             EyeStateMsg(seq=self._next("eyes"), t=cmd.t, stamp=stamp, yaw=cmd.eye_yaw,
                         pitch=cmd.eye_pitch, blink=cmd.blink, distance=cmd.distance)
@@ -398,35 +407,46 @@ class EngineNode:
             self.emit("gaze_target", t=cmd.t, category="behavior", target=cmd.target,
                       point=point_or_none(cmd.target_point))
 
+    def _send_phase(self, t: float, again: bool = False) -> None:
+        """Send the phase when it changed (``again``: also when it did not, for late
+        subscribers)."""
+        phase = self.phase
+        if self._phase_sent is None or self._phase_sent[0] != phase:
+            self._phase_sent = (phase, t)
+        elif not again:
+            return
+        try:
+            self.driver.send_phase(t, phase, self._phase_sent[1])
+        except ValueError:
+            log.debug("phase %r not sent", phase, exc_info=True)
+
+    def _check_mismatches(self) -> None:
+        """Report each topic on which a publisher of another message type was heard, once."""
+        for topic, mismatch in sorted(self.driver.type_mismatches().items()):
+            if topic in self._mismatch_warned:
+                continue
+            self._mismatch_warned.add(topic)
+            self._warn("type_mismatch", f"{mismatch}: its messages are dropped; the robot "
+                       "bridge must publish the type (and version) gazebot expects",
+                       topic=topic, expected=list(mismatch.expected), received=mismatch.received)
+
     def _check_robot_seen(self) -> None:
         """Warn once if no tracking sample or joint state arrived ``no_robot_warning`` s after
-        the start: otherwise a wrong endpoint would look like a quiet robot. A robot whose
-        samples arrive in another payload version is reported as such, at once."""
+        the start: otherwise a wrong endpoint would look like a quiet robot."""
         if self.robot_seen:
             return
         if self.frames_processed or self.driver.joint_state() is not None:
             self.robot_seen = True
             return
-        foreign = self.driver.foreign_versions()
-        if foreign and not self._version_warned:
-            self._version_warned = True
-            versions = sorted({repr(v) for v in foreign.values()})
-            text = (
-                f"a robot is on the bus but speaks payload version {', '.join(versions)} on "
-                f"{', '.join(sorted(foreign))} (this engine speaks {PAYLOAD_VERSION}): its "
-                "samples are dropped; run the same gazebot version on both sides"
-            )
-            self._warn("payload_version_mismatch", text, keys=sorted(foreign),
-                       versions=[foreign[k] for k in sorted(foreign)], expected=PAYLOAD_VERSION)
-            return
         after = self.clock() - self._run_started
-        if after < self.config.no_robot_warning or self.warnings:
+        if after < self.config.no_robot_warning or self._no_robot_warned:
             return
         peers = self.driver.peers()
         text = (
             f"no robot seen after {after:.1f} s: no tracking or joint state received "
             f"(peers: {peers or 'none'}); is the robot running and the bus endpoint right?"
         )
+        self._no_robot_warned = True
         self._warn("no_robot", text, after=after, peers=peers)
 
     def _warn(self, kind: str, text: str, **info: Any) -> None:
@@ -449,8 +469,10 @@ class EngineNode:
 
     def _heartbeat(self, stopping: bool = False) -> StatusMsg:
         self._last_beat = self.clock()
+        if self._phase_sent is not None:
+            self._send_phase(self._now_t(), again=True)
         peers = self.driver.peers()
-        no_robot = bool(self.warnings) and not self.robot_seen
+        no_robot = self._no_robot_warned and not self.robot_seen
         degraded = not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
         msg = StatusMsg(
             node=self.driver.node,

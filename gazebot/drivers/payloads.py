@@ -1,16 +1,16 @@
-"""Versioned JSON payloads of the bus (``"v": 1``), parsed strictly.
+"""The values gazebot's nodes exchange, validated strictly (frozen pydantic models): what a driver
+hands the engine node and back. On the bus they travel as ROS 2 messages
+(:mod:`gazebot.drivers.topics`, converted by :mod:`gazebot.ros2.convert`); building one from
+wire data checks types, ranges and finiteness, and a violation is counted and dropped by the
+transport.
 
-Every message is a frozen pydantic model: unknown fields, wrong types (no string-to-number
-coercion), non-finite numbers, out-of-range values and a missing or unknown version ``v`` are
-rejected by :meth:`Msg.decode` with a :class:`PayloadError`. Units are SI (s, m, rad); points are
-``[x, y, z]`` in the robot base frame, ``null`` when missing (JSON has no NaN). ``t`` is the
-robot's clock (simulation time for the simulator), ``stamp`` the sender's wall clock
-(``time.time()``), used for staleness and latency.
+Units are SI (s, m, rad); points are ``(x, y, z)`` in the robot base frame, ``None`` when
+missing. ``t`` is the robot's clock (simulation time for the simulator), ``stamp`` the sender's
+wall clock (``time.time()``), used for staleness and latency.
 """
 
 from __future__ import annotations
 
-import base64
 import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Annotated, Any, Literal
@@ -20,16 +20,20 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
-    ValidationError,
     model_validator,
 )
 
-from gazebot.types import Event, EventKind, GazeCommand, TrackingFrame, is_valid_point
+from gazebot.types import (
+    PHASE_OF_EVENT,
+    Event,
+    EventKind,
+    GazeCommand,
+    TrackingFrame,
+    is_valid_point,
+)
 
 if TYPE_CHECKING:
     from gazebot.runtime import LoopCommand
-
-VERSION = 1
 
 Point = tuple[float, float, float]
 Unit = Annotated[float, Field(ge=0.0, le=1.0)]
@@ -38,14 +42,7 @@ Seq = Annotated[int, Field(ge=0)]
 Name = Annotated[str, Field(min_length=1, max_length=64)]
 
 PHASE_KINDS = frozenset(
-    {
-        EventKind.REACH_STARTED,
-        EventKind.TRANSFER_STARTED,
-        EventKind.RETREAT_STARTED,
-        EventKind.HANDOVER_DONE,
-        EventKind.TRACKING_LOST,
-        EventKind.TRACKING_RESTORED,
-    }
+    {*PHASE_OF_EVENT, EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED}
 )
 
 
@@ -56,15 +53,6 @@ class PayloadError(ValueError):
         self.model = model
         self.reason = reason
         super().__init__(f"malformed {model} payload: {reason}")
-
-
-class PayloadVersionError(PayloadError):
-    """A well-formed payload of another protocol version (``version``: what it says, ``None``
-    when it is not a JSON object with a ``v``)."""
-
-    def __init__(self, model: str, version: Any):
-        self.version = version
-        super().__init__(model, f"v: payload version {version!r}, this gazebot speaks {VERSION}")
 
 
 def point_or_none(p: Any) -> Point | None:
@@ -97,37 +85,14 @@ def jsonable(value: Any) -> Any:
 
 
 class Msg(BaseModel):
-    """Base of every bus payload: strict, frozen, versioned."""
+    """Base of every value: strict, frozen, no unknown fields, no NaN or infinity."""
 
     model_config = ConfigDict(strict=True, extra="forbid", frozen=True, allow_inf_nan=False)
 
-    v: Literal[1] = VERSION
-
-    def encode(self) -> bytes:
-        """The JSON bytes put on the bus."""
-        return self.model_dump_json().encode()
-
-    @classmethod
-    def decode(cls, raw: bytes | bytearray | memoryview | str):
-        """Parse ``raw`` JSON strictly; raise :class:`PayloadError` on anything malformed."""
-        try:
-            msg = cls.model_validate_json(raw if isinstance(raw, str) else bytes(raw))
-        except ValidationError as exc:
-            errors = exc.errors()
-            for err in errors:  # another version first: its other fields may differ too
-                if tuple(err["loc"]) == ("v",) and err["type"] != "missing":
-                    raise PayloadVersionError(cls.__name__, err.get("input")) from None
-            err = errors[0]
-            where = ".".join(str(p) for p in err["loc"]) or "<root>"
-            raise PayloadError(cls.__name__, f"{where}: {err['msg']}") from None
-        # A payload from the bus must say its version; Python callers may leave the default.
-        if "v" not in msg.model_fields_set:
-            raise PayloadError(cls.__name__, "v: missing version field")
-        return msg
-
 
 class TrackingMsg(Msg):
-    """``gazebot/<id>/tracking``: one tracking sample (robot base frame, m).
+    """One tracking sample (robot base frame, m), on the wire the ``tracking/*``,
+    ``gripper/state`` and ``load_share`` messages of one stamp.
 
     Fields: ``seq`` sample counter, ``t`` robot time (s), ``stamp`` wall time (s),
     ``giver_hand``, ``receiver_hand``, ``giver_face`` (``[x, y, z]`` or ``null`` if not
@@ -169,7 +134,7 @@ class TrackingMsg(Msg):
 
 
 class JointStateMsg(Msg):
-    """``gazebot/<id>/joint_states``: measured joint positions by joint name (rad for revolute,
+    """``/joint_states``: measured joint positions by joint name (rad for revolute,
     m for prismatic joints; head, arm and gripper joints as the robot names them)."""
 
     seq: Seq
@@ -179,26 +144,17 @@ class JointStateMsg(Msg):
 
 
 class HeadCommandMsg(Msg):
-    """``gazebot/<id>/head/command``: head joint goals (rad, finite, within the robot's limits).
-
-    ``answers`` is the ``seq`` of the tracking sample this command answers (``null`` for
-    commands not caused by a sample, e.g. the tracking-timeout fallback). ``mode`` is
-    ``behavior`` (the gaze behavior chose the target from tracking) or ``tracking_lost`` (the
-    behavior's tracking-loss policy: holding the gaze, then looking at its ``tracking_lost``
-    target, by default the last known face). ``phase``, ``target``, ``target_point`` and
-    ``residual`` (rad) explain the command.
-    """
+    """``head/command``: head joint goals (rad, finite, within the robot's limits), the goal's
+    rate of change ``velocity`` (rad/s, by joint) and ``time_from_start`` (s, > 0) to reach it:
+    one ``JointTrajectory`` point as ros2_control's joint_trajectory_controller takes it. ``t`` is
+    the robot time the command answers (0 when the wire did not carry it)."""
 
     seq: Seq
     t: float
     stamp: float
-    answers: Seq | None = None
     head: dict[Name, float]
-    mode: Literal["behavior", "tracking_lost"] = "behavior"
-    phase: Name
-    target: Name
-    target_point: Point | None = None
-    residual: NonNeg = 0.0
+    velocity: dict[Name, float] = Field(default_factory=dict)
+    time_from_start: Annotated[float, Field(gt=0.0)] = 1.0 / 120.0
 
     @classmethod
     def from_command(
@@ -206,31 +162,31 @@ class HeadCommandMsg(Msg):
         cmd: GazeCommand | LoopCommand,
         seq: int,
         stamp: float,
-        answers: int | None = None,
-        mode: Literal["behavior", "tracking_lost"] = "behavior",
+        previous: HeadCommandMsg | None = None,
+        period: float = 1.0 / 120.0,
+        max_period: float = 0.25,
     ) -> HeadCommandMsg:
-        residual = float(cmd.residual)
-        return cls(
-            seq=seq,
-            t=float(cmd.t),
-            stamp=float(stamp),
-            answers=answers,
-            head={k: float(v) for k, v in cmd.head.items()},
-            mode=mode,
-            phase=str(getattr(cmd.phase, "value", cmd.phase)),
-            target=str(cmd.target),
-            target_point=point_or_none(cmd.target_point),
-            residual=residual if math.isfinite(residual) and residual >= 0 else 0.0,
-        )
+        """The head part of an engine command. ``velocity`` is the goal's rate of change since
+        ``previous`` (zero without one, or after a pause longer than ``max_period`` s);
+        ``time_from_start`` the time since it (``period`` without one)."""
+        head = {k: float(v) for k, v in cmd.head.items()}
+        t = float(cmd.t)
+        dt = t - previous.t if previous is not None else math.nan
+        if previous is not None and 0.0 < dt <= max_period:
+            velocity = {k: (q - previous.head.get(k, q)) / dt for k, q in head.items()}
+        else:
+            velocity, dt = dict.fromkeys(head, 0.0), period
+        return cls(seq=seq, t=t, stamp=float(stamp), head=head, velocity=velocity,
+                   time_from_start=dt)
 
 
 class EyeStateMsg(Msg):
-    """``gazebot/<id>/eyes``: eye direction on the display (rad; ``yaw`` + = robot's left,
-    ``pitch`` + = down), eyelid closure ``blink`` (0 open .. 1 closed) and ``distance`` (m, > 0)
-    from the display (the head's ``gaze`` site) to the gaze target, for the eyes' vergence.
+    """``eyes/state`` (``gazebot_msgs/EyeState``): eye direction on the display (rad; ``yaw``
+    + = robot's left, ``pitch`` + = down), eyelid closure ``blink`` (0 open .. 1 closed) and
+    ``distance`` (m, > 0) from the display (the head's ``gaze`` site) to the gaze target, for the
+    eyes' vergence.
 
-    ``distance`` is optional within ``v: 1``: ``null`` or absent means unknown (parallel eyes),
-    and it is left out of the JSON when unknown, so such messages read as before.
+    ``distance`` ``None``: unknown (parallel eyes; NaN on the wire).
     """
 
     seq: Seq
@@ -241,21 +197,17 @@ class EyeStateMsg(Msg):
     blink: Unit = 0.0
     distance: Annotated[float, Field(gt=0.0)] | None = None
 
-    def encode(self) -> bytes:
-        return self.model_dump_json(exclude_none=True).encode()
-
 
 class EyeFrameMsg(Msg):
-    """``gazebot/<id>/eyes/frame``: one rendered display image, ``format`` png or jpeg,
-    base64 in ``data``, ``width`` x ``height`` px. Published only while someone subscribes."""
+    """``eyes/image/compressed`` (``sensor_msgs/CompressedImage``): one rendered display image,
+    ``format`` png or jpeg, the encoded bytes in ``data``. Published only while someone
+    subscribes."""
 
     seq: Seq
     t: float
     stamp: float
-    width: Annotated[int, Field(gt=0, le=8192)]
-    height: Annotated[int, Field(gt=0, le=8192)]
-    format: Literal["png", "jpeg"] = "png"
-    data: str
+    format: Literal["png", "jpeg"] = "jpeg"
+    data: bytes
 
     @classmethod
     def from_image(
@@ -270,38 +222,23 @@ class EyeFrameMsg(Msg):
         ok, buf = cv2.imencode(".png" if fmt == "png" else ".jpg", img[:, :, ::-1])
         if not ok:
             raise ValueError(f"could not encode the eye frame as {fmt}")
-        return cls(
-            seq=seq,
-            t=float(t),
-            stamp=float(stamp),
-            width=int(img.shape[1]),
-            height=int(img.shape[0]),
-            format=fmt,
-            data=base64.b64encode(buf.tobytes()).decode("ascii"),
-        )
+        return cls(seq=seq, t=float(t), stamp=float(stamp), format=fmt, data=buf.tobytes())
 
     def image(self) -> np.ndarray:
-        """Decode to an (H, W, 3) uint8 RGB image; :class:`PayloadError` if it does not decode
-        or its size differs from ``width`` x ``height``."""
+        """Decode to an (H, W, 3) uint8 RGB image; :class:`PayloadError` if it does not
+        decode."""
         import cv2
 
-        try:
-            raw = base64.b64decode(self.data, validate=True)
-        except ValueError as exc:
-            raise PayloadError("EyeFrameMsg", f"data: not base64 ({exc})") from None
-        img = cv2.imdecode(np.frombuffer(raw, np.uint8), cv2.IMREAD_COLOR)
+        img = cv2.imdecode(np.frombuffer(self.data, np.uint8), cv2.IMREAD_COLOR) \
+            if self.data else None
         if img is None:
             raise PayloadError("EyeFrameMsg", f"data: not a decodable {self.format} image")
-        if img.shape[:2] != (self.height, self.width):
-            raise PayloadError(
-                "EyeFrameMsg", f"image is {img.shape[1]}x{img.shape[0]}, "
-                f"header says {self.width}x{self.height}"
-            )
         return np.ascontiguousarray(img[:, :, ::-1])
 
 
 class ArmCommandMsg(Msg):
-    """``gazebot/<id>/arm/command``: drive the arm, overriding the robot's own handover
+    """``arm/command`` (joint goals) or ``arm/mode`` (``home``, ``handover``, ``resume``): drive
+    the arm, overriding the robot's own handover
     controller until ``resume`` is sent.
 
     Exactly one of ``positions`` (joint goals by name, rad; ``gripper`` 0..1), ``pose``
@@ -330,16 +267,19 @@ EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]
 
 
 def category_of(kind: str) -> EventCategory:
-    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` else."""
+    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` for the
+    engine's ``fault`` and any other kind."""
     try:
         ek = EventKind(kind)
     except ValueError:
+        return "fault"
+    if ek is EventKind.FAULT:
         return "fault"
     return "phase" if ek in PHASE_KINDS else "robot"
 
 
 class EventMsg(Msg):
-    """``gazebot/<id>/events``: something happened.
+    """``events`` (``gazebot_msgs/HandoverEvent``): something happened.
 
     ``category``: ``phase`` (``reach_started`` ... ``handover_done``, ``tracking_lost``,
     ``tracking_restored``; from the engine's phase detector), ``robot`` (``robot_reach_started``
@@ -348,7 +288,8 @@ class EventMsg(Msg):
     ``fault`` (``tracking_stale``, ``tracking_timeout`` with ``info.face``, ``tracking_resumed``,
     ``peer_lost``/``peer_restored`` with ``info.peer``, ``payload_dropped``) or ``node``
     (``node_started``, ``engine_resynced`` with ``info.events``, ``node_stopped``).
-    ``source`` is the publishing node, ``seq`` its event counter; ``t`` when it happened,
+    ``source`` is the publishing node, ``seq`` its event counter (the publisher's sequence
+    number on the wire); ``t`` when it happened,
     ``detected_at`` when it became known (robot clock, s).
     """
 
@@ -377,6 +318,12 @@ class EventMsg(Msg):
             info=jsonable(event.info),
         )
 
+    @property
+    def identity(self) -> tuple[str, str, int, int]:
+        """The event across nodes and lives: source, kind, and its stamp and time to the
+        nanosecond (the resolution of the wire's ``builtin_interfaces/Time``)."""
+        return (self.source, self.kind, round(self.stamp * 1e9), round(self.t * 1e9))
+
     def to_event(self) -> Event | None:
         """The :class:`~gazebot.types.Event` for phase and robot events, ``None`` otherwise."""
         try:
@@ -386,22 +333,14 @@ class EventMsg(Msg):
         return Event(kind=kind, t=self.t, detected_at=self.detected_at, info=dict(self.info))
 
 
-class EventHistoryMsg(Msg):
-    """Reply of ``gazebot/<id>/events/history/<node>``: the events ``node`` has seen on the
-    bus since it started (oldest first, bounded)."""
-
-    node: Name
-    events: list[EventMsg]
-
-
 class StatusMsg(Msg):
-    """``gazebot/<id>/status``: heartbeat of ``node`` (every 0.5 s by default).
+    """Heartbeat of ``node`` (a ``DiagnosticStatus`` on ``/diagnostics``) (every 0.5 s by default).
 
     ``state``: ``ok``, ``degraded`` (a peer is lost or tracking is not ``ok``) or ``stopping``.
     ``tracking``: ``ok`` (fresh samples), ``waiting`` (none yet), ``hold`` (samples stopped:
     holding the gaze), ``lost`` (timed out: looking at the last face), ``n/a`` (a node that
     does not consume tracking). ``peers``: liveliness of the other nodes seen (node -> alive).
-    ``dropped``: malformed payloads dropped so far, by key. ``phase``: the engine's phase.
+    ``dropped``: malformed messages dropped so far, by topic. ``phase``: the engine's phase.
     """
 
     node: Name

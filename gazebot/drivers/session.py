@@ -5,25 +5,29 @@ Defaults keep a node on this machine: peer mode, multicast scouting off, and the
 (``gazebot run``) connect to it and listen on an ephemeral port (:data:`EPHEMERAL_ENDPOINT`).
 Peers do not forward traffic between other peers: a node that connects must also listen
 somewhere, so that gossip scouting can mesh it with the other connected nodes (an engine and a
-monitor both connected to the simulator then see each other). For several machines, listen on a
-routable address or connect every node to a Zenoh router (``connect=("tcp/<router>:7447",)``,
-optionally ``mode="client"``).
+monitor both connected to the simulator then see each other).
+
+In a ROS 2 deployment every node connects to a Zenoh router instead (``zenohd``, rmw_zenoh's
+``rmw_zenohd``, or ``gazebot router``): ``connect=("tcp/<router>:7447",)``, as rmw_zenoh's
+nodes do.
 """
 
 from __future__ import annotations
 
 import json
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
-from gazebot.drivers.keys import KeyLayout, check_chunk
+from gazebot.drivers.rmw.names import Names
 
 if TYPE_CHECKING:
     import zenoh
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 EPHEMERAL_ENDPOINT = "tcp/127.0.0.1:0"
+#: Where ``gazebot router`` listens by default (every interface, rmw_zenohd's port).
+ROUTER_ENDPOINT = "tcp/0.0.0.0:7447"
 _ENDPOINT = re.compile(r"^(tcp|udp|tls|quic|ws|unixsock-stream|serial)/\S+$")
 
 
@@ -41,37 +45,36 @@ class BusConfig:
     """How a node joins the bus.
 
     Attributes:
-        robot_id: The robot's key chunk: topics live under ``gazebot/<robot_id>/``.
+        names: Namespace (default ``/gazebot``), topic remapping, ROS domain id and frame
+            names of the node's topics.
         listen: Endpoints this node accepts connections on.
         connect: Endpoints this node connects to (other peers or a router); retried in the
             background until they answer.
-        mode: ``peer`` (default) or ``client`` (through a router given in ``connect``).
+        mode: ``peer`` (default), ``client`` (through a router given in ``connect``) or
+            ``router`` (``gazebot router``).
         multicast_scouting: Discover peers by UDP multicast (off: only explicit endpoints).
         retry_max_s: Upper bound of the reconnection back-off (s), so a restarted peer is found
             again quickly.
     """
 
-    robot_id: str = "sim"
+    names: Names = field(default_factory=Names)
     listen: tuple[str, ...] = (DEFAULT_ENDPOINT,)
     connect: tuple[str, ...] = ()
-    mode: Literal["peer", "client"] = "peer"
+    mode: Literal["peer", "client", "router"] = "peer"
     multicast_scouting: bool = False
     retry_max_s: float = 1.0
 
     def __post_init__(self) -> None:
-        check_chunk(self.robot_id, "robot id")
+        if not isinstance(self.names, Names):
+            raise ValueError(f"names must be a Names, got {self.names!r}")
         for ep in (*self.listen, *self.connect):
             check_endpoint(ep)
-        if self.mode not in ("peer", "client"):
-            raise ValueError(f"mode must be 'peer' or 'client', got {self.mode!r}")
+        if self.mode not in ("peer", "client", "router"):
+            raise ValueError(f"mode must be 'peer', 'client' or 'router', got {self.mode!r}")
         if self.mode == "client" and not self.connect:
             raise ValueError("client mode needs a router endpoint in 'connect'")
         if not self.retry_max_s > 0:
             raise ValueError(f"retry_max_s must be > 0, got {self.retry_max_s!r}")
-
-    @property
-    def keys(self) -> KeyLayout:
-        return KeyLayout(self.robot_id)
 
     def zenoh_config(self) -> zenoh.Config:
         """The equivalent :class:`zenoh.Config`."""

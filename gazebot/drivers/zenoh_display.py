@@ -1,6 +1,6 @@
 """``ZenohDisplayNode``: the robot's head screen on the bus. It listens to the engine's eye state
-(``gazebot/<id>/eyes``, :class:`~gazebot.drivers.payloads.EyeStateMsg`, tens of bytes) and
-reports its own heartbeat; drawing is :mod:`gazebot.render.head_display`'s."""
+(``eyes/state``, ``gazebot_msgs/msg/EyeState``, under 100 bytes) and reports its own heartbeat;
+drawing is :mod:`gazebot.render.head_display`'s."""
 
 from __future__ import annotations
 
@@ -9,9 +9,11 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from gazebot.drivers.keys import KeyLayout
 from gazebot.drivers.payloads import EyeStateMsg
-from gazebot.drivers.zenoh_node import ZenohNode
+from gazebot.drivers.rmw.names import Names
+from gazebot.drivers.rmw.node import Received
+from gazebot.drivers.zenoh_node import ZenohNode, checked, seq_stamp
+from gazebot.ros2 import convert, topics
 
 if TYPE_CHECKING:
     import zenoh
@@ -22,7 +24,7 @@ class ZenohDisplayNode(ZenohNode):
 
     Args:
         session: An open session (left open by :meth:`close` unless ``owns_session``).
-        keys: The robot's key layout.
+        names: Namespace, remapping, domain id and frame names.
         node: This node's name (default ``display``).
     """
 
@@ -31,7 +33,7 @@ class ZenohDisplayNode(ZenohNode):
     def __init__(
         self,
         session: zenoh.Session,
-        keys: KeyLayout,
+        names: Names,
         node: str = "display",
         *,
         owns_session: bool = False,
@@ -39,16 +41,20 @@ class ZenohDisplayNode(ZenohNode):
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         super().__init__(
-            session, keys, node, owns_session=owns_session, peer_timeout=peer_timeout, clock=clock
+            session, names, node, owns_session=owns_session, peer_timeout=peer_timeout, clock=clock
         )
         self._eyes_lock = threading.Lock()
         self._latest: EyeStateMsg | None = None
         self._arrived = -float("inf")
         self.received = 0
-        self.subscribe(keys.eyes, EyeStateMsg, self._on_eyes)
+        self.ros.subscription(topics.EYES.name, topics.EYES.type, self._on_eyes)
         self.announce()
 
-    def _on_eyes(self, msg: EyeStateMsg) -> None:
+    def _on_eyes(self, ros: Any, rx: Received) -> None:
+        eyes = convert.eyes_of(ros)
+        seq, stamp = seq_stamp(rx)
+        msg = checked(EyeStateMsg, convert.EYE_STATE, seq=seq, t=eyes.t, stamp=stamp,
+                     yaw=eyes.yaw, pitch=eyes.pitch, blink=eyes.blink, distance=eyes.distance)
         now = self.clock()
         with self._eyes_lock:  # Zenoh keeps one publisher's order: the last one is the newest
             self._latest = msg

@@ -1,8 +1,18 @@
-"""What every gazebot node on the bus shares: strict decoding with drop counting, the events topic
-and its history queryable, heartbeats, and peer presence through liveliness tokens.
+"""What every gazebot node on the bus shares: a ROS 2 node on the rmw_zenoh wire
+(:class:`~gazebot.drivers.rmw.node.RosNode`), the event topics (``robot/events``,
+``handover/events``) and their history queryable,
+health on ``/diagnostics``, and peer presence through the nodes' liveliness tokens.
 
-Zenoh runs subscriber callbacks on its own threads: they only decode and store; the node's loop
-does the work. A callback never raises (a malformed payload is counted, logged and dropped).
+Zenoh runs subscription callbacks on its own threads: they only decode and store; the node's
+loop does the work. A callback never raises (a malformed message is counted, logged and
+dropped by topic).
+
+Peers are the other nodes in the same namespace: alive while their ``@ros2_lv`` node token
+exists and their ``/diagnostics`` heartbeats (once seen) are not older than ``peer_timeout``.
+
+The event history is the one thing ROS 2 has no topic for: each node answers Zenoh queries on
+``@gazebot_history/<domain>/<namespace>/<node>`` with the events it has seen, one CDR
+``gazebot_msgs/msg/HandoverEvent`` per reply, so a restarted engine catches up (resync).
 """
 
 from __future__ import annotations
@@ -14,14 +24,13 @@ from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar, Literal, TypeVar
 
-from gazebot.drivers.keys import KeyLayout, check_chunk
-from gazebot.drivers.payloads import (
-    EventHistoryMsg,
-    EventMsg,
-    Msg,
-    PayloadError,
-    StatusMsg,
-)
+from gazebot.drivers.payloads import EventMsg, Msg, StatusMsg
+from gazebot.drivers.rmw.attachment import Attachment, AttachmentError
+from gazebot.drivers.rmw.graph import Entity
+from gazebot.drivers.rmw.names import Names, mangle
+from gazebot.drivers.rmw.node import DropCounter, Publisher, Received, RosNode, TypeMismatch
+from gazebot.ros2 import convert, topics
+from gazebot.ros2.errors import MessageError
 
 if TYPE_CHECKING:
     import zenoh
@@ -30,64 +39,64 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("gazebot.drivers")
 _Node = TypeVar("_Node", bound="ZenohNode")
+M = TypeVar("M", bound=Msg)
+
+HISTORY_SPACE = "@gazebot_history"
 
 
-class DropCounter:
-    """Counts dropped payloads by key; logs the first ``log_first`` of each key, then every
-    ``log_every``-th, so a flood of garbage cannot flood the log."""
-
-    def __init__(self, log_first: int = 3, log_every: int = 100) -> None:
-        self.log_first = log_first
-        self.log_every = log_every
-        self._counts: dict[str, int] = {}
-        self._versions: dict[str, Any] = {}
-        self._lock = threading.Lock()
-
-    def drop(self, key: str, reason: str, version: Any = None) -> None:
-        """Count a dropped payload on ``key``; ``version``: the protocol version it spoke when
-        that was the reason."""
-        with self._lock:
-            n = self._counts.get(key, 0) + 1
-            self._counts[key] = n
-            if version is not None:
-                self._versions[key] = version
-        if n <= self.log_first or n % self.log_every == 0:
-            log.warning("dropped payload #%d on %s: %s", n, key, reason)
-
-    def counts(self) -> dict[str, int]:
-        with self._lock:
-            return dict(self._counts)
-
-    def versions(self) -> dict[str, Any]:
-        """The other protocol version last seen on each key that had one."""
-        with self._lock:
-            return dict(self._versions)
-
-    @property
-    def total(self) -> int:
-        with self._lock:
-            return sum(self._counts.values())
+def event_to_ros(msg: EventMsg) -> Any:
+    """The ``HandoverEvent`` of an :class:`EventMsg`."""
+    return convert.handover_event(msg.source, msg.category, msg.kind, msg.t, msg.detected_at,
+                                  msg.stamp, msg.info)
 
 
-def _event_key(msg: EventMsg) -> tuple[str, int, float]:
-    # seq restarts with a node, stamp tells the two lives apart.
-    return (msg.source, msg.seq, msg.stamp)
+def event_from_ros(ros: Any, seq: int = 0) -> EventMsg:
+    """The :class:`EventMsg` of a ``HandoverEvent`` (``seq``: the publisher's sequence number);
+    :class:`MessageError` for values gazebot cannot use."""
+    v = convert.event_of(ros)
+    try:
+        return EventMsg(seq=max(0, seq), source=v.source, category=v.category, kind=v.kind,
+                        t=v.t, detected_at=v.detected_at, stamp=v.stamp, info=v.info)
+    except ValueError as exc:
+        raise MessageError(convert.HANDOVER_EVENT, str(exc).splitlines()[0]) from None
+
+
+def seq_stamp(rx: Received) -> tuple[int, float]:
+    """The publisher's sequence number (from 0) and source time (s) of a received message."""
+    if rx.attachment is None:
+        return 0, time.time()
+    return max(0, rx.attachment.sequence_number - 1), rx.attachment.source_timestamp / 1e9
+
+
+def checked(model: type[M], what: str, **fields: Any) -> M:
+    """``model(**fields)``; a value out of range becomes a :class:`MessageError` (counted and
+    dropped by the subscription) naming the first offending field."""
+    try:
+        return model(**fields)
+    except ValueError as exc:
+        errors = getattr(exc, "errors", None)
+        reason = str(exc).splitlines()[0]
+        if callable(errors) and errors():
+            err = errors()[0]
+            reason = f"{'.'.join(str(p) for p in err['loc'])}: {err['msg']}"
+        raise MessageError(what, reason) from None
 
 
 class ZenohNode:
-    """A named node on the bus of one robot.
+    """A named gazebot node on the bus of one robot.
 
     Args:
         session: An open Zenoh session (closed by :meth:`close` only if ``owns_session``: it may
             be shared).
-        keys: The robot's key layout.
-        node: This node's name (``engine``, ``sim``, ...): its liveliness token, the ``source``
-            of its events and the ``node`` of its heartbeats.
+        names: Namespace, remapping, domain id and frame names.
+        node: This node's ROS name (``engine``, ``sim``, ...): its liveliness token, the
+            ``source`` of its events and the name of its ``/diagnostics`` status.
         owns_session: Close ``session`` in :meth:`close` (set by :meth:`open`).
         history_len: Events kept for the history queryable and the inbox.
         peer_timeout: A peer whose heartbeats stop for this long (s) counts as lost even if its
             session (and token) lingers.
         clock: Monotonic clock (s).
+        max_bytes: Size cap of incoming messages by resolved topic (default 4 MiB).
     """
 
     #: The node name :meth:`open` uses when none is given.
@@ -96,41 +105,46 @@ class ZenohNode:
     def __init__(
         self,
         session: zenoh.Session,
-        keys: KeyLayout,
+        names: Names,
         node: str,
         *,
         owns_session: bool = False,
         history_len: int = 1000,
         peer_timeout: float = 2.0,
         clock: Callable[[], float] = time.monotonic,
+        max_bytes: dict[str, int] | None = None,
     ) -> None:
         self.session = session
-        self.keys = keys
-        self.node = check_chunk(node, "node name")
+        self.names = names
+        self.ros = RosNode(session, names, node, max_bytes=max_bytes)
+        self.node = self.ros.name
         self._owns_session = owns_session
         self.peer_timeout = float(peer_timeout)
         self.clock = clock
-        self.drops = DropCounter()
+        self.drops: DropCounter = self.ros.drops
         self.started = clock()
         self._lock = threading.Lock()
         self._closed = False
-        self._entities: list[Any] = []
         self._inbox: deque[EventMsg] = deque(maxlen=history_len)
         self._history: deque[EventMsg] = deque(maxlen=history_len)
-        self._history_keys: set[tuple[str, int, float]] = set()
-        self._alive: dict[str, bool] = {}
+        self._history_keys: set[tuple[str, str, int, int]] = set()
         self._last_beat: dict[str, float] = {}
-        self._event_seq = 0
         self._status_seq = 0
+        self._event_seq = 0
+        self._seen_nodes: set[str] = set()
+        self.ros.on_graph = self._on_graph
 
-        self._event_pub = self._declare(session.declare_publisher(keys.events))
-        self._status_pub = self._declare(session.declare_publisher(keys.status))
-        self.subscribe(keys.events, EventMsg, self._on_event)
-        self.subscribe(keys.status, StatusMsg, self._on_status)
-        liveliness = session.liveliness()
-        self._declare(liveliness.declare_subscriber(keys.alive_all, self._on_alive, history=True))
-        self._declare(session.declare_queryable(keys.events_history(self.node), self._on_query))
-        self._token: Any = None
+        # Robot events (category ``robot``) on ``robot/events``, the others on
+        # ``handover/events``; every node hears both.
+        self._event_pubs = {
+            name: self.ros.publisher(t.name, t.type)
+            for name, t in (("robot", topics.ROBOT_EVENTS), ("other", topics.EVENTS))
+        }
+        self._status_pub = self.ros.publisher(topics.DIAGNOSTICS.name, topics.DIAGNOSTICS.type)
+        for t in (topics.ROBOT_EVENTS, topics.EVENTS):
+            self.ros.subscription(t.name, t.type, self._on_event)
+        self.ros.subscription(topics.DIAGNOSTICS.name, topics.DIAGNOSTICS.type, self._on_status)
+        self.ros.declare(session.declare_queryable(self._history_key(self.node), self._on_query))
 
     @classmethod
     def open(cls: type[_Node], config: BusConfig, node: str | None = None, **kwargs: Any) -> _Node:
@@ -141,95 +155,68 @@ class ZenohNode:
 
         session = open_session(config)
         try:
-            return cls(session, config.keys, node or cls.default_node, owns_session=True, **kwargs)
+            return cls(session, config.names, node or cls.default_node, owns_session=True,
+                       **kwargs)
         except Exception:
             session.close()
             raise
 
     def announce(self) -> None:
         """Declare the node's liveliness token: call last in a subclass' ``__init__``, so a
-        peer that sees the node also finds all its subscribers declared."""
-        if self._token is None:
-            self._token = self._declare(
-                self.session.liveliness().declare_token(self.keys.alive(self.node))
-            )
+        peer that sees the node also finds all its subscriptions declared."""
+        self.ros.announce()
+
+    def _history_key(self, node: str) -> str:
+        return f"{HISTORY_SPACE}/{self.names.domain_id}/{mangle(self.names.namespace)}/{node}"
 
     # -- plumbing --------------------------------------------------------------------------
-    def put(self, publisher: Any, msg: Msg) -> bool:
-        """Publish ``msg``; after :meth:`close` this is a no-op returning ``False``."""
-        if self._closed:
-            return False
-        try:
-            publisher.put(msg.encode())
-        except Exception:
-            if self._closed:  # closed by another thread meanwhile
-                return False
-            raise
-        return True
-
-    def _declare(self, entity: Any) -> Any:
-        self._entities.append(entity)
-        return entity
-
-    def subscribe(self, key: str, model: type[Msg], handler: Callable[[Any], None]) -> None:
-        """Subscribe to ``key``: each payload is decoded as ``model`` and handed to ``handler``;
-        malformed ones are counted and dropped, handler errors logged."""
-
-        def callback(sample: zenoh.Sample) -> None:
-            try:
-                msg = model.decode(sample.payload.to_bytes())
-            except PayloadError as exc:
-                self.drops.drop(key, exc.reason, getattr(exc, "version", None))
-                return
-            try:
-                handler(msg)
-            except Exception:  # a bug in a handler must not kill Zenoh's thread
-                log.exception("handler for %s failed", key)
-
-        self._declare(self.session.declare_subscriber(key, callback))
-
-    def _on_event(self, msg: EventMsg) -> None:
+    def _on_event(self, ros: Any, rx: Received) -> None:
+        seq = rx.attachment.sequence_number - 1 if rx.attachment is not None else 0
+        msg = event_from_ros(ros, seq)
         with self._lock:
             self._remember(msg)
             if msg.source != self.node:
                 self._inbox.append(msg)
 
     def _remember(self, msg: EventMsg) -> None:
-        key = _event_key(msg)
+        key = msg.identity
         if key in self._history_keys:
             return
         if len(self._history) == self._history.maxlen:
-            self._history_keys.discard(_event_key(self._history[0]))
+            self._history_keys.discard(self._history[0].identity)
         self._history.append(msg)
         self._history_keys.add(key)
 
-    def _on_status(self, msg: StatusMsg) -> None:
-        if msg.node != self.node:
-            with self._lock:
-                self._last_beat[msg.node] = self.clock()
+    def _on_graph(self, entity: Entity, alive: bool) -> None:
+        if entity.kind == "NN" and alive and entity.namespace == self.names.namespace:
+            with self._lock:  # a new life: wait for its first heartbeat
+                self._last_beat.pop(entity.node, None)
 
-    def _on_alive(self, sample: zenoh.Sample) -> None:
-        import zenoh
-
-        node = self.keys.node_of_alive(str(sample.key_expr))
-        if node is None or node == self.node:
-            return
+    def _on_status(self, ros: Any, rx: Received) -> None:
+        now = self.clock()
         with self._lock:
-            self._alive[node] = sample.kind == zenoh.SampleKind.PUT
-            if self._alive[node]:
-                self._last_beat.pop(node, None)  # a new life: wait for its first heartbeat
+            for health in convert.health_of(ros):
+                if health.node != self.node:
+                    self._last_beat[health.node] = now
 
     def _on_query(self, query: zenoh.Query) -> None:
         with self._lock:
             events = list(self._history)
-        reply = EventHistoryMsg(node=self.node, events=events)
         try:
-            query.reply(self.keys.events_history(self.node), reply.encode())
+            for msg in events:
+                pub = self._event_pub(msg)
+                att = Attachment(msg.seq + 1, round(msg.stamp * 1e9), pub.gid)
+                query.reply(self._history_key(self.node), pub.codec.encode(event_to_ros(msg)),
+                            attachment=att.encode())
         except Exception:
             log.exception("could not answer the event history query")
 
     # -- events ----------------------------------------------------------------------------
+    def _event_pub(self, msg: EventMsg) -> Publisher:
+        return self._event_pubs["robot" if msg.category == "robot" else "other"]
+
     def next_event_seq(self) -> int:
+        """The number of this node's next event (from 0)."""
         with self._lock:
             self._event_seq += 1
             return self._event_seq - 1
@@ -238,7 +225,8 @@ class ZenohNode:
         """Publish one of this node's events (and keep it in the history)."""
         with self._lock:
             self._remember(msg)
-        self.put(self._event_pub, msg)
+        if not self._closed:
+            self._event_pub(msg).publish(event_to_ros(msg))
 
     def history(self) -> list[EventMsg]:
         """The events this node has seen (its own and others'), in arrival order."""
@@ -255,42 +243,57 @@ class ZenohNode:
     def event_history(self, timeout: float = 1.0) -> list[EventMsg]:
         """Ask every other node for the events it has seen; merged, de-duplicated, sorted by
         time. Malformed replies are counted and skipped; no answer gives ``[]``."""
-        key = self.keys.events_history_all
-        merged: dict[tuple[str, int, float], EventMsg] = {}
-        for reply in self.session.get(key, timeout=timeout):
+        selector = self._history_key("*")
+        codec = self._event_pubs["other"].codec
+        merged: dict[tuple[str, str, int, int], EventMsg] = {}
+        import zenoh
+
+        # One reply per event from each node: no consolidation (by default Zenoh keeps only
+        # the latest reply per key).
+        replies = self.session.get(selector, timeout=timeout,
+                                   consolidation=zenoh.ConsolidationMode.NONE)
+        for reply in replies:
             if reply.ok is None:
                 continue
+            sample = reply.ok
+            if str(sample.key_expr) == self._history_key(self.node):
+                continue
             try:
-                hist = EventHistoryMsg.decode(reply.ok.payload.to_bytes())
-            except PayloadError as exc:
-                self.drops.drop(key, exc.reason)
+                seq = 0
+                if sample.attachment is not None:
+                    seq = Attachment.decode(sample.attachment.to_bytes()).sequence_number - 1
+                msg = event_from_ros(codec.decode(sample.payload.to_bytes()), seq)
+            except (MessageError, AttachmentError) as exc:
+                self.drops.drop(selector, str(exc))
                 continue
-            if hist.node == self.node:
-                continue
-            for msg in hist.events:
-                merged.setdefault(_event_key(msg), msg)
+            merged.setdefault(msg.identity, msg)
         return sorted(merged.values(), key=lambda m: (m.t, m.detected_at, m.stamp))
 
     # -- status ----------------------------------------------------------------------------
     def peers(self) -> dict[str, bool]:
-        """Other nodes seen: alive when their liveliness token exists and their heartbeats
-        (once seen) are not older than ``peer_timeout``."""
+        """Other nodes of this namespace seen: alive when their node token exists and their
+        heartbeats (once seen) are not older than ``peer_timeout``."""
         now = self.clock()
+        alive_nodes = {e.node for e in self.ros.graph.nodes(self.names.namespace)}
+        alive_nodes.discard(self.node)
         with self._lock:
-            out = {}
-            for node, alive in self._alive.items():
-                beat = self._last_beat.get(node)
-                out[node] = alive and (beat is None or now - beat <= self.peer_timeout)
-            for node, beat in self._last_beat.items():
-                out.setdefault(node, now - beat <= self.peer_timeout)
+            seen = set(self._seen_nodes) | alive_nodes
+            self._seen_nodes = seen
+            beats = dict(self._last_beat)
+        out = {}
+        for node in seen:
+            beat = beats.get(node)
+            out[node] = node in alive_nodes and (beat is None or now - beat <= self.peer_timeout)
+        for node, beat in beats.items():
+            out.setdefault(node, now - beat <= self.peer_timeout)
         return out
 
     def dropped(self) -> dict[str, int]:
         return self.drops.counts()
 
-    def foreign_versions(self) -> dict[str, Any]:
-        """Keys on which payloads of another protocol version arrived, with that version."""
-        return self.drops.versions()
+    def type_mismatches(self) -> dict[str, TypeMismatch]:
+        """Topics on which a publisher of another type (or type version) was heard."""
+        return self.drops.mismatches()
 
     def heartbeat(
         self,
@@ -318,11 +321,12 @@ class ZenohNode:
             phase=phase,
             info=info or {},
         )
-        self.put(self._status_pub, msg)
+        self.publish_status(msg)
         return msg
 
     def publish_status(self, msg: StatusMsg) -> None:
-        self.put(self._status_pub, msg)
+        if not self._closed:
+            self._status_pub.publish(convert.diagnostics(msg, msg.stamp))
 
     # -- lifetime --------------------------------------------------------------------------
     @property
@@ -330,16 +334,11 @@ class ZenohNode:
         return self._closed
 
     def close(self) -> None:
-        """Undeclare everything this node declared (the token last-first), then close the
+        """Undeclare everything this node declared (the node token first), then close the
         session if the node owns it; idempotent."""
         if self._closed:
             return
         self._closed = True
-        for entity in reversed(self._entities):
-            try:
-                entity.undeclare()
-            except Exception:  # the session may already be closed
-                pass
-        self._entities.clear()
+        self.ros.close()
         if self._owns_session:
             self.session.close()

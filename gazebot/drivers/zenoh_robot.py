@@ -1,14 +1,14 @@
 """``ZenohRobotEndpoint``: the robot side of the bus (a simulator node or a real robot's bridge):
-publishes tracking, joint states and robot events; receives head, eye and arm commands."""
+publishes tracking, joint states, gripper, load share and robot events; receives head, eye and
+arm commands. All as ROS 2 messages on the rmw_zenoh wire (:mod:`gazebot.ros2.topics`)."""
 
 from __future__ import annotations
 
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, ClassVar, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
-from gazebot.drivers.keys import KeyLayout
 from gazebot.drivers.payloads import (
     ArmCommandMsg,
     EventMsg,
@@ -19,7 +19,11 @@ from gazebot.drivers.payloads import (
     Msg,
     TrackingMsg,
 )
-from gazebot.drivers.zenoh_node import ZenohNode
+from gazebot.drivers.rmw.names import Names
+from gazebot.drivers.rmw.node import Received
+from gazebot.drivers.zenoh_node import ZenohNode, checked, seq_stamp
+from gazebot.ros2 import convert, topics
+from gazebot.ros2.errors import MessageError
 from gazebot.types import Event, TrackingFrame
 
 if TYPE_CHECKING:
@@ -60,7 +64,7 @@ class ZenohRobotEndpoint(ZenohNode):
 
     Args:
         session: An open session (closed by :meth:`close` only if ``owns_session``).
-        keys: The robot's key layout.
+        names: Namespace, remapping, domain id and frame names.
         node: This node's name (default ``sim``).
         eye_frames: Subscribe to rendered eye frames. The engine renders frames only while
             someone subscribes, so a robot that draws its eyes from the eye state leaves this off.
@@ -71,41 +75,53 @@ class ZenohRobotEndpoint(ZenohNode):
     def __init__(
         self,
         session: zenoh.Session,
-        keys: KeyLayout,
+        names: Names,
         node: str = "sim",
         *,
         owns_session: bool = False,
         eye_frames: bool = False,
         peer_timeout: float = 2.0,
         clock: Callable[[], float] = time.monotonic,
+        max_bytes: dict[str, int] | None = None,
     ) -> None:
-        super().__init__(
-            session, keys, node, owns_session=owns_session, peer_timeout=peer_timeout, clock=clock
-        )
+        super().__init__(session, names, node, owns_session=owns_session,
+                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes)
         self._tracking_seq = 0
         self._joint_seq = 0
         self.head: Latest[HeadCommandMsg] = Latest()
         self.eyes: Latest[EyeStateMsg] = Latest()
         self.eye_frame: Latest[EyeFrameMsg] = Latest()
         self.arm: Latest[ArmCommandMsg] = Latest()
-        self._tracking_pub = self._declare(session.declare_publisher(keys.tracking))
-        self._joints_pub = self._declare(session.declare_publisher(keys.joint_states))
-        self.subscribe(keys.head_command, HeadCommandMsg, self.head.put)
-        self.subscribe(keys.eyes, EyeStateMsg, self.eyes.put)
+        ros = self.ros
+        self._point_pubs = {b: ros.publisher(t.name, t.type) for b, t in topics.TRACKING.items()}
+        self._gripper_pub = ros.publisher(topics.GRIPPER.name, topics.GRIPPER.type)
+        self._share_pub = ros.publisher(topics.LOAD_SHARE.name, topics.LOAD_SHARE.type)
+        self._joints_pub = ros.publisher(topics.JOINT_STATES.name, topics.JOINT_STATES.type)
+        ros.subscription(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type, self._on_head)
+        ros.subscription(topics.EYES.name, topics.EYES.type, self._on_eyes)
         if eye_frames:
-            self.subscribe(keys.eyes_frame, EyeFrameMsg, self.eye_frame.put)
-        self.subscribe(keys.arm_command, ArmCommandMsg, self.arm.put)
+            ros.subscription(topics.EYE_IMAGE.name, topics.EYE_IMAGE.type, self._on_frame)
+        ros.subscription(topics.ARM_COMMAND.name, topics.ARM_COMMAND.type, self._on_arm)
+        ros.subscription(topics.ARM_MODE.name, topics.ARM_MODE.type, self._on_arm_mode)
         self.announce()
 
+    # -- out -------------------------------------------------------------------------------
     def publish_tracking(self, frame: TrackingFrame) -> TrackingMsg:
-        """Publish one tracking sample (numbered) and return it."""
+        """Publish one tracking sample (each tracked body, the gripper and the load share as
+        known, stamped ``frame.t``) and return it (numbered)."""
         msg = TrackingMsg.from_frame(frame, self._tracking_seq, time.time())
         self._tracking_seq += 1
-        self.put(self._tracking_pub, msg)
+        base = self.names.base_frame
+        for body, p in convert.tracking_points(frame).items():
+            self._point_pubs[body].publish(convert.point_stamped(frame.t, p, base))
+        if frame.gripper_closed is not None:
+            self._gripper_pub.publish(convert.gripper_state(frame.t, bool(frame.gripper_closed)))
+        if frame.load_share is not None:
+            self._share_pub.publish(convert.load_share(frame.t, float(frame.load_share)))
         return msg
 
     def publish_joint_state(self, t: float, position: Mapping[str, float]) -> JointStateMsg:
-        """Publish the measured joint positions (rad or m, by joint name)."""
+        """Publish the measured joint positions (rad or m, by joint name) on ``/joint_states``."""
         msg = JointStateMsg(
             seq=self._joint_seq,
             t=float(t),
@@ -113,7 +129,7 @@ class ZenohRobotEndpoint(ZenohNode):
             position={k: float(v) for k, v in position.items()},
         )
         self._joint_seq += 1
-        self.put(self._joints_pub, msg)
+        self._joints_pub.publish(convert.joint_state(msg.t, msg.position))
         return msg
 
     def publish_robot_event(self, event: Event) -> EventMsg:
@@ -121,3 +137,48 @@ class ZenohRobotEndpoint(ZenohNode):
         msg = EventMsg.from_event(event, self.node, self.next_event_seq(), time.time())
         self.publish_event(msg)
         return msg
+
+    # -- in --------------------------------------------------------------------------------
+    def _on_head(self, ros: Any, rx: Received) -> None:
+        goal, tfs = convert.trajectory_goal(ros)
+        last = ros.points[-1]
+        names = list(ros.joint_names)
+        vel = [float(v) for v in last.velocities]
+        velocity = dict(zip(names, vel, strict=True)) if len(vel) == len(names) else {}
+        seq, stamp = seq_stamp(rx)
+        self.head.put(checked(
+            HeadCommandMsg, convert.JOINT_TRAJECTORY, seq=seq, t=convert.stamp_of(ros),
+            stamp=stamp, head=goal, velocity=velocity, time_from_start=tfs))
+
+    def _on_eyes(self, ros: Any, rx: Received) -> None:
+        eyes = convert.eyes_of(ros)
+        seq, stamp = seq_stamp(rx)
+        self.eyes.put(checked(
+            EyeStateMsg, convert.EYE_STATE, seq=seq, t=eyes.t, stamp=stamp, yaw=eyes.yaw,
+            pitch=eyes.pitch, blink=eyes.blink, distance=eyes.distance))
+
+    def _on_frame(self, ros: Any, rx: Received) -> None:
+        fmt = "png" if "png" in str(ros.format).lower() else "jpeg"
+        seq, stamp = seq_stamp(rx)
+        self.eye_frame.put(checked(
+            EyeFrameMsg, convert.COMPRESSED_IMAGE, seq=seq, t=convert.stamp_of(ros),
+            stamp=stamp, format=fmt, data=bytes(ros.data)))
+
+    def _on_arm(self, ros: Any, rx: Received) -> None:
+        goal, _ = convert.trajectory_goal(ros)  # a ``gripper`` joint (0..1) may be among them
+        seq, stamp = seq_stamp(rx)
+        self.arm.put(checked(ArmCommandMsg, convert.JOINT_TRAJECTORY, seq=seq,
+                            t=convert.stamp_of(ros), stamp=stamp, positions=goal))
+
+    def _on_arm_mode(self, ros: Any, rx: Received) -> None:
+        mode = str(ros.data)
+        seq, stamp = seq_stamp(rx)
+        if mode == "resume":
+            fields: dict[str, Any] = {"resume": True}
+        elif mode in ("home", "handover"):
+            fields = {"pose": mode}
+        else:
+            raise MessageError("std_msgs/msg/String",
+                               f"arm mode {mode!r}: expected home, handover or resume")
+        self.arm.put(checked(ArmCommandMsg, "std_msgs/msg/String", seq=seq, t=0.0, stamp=stamp,
+                            **fields))

@@ -67,6 +67,9 @@ class RobotConfig(BaseModel):
 
     name: str = Field(min_length=1)
     mjcf: str = Field(min_length=1)
+    # The ROS frame name of the base frame every point is in (the MJCF world frame); what
+    # gaze targets and tracking on the ROS 2 wire carry as ``header.frame_id``.
+    base_frame: str = Field(default="world", min_length=1)
     gaze_site: str = "gaze"
     gripper_site: str = "gripper"
     gripper_actuator: str = "gripper"
@@ -82,6 +85,9 @@ class RobotConfig(BaseModel):
     shifts: GazeShiftConfig = Field(default_factory=GazeShiftConfig)
     gaze_mode: GazeMode = "head-and-eyes"
     points: dict[str, Point]
+    # Tracked points farther than this from the robot base are implausible (a tracker's glitch,
+    # a unit error): the engine treats them as missing samples (counted).
+    workspace_radius_m: float = Field(default=4.0, gt=0.0, allow_inf_nan=False)
 
     @model_validator(mode="after")
     def _consistent(self) -> RobotConfig:

@@ -15,7 +15,6 @@ ROS bags) are read by :mod:`gazebot.recordings`.
 """
 
 from gazebot.phases.config import (
-    METHODS,
     PhaseConfig,
     default_phase_config_path,
     load_phase_config,
@@ -42,7 +41,6 @@ def segment(trajectory: Trajectory, config: PhaseConfig | None = None) -> list[S
 
 
 __all__ = [
-    "METHODS",
     "DetectorStats",
     "OnlineResult",
     "PhaseConfig",

@@ -15,14 +15,11 @@ The defaults here and in the YAML are the same; the YAML says each one's unit an
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from gazebot.config import configs_dir, load_model
-
-Method = Literal["gazebot", "seed-7.2.5", "seed-4.4.3"]
-METHODS: tuple[str, ...] = ("gazebot", "seed-7.2.5", "seed-4.4.3")
+from gazebot.phases.durations import REACH_S, RETREAT_S, TRANSFER_S
 
 
 class PhaseConfig(BaseModel):
@@ -37,11 +34,15 @@ class PhaseConfig(BaseModel):
             ``|p(t + h) - p(t - h)| / 2h`` with this ``h`` (s) in both seed methods.
         seed_d1: Seed 4.4.3: distance-from-start fraction of its maximum (seed 0.41).
         seed_v1: Seed 4.4.3: signed-speed fraction of its maximum (seed 0.43).
+        seed_min_motion: Seed 4.4.3, our addition: a giving motion moves the hand at least
+            this far from its start (m); else no segments (the fractions would split noise).
         transfer_exit_speed: gazebot: seed-rule runs split by blips slower than this merge (m/s).
         min_approach: gazebot: a handover is a dip of the hands' distance at least this deep (m).
         approach_fraction: gazebot: ... closing at least this fraction of the distance the
             hands started from.
         min_transfer: gazebot: shortest transfer kept (s).
+        pass_min_samples: gazebot: a handover without a hold (the hands pass the object on
+            the move) needs this many analysis-grid samples under ``transfer_exit_speed``.
         still_closing: Online, hands that closed more than this over the last
             ``min_transfer`` are still approaching: no transfer yet (m).
         settle_fraction: gazebot: the transfer starts where the relative speed falls below this
@@ -82,27 +83,51 @@ class PhaseConfig(BaseModel):
             trigger on the recent samples says the next boundary may have passed.
         edge_guard: Online, a phase boundary closer than this to the newest sample is not yet
             reported (s): the smoothing has not seen what follows it.
+        online_slack: Online, back-dated boundaries are compared with the current phase's
+            start with this slack (s): one analysis may place a boundary a grid step or two
+            off the previous one.
+        reach_stall: Online, a reach whose giver's hand then rested this long (s) and set off
+            again toward the receiver was an earlier movement: it ends (``stalled``) and the
+            final approach is the reach ...
+        stall_travel: ... if the hand rested less than this far (m) from where the reach
+            started (a lift; a hand held out at the handover place has come farther).
+        reach_lookback: Online, in a reach the analysis reads this many ``reach_duration``
+            before the reach's start (the rest before it dates the onset).
+        trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
+            the distances its rules need (loose: it fires before the rule can).
+        trigger_speed_baseline: ... speeds from mean positions this far apart (s).
+        trigger_deep_fraction: ... the hands closing this share of ``min_approach`` is a deep
+            dip (whoever closed it) ...
+        trigger_own_fraction: ... else the giver's own share of the closing must reach this
+            share of ``reach_confirm_distance``.
+        trigger_still_factor: ... a reach may have ended once the hands closed less than this
+            many ``still_closing`` over the recent samples.
+        trigger_far_fraction: ... a retreat may have ended once the giver's hand is this share
+            of ``retreat_far_distance`` away ...
+        trigger_landing_fraction: ... or its speed fell below this share of its peak.
         load_share_shared: Load share above which the object is shared (seed delta_1).
         load_share_robot: Load share above which the robot holds the object alone (seed delta_2).
-        reach_duration: Typical giver reach (s; seed Fig. 6.1: 8.10 frames at 8 fps).
-        transfer_duration: Typical transfer (s; seed annotations mean).
-        retreat_duration: Typical retreat (s; seed annotations mean).
+        reach_duration: Typical giver reach (s; :mod:`gazebot.phases.durations`).
+        transfer_duration: Typical transfer (s; same source).
+        retreat_duration: Typical retreat (s; same source).
         peak_passed_fraction: A motion is past its speed peak once its speed has fallen below
             this fraction of the peak (end-of-phase prediction).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
-    method: Method = "gazebot"
+    method: str = "gazebot"  # a registered phase method (gazebot.phases.methods.PHASE_METHODS)
     transfer_distance_margin: float = Field(0.20, gt=0)
     transfer_speed_max: float = Field(0.15, gt=0)
     seed_speed_half_window: float = Field(0.05, gt=0)
     seed_d1: float = Field(0.41, gt=0, lt=1)
     seed_v1: float = Field(0.43, gt=0, lt=1)
+    seed_min_motion: float = Field(0.10, ge=0)
     transfer_exit_speed: float = Field(0.20, gt=0)
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
     min_transfer: float = Field(0.08, ge=0)
+    pass_min_samples: int = Field(3, ge=1)
     still_closing: float = Field(0.005, ge=0)
     settle_fraction: float = Field(0.03, gt=0, lt=1)
     settle_floor_factor: float = Field(1.5, ge=1)
@@ -127,12 +152,30 @@ class PhaseConfig(BaseModel):
     online_window: float = Field(5.0, gt=1)
     online_refresh: float = Field(0.1, ge=0)
     edge_guard: float = Field(0.04, ge=0)
+    online_slack: float = Field(0.03, ge=0)
+    reach_stall: float = Field(1.0, gt=0)
+    stall_travel: float = Field(0.18, gt=0)
+    reach_lookback: float = Field(2.0, ge=1)
+    trigger_distance_factor: float = Field(0.5, gt=0, le=1)
+    trigger_speed_baseline: float = Field(0.1, gt=0)
+    trigger_deep_fraction: float = Field(0.8, gt=0, le=1)
+    trigger_own_fraction: float = Field(0.25, ge=0, le=1)
+    trigger_still_factor: float = Field(2.0, ge=1)
+    trigger_far_fraction: float = Field(0.8, gt=0, le=1)
+    trigger_landing_fraction: float = Field(0.5, gt=0, lt=1)
     load_share_shared: float = Field(0.1, ge=0, le=1)
     load_share_robot: float = Field(0.9, ge=0, le=1)
-    reach_duration: float = Field(1.01, gt=0)
-    transfer_duration: float = Field(0.59, gt=0)
-    retreat_duration: float = Field(1.05, gt=0)
+    reach_duration: float = Field(REACH_S, gt=0)
+    transfer_duration: float = Field(TRANSFER_S, gt=0)
+    retreat_duration: float = Field(RETREAT_S, gt=0)
     peak_passed_fraction: float = Field(0.8, gt=0, lt=1)
+
+    @field_validator("method")
+    @classmethod
+    def _registered_method(cls, value: str) -> str:
+        from gazebot.phases.methods import PHASE_METHODS  # (it imports this module)
+
+        return PHASE_METHODS.check(value)
 
     @model_validator(mode="after")
     def _consistent(self) -> PhaseConfig:

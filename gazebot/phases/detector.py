@@ -3,16 +3,15 @@
 The detector keeps the last ``online_window`` seconds of samples and, at most every
 ``online_period``, runs the configured method (:mod:`gazebot.phases.methods`) on the samples
 seen so far (``partial``: a boundary the data do not show yet stays open, and the last
-``edge_guard`` is not trusted). For ``gazebot`` that analysis costs milliseconds, so each period
-first checks a cheap trigger on the hands' mean positions per period: a necessary condition,
-loosened, of the rule that ends the current phase (idle: the hands closed with the giver's
-hand moving; reach: the hands stopped closing fast; transfer: the relative position left the
-held pose; retreat: the giver's hand slowing or far). Only when it fires does the method run;
-a reach or retreat still refreshes its end prediction every ``online_refresh``.
-Each phase start the analysis shows beyond the current phase is
-emitted once, in order (reach -> transfer -> retreat -> done), back-dated to where the
-analysis puts it (never before the current phase's start). So online and offline share every
-rule; the online latency is what the data need to show a boundary.
+``edge_guard`` is not trusted). A method may offer a cheap trigger (the
+:meth:`~gazebot.phases.methods.base.Segmenter.trigger` hook; ``gazebot``'s is
+:mod:`~gazebot.phases.methods.gazebot_trigger`) that says per period whether its analysis
+needs to run, and its own rules for when a transfer or retreat ends once the hands are in
+contact (``rules_after_contact`` / ``phase_end``); the detector has no method-specific branch.
+Each phase start the analysis shows beyond the current phase is emitted once, in order
+(reach -> transfer -> retreat -> done), back-dated to where the analysis puts it (never before
+the current phase's start). So online and offline share every rule; the online latency is what
+the data need to show a boundary.
 
 Robot evidence (seed section 4.3) comes first: a rising edge of "gripper closed" or of a load
 share above ``load_share_shared`` starts the transfer at once (and reports the reach if it was
@@ -22,7 +21,10 @@ robot has not grasped are a giver waiting).
 
 A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
 back about as far apart as when it started (taken back before any transfer), ends as
-``handover_done`` with ``source = "aborted"``; a retreat longer
+``handover_done`` with ``source = "aborted"``. A reach that was an earlier movement (the giver
+lifted the object, rested ``reach_stall``, then set off toward the receiver) ends with
+``source = "stalled"`` when the final approach shows, and that approach is the reach (a new
+``reach_started``); a retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
 
 Bad samples: a frame with a non-finite time, or a time not after the last accepted one
@@ -45,29 +47,15 @@ from itertools import islice
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, compute_signals
-from gazebot.phases.methods import GazebotSegmenter, make_segmenter
+from gazebot.phases.filtering import Signals
+from gazebot.phases.methods import make_segmenter
+from gazebot.phases.methods.base import OnlineState
 from gazebot.phases.prediction import predict_end
-from gazebot.phases.rules.release import transfer_end
-from gazebot.phases.rules.retreat import retreat_done
-from gazebot.phases.rules.transfer import TransferCore
 from gazebot.phases.segment import Segment, segments_from_events
 from gazebot.phases.trajectory import Trajectory
+from gazebot.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
+from gazebot.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
 from gazebot.types import Event, EventKind, Phase, TrackingFrame
-
-_PHASE_OF_EVENT = {
-    EventKind.REACH_STARTED: Phase.REACH,
-    EventKind.TRANSFER_STARTED: Phase.TRANSFER,
-    EventKind.RETREAT_STARTED: Phase.RETREAT,
-    EventKind.HANDOVER_DONE: Phase.DONE,
-}
-_EVENT_OF_PHASE = {v: k for k, v in _PHASE_OF_EVENT.items()}
-# What one online period runs (gazebot's cheap trigger): the whole method, only the end
-# prediction, or nothing.
-_FULL, _REFRESH, _SKIP = "full", "refresh", "skip"
-# Back-dated boundaries are compared to the current phase's start with this slack (s): one
-# analysis may place a boundary a grid step or two off the previous one.
-_SLACK = 0.03
 
 
 def _point(p: object) -> np.ndarray:
@@ -125,14 +113,9 @@ class PhaseDetector:
         self._prev_evidence = False
         self._robot_reports = False
         self._signals: Signals | None = None
-        # Cheap trigger (gazebot): the hands' mean position per online_period, so the full
-        # analysis runs only when the next boundary may have passed.
-        self._gate = isinstance(self.segmenter, GazebotSegmenter)
-        self._acc = np.zeros(6)
-        self._acc_n = np.zeros(2)
-        # rows [t, giver xyz, receiver xyz] in _sum[_s0:_s1] (grown and compacted in place)
-        self._sum = np.empty((64, 7))
-        self._s0 = self._s1 = 0
+        # The method's cheap trigger, if it has one: the full analysis runs only when the next
+        # boundary may have passed.
+        self._trigger = self.segmenter.trigger()
         self._last_full = -math.inf
         self._reach_missing_since = math.nan
         self._floor = -math.inf  # the next phase never starts before this
@@ -181,6 +164,21 @@ class PhaseDetector:
         self._enter(phase, event.t)
         self._joined_late = True
         self._queue.clear()
+
+    def adopt(self, phase: Phase, t0: float) -> None:
+        """Enter ``phase`` at ``t0`` because other evidence showed it (the handover state's:
+        the robot grasped or released), live: no event is emitted, queued events stay, and the
+        handover is counted as if the detector had started the phase itself. A phase that does
+        not move forward (or a time before the current phase's start) is ignored."""
+        order = (Phase.IDLE, Phase.REACH, Phase.TRANSFER, Phase.RETREAT, Phase.DONE)
+        current = Phase.IDLE if self.phase is Phase.DONE else self.phase
+        if order.index(phase) <= order.index(current) or not math.isfinite(t0):
+            return
+        if math.isfinite(self.phase_start) and t0 < self.phase_start:
+            return
+        if self.phase in (Phase.IDLE, Phase.DONE) and phase is not Phase.DONE:
+            self.handover += 1
+        self._enter(phase, t0)
 
     # ----------------------------------------------------------------- internals
     def _enter(self, phase: Phase, t0: float) -> None:
@@ -233,12 +231,10 @@ class PhaseDetector:
             self._r.popleft()
         if g_ok:
             self._seen_g = t
-            self._acc[:3] += g
-            self._acc_n[0] += 1
         if r_ok:
             self._seen_r = t
-            self._acc[3:] += r
-            self._acc_n[1] += 1
+        if self._trigger is not None:
+            self._trigger.add(g, g_ok, r, r_ok)
         if not (g_ok and r_ok):
             st.held += 1
             if self.tracking:
@@ -264,120 +260,26 @@ class PhaseDetector:
             return
         if t - self._last_analysis >= c.online_period:
             self._last_analysis = t
-            mode = self._may_advance(t) if self._gate else _FULL
-            if mode is not _SKIP:
+            mode = "full"
+            if self._trigger is not None:
+                state = OnlineState(
+                    self.phase,
+                    self.phase_start,
+                    self._floor,
+                    self.tracking,
+                    self._joined_late,
+                    self._last_full,
+                )
+                mode = self._trigger.decide(t, state)
+            if mode != "skip":
                 self._last_full = t
-                self._analyse(t, predict_only=mode is _REFRESH)
+                self._analyse(t, predict_only=mode == "refresh")
                 return
             self.stats.skipped += 1
             if self.phase is Phase.RETREAT and t - self.phase_start > c.max_retreat:
                 self._done(t, t, "timeout")
         if math.isfinite(self.expected_phase_end):
             self.expected_phase_end = max(self.expected_phase_end, t)
-
-    def _may_advance(self, now: float) -> str:
-        """Summarise the samples since the last period; ``_FULL`` if the next boundary may
-        have passed (a necessary condition of its rule, on the per-period mean positions),
-        ``_REFRESH`` if not but a reach or retreat is due for its ``online_refresh``."""
-        self._summarise(now)
-        if self._boundary_possible(now):
-            return _FULL
-        if now - self._last_full < self.config.online_refresh:
-            return _SKIP
-        # A retreat's end (landing) is dated from the speed profile the analysis sees: run
-        # its rule; a reach only needs its end prediction.
-        return {Phase.REACH: _REFRESH, Phase.RETREAT: _FULL}.get(self.phase, _SKIP)
-
-    def _summarise(self, now: float) -> None:
-        """Append the mean hand positions since the last period (NaN: none seen) and drop
-        rows older than ``online_window``."""
-        c = self.config
-        n = self._acc_n
-        buf = self._sum
-        while self._s0 < self._s1 and buf[self._s0, 0] < now - c.online_window:
-            self._s0 += 1
-        if self._s1 == buf.shape[0]:
-            m = self._s1 - self._s0
-            if 2 * m > buf.shape[0]:
-                self._sum = np.empty((2 * buf.shape[0], 7))
-            self._sum[:m] = buf[self._s0 : self._s1]
-            buf, self._s0, self._s1 = self._sum, 0, m
-        row = buf[self._s1]
-        row[0] = now
-        row[1:4] = self._acc[:3] / n[0] if n[0] else np.nan
-        row[4:] = self._acc[3:] / n[1] if n[1] else np.nan
-        self._s1 += 1
-        self._acc[:] = 0.0
-        n[:] = 0.0
-
-    def _boundary_possible(self, now: float) -> bool:
-        """A necessary condition of the rule that ends the current phase, on the per-period
-        means (loose: 0.5x its distances, so it fires before the rule can)."""
-        c = self.config
-        ph = self.phase
-        if self._s1 - self._s0 < 3 or not self.tracking:
-            return True
-        rows = self._sum[self._s0 : self._s1]
-        ts = rows[:, 0]
-        g = rows[:, 1:4]
-        rel = rows[:, 4:] - g
-        d = np.linalg.norm(rel, axis=1)
-        if not math.isfinite(d[-1]):
-            return True
-        k = max(1, int(round(0.1 / max(c.online_period, 1e-3))))  # 0.1 s speed baseline
-        if ph in (Phase.IDLE, Phase.DONE):
-            # A reach (or a transfer) needs the hands closer than they were since the last
-            # phase began (2 cm, smoothed) and the giver's hand moving since they were farthest.
-            after = np.flatnonzero(ts >= self._floor - c.online_period)
-            if after.size <= k:
-                return False
-            da = d[after[0] :]
-            closed = float(np.nanmax(da)) - d[-1]
-            if not closed >= 0.5 * c.reach_confirm_distance:
-                return False
-            i_max = after[0] + int(np.nanargmax(da))
-            own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(float(d[-1]), 1e-9)
-            deep = closed >= 0.8 * c.min_approach
-            if not deep and not own >= 0.25 * c.reach_confirm_distance:
-                return False  # only the receiver came closer: no reach of the giver's yet
-            # The giver's hand moving fast: since the hands were farthest for a deep dip, else
-            # within the window the rule reads (smoothing, before the edge guard).
-            span = (c.smoothing + c.edge_guard + 0.1) / max(c.online_period, 1e-3)
-            recent = ts.shape[0] - 1 - int(span)
-            gm = g[max(i_max - k, 0 if deep else recent, 0) :]
-            if gm.shape[0] <= k:
-                return True
-            v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * c.online_period)
-            return bool(np.nanmax(v, initial=0.0) >= 0.5 * c.reach_onset_speed)
-        if ph is Phase.REACH:
-            # A transfer needs the approach to have stopped, an aborted reach the hands apart:
-            # either way the hands are no longer closing fast.
-            recent = d[ts >= now - (c.min_transfer + c.edge_guard + c.online_period)]
-            return float(np.nanmax(recent)) - d[-1] <= 2.0 * c.still_closing
-        since = ts >= self.phase_start
-        if ph is Phase.TRANSFER:
-            # A release moves the hands' relative position off the held pose.
-            held = rel[since]
-            held = held[np.isfinite(held).all(axis=1)]
-            if held.shape[0] < 2:
-                return True
-            # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
-            off = float(np.linalg.norm(np.nanmean(rel[-2:], axis=0) - held.mean(axis=0)))
-            return off >= 0.5 * c.release_distance
-        if ph is Phase.RETREAT:
-            if self._joined_late:
-                return True
-            # The retreat ends landing (slowing down), at rest or far away.
-            gs = g[since]
-            if gs.shape[0] <= k or not np.isfinite(gs[[0, -1]]).all():
-                return True
-            step = np.linalg.norm(gs[k:] - gs[:-k], axis=1)
-            if float(np.linalg.norm(gs[-1] - gs[0])) >= 0.8 * c.retreat_far_distance:
-                return True
-            if not math.isfinite(float(step[-1])):
-                return True
-            return bool(step[-1] <= 0.5 * np.nanmax(step))
-        return True
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
         """Gripper / load-share evidence; True if it started a phase on this frame."""
@@ -411,10 +313,12 @@ class PhaseDetector:
             return
         t = np.fromiter(self._t, float, n)
         i0 = 0
-        if self.phase not in (Phase.IDLE, Phase.DONE) and math.isfinite(self.phase_start):
-            # After contact the rules need the hold and what follows, a reach its rest before
-            # and what follows, not the whole window (the cost grows with the samples).
-            back = c.reach_duration * (2.0 if self.phase is Phase.REACH else 1.0)
+        if self.phase is not Phase.IDLE and math.isfinite(self.phase_start):
+            # After contact the rules need the hold and what follows, a reach (or, once done,
+            # the next reach) its rest before and what follows, not the whole window (the cost
+            # grows with the samples; after a handover, re-analysing it is wasted).
+            look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
+            back = c.reach_duration * look
             i0 = int(np.searchsorted(t, self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
@@ -423,51 +327,49 @@ class PhaseDetector:
             np.array(list(islice(self._g, i0, None))),
             np.array(list(islice(self._r, i0, None))),
         )
-        if isinstance(self.segmenter, GazebotSegmenter):
-            cut = self.segmenter.signals(traj, partial=True)
-            # The last edge_guard of the smoothed speed sags (one-sided window): predictions
-            # read the same trusted part as the rules.
-            self._signals = cut
-            if cut is not None and not predict_only:
-                # Once the hands are in contact, the release and retreat-end rules run from the
-                # phase's own start; before, the whole method finds the next handover.
-                self._rules_after_contact(cut, now)
-                if self.phase not in (Phase.TRANSFER, Phase.RETREAT):
-                    self._advance(self.segmenter.segment_signals(cut, now, True), now, True)
-                    self._rules_after_contact(cut, now)
-        else:
-            self._signals = compute_signals(traj, c)
-            self._advance(self.segmenter.segment_sorted(traj, partial=True), now)
+        s = self.segmenter.online_signals(traj)
+        self._signals = s
+        if s is not None and self.phase is Phase.REACH:
+            restart = self._reach_restart()
+            if restart is not None:
+                # The reach was an earlier movement (the giver lifted the object, waited, and
+                # only now approaches): it ends, and the approach is the reach.
+                self._done(restart, now, "stalled")
+                self._start(Phase.REACH, restart, now, "motion")
+        if s is not None and not predict_only:
+            if not self.segmenter.rules_after_contact:
+                self._advance(self.segmenter.online_segments(traj, s, now), now)
+            elif not self._rules_after_contact(s, now):
+                # Once the hands are in contact the method's own end rules run from the
+                # phase's start; before, the whole method finds the next handover.
+                self._advance(self.segmenter.online_segments(traj, s, now), now, True)
+                self._rules_after_contact(s, now)
         self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
 
     def _rules_after_contact(self, s: Signals, now: float) -> bool:
-        """``gazebot`` in a transfer or retreat: apply the release and retreat-end rules from
-        the current phase's start (so a phase adopted by :meth:`resync`, or older than the
-        window, ends like any other). True if the phase is one of these two."""
+        """In a transfer or retreat, apply the method's
+        :meth:`~gazebot.phases.methods.base.Segmenter.phase_end` rule from the current
+        phase's start. True if the phase is one of these two."""
         c = self.config
         for _ in range(2):
-            if self.phase is Phase.TRANSFER:
-                i0 = min(int(np.searchsorted(s.t, self.phase_start)), s.t.shape[0] - 1)
-                n = s.t.shape[0]
-                core = TransferCore(0, i0, n - 1, n - 1, max(self.phase_start, float(s.t[0])))
-                t_end, open_end = transfer_end(s, c, core)
-                if open_end or t_end >= float(s.t[-1]):
-                    return True
-                self._start(Phase.RETREAT, t_end, now, "motion")
-                continue
-            if self.phase is Phase.RETREAT:
-                done = retreat_done(s, c, self.phase_start, self._joined_late)
-                if done is not None:
-                    self._done(done[0], now, done[1])
-                elif now - self.phase_start > c.max_retreat:
+            if self.phase not in (Phase.TRANSFER, Phase.RETREAT):
+                return False
+            end = self.segmenter.phase_end(s, self.phase, self.phase_start, self._joined_late)
+            if end is None:
+                if self.phase is Phase.RETREAT and now - self.phase_start > c.max_retreat:
                     self._done(now, now, "timeout")
                 return True
-            return False
+            t_end, source = end
+            if self.phase is Phase.TRANSFER:
+                self._start(Phase.RETREAT, t_end, now, source)
+                continue
+            self._done(t_end, now, source)
+            return True
         return True
 
     def _find(self, segs: list[Segment], phase: Phase, after: float) -> Segment | None:
         for seg in segs:
-            if seg.phase is phase and seg.start >= after - _SLACK:
+            if seg.phase is phase and seg.start >= after - self.config.online_slack:
                 return seg
         return None
 
@@ -494,7 +396,8 @@ class PhaseDetector:
                     self._start(Phase.TRANSFER, tr.start, now, "motion")
                     continue
                 alive = any(
-                    sg.phase in (Phase.REACH, Phase.TRANSFER) and sg.end >= self._floor - _SLACK
+                    sg.phase in (Phase.REACH, Phase.TRANSFER)
+                    and sg.end >= self._floor - c.online_slack
                     for sg in segs
                 )
                 if alive:
@@ -517,7 +420,7 @@ class PhaseDetector:
                 return
             # Retreat: done when its end is seen, or a next reach began.
             ret = self._find(segs, Phase.RETREAT, self._floor)
-            nxt = self._find(segs, Phase.REACH, self._floor + _SLACK * 2)
+            nxt = self._find(segs, Phase.REACH, self._floor + c.online_slack * 2)
             if ret is not None and not ret.open:
                 self._done(ret.end, now, "motion")
                 continue
@@ -527,6 +430,42 @@ class PhaseDetector:
             if now - self.phase_start > c.max_retreat:
                 self._done(now, now, "timeout")
             return
+
+    def _reach_restart(self) -> float | None:
+        """When the final approach began, if the reach under way was an earlier movement: the
+        giver's hand, less than ``stall_travel`` from where the reach started, rested (under
+        ``rest_speed``) for ``reach_stall``, then moved again (``reach_onset_speed``) and the
+        hands have closed ``reach_confirm_distance`` since. ``None`` otherwise (a giver holding
+        the object out for a slow robot rests too, but does not set off again)."""
+        c = self.config
+        s = self._signals
+        if s is None or s.t.shape[0] < 3:
+            return None
+        i_start = int(np.searchsorted(s.t, self.phase_start))
+        v = s.giver_speed[i_start:]
+        rest = np.isfinite(v) & (v < c.rest_speed)
+        need = int(round(c.reach_stall / max(s.dt, 1e-9)))
+        if need < 1 or rest.size <= need:
+            return None
+        # the last sample of the last rest at least reach_stall long
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
+        runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+        runs = [(a, b) for a, b in runs if b - a + 1 >= need and b < rest.size - 1]
+        if not runs:
+            return None
+        a, b = runs[-1]
+        i_a, i_b = i_start + a, i_start + b
+        if not np.isfinite(s.giver[[i_start, i_a]]).all():
+            return None
+        if float(np.linalg.norm(s.giver[i_a] - s.giver[i_start])) >= c.stall_travel:
+            return None  # the hand was held out at the handover place: the reach goes on
+        after = s.giver_speed[i_b + 1 :]
+        d = s.distance[i_b:]
+        if not np.nanmax(after, initial=0.0) >= c.reach_onset_speed:
+            return None
+        if not float(d[0]) - float(np.nanmin(d)) >= c.reach_confirm_distance:
+            return None
+        return float(s.t[i_b])
 
     def _hands_back_apart(self) -> bool:
         """The hands are (almost) as far apart as when the current reach started: the reach

@@ -40,6 +40,14 @@ class Signals:
         rel_speed: Relative speed (N,) m/s.
         giver_speed: Giver hand speed (N,) m/s.
         receiver_speed: Receiver hand speed (N,) m/s.
+        closing: Closing speed, ``-d distance / dt`` (N,) m/s: positive while the hands close.
+        common_speed: Speed of the hands' midpoint (N,) m/s: their common motion.
+        hold_speed: Relative speed judged against the common motion (N,) m/s: the relative
+            speed in excess of the speed both hands share (the slower hand's), never below
+            the closing speed's magnitude. Hands carrying an object together while the pair
+            turns (the marker frames behind the hands swing with it at a constant distance)
+            read slow; an approach or a separation (the distance changing), or one hand moving
+            past the other, reads at its full speed.
     """
 
     t: np.ndarray
@@ -53,6 +61,9 @@ class Signals:
     rel_speed: np.ndarray
     giver_speed: np.ndarray
     receiver_speed: np.ndarray
+    closing: np.ndarray
+    common_speed: np.ndarray
+    hold_speed: np.ndarray
 
     @property
     def dt(self) -> float:
@@ -154,6 +165,12 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
         rv = np.full_like(r, np.nan)
     rel = r - g
     rel_v = rv - gv
+    distance = np.linalg.norm(rel, axis=1)
+    rel_speed = np.linalg.norm(rel_v, axis=1)
+    closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
+    common = 0.5 * np.linalg.norm(gv + rv, axis=1)
+    g_speed = np.linalg.norm(gv, axis=1)
+    r_speed = np.linalg.norm(rv, axis=1)
     return Signals(
         t=grid,
         giver=g,
@@ -162,8 +179,11 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
         receiver_v=rv,
         rel=rel,
         rel_v=rel_v,
-        distance=np.linalg.norm(rel, axis=1),
-        rel_speed=np.linalg.norm(rel_v, axis=1),
-        giver_speed=np.linalg.norm(gv, axis=1),
-        receiver_speed=np.linalg.norm(rv, axis=1),
+        distance=distance,
+        rel_speed=rel_speed,
+        giver_speed=g_speed,
+        receiver_speed=r_speed,
+        closing=closing,
+        common_speed=common,
+        hold_speed=np.maximum(np.abs(closing), rel_speed - np.minimum(g_speed, r_speed)),
     )

@@ -7,13 +7,10 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from gazebot.types import Event, EventKind, Phase
+from gazebot.types import PHASE_OF_EVENT, Event, EventKind, Phase
 
-_START_KIND = {
-    EventKind.REACH_STARTED: Phase.REACH,
-    EventKind.TRANSFER_STARTED: Phase.TRANSFER,
-    EventKind.RETREAT_STARTED: Phase.RETREAT,
-}
+# The events that start a phase segment (``handover_done`` ends one).
+_START_KIND = {k: p for k, p in PHASE_OF_EVENT.items() if p is not Phase.DONE}
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,19 @@ gripper state and load share (seed section 4.3).
 Ground truth per handover (:class:`HandoverTruth`): reach starts at the giver's motion onset;
 transfer starts when both hands touch the object (the later of the two arrivals) and ends at the
 giver's release; the retreat ends when the giver's hand is back at rest.
+
+The hold (``SyntheticOptions.hold``) is one of the kinds seen on real handovers (issue 20):
+
+- ``pull``: both hands hold the object and drift up to 3 cm toward the robot (the default);
+- ``carry``: a heavy full container: the hands meet, then move *together* for about 1 s (common
+  speed 0.1-0.3 m/s) while their relative position wobbles (relative speed 0.02-0.10 m/s,
+  distance within +-1 cm) before they separate;
+- ``still``: a full cup: both hands steady (relative speed under 0.03 m/s) for about 1.3 s.
+
+:func:`case_set` makes those and the quick light-cup handover (30 Hz, 5 mm noise);
+:func:`early_lift_set` makes givers who lift the object early and wait before the final approach;
+:func:`rest_recording` makes recordings with no handover at all (a resting or fidgeting giver
+under marker noise) for the no-false-event checks.
 """
 
 from __future__ import annotations
@@ -26,6 +39,8 @@ from gazebot.phases.trajectory import Trajectory
 from gazebot.types import Phase
 
 Posture = Literal["standing", "sitting"]
+Hold = Literal["pull", "carry", "still"]
+CaseKind = Literal["carry", "still", "quick30", "quick_noisy"]
 
 
 def min_jerk(s: np.ndarray) -> np.ndarray:
@@ -105,6 +120,16 @@ class SyntheticOptions:
         robot_lead: When > 0, the robot sets off this long (s) *before* the giver (a
             robot-initiated handover, seed 6.3: the receiver's hand moves first); 0: the robot
             reacts to the giver 0.05-0.4 s after its onset.
+        hold: What the hands do while both hold the object: ``pull``, ``carry`` or ``still``
+            (see the module docstring).
+        hold_time: ``(low, high)`` range the hold's duration is drawn from (s, before the
+            ``speed`` scaling); ``None``: the hold kind's own (pull 0.3-1.2, carry 0.9-1.1,
+            still 1.2-1.4).
+        early_lift: When > 0, before each reach the giver lifts the object (10-15 cm up, a
+            few cm toward the robot) and waits this long (s) before the final approach, which
+            is the reach (issue 20: a giver who lifted the cup early, then waited).
+        robot_delay: The robot sets off this much later (s) than it would: the giver holds
+            the object out at the handover place and waits.
     """
 
     rate: float = 100.0
@@ -119,6 +144,10 @@ class SyntheticOptions:
     marker_offset: float = 0.0
     frozen_per_s: float = 0.0
     robot_lead: float = 0.0
+    hold: Hold = "pull"
+    hold_time: tuple[float, float] | None = None
+    early_lift: float = 0.0
+    robot_delay: float = 0.0
 
     def __post_init__(self) -> None:
         if not 1.0 <= self.rate <= 2000.0:
@@ -129,6 +158,17 @@ class SyntheticOptions:
             raise ValueError("handovers must be >= 1 and speed > 0")
         if not 0.0 <= self.robot_lead <= 3.0:
             raise ValueError(f"robot_lead must be 0..3 s, got {self.robot_lead}")
+        if self.hold not in _HOLD_TIME:
+            raise ValueError(f"hold must be one of {sorted(_HOLD_TIME)}, got {self.hold!r}")
+        if self.hold_time is not None and not 0.1 <= self.hold_time[0] <= self.hold_time[1]:
+            raise ValueError(
+                f"hold_time must be (low, high) with 0.1 <= low <= high s, got {self.hold_time}"
+            )
+
+
+# Hold durations per hold kind (s, before the speed scaling): the seed's 0.25-1.75 s transfers,
+# about 1 s of joint carrying and about 1.3 s of a still hold (issue 20's held-out recordings).
+_HOLD_TIME = {"pull": (0.3, 1.2), "carry": (0.9, 1.1), "still": (1.2, 1.4)}
 
 
 @dataclass
@@ -174,9 +214,18 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
     grip = _Path(home.copy())
     lean = _Path(np.zeros(3))
     grip_events: list[tuple[float, float, float]] = []  # (t_close, t_release, t_open)
+    # carried holds: (t0, duration, cycles, giver wobble amplitude m, turn amplitude rad)
+    wobbles: list[tuple[float, float, int, np.ndarray, float]] = []
     truth: list[HandoverTruth] = []
     t = u(0.4, 1.2) + opts.robot_lead
     for _ in range(opts.handovers):
+        if opts.early_lift > 0:
+            # The giver lifts the object early (10-15 cm up, 3-6 cm toward the robot, 0.6 s)
+            # and waits before the final approach: the reach is the final approach.
+            lifted = rest + np.array([-u(0.03, 0.06), u(-0.02, 0.02), u(0.10, 0.15)])
+            hand.move(t, 0.6, lifted)
+            rest = lifted
+            t += 0.6 + opts.early_lift
         onset = t
         reach = float(np.clip(u(0.7, 1.25) / opts.speed, 0.4, 2.5))
         target = np.array([giver[0] - u(0.3, 0.5), giver[1] + u(-0.12, 0.12), u(*hand_z)])
@@ -187,17 +236,34 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
         lag = u(0.05, 0.4)
         if opts.robot_lead > 0:
             lag = -opts.robot_lead
+        lag += opts.robot_delay
         g_dur = u(0.8, 1.5)
         offset = np.array([-u(0.04, 0.15), u(-0.01, 0.01), u(-0.01, 0.01)])
         grip.move(onset + lag, g_dur, target + offset)
         contact = max(onset + reach, onset + lag + g_dur)
         t_close = contact + u(0.05, 0.25)
-        hold = float(np.clip(u(0.3, 1.2) / opts.speed, 0.25, 1.75))
+        lo_hold, hi_hold = opts.hold_time or _HOLD_TIME[opts.hold]
+        hold = float(np.clip(u(lo_hold, hi_hold) / opts.speed, 0.2, 1.75))
         release = max(contact + hold, t_close + 0.1)
-        # Both hold the object: a small common pull toward the robot.
-        pull = np.array([-u(0.0, 0.03), 0.0, u(-0.01, 0.01)])
         pull_t0 = contact + 0.05
-        if release - pull_t0 > 0.1:
+        if opts.hold == "pull":
+            # Both hold the object: a small common pull toward the robot.
+            pull = np.array([-u(0.0, 0.03), 0.0, u(-0.01, 0.01)])
+        elif opts.hold == "carry":
+            # Both carry it together: mean common speed 0.1-0.3 m/s along a random direction.
+            way = rng.normal(size=3) * [1.0, 1.0, 0.5]
+            pull = u(0.1, 0.3) * (release - pull_t0) * way / np.linalg.norm(way)
+            # ... while the pair turns back and forth about the vertical (by 0.03-0.09 rad):
+            # the marker frames, behind the hands, turn with it, so their relative position
+            # swings at 0.02-0.10 m/s (offset x turn rate) at a constant distance, and the
+            # giver's hand wobbles by +-0.3-0.6 cm against the receiver's.
+            cycles = max(1, round(u(0.8, 1.3) * (release - pull_t0)))
+            axis = rng.normal(size=3)
+            wobble = u(0.003, 0.006) * axis / np.linalg.norm(axis)
+            wobbles.append((pull_t0, release - pull_t0, cycles, wobble, u(0.03, 0.09)))
+        else:
+            pull = np.zeros(3)  # still: both hands steady
+        if release - pull_t0 > 0.1 and opts.hold != "still":
             hand.move(pull_t0, release - pull_t0, target + pull)
             grip.move(pull_t0, release - pull_t0, target + offset + pull)
         back = rest + np.array([u(-0.03, 0.03), u(-0.03, 0.03), u(-0.02, 0.02)])
@@ -221,10 +287,15 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
     n = ts.shape[0]
     sway = 0.004 * np.sin(2 * np.pi * u(0.2, 0.4) * ts + u(0, 6))[:, None] * np.array([1, 0.5, 0.3])
     gh = hand.at(ts) + sway + rng.normal(0.0, opts.noise, (n, 3))
+    turn = np.zeros(n)  # the pair's turn about the vertical while carrying (rad)
+    for t0, dur, cycles, amp, turn_amp in wobbles:
+        wave = np.sin(np.pi * cycles * np.clip((ts - t0) / dur, 0.0, 1.0))
+        gh += wave[:, None] * amp
+        turn += turn_amp * wave
     rh = grip.at(ts) + rng.normal(0.0, opts.gripper_noise, (n, 3))
     gf = face + lean.at(ts) + 0.5 * sway + rng.normal(0.0, opts.noise, (n, 3))
     if opts.marker_offset > 0:
-        half = np.array([0.5 * opts.marker_offset, 0.0, 0.0])
+        half = 0.5 * opts.marker_offset * np.stack([np.cos(turn), np.sin(turn), 0 * turn], 1)
         gh = gh + half  # the giver stands at +x, the robot at -x
         rh = rh - half
     if opts.frozen_per_s > 0:
@@ -276,5 +347,95 @@ def synthetic_set(n: int = 40, seed: int = 0, **overrides: object) -> list[Synth
         )
         if overrides:
             opts = replace(opts, **overrides)  # type: ignore[arg-type]
+        out.append(generate(int(rng.integers(2**31)), opts))
+    return out
+
+
+# The issue-20 cases: (hold kind, rate Hz, noise m, speed factor, hold_time, marker offset m).
+_CASES: dict[str, tuple[Hold, float, float, float, tuple[float, float] | None, float]] = {
+    # A heavy full container carried together; hand frames 0.3-0.4 m apart at contact.
+    "carry": ("carry", 120.0, 0.0015, 1.0, None, 0.25),
+    # A full cup held still for ~1.3 s.
+    "still": ("still", 120.0, 0.0015, 1.0, None, 0.25),
+    # A quick handover of a light cup (short hold, fast giver) at 30 Hz ...
+    "quick30": ("pull", 30.0, 0.0015, 1.5, (0.25, 0.4), 0.3),
+    # ... and at 120 Hz with 5 mm of marker noise.
+    "quick_noisy": ("pull", 120.0, 0.005, 1.5, (0.25, 0.4), 0.3),
+}
+CASE_KINDS: tuple[str, ...] = tuple(_CASES)
+
+
+def case_set(kind: CaseKind, n: int = 12, seed: int = 0) -> list[SyntheticHandover]:
+    """``n`` recordings of one of issue 20's failing cases (:data:`CASE_KINDS`): ``carry``,
+    ``still``, ``quick30`` or ``quick_noisy`` (see the module docstring), both postures, with
+    the marker offsets of real motion capture."""
+    if kind not in _CASES:
+        raise ValueError(f"kind must be one of {list(_CASES)}, got {kind!r}")
+    hold, rate, noise, speed, hold_time, offset = _CASES[kind]
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        opts = SyntheticOptions(
+            rate=rate,
+            irregular=0.1,
+            noise=noise,
+            posture="standing" if i % 2 == 0 else "sitting",
+            speed=speed * float(rng.uniform(0.9, 1.1)),
+            hold=hold,
+            hold_time=hold_time,
+            marker_offset=offset + float(rng.uniform(-0.03, 0.03)),
+        )
+        out.append(generate(int(rng.integers(2**31)), opts))
+    return out
+
+
+def rest_recording(
+    rate: float,
+    noise: float,
+    seconds: float = 20.0,
+    seed: int = 0,
+    jitter: float = 0.3,
+    fidget: bool = False,
+) -> Trajectory:
+    """A recording with no handover: the giver's hand at rest (0.4 cm of sway) under ``noise``
+    (m) at ``rate`` (Hz, ``jitter`` relative sampling jitter), the robot's gripper at home.
+
+    ``fidget``: small adjustments at rest, 0.8-2 cm in 0.25-0.6 s (peak speed up to 0.15 m/s),
+    in any direction, half of them toward the receiver; a handover detector must report
+    nothing on either kind."""
+    rng = np.random.default_rng(seed)
+    n = int(seconds * rate)
+    t = np.cumsum((1.0 / rate) * (1.0 + rng.uniform(-jitter, jitter, n)))
+    sway = 0.004 * np.sin(2 * np.pi * 0.3 * t)[:, None] * np.array([1.0, 0.5, 0.3])
+    g = np.array([1.05, -0.2, 0.9]) + sway + rng.normal(0.0, noise, (n, 3))
+    if fidget:
+        t0 = 1.0
+        while t0 < seconds - 2.0:
+            dur = rng.uniform(0.25, 0.6)
+            way = rng.normal(size=3)
+            if rng.random() < 0.5:
+                way[0] = -abs(way[0])  # toward the receiver (at -x)
+            g += min_jerk((t - t0) / dur)[:, None] * (
+                rng.uniform(0.008, 0.02) * way / np.linalg.norm(way)
+            )
+            t0 += dur + rng.uniform(0.2, 1.0)
+    r = np.array([0.35, -0.3, 0.25]) + rng.normal(0.0, 0.0003, (n, 3))
+    return Trajectory(t, g, r)
+
+
+def early_lift_set(n: int = 12, seed: int = 0) -> list[SyntheticHandover]:
+    """``n`` recordings of issue 20's early movement: the giver lifts the object 1.5-2.5 s
+    before the final approach and waits (120 Hz, 1.5 mm noise, marker offsets); the truth's
+    reach is the final approach."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        opts = SyntheticOptions(
+            rate=120.0,
+            noise=0.0015,
+            posture="standing" if i % 2 else "sitting",
+            early_lift=float(rng.uniform(1.5, 2.5)),
+            marker_offset=0.3,
+        )
         out.append(generate(int(rng.integers(2**31)), opts))
     return out

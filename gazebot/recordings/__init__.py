@@ -1,7 +1,8 @@
 """Recording readers: the formats labs record, into a :class:`~gazebot.phases.Trajectory` in SI.
 
 :func:`load_recording` picks the reader from the file: ``.csv`` (:mod:`.csv_table`), ``.c3d``
-(:mod:`.c3d_file`), ROS 1 ``.bag`` / ROS 2 bag folders, ``.db3`` and ``.mcap`` (:mod:`.rosbag`),
+(:mod:`.c3d_file`), ``.mcap`` files of ROS 2 messages (:mod:`.mcap_file`), ROS 1 ``.bag`` / ROS 2
+bag folders and ``.db3`` (:mod:`.rosbag`),
 and folders of per-body pose CSVs (:mod:`.pose_folder`). Point names choose the giver's hand,
 the receiver's hand and (optionally) the giver's face; a name the file lacks is an error that
 lists the names it has.
@@ -11,9 +12,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gazebot.recordings.base import PointNames, Recording, RecordingError, median_rate
+from gazebot.recordings.base import (
+    PointNames,
+    Recording,
+    RecordingError,
+    RecordingLimits,
+    median_rate,
+)
 from gazebot.recordings.c3d_file import read_c3d
 from gazebot.recordings.csv_table import read_csv
+from gazebot.recordings.mcap_file import read_mcap
 from gazebot.recordings.pose_folder import read_pose_folder
 from gazebot.recordings.rosbag import read_bag
 
@@ -23,6 +31,7 @@ def load_recording(
     names: PointNames | None = None,
     unit: str | None = None,
     rate: float | None = None,
+    limits: RecordingLimits | None = None,
 ) -> Recording:
     """Read any supported recording (see the module docstring).
 
@@ -32,9 +41,11 @@ def load_recording(
         unit: Length unit of CSV and pose-folder coordinates (m, cm, mm; default m). C3D files
             and bags carry their own.
         rate: Sampling rate of a pose folder (Hz).
+        limits: Largest time gap and coordinate magnitude (:class:`RecordingLimits`).
 
     Raises:
-        RecordingError: Missing or unreadable file, unknown format or unit, a wrong name.
+        RecordingError: Missing or unreadable file, unknown format or unit, a wrong name, times
+            not finite and increasing or a gap beyond ``limits.max_gap_s``.
     """
     path = Path(path)
     if not path.exists():
@@ -46,20 +57,22 @@ def load_recording(
             or any(path.glob("*.db3"))
             or any(path.glob("*.mcap"))
         ):
-            return read_bag(path, names)
-        return read_pose_folder(path, names, rate, unit or "m")
+            return read_bag(path, names, limits=limits)
+        return read_pose_folder(path, names, rate, unit or "m", limits)
     if suffix == ".csv":
-        return read_csv(path, names, unit or "m")
+        return read_csv(path, names, unit or "m", limits)
     if suffix == ".c3d":
         if unit is not None:
             raise RecordingError(path, "a C3D file states its own unit (POINT:UNITS): drop --unit")
-        return read_c3d(path, names)
-    if suffix in (".bag", ".db3", ".mcap"):
-        return read_bag(path, names)
+        return read_c3d(path, names, limits)
+    if suffix == ".mcap":
+        return read_mcap(path, names, limits=limits)
+    if suffix in (".bag", ".db3"):
+        return read_bag(path, names, limits=limits)
     raise RecordingError(
         path,
         f"unknown format {suffix or '(no extension)'}: expected .csv, "
-        ".c3d, .bag, a ROS 2 bag folder or a folder of pose CSVs",
+        ".c3d, .mcap, .bag, a ROS 2 bag folder or a folder of pose CSVs",
     )
 
 
@@ -67,10 +80,12 @@ __all__ = [
     "PointNames",
     "Recording",
     "RecordingError",
+    "RecordingLimits",
     "load_recording",
     "median_rate",
     "read_bag",
     "read_c3d",
     "read_csv",
+    "read_mcap",
     "read_pose_folder",
 ]

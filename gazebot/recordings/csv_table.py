@@ -13,20 +13,32 @@ from pathlib import Path
 
 import numpy as np
 
-from gazebot.recordings.base import PointNames, Recording, RecordingError, build
+from gazebot.recordings.base import (
+    PointNames,
+    Recording,
+    RecordingError,
+    RecordingLimits,
+    build,
+)
 
 TIME_COLUMNS = ("t", "time", "timestamp")
 DEFAULTS = ("giver_hand", "receiver_hand", "giver_face")
 _MISSING = {"", "nan", "-nan", "+nan"}
 
 
-def read_csv(path: str | Path, names: PointNames | None = None, unit: str = "m") -> Recording:
-    """Read a CSV recording (see the module docstring).
+def read_csv(
+    path: str | Path,
+    names: PointNames | None = None,
+    unit: str = "m",
+    limits: RecordingLimits | None = None,
+) -> Recording:
+    """Read a CSV recording (see the module docstring); ``limits``: see
+    :class:`~gazebot.recordings.base.RecordingLimits`.
 
     Raises:
         RecordingError: Not UTF-8, no header or time column, a cell that is not a number, an
-            infinite value, a wrong row length, or a point name the file lacks (names the file,
-            line and column).
+            infinite value, a wrong row length, times not increasing or a gap over the limit,
+            or a point name the file lacks (names the file, line and column).
     """
     path = Path(path)
     names = names or PointNames()
@@ -50,6 +62,7 @@ def read_csv(path: str | Path, names: PointNames | None = None, unit: str = "m")
         if header.count(col) > 1:
             raise RecordingError(path, f"line 1, column '{col}': duplicate column")
     values: list[list[float]] = []
+    lines: list[int] = []
     for lineno, row in enumerate(rows[1:], start=2):
         if not row or all(not c.strip() for c in row):
             continue
@@ -83,6 +96,7 @@ def read_csv(path: str | Path, names: PointNames | None = None, unit: str = "m")
                 )
             out.append(v)
         values.append(out)
+        lines.append(lineno)
     data = np.array(values, dtype=float).reshape(-1, len(header))
     col = {h: data[:, i] for i, h in enumerate(header)}
     points: dict[str, np.ndarray] = {}
@@ -94,4 +108,15 @@ def read_csv(path: str | Path, names: PointNames | None = None, unit: str = "m")
                 p[np.isnan(p).any(axis=1)] = np.nan
                 points[base] = p
     extra = {k: col[k] for k in ("gripper_closed", "load_share") if k in col}
-    return build(path, "csv", col[time_col], points, names, unit, DEFAULTS, extra)
+    return build(
+        path,
+        "csv",
+        col[time_col],
+        points,
+        names,
+        unit,
+        DEFAULTS,
+        extra,
+        limits=limits,
+        where=lambda i: f"line {lines[i]}",
+    )

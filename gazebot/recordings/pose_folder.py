@@ -5,11 +5,19 @@ Names are the file names without ``_pose_saved.csv`` / ``.csv``; rows are sample
 
 from __future__ import annotations
 
+import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from gazebot.recordings.base import PointNames, Recording, RecordingError, build
+from gazebot.recordings.base import (
+    PointNames,
+    Recording,
+    RecordingError,
+    RecordingLimits,
+    build,
+)
 
 
 def body_name(path: Path) -> str:
@@ -21,10 +29,14 @@ def body_name(path: Path) -> str:
 
 
 def read_pose_folder(
-    path: str | Path, names: PointNames | None = None, rate: float | None = None, unit: str = "m"
+    path: str | Path,
+    names: PointNames | None = None,
+    rate: float | None = None,
+    unit: str = "m",
+    limits: RecordingLimits | None = None,
 ) -> Recording:
     """Read the bodies of a pose folder sampled at ``rate`` (Hz, required: the files hold no
-    time).
+    time); ``limits``: see :class:`~gazebot.recordings.base.RecordingLimits`.
 
     Raises:
         RecordingError: No rate, no pose CSV, a file without x,y,z columns or with another row
@@ -36,26 +48,48 @@ def read_pose_folder(
     files = sorted(p for p in path.glob("*.csv"))
     points: dict[str, np.ndarray] = {}
     for f in files:
-        with f.open(encoding="utf-8-sig") as fh:
-            header = [h.strip().lower() for h in fh.readline().split(",")]
+        try:
+            text = f.read_text(encoding="utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise RecordingError(
+                f, f"not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start})"
+            ) from None
+        except OSError as exc:
+            raise RecordingError(f, f"cannot read: {exc.strerror or exc}") from None
+        lines = text.splitlines()
+        header = [h.strip().lower() for h in lines[0].split(",")] if lines else []
         if not {"x", "y", "z"} <= set(header):
             continue  # e.g. a wrench file
         try:
-            data = np.genfromtxt(
-                f,
-                delimiter=",",
-                skip_header=1,
-                usecols=[header.index(a) for a in "xyz"],
-                missing_values=("", "nan", "NaN"),
-                filling_values=np.nan,
-            )
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # "Empty input file": no rows is zero samples
+                data = np.genfromtxt(
+                    lines[1:],
+                    delimiter=",",
+                    usecols=[header.index(a) for a in "xyz"],
+                    missing_values=("", "nan", "NaN"),
+                    filling_values=np.nan,
+                )
         except ValueError as exc:
-            raise RecordingError(f, f"not a numeric pose table ({exc})") from None
-        points[body_name(f)] = np.atleast_2d(data).reshape(-1, 3)
+            # numpy lists every bad row ("Line #1 (got 2 columns instead of 3)"): name the first.
+            bad = re.search(r"Line #(\d+) \((.*?)\)", str(exc))
+            where = f"line {int(bad.group(1)) + 1}: {bad.group(2)}" if bad else str(exc)
+            raise RecordingError(f, f"not a numeric pose table ({where})") from None
+        points[body_name(f)] = np.atleast_2d(data).reshape(-1, 3) if data.size else np.zeros((0, 3))
     if not points:
         raise RecordingError(path, "no pose CSV with x, y, z columns in this folder")
     counts = {len(v) for v in points.values()}
     n = min(counts)
     points = {k: v[:n] for k, v in points.items()}
     t = np.arange(n) / float(rate)
-    return build(path, "pose-folder", t, points, names or PointNames(), unit, (None, None, None))
+    return build(
+        path,
+        "pose-folder",
+        t,
+        points,
+        names or PointNames(),
+        unit,
+        (None, None, None),
+        limits=limits,
+        where=lambda i: f"row {i + 2}",
+    )

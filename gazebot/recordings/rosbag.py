@@ -9,9 +9,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
-from gazebot.recordings.base import PointNames, Recording, RecordingError, build
+from gazebot.recordings.base import (
+    PointNames,
+    Recording,
+    RecordingError,
+    RecordingLimits,
+    bound_streams,
+    build,
+    sample_streams,
+)
 
 _POSE = ("geometry_msgs/msg/PoseStamped", "geometry_msgs/PoseStamped")
 _POINT = ("geometry_msgs/msg/PointStamped", "geometry_msgs/PointStamped")
@@ -24,8 +30,15 @@ def _stamp(header: object) -> float:
     return float(st.sec) + 1e-9 * float(st.nanosec)
 
 
-def read_bag(path: str | Path, names: PointNames | None = None, max_gap: float = 0.25) -> Recording:
-    """Read the point streams of a ROS 1 (``.bag``) or ROS 2 (folder or ``.mcap``/``.db3``) bag.
+def read_bag(
+    path: str | Path,
+    names: PointNames | None = None,
+    max_gap: float = 0.25,
+    limits: RecordingLimits | None = None,
+) -> Recording:
+    """Read the point streams of a ROS 1 (``.bag``) or ROS 2 (folder or ``.mcap``/``.db3``) bag;
+    ``max_gap``: longest interpolation gap of one stream (s); ``limits``: see
+    :class:`~gazebot.recordings.base.RecordingLimits`.
 
     Raises:
         RecordingError: Not a readable bag, no usable topic, or a name the bag lacks.
@@ -60,18 +73,19 @@ def read_bag(path: str | Path, names: PointNames | None = None, max_gap: float =
         raise RecordingError(path, f"not a readable ROS bag ({exc})") from None
     if not series:
         raise RecordingError(path, "no PoseStamped, PointStamped, TransformStamped or /tf data")
-    t = np.unique(np.concatenate([[s[0] for s in v] for v in series.values()]))
-    points: dict[str, np.ndarray] = {}
-    for name, rows in series.items():
-        a = np.array(sorted(rows))
-        _, keep = np.unique(a[:, 0], return_index=True)
-        a = a[keep]
-        p = np.stack([np.interp(t, a[:, 0], a[:, k]) for k in (1, 2, 3)], axis=1)
-        j = np.searchsorted(a[:, 0], t, side="right")
-        exact = np.isin(t, a[:, 0])
-        inside = (j > 0) & (j < a.shape[0])
-        gap = np.full(t.shape[0], np.inf)
-        gap[inside] = a[j[inside], 0] - a[j[inside] - 1, 0]
-        p[~exact & (gap > max_gap)] = np.nan
-        points[name] = p
-    return build(path, "rosbag", t, points, names or PointNames(), "m", (None, None, None))
+    limits = limits or RecordingLimits()
+    series, beyond, namer = bound_streams(path, series, limits)
+    t, points = sample_streams(series, max_gap)
+    rec = build(
+        path,
+        "rosbag",
+        t,
+        points,
+        names or PointNames(),
+        "m",
+        (None, None, None),
+        limits=limits,
+        where=namer(t),
+    )
+    rec.out_of_workspace += sum(beyond[n] for n in set(rec.names) - {None})
+    return rec

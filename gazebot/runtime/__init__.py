@@ -3,6 +3,7 @@ shared by the video recordings, the engine node on the bus and the in-process dr
 
 from __future__ import annotations
 
-from gazebot.runtime.loop import GazeLoop, LoopCommand, TrackingState
+from gazebot.runtime.loop import EngineLike, GazeLoop, LoopCommand, RobotLike
+from gazebot.types import TrackingState
 
-__all__ = ["GazeLoop", "LoopCommand", "TrackingState"]
+__all__ = ["EngineLike", "GazeLoop", "LoopCommand", "RobotLike", "TrackingState"]

@@ -26,6 +26,10 @@ from gazebot.sim.motion import PEAK_RATE, MinJerkSegment
 from gazebot.sim.scene_config import ControllerConfig, RetreatTrigger
 from gazebot.types import Event, EventKind
 
+# An infeasible reach whose arm has stood still this long (s) has given up: the handover is over
+# ("If no feasible control input is found, the robot stops", the seed's STL reach).
+GIVE_UP_AFTER_S = 1.0
+
 
 class ControllerState(str, Enum):
     PICKING_UP = "picking_up"  # giver with a pick-up: going to the object (t_5)
@@ -121,6 +125,10 @@ class HandoverController:
         self.handover_start: float | None = None  # the "handover's start" of the timing
         self.reach_started_at: float | None = None  # the robot's reach start (first motion)
         self.infeasible_at: float | None = None
+        # The seed's STL reach: "If no feasible control input is found, the robot stops." Since
+        # when the latest plan is infeasible and the arm is commanded still (None otherwise).
+        self.stopped_at: float | None = None
+        self._plan_feasible = True
         self._last_t: float | None = None
         self._last_q = self.home.copy()
         self.pickup = None if pickup is None else np.asarray(pickup, float)
@@ -148,6 +156,12 @@ class HandoverController:
         """Duration of a minimum-jerk move whose fastest joint peaks at the speed limit."""
         v_max = np.deg2rad(self.config.max_joint_speed_deg)
         return float(max(minimum, PEAK_RATE * np.max(np.abs(goal - start)) / v_max))
+
+    def gave_up(self, t: float) -> bool:
+        """Whether the robot has given up the handover at time ``t``: its reach has been
+        infeasible and the arm still for :data:`GIVE_UP_AFTER_S` (a controller that finds a
+        feasible plan again moves on, and has not given up)."""
+        return self.stopped_at is not None and t - self.stopped_at >= GIVE_UP_AFTER_S - 1e-9
 
     def pop_events(self) -> list[Event]:
         """Robot events since the last call, oldest first."""
@@ -187,6 +201,13 @@ class HandoverController:
                 reach_time=float(self.reach.controller.config.reach_time_s),
                 since_start=float(self.reach.elapsed(t)),
             )
+        if step.plan is not None:
+            self._plan_feasible = bool(step.plan.feasible)
+        still = float(np.linalg.norm(step.velocity)) <= 1e-9
+        if self._plan_feasible or not still:
+            self.stopped_at = None  # a feasible plan again, or moving: not given up
+        elif self.stopped_at is None:
+            self.stopped_at = t
         if self.reach_started_at is None and float(np.linalg.norm(step.velocity)) > 1e-6:
             self.reach_started_at = t
             left = self.reach.controller.config.reach_time_s - self.reach.elapsed(t)

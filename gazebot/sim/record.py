@@ -23,7 +23,13 @@ from gazebot.runtime import GazeLoop
 from gazebot.types import Event, Phase
 
 if TYPE_CHECKING:
+    from typing import Any
+
     from gazebot.sim.simulation import HandoverSimulation
+    from gazebot.types import TrackingFrame
+
+    # t, tracking frame, measured joints, robot events, the loop's command (None: unsafe).
+    StepObserver = Callable[[float, TrackingFrame, dict[str, float], list[Event], Any], None]
 
 CONTROL_HZ = 120.0  # tracking rate of the seed's motion capture setup
 MAX_DURATION_S = 30.0  # a handover that has not finished by then is cut (and reported)
@@ -83,6 +89,7 @@ def record_handover(
     progress: bool = True,
     on_tick: Callable[[HandoverSimulation, TickRecord], None] | None = None,
     loop: GazeLoop | None = None,
+    on_step: StepObserver | None = None,
     giver_factory=None,
 ) -> HandoverRecording:
     """Run one handover with the gaze engine in the loop; record the video when ``out_path``.
@@ -93,15 +100,16 @@ def record_handover(
     inspect or render it); it must not step the simulation. ``loop`` replaces the default
     :class:`~gazebot.runtime.GazeLoop` (``behavior`` and ``seed`` for its engine and blinks); it
     must be built for the same robot. ``giver_factory`` replaces the simulated giver (see
-    :class:`HandoverSimulation`; e.g. recorded motion, ``--giver-motion``).
+    :class:`HandoverSimulation`; e.g. recorded motion, ``--giver-motion``). ``on_step(t,
+    frame, joints, robot_events, cmd)``, when given, sees every control tick's input and the
+    loop's command (``None`` when none was safe to send), e.g. to record them as ROS 2 messages.
 
     Returns the per-tick timeline, the frame count and the robot's events.
     """
     from gazebot.sim.gl_check import ensure_gl_backend
 
     ensure_gl_backend()
-    from tqdm import tqdm
-
+    from gazebot.render.progress import FrameProgress
     from gazebot.render.video import open_h264_writer
     from gazebot.sim.robot import load_sim_robot
     from gazebot.sim.simulation import HandoverSimulation
@@ -126,12 +134,8 @@ def record_handover(
         )
         with (
             writer_ctx as writer,
-            tqdm(
-                total=int(expected_duration(sim) * fps) + 1 if writer is not None else None,
-                unit="frame",
-                desc=label,
-                disable=not progress,
-                leave=False,
+            FrameProgress(
+                fps, expected_duration(sim), desc=label, enabled=progress and writer is not None
             ) as bar,
         ):
             while True:
@@ -140,7 +144,7 @@ def record_handover(
                 events.extend(robot_events)
                 loop.notify(robot_events)
                 # The measured arm pose: on Sawyer the head rides on right_j0.
-                cmd = loop.tick(frame.t, frame, joints=sim.joint_state())
+                cmd = loop.tick(frame, joints=sim.joint_state())
                 if cmd is not None:  # None: an unsafe command, never applied
                     sim.apply_head(cmd.head)
                     sim.apply_eyes(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)
@@ -163,13 +167,15 @@ def record_handover(
                             ),
                         )
                     )
+                if on_step is not None:  # the tick's input and answer (the sim has not moved)
+                    on_step(frame.t, frame, sim.joint_state(), robot_events, cmd)
                 if on_tick is not None and ticks:
                     on_tick(sim, ticks[-1])
                 # Frame k shows the first tick at or after k / fps.
                 if writer is not None and sim.t >= frames / fps - 1e-9:
                     writer.append(sim.render(width=width, height=height))
                     frames += 1
-                    bar.update(1)
+                    bar.advance(done_at + tail if done_at is not None else None)
                 if cmd is not None:
                     phase = cmd.phase
                 if sim_done_at is None and sim.done:
@@ -183,9 +189,7 @@ def record_handover(
                 if (done_at is not None and sim.t >= done_at + tail) or sim.t >= MAX_DURATION_S:
                     break
                 sim.step(dt)
-            if bar.total is not None and bar.n != bar.total:
-                bar.total = bar.n  # the estimate was off: end the bar where the video ended
-                bar.refresh()
+            bar.finish()
     finally:
         sim.close()
     return HandoverRecording(

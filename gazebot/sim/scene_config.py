@@ -8,7 +8,7 @@ from enum import Enum
 from pathlib import Path
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from gazebot.config import configs_dir, load_model
 
@@ -81,15 +81,17 @@ class GiverConfig(_Strict):
     )
 
 
-class ReachControllerName(str, Enum):
-    """How the robot reaches: ``joint`` (a joint-space minimum-jerk move to the predefined
-    handover pose, the gaze studies' robot) or one of the seed's controllers (chapters 3-4)."""
+#: The reach without a controller: a joint-space minimum-jerk move to the predefined handover
+#: pose (the gaze studies' robot).
+JOINT_REACH = "joint"
 
-    JOINT = "joint"
-    PV = "pv"
-    MCJ = "mcj"
-    MCE = "mce"
-    STL = "stl"
+
+def reach_controller_names() -> tuple[str, ...]:
+    """How the robot may reach: ``joint`` or a registered controller (seed chapters 3-4;
+    :data:`gazebot.controllers.CONTROLLERS`)."""
+    from gazebot.controllers import CONTROLLERS
+
+    return (JOINT_REACH, *CONTROLLERS.names())
 
 
 class RetreatTrigger(str, Enum):
@@ -121,7 +123,21 @@ class ControllerConfig(_Strict):
     """The robot's handover controller (seed 6.3.2/6.4.3): reach once the handover starts, grasp
     when the object is close, retreat home after the giver lets go (or after grasping)."""
 
-    reach_controller: ReachControllerName = ReachControllerName.JOINT
+    reach_controller: str = JOINT_REACH  # joint or a registered controller
+
+    @field_validator("reach_controller")
+    @classmethod
+    def _known_controller(cls, value: str) -> str:
+        if value == JOINT_REACH:
+            return value
+        from gazebot.controllers import CONTROLLERS
+
+        try:
+            return CONTROLLERS.check(value)
+        except ValueError:
+            raise ValueError(
+                f"one of {', '.join(reach_controller_names())}, got {value!r}"
+            ) from None
     reach_time_s: float | None = Field(
         default=None, gt=0, description="'Reach before' from the handover's start (None: YAML)"
     )
@@ -236,7 +252,7 @@ class SceneConfig(_Strict):
         ):
             if getattr(ctrl, field) is None:
                 continue
-            if ctrl.reach_controller is not ReachControllerName.STL:
+            if ctrl.reach_controller != "stl":
                 raise ValueError(f"controller.{field} needs reach_controller: stl (Table 4.2)")
             if self.direction is not direction:
                 raise ValueError(f"controller.{field} needs direction: {direction.value}")

@@ -27,11 +27,11 @@ from gazebot.sim.receiver import ReceiverState, SimulatedReceiver
 from gazebot.sim.robot import SimRobot, load_sim_robot
 from gazebot.sim.scene import OBSERVER, Scene, build_scene
 from gazebot.sim.scene_config import (
+    JOINT_REACH,
     ControllerConfig,
     Direction,
     Initiator,
     InsetConfig,
-    ReachControllerName,
     RetreatTrigger,
     SceneConfig,
     TrackingNoiseConfig,
@@ -216,7 +216,7 @@ class HandoverSimulation:
     # ----------------------------------------------------------------------------- helpers
     def _cartesian_reach(self, ctrl: ControllerConfig) -> CartesianReach | None:
         """The seed's reach controller on the arm, or None for the joint-space reach."""
-        if ctrl.reach_controller is ReachControllerName.JOINT:
+        if ctrl.reach_controller == JOINT_REACH:
             return None
         from gazebot.controllers import make_controller
         from gazebot.controllers.arm_ik import ArmIK
@@ -236,7 +236,7 @@ class HandoverSimulation:
         # The STL handover zone is centred on the robot's base: the first arm joint's body.
         mujoco.mj_kinematics(m, self.data)
         base = self.data.xpos[m.jnt_bodyid[m.joint(self.robot.arm_joints[0]).id]].copy()
-        return CartesianReach(make_controller(ctrl.reach_controller.value, cfg), ik, base)
+        return CartesianReach(make_controller(ctrl.reach_controller, cfg), ik, base)
 
     def _whole_task(self, ctrl: ControllerConfig) -> dict:
         """The pick-up / drop-off of Table 4.2's whole task, with the STL gripper (scene
@@ -352,7 +352,11 @@ class HandoverSimulation:
 
     @property
     def done(self) -> bool:
-        """True once the robot is back home with the object and the giver has retreated."""
+        """True once the robot is back home with the object and the giver has retreated, or
+        once the robot has stopped after finding its reach infeasible (it has said so: the
+        failure feedback is on its frames; nothing more will happen)."""
+        if self.controller.gave_up(self._t):
+            return True
         human_done = self.giver.state in (GiverState.DONE, ReceiverState.DONE)
         return self.controller.state is ControllerState.DONE and human_done
 

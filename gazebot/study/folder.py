@@ -60,12 +60,16 @@ class StudyFolder:
         return self.practice if session == PRACTICE else self.videos[(participant, session)]
 
     def video_path(self, participant: int, session: int, which: int) -> Path:
-        """The file of handover ``which`` (1 or 2) of a session; ``KeyError`` if none."""
+        """The file of handover ``which`` (1 or 2) of a session, an absolute path inside the
+        study folder; ``KeyError`` if none (or if the manifest points outside the folder)."""
         v = self.session_videos(participant, session)
         rel = v.first if which == 1 else v.second if which == 2 else None
         if rel is None:
             raise KeyError(which)
-        return self.root / rel
+        path = (self.root / rel).resolve()
+        if not path.is_relative_to(self.root):
+            raise KeyError(rel)
+        return path
 
     @property
     def database(self) -> Path:
@@ -77,8 +81,10 @@ class StudyFolder:
 
 def load_study(root: str | Path) -> StudyFolder:
     """Read ``root/plan.csv`` and ``root/manifest.json``; a folder that is not a rendered study,
-    or was rendered by a gazebot without the session map, raises ``ValueError`` saying so."""
-    root = Path(root)
+    or was rendered by a gazebot without the session map, raises ``ValueError`` saying so.
+    ``root`` is resolved: a relative folder means the one under the current directory now, not
+    wherever a library later resolves it from."""
+    root = Path(root).expanduser().resolve()
     if not root.is_dir():
         raise FileNotFoundError(f"study folder not found: {root}")
     plan_path, manifest_path = root / "plan.csv", root / "manifest.json"

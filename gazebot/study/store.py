@@ -16,12 +16,16 @@ Tables:
   double submit record once (the first one wins).
 - ``views(participant, session, shown_at)``: when a session page was first shown, for the time
   spent per session.
+- ``links(participant, token)``: each participant's random link token (made once, kept across
+  restarts, so a link handed out stays valid).
+- ``secrets(name, value)``: the server's secrets (the CSRF key), made once.
 
 Times are UTC seconds since the epoch (floats).
 """
 
 from __future__ import annotations
 
+import secrets
 import sqlite3
 import threading
 import time
@@ -60,6 +64,14 @@ CREATE TABLE IF NOT EXISTS views (
     session INTEGER NOT NULL,
     shown_at REAL NOT NULL,
     PRIMARY KEY (participant, session)
+);
+CREATE TABLE IF NOT EXISTS links (
+    participant INTEGER PRIMARY KEY,
+    token TEXT NOT NULL UNIQUE
+);
+CREATE TABLE IF NOT EXISTS secrets (
+    name TEXT PRIMARY KEY,
+    value TEXT NOT NULL
 );
 """
 
@@ -210,6 +222,30 @@ class ResponseStore:
                     (now, participant),
                 )
         return stored
+
+    def links(self, participants: list[int], nbytes: int = 18) -> dict[int, str]:
+        """Each participant's link token, a random one made (``nbytes`` random bytes) for a
+        participant who has none yet."""
+        with self._transaction() as con:
+            for p in participants:
+                con.execute(
+                    "INSERT INTO links (participant, token) VALUES (?, ?) "
+                    "ON CONFLICT (participant) DO NOTHING",
+                    (p, secrets.token_urlsafe(nbytes)),
+                )
+            rows = con.execute("SELECT participant, token FROM links").fetchall()
+        wanted = set(participants)
+        return {p: t for p, t in rows if p in wanted}
+
+    def secret(self, name: str, nbytes: int = 32) -> bytes:
+        """The server secret ``name`` (random, made on first use, then kept)."""
+        with self._transaction() as con:
+            con.execute(
+                "INSERT INTO secrets (name, value) VALUES (?, ?) ON CONFLICT (name) DO NOTHING",
+                (name, secrets.token_hex(nbytes)),
+            )
+            value = con.execute("SELECT value FROM secrets WHERE name = ?", (name,)).fetchone()
+        return bytes.fromhex(value[0])
 
     def progress(self, participant: int) -> Progress:
         """The participant's stored progress (all empty for one who has not started)."""

@@ -33,7 +33,9 @@ def points(t: float, **override: np.ndarray) -> dict[str, np.ndarray]:
 def ctx(
     t: float, phase: Phase, start: float, end: float = math.nan, **override: np.ndarray
 ) -> GazeContext:
-    return GazeContext(t, phase, start, end, points(t, **override))
+    """The context at ``t``; ``end`` is the tracking's predicted phase end. ``phase`` and
+    ``start`` only document the caller's script: the machine reads its handover state."""
+    return GazeContext(t, points(t, **override), tracking_end=end)
 
 
 def ev(kind: str, t: float, **info: float) -> Event:

@@ -8,6 +8,8 @@ import json
 
 import pytest
 
+from gazebot.behaviors.spec import AtEvent, AtNever
+
 cli = importlib.import_module("gazebot.cli.behaviors")
 
 
@@ -17,6 +19,13 @@ def run(argv: list[str]) -> int:
     cli.register(sub)
     args = parser.parse_args(argv)
     return args.func(args)
+
+
+#: The seed's eight gaze behaviors (chapter 6).
+SEED_BEHAVIORS = (
+    "face", "hand", "face-hand-face", "hand-face", "short-face-hand", "long-face-hand",
+    "face-hand-face-as-studied", "hand-face-as-studied",
+)
 
 
 def test_list_json_lists_builtins_with_their_variants(capsys):
@@ -49,17 +58,28 @@ def test_show_diagram_writes_the_machine_with_its_phase_and_gaze_states(tmp_path
     assert run(["behaviors", "show", "face-hand-face", "--diagram", str(out)]) == 0
     text = out.read_text(encoding="utf-8")
     assert text.startswith("```mermaid\n") and "stateDiagram-v2" in text
+    # The handover state's phases (the one phase the behavior reads) and the gaze states.
     for phase in ("idle", "reach", "transfer", "retreat", "done"):
         assert f'state "{phase}" as behavior_handover_{phase}' in text
-    for gaze in ("reach_face", "reach_hand", "transfer_hand", "retreat_face"):
-        assert f"as behavior_handover_{gaze}" in text
-    # The gaze shifts are the machine's transitions, labelled with the segment's timing.
+    for gaze in ("face", "hand"):
+        assert f'state "{gaze}" as behavior_gaze_{gaze}' in text
+    # The gaze shifts are the machine's transitions, labelled with the segment's timing and the
+    # rule that picks the phase's expected end.
     assert (
-        "behavior_handover_reach --> behavior_handover_reach_hand: timer [0.5 of the reach]" in text
+        "timer [reach: 0.5 of the reach (end: latest of tracking, event, robot plan; else 1.01 s)]"
+        in text
     )
+    assert "timer [retreat: 0.5 of the retreat (end: first known of" in text
+    # New handovers, the end of a handover and the carried gaze are rules of the machine too.
+    assert "phase [new handover]" in text and "phase [handover done]" in text
+    assert "[same handover: the gaze carries]" in text
+    # ...and so are the handover state's merging rules (first reach wins, grasp, stale events).
     assert (
-        "behavior_handover_reach_hand --> behavior_handover_transfer_hand: transfer_started" in text
+        "behavior_handover_idle --> behavior_handover_reach: reach_started [not older than the "
+        "last phase change] | robot_reach_started" in text
     )
+    assert "robot_grasped [not older than the last phase change: the grasp is transfer" in text
+    assert "tracking_restored [after the loss]" in text
 
 
 def test_show_diagram_into_a_missing_folder_is_a_usage_error_naming_the_option(tmp_path):
@@ -80,5 +100,38 @@ def test_the_diagram_is_the_machine_the_behavior_runs_on():
     text = diagram(spec)
     for state in m.states:
         phase, gaze = state.split("_")[:2]
-        assert f"as behavior_handover_{phase}_{gaze}" in text
-    assert "timer [robot_retreat_started]" in text
+        assert f"as behavior_handover_{phase}" in text and f"as behavior_gaze_{gaze}" in text
+    assert "timer [retreat: robot_retreat_started]" in text
+
+
+@pytest.mark.parametrize("name", SEED_BEHAVIORS)
+def test_a_seed_behaviors_diagram_shows_every_segment_that_decides_its_targets(name):
+    from gazebot.behaviors import load_behavior
+    from gazebot.behaviors.machine import diagram
+
+    spec = load_behavior(name)
+    text = diagram(spec)
+    for seg in spec.segments:
+        at = spec.resolve(seg)
+        if isinstance(at, AtNever):
+            continue
+        assert f"behavior_gaze_{seg.target.replace('_', '-')}" in text
+        label = f"timer [{seg.phase}: "
+        if isinstance(at, AtEvent):
+            label += at.after.value
+        elif at.fraction == 0:
+            label += f"at the {seg.phase}'s start"
+        else:
+            label += f"{at.fraction:g} of the {seg.phase} (end: "
+        assert label in text, label
+    assert f"timer [held {spec.tracking_lost.hold_s:g} s]" in text
+
+
+def test_the_readmes_diagram_is_the_one_the_machine_draws():
+    from pathlib import Path
+
+    from gazebot.behaviors import load_behavior
+    from gazebot.behaviors.machine import diagram
+
+    readme = Path(__file__).resolve().parents[2] / "README.md"
+    assert diagram(load_behavior("face-hand-face")).strip() in readme.read_text(encoding="utf-8")

@@ -52,7 +52,7 @@ def _ctx(t, phase, start, end, hand, face) -> GazeContext:
         pts["hand"] = hand
     if face is not None:
         pts["face"] = face
-    return GazeContext(t, phase, start, end, pts)
+    return GazeContext(t, pts, tracking_end=end)
 
 
 @settings(
@@ -98,7 +98,8 @@ def test_shuffled_and_duplicated_handover_events_end_in_a_defined_state(name, or
     for i in list(order) + list(dup):
         m.handle(base[i])
         assert m.state in m.states
-    # Whatever arrived late was ignored; the detector's view (ctx) always wins afterwards.
+    # Whatever arrived late was ignored; the handover ends with the next (in-order) report.
+    m.handle(Event(EventKind.HANDOVER_DONE, 4.0, 4.0))
     assert m.target(_ctx(4.0, Phase.DONE, 3.5, math.nan, None, None)).kind == SPECS[name].after
     assert m.state.startswith("done_")
 
@@ -108,7 +109,7 @@ def test_a_duplicated_reach_start_keeps_the_first_start_time():
     m.handle(Event(EventKind.REACH_STARTED, 1.0, 1.0))
     m.handle(Event(EventKind.REACH_STARTED, 1.4, 1.4))
     assert m.ignored == 1
-    kind = m.target(GazeContext(1.55, Phase.REACH, math.nan, 2.0, points(1.55))).kind
+    kind = m.target(GazeContext(1.55, points(1.55), tracking_end=2.0)).kind
     assert kind == "hand"  # halfway of 1.0-2.0 s, not of 1.4-2.0 s
 
 
@@ -122,16 +123,19 @@ def test_a_stale_phase_event_is_ignored():
 def test_a_missing_transfer_is_skipped_and_the_reach_gaze_carries_on():
     m = BehaviorMachine(SPECS["face-hand-face"])
     m.handle(Event(EventKind.REACH_STARTED, 0.0, 0.0))
-    assert m.target(GazeContext(0.8, Phase.REACH, 0.0, 1.0, points(0.8))).kind == "hand"
+    assert m.target(GazeContext(0.8, points(0.8), tracking_end=1.0)).kind == "hand"
     m.handle(Event(EventKind.RETREAT_STARTED, 1.0, 1.0))
-    assert m.target(GazeContext(1.1, Phase.RETREAT, 1.0, 2.0, points(1.1))).kind == "hand"
+    assert m.target(GazeContext(1.1, points(1.1), tracking_end=2.0)).kind == "hand"
     assert m.state == "retreat_hand"
 
 
-def test_the_context_phase_wins_over_missing_events():
+def test_the_machine_reads_its_phase_only_from_the_handover_state():
+    # No phase copy to reconcile: a context has no phase, the handover state's is the only one.
     m = BehaviorMachine(SPECS["face-hand-face"])
-    assert m.target(GazeContext(2.1, Phase.TRANSFER, 2.0, math.nan, points(2.1))).kind == "hand"
-    assert m.state == "transfer_hand"
+    assert m.target(GazeContext(2.1, points(2.1), tracking_end=math.nan)).kind == "face"
+    assert m.state == "idle_face" and m.phase is m.handover.phase is Phase.IDLE
+    m.handover.apply(Event(EventKind.TRANSFER_STARTED, 2.0, 2.0))  # fed behind its back
+    assert m.phase is Phase.TRANSFER
 
 
 def test_a_new_reach_after_a_missed_handover_done_starts_a_new_handover():
@@ -140,7 +144,7 @@ def test_a_new_reach_after_a_missed_handover_done_starts_a_new_handover():
         m.handle(Event(EventKind(kind), t, t))
     m.handle(Event(EventKind.REACH_STARTED, 5.0, 5.0))
     assert m.phase is Phase.REACH
-    assert m.target(GazeContext(5.1, Phase.REACH, 5.0, 6.0, points(5.1))).kind == "face"
+    assert m.target(GazeContext(5.1, points(5.1), tracking_end=6.0)).kind == "face"
 
 
 def test_garbage_events_are_ignored():
@@ -158,12 +162,12 @@ def test_unknown_named_target_falls_back_to_the_last_known_point(tmp_path):
     m = BehaviorMachine(load_behavior(path))
     m.handle(Event(EventKind.REACH_STARTED, 0.0, 0.0))
     pts = points(0.1)
-    target = m.target(GazeContext(0.1, Phase.REACH, 0.0, 1.0, pts))
+    target = m.target(GazeContext(0.1, pts, tracking_end=1.0))
     assert target.kind == "shelf"
     np.testing.assert_allclose(target.point, pts["face"])
     pts["shelf"] = np.array([0.5, 0.5, 1.2])
     np.testing.assert_allclose(
-        m.target(GazeContext(0.2, Phase.REACH, 0.0, 1.0, pts)).point, pts["shelf"]
+        m.target(GazeContext(0.2, pts, tracking_end=1.0)).point, pts["shelf"]
     )
 
 
@@ -176,4 +180,4 @@ def test_robot_events_of_the_previous_handover_do_not_leak_into_the_next():
     m.handle(Event(EventKind.ROBOT_REACH_STARTED, 4.9, 4.9, {"planned_duration": 1.0}))
     m.handle(Event(EventKind.REACH_STARTED, 5.0, 5.0))
     m.handle(Event(EventKind.RETREAT_STARTED, 6.0, 6.0))
-    assert m.target(GazeContext(6.1, Phase.RETREAT, 6.0, 7.0, points(6.1))).kind == "hand"
+    assert m.target(GazeContext(6.1, points(6.1), tracking_end=7.0)).kind == "hand"

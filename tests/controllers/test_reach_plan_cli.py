@@ -102,7 +102,7 @@ def test_demo_options_override_the_scene_controller():
         scene="default", controller="mce", reach_time=2.5, stall_time=0.5, retreat=None
     )
     scene = scene_with_overrides(args)
-    assert scene.controller.reach_controller.value == "mce"
+    assert scene.controller.reach_controller == "mce"
     assert scene.controller.reach_time_s == 2.5 and scene.controller.stall_time_s == 0.5
     plain = argparse.Namespace(
         scene="default", controller=None, reach_time=None, stall_time=None, retreat=None

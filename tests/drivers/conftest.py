@@ -8,6 +8,7 @@ import threading
 import pytest
 from drivers_fakes import free_port
 
+from gazebot.drivers.rmw.names import Names
 from gazebot.drivers.session import EPHEMERAL_ENDPOINT, BusConfig, open_session
 
 _ids = itertools.count()
@@ -15,10 +16,10 @@ _ids = itertools.count()
 
 class Bus:
     """Opens sessions of one test's bus: the robot side listens on a fresh port, the others
-    connect to it; every session is closed at teardown."""
+    connect to it; every session is closed at teardown. Each test has its own namespace."""
 
     def __init__(self) -> None:
-        self.robot_id = f"t{next(_ids)}"
+        self.names = Names(f"/t{next(_ids)}")
         self.port = free_port()
         self.endpoint = f"tcp/127.0.0.1:{self.port}"
         self.sessions: list = []
@@ -26,16 +27,16 @@ class Bus:
         self.threads: list[threading.Thread] = []
 
     def listener(self):
-        return self._open(BusConfig(self.robot_id, listen=(self.endpoint,)))
+        return self._open(BusConfig(self.names, listen=(self.endpoint,)))
 
     def connector(self):
         # Connectors listen on an ephemeral port too, so gossip meshes them with each other.
         return self._open(
-            BusConfig(self.robot_id, listen=(EPHEMERAL_ENDPOINT,), connect=(self.endpoint,))
+            BusConfig(self.names, listen=(EPHEMERAL_ENDPOINT,), connect=(self.endpoint,))
         )
 
     def config(self, **kw) -> BusConfig:
-        return BusConfig(self.robot_id, **kw)
+        return BusConfig(self.names, **kw)
 
     def _open(self, cfg: BusConfig):
         session = open_session(cfg)

@@ -1,5 +1,5 @@
 """Fakes and bus helpers for the driver tests: a tiny engine with GazeEngine's interface (so the
-transport is tested on its own) and free loopback ports."""
+transport is tested on its own), free loopback ports and a recorder of one topic's messages."""
 
 from __future__ import annotations
 
@@ -14,6 +14,34 @@ import numpy as np
 from gazebot.types import Event, EventKind, GazeCommand, Phase, TrackingFrame, is_valid_point
 
 PAN_LIMIT = 1.3
+
+
+class Recorder:
+    """Collects the messages of one topic from a plain Zenoh subscriber on the node's session,
+    decoded as its ROS type and passed through ``convert`` (a list result is spread)."""
+
+    def __init__(self, node, topic, convert: Callable = lambda m: m) -> None:
+        from gazebot.ros2.codec import Codec
+        from gazebot.ros2.typestore import typestore
+
+        codec = Codec.for_type(typestore(), topic.type)
+        resolved = node.names.resolve(topic.name)
+        self.key = node.names.key(resolved, codec.info.dds_name, codec.info.hash)
+        self.msgs: list = []
+
+        from gazebot.ros2.errors import MessageError
+
+        def on(sample) -> None:
+            try:  # garbage a test puts on the topic is not the recorder's business
+                out = convert(codec.decode(sample.payload.to_bytes()))
+            except MessageError:
+                return
+            self.msgs.extend(out if isinstance(out, list) else [out])
+
+        self._sub = node.session.declare_subscriber(self.key, on)
+
+    def where(self, **kw) -> list:
+        return [m for m in self.msgs if all(getattr(m, k) == v for k, v in kw.items())]
 
 
 def free_port() -> int:
@@ -133,7 +161,7 @@ class FakeEngine:
         st = self.gaze.update(frame.t, self._face)
         return GazeCommand(
             t=frame.t, phase=self.phase, target="face", target_point=self._face, head=st.head,
-            eye_yaw=0.0, eye_pitch=0.0, events=tuple(events),
+            eye_yaw=0.0, eye_pitch=0.0, events=tuple(events), tracking=self.tracking,
         )
 
     def notify(self, event: Event) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import threading
 import time
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -56,9 +57,14 @@ def test_pupils_follow_the_eye_state_go_neutral_in_silence_and_recover(bus, tmp_
     from gazebot.render.video import open_h264_writer
 
     renderer = EyeRenderer.for_robot("jaco2")
-    node = ZenohDisplayNode(bus.connector(), bus.config().keys)
+    node = ZenohDisplayNode(bus.connector(), bus.names)
     bus.closers.append(node.close)
-    publisher = bus.listener()
+    from gazebot.drivers.rmw.node import RosNode
+    from gazebot.ros2 import convert, topics
+
+    publisher = RosNode(bus.listener(), bus.names, "fake_engine")
+    bus.closers.append(publisher.close)
+    eyes_pub = publisher.publisher(topics.EYES.name, topics.EYES.type)
     screen = LoggingScreen(HeadScreen(renderer))
     anim = EyeAnimator(EyeAnimatorConfig(silent_after=0.3, neutral_s=0.2, drift_deg=0.3))
     yaw = {"value": 0.3, "on": True}
@@ -69,7 +75,9 @@ def test_pupils_follow_the_eye_state_go_neutral_in_silence_and_recover(bus, tmp_
             if yaw["on"]:
                 msg = EyeStateMsg(seq=seq, t=seq / 100, stamp=time.time(), yaw=yaw["value"],
                                   pitch=0.0, blink=0.0)
-                publisher.put(bus.config().keys.eyes, msg.encode())
+                eyes_pub.publish(convert.eye_state(
+                    SimpleNamespace(t=msg.t, eye_yaw=msg.yaw, eye_pitch=msg.pitch, blink=0.0,
+                                    distance=None), "gaze"))
                 seq += 1
             time.sleep(0.01)
 
@@ -120,15 +128,18 @@ def test_pupils_follow_the_eye_state_go_neutral_in_silence_and_recover(bus, tmp_
 
 def test_display_records_30_frames_a_second_of_sim_with_engine_and_pupils_follow(bus, tmp_path):
     import imageio
+    from drivers_fakes import Recorder
 
     from gazebot.cli import main
+    from gazebot.drivers.zenoh_node import ZenohNode
     from gazebot.render import EyeRenderer
+    from gazebot.ros2 import convert, topics
 
-    sent: list[EyeStateMsg] = []
-    watcher = bus.connector()
-    watcher.declare_subscriber(bus.config().keys.eyes,
-                               lambda s: sent.append(EyeStateMsg.decode(s.payload.to_bytes())))
-    sim_args = ["sim", "--with-engine", "--headless", "--id", bus.robot_id, "--listen",
+    watcher = ZenohNode(bus.connector(), bus.names, "watcher")
+    bus.closers.append(watcher.close)
+    sent = Recorder(watcher, topics.EYES, convert.eyes_of).msgs
+    sim_args = ["sim", "--with-engine", "--headless", "--namespace", bus.names.namespace,
+                "--listen",
                 bus.endpoint, "--duration", "9", "--seed", "1"]
     sim_thread = threading.Thread(target=main, args=(sim_args,), daemon=True)
     sim_thread.start()
@@ -136,7 +147,8 @@ def test_display_records_30_frames_a_second_of_sim_with_engine_and_pupils_follow
     # the simulation): all six seconds then show a running handover.
     assert wait_until(lambda: sent, timeout=60)
     out = tmp_path / "out.mp4"
-    rc = main(["display", "--robot", "sawyer", "--id", bus.robot_id, "--connect", bus.endpoint,
+    rc = main(["display", "--robot", "sawyer", "--namespace", bus.names.namespace,
+               "--connect", bus.endpoint,
                "--duration", "6", "--record", str(out), "--json"])
     sim_thread.join(timeout=60)
     assert rc == 0

@@ -12,13 +12,14 @@ import threading
 
 import numpy as np
 import pytest
-from drivers_fakes import wait_until
+from drivers_fakes import Recorder, wait_until
 
 from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
-from gazebot.drivers.payloads import EventMsg, EyeStateMsg, HeadCommandMsg
 from gazebot.drivers.sim_node import SimNode, SimNodeConfig
 from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+from gazebot.drivers.zenoh_node import event_from_ros
 from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
+from gazebot.ros2 import convert, topics
 
 pytestmark = pytest.mark.zenoh
 
@@ -36,7 +37,7 @@ def sim():
 
 
 def start_sim_node(bus, sim, speed=SPEED):
-    ep = ZenohRobotEndpoint(bus.listener(), bus.config().keys, "sim")
+    ep = ZenohRobotEndpoint(bus.listener(), bus.names, "sim")
     node = SimNode(sim, ep, SimNodeConfig(speed=speed))
     stop = threading.Event()
     th = threading.Thread(target=node.run, kwargs={"stop": stop, "duration": 12.0}, daemon=True)
@@ -55,7 +56,7 @@ def start_engine_node(bus, behavior="face-hand-face"):
     from gazebot.engine import GazeEngine
     from gazebot.runtime import GazeLoop
 
-    drv = ZenohRobotDriver(bus.connector(), bus.config().keys, "engine")
+    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
     # No silence ticks: on a loaded machine the simulator thread may stall between samples.
     # The resync returns as soon as the joint state and the history arrived; the long deadline
     # only matters on a slow machine.
@@ -76,10 +77,15 @@ def start_engine_node(bus, behavior="face-hand-face"):
 
 
 class Log:
-    def __init__(self, session, key, model):
-        self.msgs: list = []
-        self._sub = session.declare_subscriber(
-            key, lambda s: self.msgs.append(model.decode(s.payload.to_bytes())))
+    """Every event on both event topics (robot's and the others')."""
+
+    def __init__(self, node):
+        self._recs = [Recorder(node, t, event_from_ros)
+                      for t in (topics.ROBOT_EVENTS, topics.EVENTS)]
+
+    @property
+    def msgs(self):
+        return sorted((m for r in self._recs for m in r.msgs), key=lambda m: m.stamp)
 
     def kinds(self, source):
         return [m.kind for m in self.msgs if m.source == source and m.category == "phase"]
@@ -91,9 +97,10 @@ def head_pan(sim) -> float:
 
 def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     sim_node, ep, sim_thread, _ = start_sim_node(bus, sim)
-    events = Log(ep.session, ep.keys.events, EventMsg)
-    heads = Log(ep.session, ep.keys.head_command, HeadCommandMsg)
-    eyes = Log(ep.session, ep.keys.eyes, EyeStateMsg)
+    events = Log(ep)
+    heads = Recorder(ep, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m)[0])
+    eyes = Recorder(ep, topics.EYES, convert.eyes_of)
+    target_events = lambda: [m for m in events.msgs if m.kind == "gaze_target"]  # noqa: E731
     engine_node, drv, *_ = start_engine_node(bus)
     assert wait_until(lambda: ep.peers().get("engine") and drv.peers().get("sim"))
     assert engine_node.ready.wait(30)
@@ -110,11 +117,10 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     assert robot[:2] == ["robot_reach_started", "robot_reach_ended"]
     # head commands answered the tracking and the simulator obeyed them: the head turned
     assert sim_node.applied["head"] > 100 and heads.msgs
-    assert all(m.answers is not None and m.mode == "behavior" for m in heads.msgs)
-    assert {m.target for m in heads.msgs} >= {"face", "hand"}
+    assert {m.info["target"] for m in target_events()} >= {"face", "hand"}
     assert abs(pan_end - pan0) > 0.05
-    assert pan_end == pytest.approx(heads.msgs[-1].head["head_pan"], abs=0.05)
-    assert np.isfinite([m.head["head_pan"] for m in heads.msgs]).all()
+    assert pan_end == pytest.approx(heads.msgs[-1]["head_pan"], abs=0.05)
+    assert np.isfinite([m["head_pan"] for m in heads.msgs]).all()
     # the eyes' vergence distance crossed the bus: the giver is 0.3-2 m from the display
     distances = [m.distance for m in eyes.msgs]
     assert distances and all(d is not None and 0.2 < d < 2.5 for d in distances)
@@ -124,7 +130,7 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
 
 def test_engine_restarted_mid_handover_resumes_the_phase_over_the_bus(bus, sim):
     sim_node, ep, sim_thread, _ = start_sim_node(bus, sim)
-    events = Log(ep.session, ep.keys.events, EventMsg)
+    events = Log(ep)
     first, drv1, _, _, close1 = start_engine_node(bus)
     assert wait_until(lambda: ep.peers().get("engine") and drv1.peers().get("sim"))
     assert first.ready.wait(30)
@@ -147,7 +153,7 @@ def test_engine_restarted_mid_handover_resumes_the_phase_over_the_bus(bus, sim):
     assert second.frames_processed > 0
 
 
-def test_sim_cli_with_engine_runs_a_handover_and_reports(bus, capsys):
+def test_sim_cli_with_engine_runs_a_handover_reports_and_records_the_bus(bus, capsys, tmp_path):
     import argparse
 
     from gazebot.cli import run as run_cli
@@ -159,12 +165,26 @@ def test_sim_cli_with_engine_runs_a_handover_and_reports(bus, capsys):
     run_cli.register(sub)
     args = parser.parse_args(
         ["sim", "--robot", "sawyer", "--with-engine", "--behavior", "face-hand-face",
-         "--headless", "--duration", "3", "--speed", "2", "--id", bus.robot_id,
-         "--listen", bus.endpoint, "--json"]
+         "--headless", "--duration", "3", "--speed", "2", "--namespace", bus.names.namespace,
+         "--listen", bus.endpoint, "--record", str(tmp_path / "bus.mcap"), "--json"]
     )
     assert args.func(args) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["t"] == pytest.approx(3.0, abs=0.01)
+    # the recording holds the bus' topics as ROS 2 messages rosbags reads back
+    from rosbags.highlevel import AnyReader
+
+    ns = bus.names.namespace
+    with AnyReader([tmp_path / "bus.mcap"]) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+        types = {c.topic: c.msgtype for c in reader.connections}
+        [conn] = [c for c in reader.connections if c.topic == f"{ns}/gaze_target"]
+        _, _, raw = next(reader.messages(connections=[conn]))
+        target = reader.deserialize(raw, conn.msgtype)
+    assert types[f"{ns}/head/command"] == "trajectory_msgs/msg/JointTrajectory"
+    assert counts[f"{ns}/tracking/giver_hand"] > 100 and counts["/joint_states"] > 50
+    assert target.header.frame_id == "world"
+    assert summary["recorded"]["messages"] == sum(counts.values())
     assert summary["applied"]["head"] > 0 and summary["engine"]["frames"] > 0
     assert summary["engine"]["phase"] in ("reach", "transfer")
 
@@ -182,27 +202,31 @@ def _parser():
     return parser
 
 
-def test_run_cli_drives_a_simulator_on_the_bus(bus, sim, capsys):
+def test_run_cli_drives_a_simulator_on_the_bus_and_records_it(bus, sim, capsys, tmp_path):
     # Real time: the simulator must still run while the engine loads on a slow machine.
     sim_node, ep, sim_thread, _ = start_sim_node(bus, sim, speed=1.0)
     sim_thread.start()
     args = _parser().parse_args(
         ["run", "--robot", "sawyer", "--behavior", "face-hand-face", "--duration", "1.5",
-         "--id", bus.robot_id, "--connect", bus.endpoint, "--json"]
+         "--namespace", bus.names.namespace, "--connect", bus.endpoint,
+         "--record", str(tmp_path / "run.mcap"), "--json"]
     )
     assert args.func(args) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["frames"] > 0 and summary["commands"] > 0
-    assert summary["peers"] == {"sim": True} and summary["dropped"] == {}
+    # the recorder is a node of its own (as ros2 bag's is)
+    assert summary["peers"] == {"sim": True, "recorder": True} and summary["dropped"] == {}
     assert summary["robot_seen"] is True and summary["warnings"] == []
     assert sim_node.applied["head"] > 0
+    recorded = summary["recorded"]
+    assert recorded["file"] == str(tmp_path / "run.mcap") and recorded["messages"] > 100
 
 
 def test_simulator_node_obeys_arm_commands(bus, sim):
     from gazebot.drivers.payloads import ArmCommandMsg
 
     sim_node, ep, _, _ = start_sim_node(bus, sim)
-    drv = ZenohRobotDriver(bus.connector(), bus.config().keys, "operator")
+    drv = ZenohRobotDriver(bus.connector(), bus.names, "operator")
     bus.closers.append(drv.close)
     assert wait_until(lambda: drv.peers().get("sim"))
     goal = {j: 0.1 * i for i, j in enumerate(sim.robot.arm_joints)}

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
+import math
 
 import numpy as np
 import pytest
@@ -13,7 +13,7 @@ from drivers_fakes import FakeEngine, free_port
 
 from gazebot.drivers.base import RobotDriver
 from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
-from gazebot.drivers.payloads import EyeStateMsg, PayloadError, TrackingMsg
+from gazebot.drivers.payloads import EyeStateMsg, TrackingMsg
 from gazebot.runtime import GazeLoop
 from gazebot.types import TrackingFrame
 
@@ -78,25 +78,26 @@ class RecordingRenderer:
         return np.zeros((8, 8, 3), np.uint8)
 
 
-# -- payload -------------------------------------------------------------------------------
-def test_eye_state_distance_round_trips_and_is_optional_in_v1():
+# -- on the wire --------------------------------------------------------------------------
+def test_eye_state_distance_round_trips_and_unknown_is_nan_on_the_wire():
+    from gazebot.drivers.zenoh_driver import _EyeCommand
+    from gazebot.ros2 import convert
+    from gazebot.ros2.codec import Codec
+    from gazebot.ros2.typestore import typestore
+
+    codec = Codec.for_type(typestore(), convert.EYE_STATE)
     msg = EyeStateMsg(seq=1, t=0.5, stamp=1.0, yaw=0.1, pitch=-0.2, blink=0.0, distance=0.8)
-    back = EyeStateMsg.decode(msg.encode())
-    assert back.distance == 0.8 and back == msg
-    # A v1 message of an older sender, without the field: unknown distance.
-    old = b'{"v": 1, "seq": 2, "t": 0.5, "stamp": 1.0, "yaw": 0.0, "pitch": 0.0, "blink": 0.0}'
-    assert EyeStateMsg.decode(old).distance is None
-    # Unknown distance is left out, so older v1 receivers (extra fields forbidden) still read it.
+    back = convert.eyes_of(codec.decode(codec.encode(convert.eye_state(_EyeCommand(msg), "gaze"))))
+    assert (back.t, back.yaw, back.pitch, back.distance) == (0.5, 0.1, -0.2, 0.8)
     unknown = EyeStateMsg(seq=3, t=0.5, stamp=1.0, yaw=0.0, pitch=0.0)
-    assert "distance" not in json.loads(unknown.encode())
-    assert EyeStateMsg.decode(b'{"v":1,"seq":2,"t":0,"stamp":1,"yaw":0,"pitch":0,"distance":null}')
+    ros = convert.eye_state(_EyeCommand(unknown), "gaze")
+    assert math.isnan(ros.distance) and convert.eyes_of(ros).distance is None
 
 
-@pytest.mark.parametrize("bad", ["0", "-0.5", "NaN", "Infinity", '"1.0"'])
+@pytest.mark.parametrize("bad", [0.0, -0.5, math.inf])
 def test_eye_state_distance_must_be_positive_finite_metres(bad):
-    raw = f'{{"v": 1, "seq": 2, "t": 0.5, "stamp": 1.0, "yaw": 0, "pitch": 0, "distance": {bad}}}'
-    with pytest.raises(PayloadError, match="distance"):
-        EyeStateMsg.decode(raw)
+    with pytest.raises(ValueError, match="distance"):
+        EyeStateMsg(seq=2, t=0.5, stamp=1.0, yaw=0.0, pitch=0.0, distance=bad)
 
 
 # -- engine node computes the distance ----------------------------------------------------
@@ -223,7 +224,7 @@ def test_run_cli_with_unreachable_connect_warns_and_reports_it_in_json(capsys):
     nowhere = f"tcp/127.0.0.1:{free_port()}"
     args = parser.parse_args(
         ["run", "--robot", "sawyer", "--duration", "1.2", "--no-robot-warning", "0.4",
-         "--id", "nobody", "--connect", nowhere, "--no-eye-frames", "--json"]
+         "--namespace", "/nobody", "--connect", nowhere, "--no-eye-frames", "--json"]
     )  # fmt: skip
     assert args.func(args) == 0
     captured = capsys.readouterr()
@@ -233,52 +234,34 @@ def test_run_cli_with_unreachable_connect_warns_and_reports_it_in_json(capsys):
     assert "gazebot run: warning: no robot seen" in captured.err and nowhere in captured.err
 
 
-# -- another payload version ---------------------------------------------------------------
-def test_a_payload_of_another_version_is_told_apart_from_a_malformed_one():
-    from gazebot.drivers.payloads import PayloadVersionError
+# -- another message type ----------------------------------------------------------------
+class OtherTypeRobot(MemoryDriver):
+    def type_mismatches(self):
+        from gazebot.drivers.rmw.node import TypeMismatch
 
-    with pytest.raises(PayloadVersionError, match="payload version 2") as info:
-        TrackingMsg.decode(b'{"v":2,"seq":0,"t":0.0,"stamp":0.0,"hand":[1,2,3]}')
-    assert info.value.version == 2
-    with pytest.raises(PayloadError) as info:
-        TrackingMsg.decode(b'{"seq":0,"t":0.0,"stamp":0.0}')
-    assert not isinstance(info.value, PayloadVersionError)
+        return {"/gazebot/tracking/giver_hand": TypeMismatch(
+            "/gazebot/tracking/giver_hand", ("geometry_msgs/msg/PointStamped (RIHS01_aa)",),
+            "geometry_msgs/msg/Vector3Stamped (RIHS01_bb)")}
 
 
-class OtherVersionRobot(MemoryDriver):
-    def foreign_versions(self):
-        return {"gazebot/sim/tracking": 2}
-
-
-def test_a_robot_speaking_another_payload_version_is_reported_as_such_at_once():
+def test_a_robot_speaking_another_message_type_is_reported_as_such_at_once():
     clock = Clock()
-    drv = OtherVersionRobot()
+    drv = OtherTypeRobot()
     warnings: list[str] = []
     cfg = EngineNodeConfig(no_robot_warning=3.0, resync=False)
     node = EngineNode(GazeLoop(FakeEngine()), drv, cfg, warn=warnings.append, clock=clock)
     node.start()
-    for now in (0.1, 0.2, 5.0, 9.0):
+    clock.now = 0.1
+    node.tick()
+    assert len(warnings) == 1  # at once, not after the no-robot delay
+    assert "type mismatch on /gazebot/tracking/giver_hand" in warnings[0]
+    assert "PointStamped" in warnings[0] and "Vector3Stamped" in warnings[0]
+    for now in (0.2, 5.0, 9.0):
         clock.now = now
         node.tick()
-    assert len(warnings) == 1
-    assert "payload version 2 on gazebot/sim/tracking" in warnings[0]
-    assert "no robot seen" not in warnings[0]
-    [event] = [e for e in drv.events if e.kind == "payload_version_mismatch"]
-    assert event.info["versions"] == [2] and event.info["expected"] == 1
-    assert not [e for e in drv.events if e.kind == "no_robot"]
-
-
-@pytest.mark.zenoh
-def test_zenoh_driver_remembers_the_version_a_robot_spoke(bus):
-    from gazebot.drivers.zenoh_driver import ZenohRobotDriver
-
-    drv = ZenohRobotDriver(bus.connector(), bus.config().keys)
-    bus.closers.append(drv.close)
-    robot = bus.listener()
-    key = bus.config().keys.tracking
-    deadline = time.monotonic() + 30
-    while not drv.foreign_versions():
-        robot.put(key, b'{"v":3,"seq":0,"t":0.0,"stamp":0.0}')
-        assert time.monotonic() < deadline
-        time.sleep(0.02)
-    assert drv.foreign_versions() == {key: 3} and drv.dropped()[key] >= 1
+    [event] = [e for e in drv.events if e.kind == "type_mismatch"]
+    assert event.info["topic"] == "/gazebot/tracking/giver_hand"
+    assert event.info["received"] == "geometry_msgs/msg/Vector3Stamped (RIHS01_bb)"
+    # the type mismatch is reported once; the missing robot is reported too, later
+    assert len([w for w in warnings if "type mismatch" in w]) == 1
+    assert [e for e in drv.events if e.kind == "no_robot"]

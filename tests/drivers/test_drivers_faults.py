@@ -1,6 +1,7 @@
-"""Transport and faults with real Zenoh sessions on loopback and a fake engine.
+"""Transport and faults with real Zenoh sessions on loopback and a fake engine, on the rmw_zenoh
+wire (ROS 2 messages in CDR under ``<domain>/<topic>/<type>/<hash>``).
 
-Each test has its own robot id and port; the robot side listens, the engine connects.
+Each test has its own namespace and port; the robot side listens, the engine connects.
 """
 
 from __future__ import annotations
@@ -9,12 +10,15 @@ import threading
 
 import numpy as np
 import pytest
-from drivers_fakes import FakeClock, FakeEngine, wait_until
+from drivers_fakes import FakeClock, FakeEngine, Recorder, wait_until
 
 from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig, current_handover
-from gazebot.drivers.payloads import EventMsg, HeadCommandMsg, StatusMsg
 from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+from gazebot.drivers.zenoh_node import event_from_ros
 from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
+from gazebot.ros2 import convert, topics
+from gazebot.ros2.codec import Codec
+from gazebot.ros2.typestore import typestore
 from gazebot.runtime import GazeLoop
 from gazebot.types import Event, EventKind, TrackingFrame
 
@@ -28,27 +32,34 @@ SILENCE = EngineNodeConfig(silence_after=0.05, heartbeat_period=0.05, resync=Fal
 RESYNC = EngineNodeConfig(silence_after=1e3, heartbeat_period=0.05, resync_timeout=10.0)
 
 
-class Recorder:
-    """Collects decoded messages of one key from a plain subscriber."""
+def events_of(node, topic=topics.EVENTS) -> Recorder:
+    return Recorder(node, topic, event_from_ros)
 
-    def __init__(self, session, key, model):
-        self.msgs: list = []
-        self._sub = session.declare_subscriber(
-            key, lambda s: self.msgs.append(model.decode(s.payload.to_bytes())))
 
-    def where(self, **kw):
-        return [m for m in self.msgs if all(getattr(m, k) == v for k, v in kw.items())]
+def health_of(node) -> Recorder:
+    """The nodes' statuses on /diagnostics (``node``, ``state``, ``values``)."""
+    return Recorder(node, topics.DIAGNOSTICS, convert.health_of)
+
+
+def heads_of(node) -> Recorder:
+    """The head goals (joint -> rad) sent on head/command."""
+    return Recorder(node, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m)[0])
+
+
+def targets_of(node) -> Recorder:
+    """``(t, point)`` of the gaze targets sent."""
+    return Recorder(node, topics.GAZE_TARGET, convert.point_of)
 
 
 def robot_side(bus, peer_timeout=2.0) -> ZenohRobotEndpoint:
-    ep = ZenohRobotEndpoint(bus.listener(), bus.config().keys, "sim", peer_timeout=peer_timeout)
+    ep = ZenohRobotEndpoint(bus.listener(), bus.names, "sim", peer_timeout=peer_timeout)
     bus.closers.append(ep.close)
     return ep
 
 
 def engine_side(bus, engine=None, config=FAST, peer_timeout=2.0, clock=None):
     kw = {"clock": clock} if clock is not None else {}
-    drv = ZenohRobotDriver(bus.connector(), bus.config().keys, "engine", peer_timeout=peer_timeout,
+    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine", peer_timeout=peer_timeout,
                            **kw)
     node = EngineNode(GazeLoop(engine or FakeEngine()), drv, config)
     stop = threading.Event()
@@ -75,15 +86,19 @@ def frame(t, hand_x=1.0, face=(1.0, 0.3, 1.5)):
 def test_tracking_in_head_command_out_over_the_bus(bus):
     ep = robot_side(bus)
     node, drv, _, th = engine_side(bus)
-    events = Recorder(ep.session, ep.keys.events, EventMsg)
+    events = events_of(ep)
+    targets = targets_of(ep)
     assert wait_until(lambda: connected(ep, drv))
     th.start()
     assert node.ready.wait(30)
-    sent = [ep.publish_tracking(frame(i / 120, hand_x=1.0 - i * 0.02)) for i in range(20)]
-    assert wait_until(lambda: (m := ep.head.peek()) is not None and m.answers == sent[-1].seq)
+    for i in range(20):
+        ep.publish_tracking(frame(i / 120, hand_x=1.0 - i * 0.02))
+    # the last sample's gaze target, stamped with its robot time
+    assert wait_until(lambda: targets.msgs and targets.msgs[-1][0] == pytest.approx(19 / 120))
+    assert wait_until(lambda: ep.head.peek() is not None)
     cmd = ep.head.peek()
     assert cmd.head["head_pan"] == pytest.approx(np.arctan2(0.3, 1.0))
-    assert cmd.mode == "behavior" and cmd.v == 1
+    assert cmd.time_from_start > 0 and set(cmd.velocity) == {"head_pan"}
     assert wait_until(lambda: ep.eyes.peek() is not None)
     # the fake engine's phase event is published once, with the engine as source
     assert wait_until(lambda: events.where(kind="reach_started"))
@@ -104,61 +119,122 @@ def test_robot_events_reach_the_engine(bus):
     assert node.engine.notified == [reach]
 
 
-def test_malformed_payloads_are_counted_dropped_and_never_crash(bus):
+def _key(node, topic, type_name=None):
+    codec = Codec.for_type(typestore(), type_name or topic.type)
+    return node.names.key(node.names.resolve(topic.name), codec.info.dds_name, codec.info.hash)
+
+
+def test_bad_input_is_counted_dropped_reported_with_its_topic_and_never_crashes(bus):
     ep = robot_side(bus)
     node, drv, _, th = engine_side(bus)
-    status = Recorder(ep.session, ep.keys.status, StatusMsg)
+    status = health_of(ep)
     assert wait_until(lambda: connected(ep, drv))
     th.start()
     assert node.ready.wait(30)
-    garbage = [b"", b"\x00\xff", b"{", b"[]", b'{"v":1}', b'{"v":9,"seq":0,"t":0,"stamp":0}',
-               b'{"v":1,"seq":0,"t":NaN,"stamp":0}']
-    for raw in garbage:
-        for key in (ep.keys.tracking, ep.keys.joint_states, ep.keys.events, ep.keys.status):
-            ep.session.put(key, raw)
-        ep.session.put(ep.keys.head_command, raw)  # the robot side drops these
+    hand = ep.names.resolve(topics.GIVER_HAND.name)
+    nan = Codec.for_type(typestore(), convert.POINT_STAMPED).encode(
+        convert.point_stamped(0.5, [1.0, 0.0, 1.0], "world"))
+    nan = nan[:-24] + np.array([np.nan, 0.0, np.inf]).tobytes()  # x NaN, z inf on the wire
+    cdr_garbage = [b"", b"\x00\xff", b"\x00\x01\x00\x00\x01", b"garbage bytes!",
+                   nan[:20],  # truncated
+                   nan,  # NaN / inf coordinates
+                   b"\x00\x01\x00\x00" + b"\x00" * (5 * 1024 * 1024)]  # oversized
+    import zenoh
+
+    block = zenoh.CongestionControl.BLOCK  # 5 MB puts must not crowd the others out in Zenoh
+    for raw in cdr_garbage:
+        for topic in (topics.GIVER_HAND, topics.JOINT_STATES, topics.EVENTS, topics.DIAGNOSTICS):
+            ep.session.put(_key(ep, topic), raw, congestion_control=block)
+        # the robot side drops these
+        ep.session.put(_key(ep, topics.HEAD_COMMAND), raw, congestion_control=block)
     ep.publish_tracking(frame(1.0))
-    assert wait_until(lambda: (m := ep.head.peek()) is not None and m.t == 1.0)
-    n = len(garbage)
-    assert wait_until(lambda: drv.dropped().get(ep.keys.tracking) == n)
-    assert drv.dropped() == {k: n for k in (ep.keys.tracking, ep.keys.joint_states,
-                                            ep.keys.events, ep.keys.status)}
-    assert ep.dropped()[ep.keys.head_command] == n
-    # the engine's heartbeat reports the counts and the loop is still alive
-    assert wait_until(lambda: any(s.node == "engine" and s.dropped.get(ep.keys.tracking) == n
+    assert wait_until(lambda: ep.head.peek() is not None)
+    n = len(cdr_garbage)
+    resolved = {t: ep.names.resolve(t.name) for t in
+                (topics.GIVER_HAND, topics.JOINT_STATES, topics.EVENTS, topics.DIAGNOSTICS)}
+    assert wait_until(lambda: drv.dropped().get(hand) == n), (drv.dropped(), drv.drops.reasons())
+    assert wait_until(lambda: drv.dropped() == {r: n for r in resolved.values()}), (
+        drv.dropped(), drv.drops.reasons())
+    assert wait_until(lambda: ep.dropped().get(ep.names.resolve(topics.HEAD_COMMAND.name)) == n)
+    reasons = drv.drops.reasons()
+    assert "oversized" in reasons[hand]
+    # the engine's heartbeat reports the counts by topic and the loop is still alive
+    assert wait_until(lambda: any(s.node == "engine" and s.values.get(f"dropped/{hand}") == n
                                   for s in status.msgs))
     assert th.is_alive() and node.frames_processed == 1
+
+
+def test_nan_coordinates_and_foreign_frames_are_dropped_and_counted_with_their_topic(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(30)
+    face = ep.names.resolve(topics.GIVER_FACE.name)
+    msg = convert.point_stamped(0.5, [1.0, 0.0, 1.0], "world")
+    msg.point.x = float("nan")
+    codec = Codec.for_type(typestore(), convert.POINT_STAMPED)
+    ep.session.put(_key(ep, topics.GIVER_FACE), codec.encode(msg))
+    assert wait_until(lambda: drv.dropped().get(face) == 1)
+    assert "not finite" in drv.drops.reasons()[face]
+    # a point in another frame than the robot base frame is not used either
+    ep.session.put(_key(ep, topics.GIVER_FACE), codec.encode(
+        convert.point_stamped(0.6, [1.0, 0.0, 1.0], "camera")))
+    assert wait_until(lambda: drv.dropped().get(face) == 2)
+    assert "frame_id 'camera'" in drv.drops.reasons()[face]
+    assert th.is_alive() and node.frames_processed == 0
+
+
+def test_a_wrong_type_hash_is_reported_as_a_type_mismatch_with_topic_and_types(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    warnings = []
+    node.warn = warnings.append
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(30)
+    hand = ep.names.resolve(topics.GIVER_HAND.name)
+    good = _key(ep, topics.GIVER_HAND)
+    other = good.rsplit("/", 1)[0] + "/RIHS01_" + "ab" * 32  # another version of the type
+    raw = Codec.for_type(typestore(), convert.POINT_STAMPED).encode(
+        convert.point_stamped(0.5, [1.0, 0.0, 1.0], "world"))
+    ep.session.put(other, raw)
+    ep.session.put(_key(ep, topics.GIVER_HAND, convert.JOINT_STATE), raw)  # another type
+    assert wait_until(lambda: drv.dropped().get(hand) == 2)
+    mismatch = drv.type_mismatches()[hand]
+    assert mismatch.topic == hand and mismatch.expected[0].startswith(convert.POINT_STAMPED)
+    assert wait_until(lambda: any("type mismatch on " + hand in w for w in warnings))
+    assert node.frames_processed == 0 and th.is_alive()
 
 
 def test_tracking_stop_ticks_the_loop_whose_policy_holds_then_looks_at_the_last_face(bus):
     ep = robot_side(bus)
     node, drv, _, th = engine_side(bus, config=SILENCE)
-    events = Recorder(ep.session, ep.keys.events, EventMsg)
-    heads = Recorder(ep.session, ep.keys.head_command, HeadCommandMsg)
-    status = Recorder(ep.session, ep.keys.status, StatusMsg)
+    events = events_of(ep)
+    heads = heads_of(ep)
+    targets = targets_of(ep)
+    status = health_of(ep)
     assert wait_until(lambda: connected(ep, drv))
     th.start()
     assert node.ready.wait(30)
     last_face = (1.2, -0.4, 1.6)
     ep.publish_tracking(frame(0.0))
     ep.publish_tracking(frame(1 / 120, face=last_face))
-    assert wait_until(lambda: len([m for m in heads.msgs if m.answers is not None]) == 2)
-    assert all(m.mode == "behavior" for m in heads.msgs if m.answers is not None)
+    assert wait_until(lambda: node.frames_processed == 2)
     # silence: the node ticks the loop without samples; the engine's policy holds, then loses
     assert wait_until(lambda: events.where(kind="tracking_stale"), timeout=10)
     assert wait_until(lambda: events.where(kind="tracking_timeout"), timeout=10)
     [timeout] = events.where(kind="tracking_timeout")
     assert timeout.info["face"] == pytest.approx(list(last_face))
-    assert wait_until(lambda: heads.where(mode="tracking_lost"), timeout=10)
-    fallback = heads.where(mode="tracking_lost")[-1]
-    assert fallback.answers is None and fallback.target == "face"
-    assert fallback.head["head_pan"] == pytest.approx(np.arctan2(-0.4, 1.2))
-    assert wait_until(lambda: any(s.node == "engine" and s.tracking == "lost"
+    # meanwhile the head looks at the last face, commanded by silence ticks
+    assert wait_until(lambda: len(heads.msgs) > 2)
+    assert heads.msgs[-1]["head_pan"] == pytest.approx(np.arctan2(-0.4, 1.2))
+    assert wait_until(lambda: any(s.node == "engine" and s.values.get("tracking") == "lost"
                                   and s.state == "degraded" for s in status.msgs), timeout=10)
-    # tracking returns: resumed, behavior commands again
+    # tracking returns: resumed, the sample answered
     ep.publish_tracking(frame(30.0))
     assert wait_until(lambda: events.where(kind="tracking_resumed"), timeout=10)
-    assert wait_until(lambda: heads.msgs[-1].mode == "behavior" and heads.msgs[-1].t == 30.0)
+    assert wait_until(lambda: any(t == 30.0 for t, _ in targets.msgs))
     assert node.tracking == "ok"
 
 
@@ -203,8 +279,8 @@ def test_history_replays_only_the_current_handover():
 def test_robot_gone_engine_keeps_running_and_reports_peer_lost(bus):
     ep = robot_side(bus)
     node, drv, _, th = engine_side(bus)
-    events = Recorder(drv.session, drv.keys.events, EventMsg)
-    status = Recorder(drv.session, drv.keys.status, StatusMsg)
+    events = events_of(drv)
+    status = health_of(drv)
     assert wait_until(lambda: connected(ep, drv))
     th.start()
     assert node.ready.wait(30)
@@ -214,8 +290,8 @@ def test_robot_gone_engine_keeps_running_and_reports_peer_lost(bus):
     ep.session.close()  # the simulator process is gone
     assert wait_until(lambda: events.where(kind="peer_lost"))
     assert events.where(kind="peer_lost")[0].info == {"peer": "sim"}
-    assert wait_until(lambda: any(s.peers == {"sim": False} and s.state == "degraded"
-                                  for s in status.msgs))
+    assert wait_until(lambda: any(s.node == "engine" and s.values.get("peer/sim") == "lost"
+                                  and s.state == "degraded" for s in status.msgs))
     n = len(status.msgs)
     assert wait_until(lambda: len(status.msgs) > n + 2)  # still beating
     assert th.is_alive()
@@ -225,8 +301,8 @@ def test_robot_whose_heartbeat_stops_counts_as_lost(bus):
     clock = FakeClock(100.0)  # the engine's view of heartbeat ages: moved by hand
     ep = robot_side(bus)
     node, drv, _, th = engine_side(bus, peer_timeout=0.2, clock=clock)
-    events = Recorder(drv.session, drv.keys.events, EventMsg)
-    status = Recorder(drv.session, drv.keys.status, StatusMsg)
+    events = events_of(drv)
+    status = health_of(drv)
     assert wait_until(lambda: connected(ep, drv))
     th.start()
     assert node.ready.wait(30)
@@ -241,8 +317,8 @@ def test_robot_whose_heartbeat_stops_counts_as_lost(bus):
         return bool(events.where(kind="peer_lost"))
 
     assert wait_until(hung)
-    ep.heartbeat()
-    assert wait_until(lambda: events.where(kind="peer_restored"))
+    # it beats again (as a live robot does, every 0.5 s): restored
+    assert wait_until(lambda: ep.heartbeat() and events.where(kind="peer_restored"), poll=0.1)
 
 
 class CountingRenderer:
@@ -256,7 +332,7 @@ class CountingRenderer:
 
 def test_eye_frames_are_rendered_only_while_someone_subscribes(bus):
     ep = robot_side(bus)  # draws its own eyes: does not ask for frames
-    drv = ZenohRobotDriver(bus.connector(), bus.config().keys, "engine")
+    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
     bus.closers.append(drv.close)
     renderer = CountingRenderer()
     node = EngineNode(GazeLoop(FakeEngine()), drv, FAST, eye_renderer=renderer)
@@ -265,7 +341,7 @@ def test_eye_frames_are_rendered_only_while_someone_subscribes(bus):
         node.on_tracking(ep.publish_tracking(frame(i / 120)))
     assert renderer.calls == 0 and node.commands_sent == 5
     # a display that wants frames joins
-    viewer = ZenohRobotEndpoint(bus.connector(), bus.config().keys, "display", eye_frames=True)
+    viewer = ZenohRobotEndpoint(bus.connector(), bus.names, "display", eye_frames=True)
     bus.closers.append(viewer.close)
     assert wait_until(drv.wants_eye_frames)
     node.on_tracking(ep.publish_tracking(frame(1.0)))
@@ -279,13 +355,13 @@ def test_listening_on_a_taken_endpoint_is_a_clear_error(bus):
 
     bus.listener()
     with pytest.raises(ValueError, match="could not open a Zenoh session.*" + bus.endpoint):
-        open_session(BusConfig(bus.robot_id, listen=(bus.endpoint,)))
+        open_session(BusConfig(bus.names, listen=(bus.endpoint,)))
 
 
 def test_robot_clock_going_back_resets_and_resyncs_the_engine(bus):
     ep = robot_side(bus)
     node, drv, _, th = engine_side(bus, config=RESYNC)
-    events = Recorder(ep.session, ep.keys.events, EventMsg)
+    events = events_of(ep)
     assert wait_until(lambda: connected(ep, drv))
     ep.publish_joint_state(0.0, {"head_pan": 0.2})
     assert wait_until(lambda: drv.joint_state() is not None)
@@ -300,3 +376,41 @@ def test_robot_clock_going_back_resets_and_resyncs_the_engine(bus):
     assert wait_until(lambda: events.where(kind="tracking_clock_reset"))
     assert wait_until(lambda: node.engine.frames and node.engine.frames[-1].t == 0.0)
     assert node.engine.reset_heads == [{"head_pan": 0.2}, {"head_pan": -0.3}]
+
+
+def test_pose_stamped_and_tf_frames_are_tracking_too_and_remapped_topics_are_used(bus):
+    from gazebot.drivers.rmw.names import Names
+    from gazebot.drivers.rmw.node import RosNode
+
+    names = Names(bus.names.namespace, {"gaze_target": "/robot/look_at"},
+                  tf_frames={"giver_face": "mocap/face"})
+    ep = ZenohRobotEndpoint(bus.listener(), names, "sim")
+    bus.closers.append(ep.close)
+    drv = ZenohRobotDriver(bus.connector(), names, "engine")
+    bus.closers.append(drv.close)
+    mocap = RosNode(ep.session, names, "mocap")
+    bus.closers.append(mocap.close)
+    pose = mocap.publisher(topics.GIVER_HAND.name, convert.POSE_STAMPED)
+    tf = mocap.publisher(topics.TF.name, topics.TF.type)
+    targets = Recorder(ep, topics.GAZE_TARGET, convert.point_of)  # resolves the remap
+    assert targets.key.startswith("0/robot/look_at/")
+    node = EngineNode(GazeLoop(FakeEngine()), drv, FAST)
+    assert wait_until(lambda: connected(ep, drv))
+    for i in range(3):
+        t = 0.5 + i / 120
+        sample = TrackingFrame.make(t, giver_hand=[0.9, 0.0, 1.0], giver_face=[1.1, 0.2, 1.6])
+        pose.publish(convert.pose_stamped(t, sample.giver_hand, "world"))
+        tf.publish(convert.tracking_tf(TrackingFrame.make(t, giver_face=sample.giver_face),
+                                       "world", {"giver_face": "mocap/face"}))
+    got = []
+
+    def three_samples() -> bool:
+        if (m := drv.wait_tracking(0.05)) is not None:
+            got.append(m)
+        return len(got) >= 3
+
+    assert wait_until(three_samples)
+    assert got[0].giver_hand == (0.9, 0.0, 1.0) and got[0].giver_face == (1.1, 0.2, 1.6)
+    node.on_tracking(got[-1])
+    assert wait_until(lambda: targets.msgs)
+    assert targets.msgs[-1][1].tolist() == [1.1, 0.2, 1.6]  # the fake engine looks at the face

@@ -1,6 +1,25 @@
-"""An independent implementation of the seed's section 7.2.5 rule, written from the sentence
-("within 20cm of the minimum distance, and their relative velocity is less than 15cm/s") for
-checking ``--method seed-7.2.5``. Plain Python loops, no code shared with gazebot."""
+"""The seed's section 7.2.5 rule read from its sentence alone, to check ``--method seed-7.2.5``.
+
+The sentence: "the 'transfer' phase corresponds to the portion of the handover where the
+distance between the giver's and receiver's hands is within 20cm of the minimum distance, and
+their relative velocity is less than 15cm/s."
+
+Read literally, for ONE handover: take the minimum distance over that handover; the transfer
+is the portion of the samples with distance <= minimum + 0.20 m and relative speed < 0.15 m/s.
+The sentence leaves three things open; each is a parameter here, and every test that calls
+this states the value it passes and why:
+
+- ``handover``: which samples form "the handover" (the seed cut its recordings by hand). The
+  caller passes a time window (tests: the generator's known handover windows, or the whole KTH
+  sample, which holds one handover).
+- ``half``: how "relative velocity" is measured. Here the central difference
+  ``|p(t + half) - p(t - half)| / (2 half)`` of the relative position, taking the samples
+  *nearest* to ``t +- half`` (no interpolation); the caller passes ``half``.
+- "portion" as an interval: here the span from the first to the last qualifying sample (the
+  widest reading); :func:`qualifying_runs` gives the runs inside it when a test needs them.
+
+Missing samples (NaN) are dropped. Plain Python, nothing imported from gazebot.
+"""
 
 from __future__ import annotations
 
@@ -8,60 +27,62 @@ import bisect
 import math
 
 
-def _lerp(ts: list[float], ps: list[tuple[float, float, float]], x: float):
-    i = bisect.bisect_left(ts, x)
-    if i < len(ts) and abs(ts[i] - x) < 1e-12:
-        return ps[i]
-    if i == 0 or i == len(ts):
-        return None
-    w = (x - ts[i - 1]) / (ts[i] - ts[i - 1])
-    return tuple(a + w * (b - a) for a, b in zip(ps[i - 1], ps[i], strict=True))
-
-
-def seed_transfers(t, giver, receiver, margin=0.20, vmax=0.15, h=0.05):
-    """``[(start, end)]`` of the transfer of each handover (one per dip of the distance)."""
+def _rows(t, giver, receiver, window):
+    lo, hi = window
     ts, ps = [], []
     for ti, g, r in zip(t, giver, receiver, strict=True):
-        if all(math.isfinite(v) for v in (*g, *r)):
+        if lo <= ti <= hi and all(math.isfinite(v) for v in (*g, *r)):
             ts.append(float(ti))
             ps.append(tuple(float(b - a) for a, b in zip(g, r, strict=True)))
-    n = len(ts)
+    return ts, ps
+
+
+def _nearest(ts, x):
+    i = bisect.bisect_left(ts, x)
+    if i == 0:
+        return 0
+    if i == len(ts):
+        return len(ts) - 1
+    return i if ts[i] - x < x - ts[i - 1] else i - 1
+
+
+def qualifying(t, giver, receiver, handover, half, margin=0.20, vmax=0.15):
+    """``[(time, qualifies)]`` over the handover window (``qualifies``: within ``margin`` of
+    the window's minimum distance and slower than ``vmax``; samples whose ``t +- half`` leave
+    the window do not qualify)."""
+    ts, ps = _rows(t, giver, receiver, handover)
+    if not ts:
+        return []
     d = [math.sqrt(sum(c * c for c in p)) for p in ps]
-    v = []
-    for i in range(n):
-        a, b = _lerp(ts, ps, ts[i] - h), _lerp(ts, ps, ts[i] + h)
-        if a is None or b is None:
-            v.append(math.inf)
-        else:
-            v.append(math.sqrt(sum((y - x) ** 2 for x, y in zip(a, b, strict=True))) / (2 * h))
-    # Handovers: from the lowest unassigned minimum, the region within 20 cm of it.
-    assigned = [False] * n
+    d_min = min(d)
     out = []
-    for i0 in sorted(range(n), key=lambda i: d[i]):
-        if assigned[i0]:
+    for i, ti in enumerate(ts):
+        if ti - half < ts[0] or ti + half > ts[-1]:
+            out.append((ti, False))
             continue
-        lim = d[i0] + margin
-        lo = i0
-        while lo > 0 and not assigned[lo - 1] and d[lo - 1] <= lim:
-            lo -= 1
-        hi = i0
-        while hi < n - 1 and not assigned[hi + 1] and d[hi + 1] <= lim:
-            hi += 1
-        bounded = (lo > 0 and d[lo - 1] > lim) or (hi < n - 1 and d[hi + 1] > lim)
-        touching = (lo > 0 and assigned[lo - 1]) or (hi < n - 1 and assigned[hi + 1])
-        for i in range(lo, hi + 1):
-            assigned[i] = True
-        if not bounded or touching:
-            continue
-        best, run_start = None, None
-        for i in range(lo, hi + 2):
-            slow = i <= hi and v[i] < vmax
-            if slow and run_start is None:
-                run_start = i
-            if not slow and run_start is not None:
-                if best is None or i - 1 - run_start > best[1] - best[0]:
-                    best = (run_start, i - 1)
-                run_start = None
-        if best is not None:
-            out.append((ts[best[0]], ts[best[1]]))
-    return sorted(out)
+        a, b = ps[_nearest(ts, ti - half)], ps[_nearest(ts, ti + half)]
+        dt = ts[_nearest(ts, ti + half)] - ts[_nearest(ts, ti - half)]
+        v = math.sqrt(sum((y - x) ** 2 for x, y in zip(a, b, strict=True))) / dt
+        out.append((ti, d[i] <= d_min + margin and v < vmax))
+    return out
+
+
+def seed_transfer(t, giver, receiver, handover, half, margin=0.20, vmax=0.15):
+    """``(start, end)``: first and last qualifying sample of the handover, or ``None``."""
+    q = [ti for ti, ok in qualifying(t, giver, receiver, handover, half, margin, vmax) if ok]
+    return (q[0], q[-1]) if q else None
+
+
+def qualifying_runs(t, giver, receiver, handover, half, margin=0.20, vmax=0.15):
+    """The contiguous runs of qualifying samples, as ``[(start, end)]`` in time order."""
+    runs, start, prev = [], None, None
+    for ti, ok in qualifying(t, giver, receiver, handover, half, margin, vmax):
+        if ok and start is None:
+            start = ti
+        if not ok and start is not None:
+            runs.append((start, prev))
+            start = None
+        prev = ti
+    if start is not None:
+        runs.append((start, prev))
+    return runs

@@ -20,14 +20,14 @@ def test_silence_holds_for_the_behaviors_hold_time_then_looks_at_its_target():
     hand = np.array([1.0, 0.3, 0.9])
     t = 0.0
     for _ in range(120):  # 1 s of tracking: the gaze settles on the face
-        cmd = loop.tick(t, TrackingFrame.make(t, giver_hand=hand, receiver_hand=[0.4, 0, 0.9],
+        cmd = loop.tick(TrackingFrame.make(t, giver_hand=hand, receiver_hand=[0.4, 0, 0.9],
                                               giver_face=face))
         t += 1 / 120
     last = t - 1 / 120
     assert cmd.tracking == "ok" and cmd.target == "face"
     states = []
     while t < last + gap + spec.hold_s + 1.0:  # silence at 30 Hz
-        cmd = loop.tick(t)
+        cmd = loop.tick(None, t=t)
         states.append((t, cmd.tracking, cmd.target))
         assert not cmd.answers_sample
         t += 1 / 30
@@ -43,7 +43,7 @@ def test_silence_holds_for_the_behaviors_hold_time_then_looks_at_its_target():
     assert lost and all(target == spec.target for _, _, target in lost)
     np.testing.assert_allclose(cmd.target_point, face)
     # samples return: ok again
-    cmd = loop.tick(t, TrackingFrame.make(t, giver_hand=hand, receiver_hand=[0.4, 0, 0.9],
+    cmd = loop.tick(TrackingFrame.make(t, giver_hand=hand, receiver_hand=[0.4, 0, 0.9],
                                           giver_face=face))
     assert cmd.tracking == "ok" and cmd.answers_sample
 
@@ -69,9 +69,9 @@ def sawyer():
     return RobotModel.load("sawyer")
 
 
-def _cmd(head, yaw=0.0, pitch=0.0, t=1.0, point=(1.0, 0.0, 1.5)):
+def _cmd(head, yaw=0.0, pitch=0.0, t=1.0, point=(1.0, 0.0, 1.5), shift=0.0):
     return GazeCommand(t=t, phase=Phase.IDLE, target="face", target_point=np.array(point),
-                       head=head, eye_yaw=yaw, eye_pitch=pitch)
+                       head=head, eye_yaw=yaw, eye_pitch=pitch, gaze_shift=shift)
 
 
 @pytest.mark.parametrize("bad", [
@@ -81,21 +81,29 @@ def test_a_non_finite_head_goal_is_never_returned(sawyer, bad):
     engine = _Engine(sawyer)
     loop = GazeLoop(engine)
     engine.next = _cmd(bad)
-    assert loop.tick(1.0, TrackingFrame(t=1.0)) is None
+    assert loop.tick(TrackingFrame(t=1.0)) is None
     engine.next = _cmd({"head_pan": 0.1}, yaw=math.nan)
-    assert loop.tick(1.1, TrackingFrame(t=1.1)) is None
+    assert loop.tick(TrackingFrame(t=1.1)) is None
     assert loop.unsafe == 2
 
 
-def test_out_of_limit_head_and_eye_commands_are_clipped_into_the_limits(sawyer):
+def test_out_of_limit_head_and_eye_commands_are_refused_not_clipped_again(sawyer):
+    # The gaze controller is the one clip; the loop only checks what any engine hands it.
     engine = _Engine(sawyer)
     loop = GazeLoop(engine)
-    engine.next = _cmd({"head_pan": 50.0}, yaw=3.0, pitch=-3.0)
-    cmd = loop.tick(1.0, TrackingFrame(t=1.0))
-    assert cmd.head["head_pan"] == pytest.approx(float(sawyer.upper[0]))
-    assert cmd.eye_yaw == pytest.approx(sawyer.eyes.yaw_range[1])
-    assert cmd.eye_pitch == pytest.approx(sawyer.eyes.pitch_range[0])
-    assert loop.clipped == 1 and 0.0 <= cmd.blink <= 1.0
+    for t, cmd in enumerate([
+        _cmd({"head_pan": 50.0}),
+        _cmd({"head_pan": 0.0}, yaw=3.0),
+        _cmd({"head_pan": 0.0}, pitch=-3.0),
+        _cmd({"head_pan": 0.0, "elbow": 0.0}),  # a joint the robot lacks
+    ]):
+        engine.next = cmd.replaced(t=float(t))
+        assert loop.tick(TrackingFrame(t=float(t))) is None
+    assert loop.unsafe == 4
+    hi = float(sawyer.upper[0])
+    engine.next = _cmd({"head_pan": hi}, yaw=sawyer.eyes.yaw_range[1], t=5.0)
+    cmd = loop.tick(TrackingFrame(t=5.0))  # at the limits is within them
+    assert cmd.head == {"head_pan": hi} and 0.0 <= cmd.blink <= 1.0 and loop.unsafe == 4
 
 
 def test_distance_is_from_the_gaze_frame_at_the_commanded_head_pose(sawyer):
@@ -103,11 +111,11 @@ def test_distance_is_from_the_gaze_frame_at_the_commanded_head_pose(sawyer):
     loop = GazeLoop(engine)
     point = np.array([1.2, 0.4, 1.3])
     engine.next = _cmd({"head_pan": 0.3}, point=point)
-    cmd = loop.tick(1.0, TrackingFrame(t=1.0))
+    cmd = loop.tick(TrackingFrame(t=1.0))
     origin = sawyer.gaze_pose(sawyer.head_vector({"head_pan": 0.3})).position
     assert cmd.distance == pytest.approx(float(np.linalg.norm(point - origin)))
     engine.next = _cmd({"head_pan": 0.3}, point=(math.nan,) * 3, t=1.1)
-    assert loop.tick(1.1, TrackingFrame(t=1.1)).distance is None
+    assert loop.tick(TrackingFrame(t=1.1)).distance is None
 
 
 def test_big_gaze_shifts_bring_blinks_and_the_blink_stream_is_seeded(sawyer):
@@ -116,8 +124,10 @@ def test_big_gaze_shifts_bring_blinks_and_the_blink_stream_is_seeded(sawyer):
         out = []
         for i in range(600):  # the target jumps 60 degrees every second
             y = 1.0 if (i // 120) % 2 else -1.0
-            loop.engine.next = _cmd({"head_pan": 0.0}, t=i / 120, point=(1.0, y, 1.5))
-            out.append(loop.tick(i / 120, TrackingFrame(t=i / 120)).blink)
+            jump = math.radians(60.0) if i % 120 == 0 and i else 0.0  # the engine's gaze_shift
+            loop.engine.next = _cmd({"head_pan": 0.0}, t=i / 120, point=(1.0, y, 1.5),
+                                    shift=jump)
+            out.append(loop.tick(TrackingFrame(t=i / 120)).blink)
         return out, loop.blinks.blink_times
 
     a, times = blinks(0)
@@ -125,3 +135,15 @@ def test_big_gaze_shifts_bring_blinks_and_the_blink_stream_is_seeded(sawyer):
     assert a == b and max(a) == 1.0
     hit = sum(any(abs(bt - k) < 0.05 for bt in times) for k in range(1, 5))
     assert hit >= 2  # shift_probability 0.9: most jumps blink at once
+
+
+def test_the_loop_fills_the_engines_command_without_copying_its_fields_by_hand(sawyer):
+    engine = _Engine(sawyer)
+    loop = GazeLoop(engine)
+    engine.next = _cmd({"head_pan": 0.2})
+    cmd = loop.tick(TrackingFrame(t=1.0))
+    assert type(cmd) is GazeCommand and cmd.head == {"head_pan": 0.2}
+    assert engine.next.blink == 0.0 and engine.next.distance is None  # the engine's is untouched
+    assert cmd.replaced(blink=0.5).blink == 0.5
+    with pytest.raises(TypeError, match="no fields"):
+        cmd.replaced(blinks=0.5)

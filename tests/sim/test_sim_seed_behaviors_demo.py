@@ -79,8 +79,8 @@ class _AllBehaviors:
         for loop in self.loops.values():
             loop.notify(events)
 
-    def tick(self, t, frame=None, joints=None):
-        cmds = {n: loop.tick(t, frame, joints=joints) for n, loop in self.loops.items()}
+    def tick(self, frame, *, t=None, joints=None):
+        cmds = {n: loop.tick(frame, t=t, joints=joints) for n, loop in self.loops.items()}
         for name, cmd in cmds.items():
             assert cmd is not None, f"{name}: unsafe command at t={t:.3f}"
             self.targets[name].append((cmd.t, cmd.target))

@@ -13,9 +13,10 @@ import time
 
 import numpy as np
 import pytest
-from study_web import REPO, StudyServer, http, render_tiny_study
+from study_web import REPO, StudyServer, form_token, http, render_tiny_study
 
 from gazebot.study.folder import load_study
+from gazebot.study.web.app import VISITOR_COOKIE
 
 pytestmark = pytest.mark.browser
 
@@ -33,8 +34,8 @@ def _chromium() -> tuple[str, str]:
     return browser, driver
 
 
-@pytest.fixture
-def driver(tmp_path):
+def _chrome(tmp_path, *extra: str):
+    """Headless Chromium driven by chromedriver; ``extra``: more command-line switches."""
     webdriver = pytest.importorskip("selenium.webdriver")
     from selenium.webdriver.chrome.service import Service
 
@@ -53,11 +54,18 @@ def driver(tmp_path):
         f"--user-data-dir={tmp_path / 'chromium-profile'}",
         "--autoplay-policy=no-user-gesture-required",
         "--window-size=900,1400",
+        *extra,
     ):
         opts.add_argument(arg)
     # An explicit driver path: Selenium Manager would otherwise try to download one.
     d = webdriver.Chrome(service=Service(executable_path=chromedriver), options=opts)
     d.set_page_load_timeout(60)
+    return d
+
+
+@pytest.fixture
+def driver(tmp_path):
+    d = _chrome(tmp_path)
     yield d
     d.quit()
 
@@ -184,11 +192,14 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
     sessions = study.sessions_of(1)
     rng = np.random.default_rng(14)
     clicked: dict[int, dict[str, int]] = {}
-    server = StudyServer(study_dir).start()
+    # `gazebot study serve study/` with a relative folder, exactly as the README shows it.
+    server = StudyServer("study", cwd=tmp_path).start()
     try:
         d = driver
-        d.get(f"{server.base}/p/1")
+        link = server.links[1]  # participant 1's own link, from participant-links.csv
+        d.get(link)
         _at(d, "Consent")
+        csrf = form_token(d.page_source)  # this participant's forms' token, for a resent form
         d.find_element(By.ID, "consent").click()
         _submit(d)
         _at(d, "Instructions")
@@ -228,7 +239,7 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
                 # A closed tab: a new one opens the same session.
                 old = d.current_window_handle
                 d.switch_to.new_window("tab")
-                d.get(f"{server.base}/p/1")
+                d.get(link)
                 _at(d, f"Session {s.session} of {len(sessions)}")
                 d.close()
                 d.switch_to.window(old)
@@ -243,12 +254,19 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
         _at(d, "Thank you")
         # A resent form after the end (browser back + resubmit) changes nothing.
         last = sessions[-1].session
-        status, _, _ = http("POST", f"{server.base}/p/1/session/{last}", {"q1": "2"})
+        # The browser's own cookie and Origin go with it, as a resubmitted form's would.
+        visitor = d.get_cookie(VISITOR_COOKIE)["value"]
+        headers = {"Cookie": f"{VISITOR_COOKIE}={visitor}", "Origin": server.base}
+        resent = {"q1": "2", "csrf_token": csrf}
+        status, _, _ = http("POST", f"{link}/session/{last}", resent, headers)
         assert status == 303
-        d.get(f"{server.base}/p/1")
+        # Without the cookie the same token is refused: it names this browser's visitor id.
+        status, _, _ = http("POST", f"{link}/session/{last}", resent, {"Origin": server.base})
+        assert status == 403
+        d.get(link)
         assert "completed all" in d.find_element(By.ID, "message").text
-        d.get(f"{server.base}/p/77")
-        assert "Participant 77 is not in this study's plan." in d.page_source
+        d.get(f"{server.base}/p/1")  # a participant number is no link
+        assert "No such participant link" in d.page_source
     finally:
         server.stop()
 
@@ -268,3 +286,49 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
         [*cli, "analyze", str(out), "--json"], check=True, env=env, capture_output=True, text=True
     )
     assert json.loads(analyzed.stdout)["per_level"][""]["likability"]["participants"] == 1
+
+
+def test_plain_http_lan_name_forms_work_and_an_opaque_origin_post_is_refused(tmp_path):
+    """The server under a LAN name over plain HTTP (``study.test``, mapped to loopback): no
+    secure context, so Chromium sends no ``Sec-Fetch-*`` headers. The site's own forms still
+    go through (``Referrer-Policy: same-origin``: they carry their real ``Origin``), signing in
+    included; a form posted from an opaque origin (``Origin: null``, as a no-referrer or
+    sandboxed page of another site sends it) is refused and changes nothing."""
+    from selenium.webdriver.common.by import By
+
+    render_tiny_study(tmp_path / "study")
+    server = StudyServer(
+        tmp_path / "study", token="lan-admin-token", args=("--allowed-host", "study.test")
+    ).start()
+    d = _chrome(tmp_path, "--host-resolver-rules=MAP study.test 127.0.0.1")
+    try:
+        base = f"http://study.test:{server.port}"
+        link = server.links[1].replace(server.base, base)
+        d.get(link)
+        _at(d, "Consent")
+        assert d.execute_script("return window.isSecureContext") is False
+        d.find_element(By.ID, "consent").click()
+        _submit(d)
+        _at(d, "Instructions")
+        d.get(f"{base}/admin")
+        _at(d, "Experimenter sign-in")
+        d.find_element(By.NAME, "token").send_keys("lan-admin-token")
+        d.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        _at(d, "Study progress")
+        # Another site's form, from an opaque origin, with a token of participant 2's page.
+        target = server.links[2].replace(server.base, base)
+        d.get(target)
+        token = form_token(d.page_source)
+        attack = (
+            f"<form method=post action='{target}/consent'>"
+            f"<input name=consent value=yes><input name=csrf_token value='{token}'></form>"
+            "<script>document.forms[0].submit()</script>"
+        )
+        d.get("data:text/html," + attack)
+        _at(d, "Forbidden")
+        assert "Origin: null" in d.page_source
+        store = load_study(tmp_path / "study").store()
+        assert store.progress(2).mode is None and store.progress(1).mode == "video"
+    finally:
+        d.quit()
+        server.stop()

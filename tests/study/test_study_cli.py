@@ -223,3 +223,11 @@ def test_serve_and_export_on_a_folder_that_is_not_a_rendered_study_say_so(tmp_pa
         run(["study", "export", str(tmp_path), "--out", str(tmp_path / "r.csv")])
     with pytest.raises(ValueError, match="is not a rendered study"):
         run(["study", "serve", str(tmp_path), "--port", "0"])
+
+
+@pytest.mark.parametrize(
+    "name", ["http://study.example", "study.example:8000", "a/b", "", "no space"]
+)
+def test_serve_allowed_host_must_be_a_host_name(tmp_path, name):
+    with pytest.raises(ValueError, match="--allowed-host: .* is not a host name"):
+        run(["study", "serve", str(tmp_path), "--port", "0", "--allowed-host", name])

@@ -6,18 +6,20 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import sqlite3
 
 import numpy as np
 import pytest
 from study_responses import BEHAVIORS, responses_from_tables
 from study_seed_tables import TABLE_6_1
-from study_web import reach_start_time_of, render_tiny_study
+from study_web import form_token, reach_start_time_of, render_tiny_study
 
 from gazebot.study.analysis import analyze, read_responses
 from gazebot.study.export import export_responses
 from gazebot.study.folder import load_study
-from gazebot.study.web.app import create_app
+from gazebot.study.web.app import ADMIN_COOKIE, VISITOR_COOKIE, create_app
+from gazebot.study.web.security import new_token
 
 ANSWERS = {"q1": "1", "q2": "2", "q3": "1", "q4": "1", "q5": "2"}
 
@@ -37,11 +39,54 @@ def fresh(study_dir, tmp_path):
     return study_dir
 
 
-def client(study_dir, remote="127.0.0.1"):
-    app = create_app(str(study_dir), admin_token="tok")
-    c = app.test_client()
-    c.environ_base["REMOTE_ADDR"] = remote
-    return c
+class Client:
+    """Flask's test client used as a participant's browser would: ``/p/N...`` in a test stands
+    for participant N's own link ``/p/TOKEN...``, it holds a visitor cookie (and with ``admin``
+    signs in with the admin token), and every POST carries its form's CSRF token and the
+    ``Origin`` a browser sends on the site's own forms."""
+
+    def __init__(self, study_dir, remote="127.0.0.1", admin=False, **kw):
+        self.app = create_app(str(study_dir), admin_token="admin-token-1234", **kw)
+        self.web = self.app.extensions["gazebot_study"]
+        self.c = self.app.test_client()
+        self.c.environ_base["REMOTE_ADDR"] = remote
+        self.c.environ_base["HTTP_ORIGIN"] = "http://localhost"
+        self.c.set_cookie(VISITOR_COOKIE, new_token())  # as a browser that visited before
+        if admin:
+            self.sign_in()
+
+    def sign_in(self, token="admin-token-1234"):
+        """The experimenter's sign-in form, filled in as a browser would."""
+        csrf = form_token(self.c.get("/admin").data)
+        resp = self.c.post("/admin/login", data={"token": token, "csrf_token": csrf})
+        assert resp.status_code == 303, resp.status_code
+        return resp
+
+    def url(self, path: str) -> str:
+        m = re.fullmatch(r"/p/(\d+)(.*)", path)
+        return self.web.link_path(int(m.group(1))) + m.group(2) if m else path
+
+    def scope(self, path: str) -> str:
+        return "p:" + self.url(path).split("/")[2] if path.startswith("/p/") else "admin"
+
+    def csrf(self, path: str) -> str:
+        """The CSRF token the form posting to ``path`` shows this browser."""
+        scope = self.scope(path)
+        if scope == "admin":
+            cookie = self.c.get_cookie(ADMIN_COOKIE)
+            return self.web.csrf(scope, cookie.value.split(".")[0]) if cookie else ""
+        return self.web.csrf(scope, self.c.get_cookie(VISITOR_COOKIE).value)
+
+    def get(self, path, **kw):
+        return self.c.get(self.url(path), **kw)
+
+    def post(self, path, data=None, **kw):
+        data = {"csrf_token": self.csrf(path), **(data or {})}
+        return self.c.post(self.url(path), data=data, **kw)
+
+
+def client(study_dir, remote="127.0.0.1", **kw):
+    return Client(study_dir, remote, **kw)
 
 
 def start(c, pid=1):
@@ -54,7 +99,8 @@ def test_participant_steps_in_order_consent_instructions_practice_sessions_done(
     page = c.get("/p/1")
     assert page.status_code == 200 and b"Consent" in page.data
     assert c.post("/p/1/consent", data={}).status_code == 400  # the box must be ticked
-    assert c.post("/p/1/consent", data={"consent": "yes"}).headers["Location"].endswith("/p/1")
+    resp = c.post("/p/1/consent", data={"consent": "yes"})
+    assert resp.headers["Location"].endswith(c.url("/p/1"))
     page = c.get("/p/1").get_data(as_text=True)
     assert "Instructions" in page and "robot&#39;s head movement" in page  # the plan's head-only
     c.post("/p/1/instructions")
@@ -64,7 +110,7 @@ def test_participant_steps_in_order_consent_instructions_practice_sessions_done(
     for k in range(1, n + 1):
         page = c.get("/p/1").get_data(as_text=True)
         assert f"Session {k} of {n}" in page
-        assert f'action="/p/1/session/{k}"' in page
+        assert f'action="{c.url("/p/1")}/session/{k}"' in page
         assert c.post(f"/p/1/session/{k}", data={**ANSWERS, "comment": f"c{k}"}).status_code == 303
     page = c.get("/p/1")
     assert page.status_code == 200 and b"You have completed all 6 sessions" in page.data
@@ -121,22 +167,47 @@ def test_a_new_app_on_the_same_folder_resumes_where_the_participant_was(fresh):
     assert "Session 3 of 6" in resumed.get("/p/1").get_data(as_text=True)
 
 
-@pytest.mark.parametrize("path", ["/p/99", "/p/0", "/p/abc", "/p/-1", "/nowhere"])
-def test_unknown_participant_or_page_gets_a_clear_page_not_a_traceback(fresh, path):
-    resp = client(fresh).get(path)
+@pytest.mark.parametrize(
+    "path", ["/p/99", "/p/0", "/p/abc", "/p/-1", "/p/AAAAAAAAAAAAAAAAAAAAAAAA", "/nowhere"]
+)
+def test_unknown_participant_link_or_page_gets_a_clear_page_not_a_traceback(fresh, path):
+    resp = client(fresh).c.get(path)  # the path as typed, not a participant's link
     assert resp.status_code == 404
     text = resp.get_data(as_text=True)
     assert "Traceback" not in text
-    if path in ("/p/99", "/p/0"):
-        assert f"Participant {path[3:]} is not in this study&#39;s plan." in text
+    if path.startswith("/p/"):
+        assert "No such participant link: check the link you were given." in text
     else:
         assert "no such page" in text
 
 
-def test_index_sends_a_participant_number_to_their_page(fresh):
+def test_participant_links_are_random_tokens_not_their_numbers(fresh):
     c = client(fresh)
-    assert c.get("/?participant=2").headers["Location"].endswith("/p/2")
+    links = c.web.links
+    assert sorted(links) == load_study(fresh).participants
+    assert len(set(links.values())) == len(links)
+    for p, token in links.items():
+        assert re.fullmatch(r"[A-Za-z0-9_-]{24}", token) and str(p) != token
+    # Participant 1's page by number does not open, and its forms refuse another's token.
+    assert c.c.get("/p/1").status_code == 404
+    other = {"consent": "yes", "csrf_token": c.csrf("/p/2")}
+    assert c.c.post(c.url("/p/1") + "/consent", data=other).status_code == 403
+    assert load_study(fresh).store().progress(1).mode is None
+    # A restarted server keeps the links handed out.
+    assert client(fresh).web.links == links
+
+
+def test_index_sends_a_participant_code_to_their_page(fresh):
+    c = client(fresh)
+    token = c.web.links[2]
+    assert c.get(f"/?participant={token}").headers["Location"].endswith(f"/p/{token}")
     assert c.get("/?participant=x1").status_code == 400
+    # A digit that is not ASCII (int() would take "²" apart) is a clear 400, not a 500.
+    for code in ("²", "١٢", "3²", "%00", " "):
+        resp = c.get("/", query_string={"participant": code})
+        assert resp.status_code in (200, 400), code
+        assert b"Something went wrong" not in resp.data
+    assert c.get("/", query_string={"participant": "²"}).status_code == 400
 
 
 def test_videos_are_served_with_range_requests_and_without_their_file_name(fresh):
@@ -153,17 +224,34 @@ def test_videos_are_served_with_range_requests_and_without_their_file_name(fresh
     assert c.get("/p/1/video/99/1.mp4").status_code == 404
 
 
-def test_admin_needs_loopback_or_the_token(fresh):
-    assert client(fresh, remote="192.0.2.7").get("/admin").status_code == 403
-    remote = client(fresh, remote="192.0.2.7")
-    assert remote.get("/admin?token=tok").status_code == 200
-    assert remote.get("/admin").status_code == 200  # the token is kept in a cookie
-    assert client(fresh, remote="192.0.2.7").get("/admin?token=bad").status_code == 403
-    assert client(fresh).get("/admin").status_code == 200
+@pytest.mark.parametrize("remote", ["192.0.2.7", "127.0.0.1", "127.0.1.1"])
+def test_admin_needs_the_token_signed_in_by_a_form_not_a_url(fresh, remote):
+    """From anywhere, loopback included (on Debian a browser on the machine opening its own
+    name comes from 127.0.1.1), unless ``local_admin`` is asked for."""
+    remote = client(fresh, remote=remote)
+    page = remote.get("/admin")
+    assert page.status_code == 403 and b'action="/admin/login"' in page.data
+    # A token in the URL (which logs and browser histories keep) opens nothing.
+    assert remote.get("/admin?token=admin-token-1234").status_code == 403
+    login_csrf = form_token(page.data)
+    bad = remote.c.post("/admin/login", data={"token": "bad", "csrf_token": login_csrf})
+    assert bad.status_code == 403 and b"not the admin token" in bad.data
+    resp = remote.sign_in()
+    assert resp.headers["Location"].endswith("/admin")
+    cookie = resp.headers["Set-Cookie"]
+    assert "admin-token-1234" not in cookie and "HttpOnly" in cookie and "SameSite=Strict" in cookie
+    assert remote.get("/admin").status_code == 200  # the sign-in is kept in a cookie
+
+
+def test_admin_page_lists_each_participants_link(fresh):
+    c = client(fresh, admin=True)
+    page = c.get("/admin").get_data(as_text=True)
+    for token in c.web.links.values():
+        assert f"http://localhost/p/{token}</code>" in page
 
 
 def test_admin_shows_each_participants_progress(fresh):
-    c = client(fresh)
+    c = client(fresh, admin=True)
     start(c, 2)
     c.post("/p/2/session/0", data=ANSWERS)
     c.post("/p/2/session/1", data=ANSWERS)
@@ -174,7 +262,7 @@ def test_admin_shows_each_participants_progress(fresh):
 
 def test_in_person_mode_enters_answers_in_plan_order_with_the_in_person_question_5(fresh):
     study = load_study(fresh)
-    c = client(fresh)
+    c = client(fresh, admin=True)
     sessions = study.sessions_of(3)
     for s in sessions:
         page = c.get("/admin/in-person/3").get_data(as_text=True)
@@ -196,7 +284,7 @@ def test_admin_table_shows_an_in_person_participants_next_live_pair_not_a_practi
     """In person there is no practice session: after two entered pairs the table says session
     3 (it said "practice" for as long as the participant took part)."""
     study = load_study(fresh)
-    c = client(fresh)
+    c = client(fresh, admin=True)
     for s in study.sessions_of(3)[:2]:
         resp = c.post("/admin/in-person/3", data={**ANSWERS, "session": str(s.session)})
         assert resp.status_code == 303
@@ -205,7 +293,7 @@ def test_admin_table_shows_an_in_person_participants_next_live_pair_not_a_practi
 
 
 def test_in_person_entry_for_an_online_participant_is_refused(fresh):
-    c = client(fresh)
+    c = client(fresh, admin=True)
     start(c, 4)
     resp = c.post("/admin/in-person/4", data={**ANSWERS, "session": "1"})
     assert resp.status_code == 409 and b"answers online" in resp.data
@@ -282,16 +370,19 @@ def test_table_6_1_reproduced_through_the_served_6_3_study(tmp_path):
     json.dumps(result.to_json())
 
 
-def test_token_only_admin_refuses_loopback_without_the_token(fresh):
-    app = create_app(str(fresh), admin_token="tok", local_admin=False)
-    c = app.test_client()
-    c.environ_base["REMOTE_ADDR"] = "127.0.0.1"
-    assert c.get("/admin").status_code == 403
-    assert c.get("/admin?token=tok").status_code == 200
+def test_local_admin_opens_admin_to_loopback_only_when_asked_for(fresh):
+    assert client(fresh).get("/admin").status_code == 403  # the default
+    c = client(fresh, local_admin=True)
+    assert c.get("/admin").status_code == 200
+    # Its forms work with a session of its own (a cookie), as a signed-in one's do.
+    start(client(fresh), 5)
+    resp = c.post("/admin/in-person/5", data={**ANSWERS, "session": "1"})
+    assert resp.status_code == 409 and b"answers online" in resp.data
+    assert client(fresh, remote="192.0.2.7", local_admin=True).get("/admin").status_code == 403
 
 
 def test_export_names_the_mode_as_group_when_a_study_has_both(fresh, tmp_path):
-    c = client(fresh)
+    c = client(fresh, admin=True)
     start(c, 1)
     c.post("/p/1/session/0", data=ANSWERS)
     c.post("/p/1/session/1", data=ANSWERS)

@@ -7,19 +7,28 @@ from __future__ import annotations
 import threading
 import time
 
-from study_web import StudyServer, http, render_tiny_study
+from study_web import StudyServer, Visitor, http, render_tiny_study
 
 from gazebot.study.folder import load_study
 
 ANSWERS = {"q1": "2", "q2": "1", "q3": "2", "q4": "1", "q5": "1"}
 
 
-def _post_all(base: str, pid: int, sessions: list[int], confirmed: list, stop: threading.Event):
+def _post_all(
+    browser: Visitor,
+    link: str,
+    pid: int,
+    sessions: list[int],
+    confirmed: list,
+    stop: threading.Event,
+):
+    csrf = browser.form_token(link)
     for k in sessions:
         if stop.is_set():
             return
         try:
-            status, _, _ = http("POST", f"{base}/p/{pid}/session/{k}", ANSWERS)
+            data = {**ANSWERS, "csrf_token": csrf}
+            status, _, _ = browser.request("POST", f"{link}/session/{k}", data)
         except OSError:  # the server died under this request
             return
         if status == 303:
@@ -32,16 +41,22 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
     study = load_study(study_dir)
     server = StudyServer(study_dir).start()
     try:
+        links = server.links
+        browsers = {pid: Visitor(server.base) for pid in study.participants}
+        csrf = {pid: browsers[pid].form_token(links[pid]) for pid in study.participants}
         for pid in study.participants:
-            http("POST", f"{server.base}/p/{pid}/consent", {"consent": "yes"})
-            http("POST", f"{server.base}/p/{pid}/instructions")
+            b, link, token = browsers[pid], links[pid], csrf[pid]
+            consent = {"consent": "yes", "csrf_token": token}
+            assert b.request("POST", f"{link}/consent", consent)[0] == 303
+            assert b.request("POST", f"{link}/instructions", {"csrf_token": token})[0] == 303
         confirmed: list[tuple[int, int]] = []
         stop = threading.Event()
         threads = [
             threading.Thread(
                 target=_post_all,
                 args=(
-                    server.base,
+                    browsers[pid],
+                    links[pid],
                     pid,
                     [0] + [s.session for s in study.sessions_of(pid)],
                     confirmed,
@@ -65,17 +80,19 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
         assert len(at_kill) < len(study.participants) * 7  # the kill came mid-study
 
         server.start()
+        assert server.links == links  # a link handed out stays valid across a restart
         stored = {(a.participant, a.session) for a in study.store().answers(include_practice=True)}
         assert set(at_kill) <= stored  # nothing confirmed is lost
         # Everyone carries on from where the server says they are; resent answers count once.
         for pid in study.participants:
             for k in [0] + [s.session for s in study.sessions_of(pid)]:
-                status, _, _ = http("POST", f"{server.base}/p/{pid}/session/{k}", ANSWERS)
+                data = {**ANSWERS, "csrf_token": csrf[pid]}  # a form loaded before the kill
+                status, _, _ = browsers[pid].request("POST", f"{links[pid]}/session/{k}", data)
                 assert status == 303
         answers = study.store().answers(include_practice=True)
         keys = [(a.participant, a.session) for a in answers]
         assert len(keys) == len(set(keys)) == len(study.participants) * 7
-        status, _, body = http("GET", f"{server.base}/p/1")
+        status, _, body = http("GET", links[1])
         assert status == 200 and b"You have completed all 6 sessions" in body
     finally:
         server.stop()

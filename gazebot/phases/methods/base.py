@@ -3,12 +3,48 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Literal, Protocol
 
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import Signals, compute_signals
 from gazebot.phases.segment import Segment
 from gazebot.phases.trajectory import Trajectory
+from gazebot.types import Phase
+
+# What one online period runs: the whole method, only the end-of-phase prediction, or nothing.
+TriggerMode = Literal["full", "refresh", "skip"]
+
+
+@dataclass(frozen=True)
+class OnlineState:
+    """What an online trigger reads of the detector at the end of a period.
+
+    Attributes:
+        phase: Current phase.
+        phase_start: Its start (s; NaN in ``idle``).
+        floor: The next phase never starts before this (s).
+        tracking: False while tracking is lost.
+        joined_late: The current phase began before the detector saw the hands move.
+        last_full: When the method last ran (s).
+    """
+
+    phase: Phase
+    phase_start: float
+    floor: float
+    tracking: bool
+    joined_late: bool
+    last_full: float
+
+
+class OnlineTrigger(Protocol):
+    """A method's cheap per-period check of whether its analysis needs to run."""
+
+    def add(self, g: np.ndarray, g_ok: bool, r: np.ndarray, r_ok: bool) -> None: ...
+
+    def decide(self, now: float, state: OnlineState) -> TriggerMode: ...
 
 
 class Segmenter(ABC):
@@ -19,6 +55,9 @@ class Segmenter(ABC):
     """
 
     name: str = ""
+    # Online, once the hands are in contact, the method's own :meth:`phase_end` rules end the
+    # transfer and the retreat (else the detector reads those ends from the segments).
+    rules_after_contact: bool = False
 
     def __init__(self, config: PhaseConfig) -> None:
         self.config = config
@@ -35,6 +74,26 @@ class Segmenter(ABC):
         """Segments of a whole recording (sorted first, see :meth:`Trajectory.cleaned`)."""
         traj, _, _ = trajectory.cleaned()
         return self.segment_sorted(traj)
+
+    # ---- online hooks (the PhaseDetector calls these; the defaults re-run the whole method)
+    def trigger(self) -> OnlineTrigger | None:
+        """A fresh cheap trigger for one online detector, or ``None``: analyse every period."""
+        return None
+
+    def online_signals(self, trajectory: Trajectory) -> Signals | None:
+        """The signals of the samples seen so far (for the end-of-phase prediction)."""
+        return compute_signals(trajectory, self.config) if len(trajectory) else None
+
+    def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
+        """Segments of the samples seen so far (``s``: :meth:`online_signals` of them)."""
+        return self.segment_sorted(trajectory, partial=True)
+
+    def phase_end(
+        self, s: Signals, phase: Phase, phase_start: float, joined_late: bool
+    ) -> tuple[float, str] | None:
+        """For a method with ``rules_after_contact``: once in a transfer or retreat, when that
+        phase ended (``(time, source)``), or ``None`` while it goes on."""
+        raise NotImplementedError(f"{self.name} reads phase ends from its segments")
 
 
 def central_speed(t: np.ndarray, p: np.ndarray, half: float) -> np.ndarray:

@@ -18,11 +18,12 @@ import math
 import numpy as np
 
 from gazebot.phases.filtering import Signals, compute_signals
-from gazebot.phases.methods.base import Segmenter
+from gazebot.phases.methods.base import OnlineTrigger, Segmenter
+from gazebot.phases.methods.gazebot_trigger import GazebotTrigger
 from gazebot.phases.rules.reach import reach_start, trailing_reach
 from gazebot.phases.rules.release import transfer_end
-from gazebot.phases.rules.retreat import far_after, rest_after
-from gazebot.phases.rules.transfer import find_cores
+from gazebot.phases.rules.retreat import far_after, rest_after, retreat_done
+from gazebot.phases.rules.transfer import TransferCore, find_cores
 from gazebot.phases.segment import Segment
 from gazebot.phases.trajectory import Trajectory
 from gazebot.types import Phase
@@ -32,6 +33,7 @@ class GazebotSegmenter(Segmenter):
     """The robust default method (see the module docstring)."""
 
     name = "gazebot"
+    rules_after_contact = True
 
     def signals(self, trajectory: Trajectory, partial: bool = False) -> Signals | None:
         """The smoothed signals (cut ``edge_guard`` before the last sample when ``partial``)."""
@@ -44,6 +46,37 @@ class GazebotSegmenter(Segmenter):
                 return None
             s = Signals(*(getattr(s, f)[keep] for f in s.__dataclass_fields__))
         return s
+
+    # ---- online hooks
+    def trigger(self) -> OnlineTrigger:
+        """The cheap per-period trigger (:mod:`~gazebot.phases.methods.gazebot_trigger`)."""
+        return GazebotTrigger(self.config)
+
+    def online_signals(self, trajectory: Trajectory) -> Signals | None:
+        """The signals cut ``edge_guard`` before the newest sample: the last stretch of the
+        smoothed speed sags (one-sided window), so predictions read what the rules read."""
+        return self.signals(trajectory, partial=True)
+
+    def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
+        return self.segment_signals(s, now, True)
+
+    def phase_end(
+        self, s: Signals, phase: Phase, phase_start: float, joined_late: bool
+    ) -> tuple[float, str] | None:
+        """Once the hands are in contact, the release and retreat-end rules run from the
+        phase's own start (so a phase adopted from elsewhere, or older than the online window,
+        ends like any other); before, the whole method finds the next handover."""
+        if phase is Phase.TRANSFER:
+            n = s.t.shape[0]
+            i0 = min(int(np.searchsorted(s.t, phase_start)), n - 1)
+            core = TransferCore(0, i0, n - 1, n - 1, max(phase_start, float(s.t[0])))
+            t_end, open_end = transfer_end(s, self.config, core)
+            if open_end or t_end >= float(s.t[-1]):
+                return None
+            return t_end, "motion"
+        if phase is Phase.RETREAT:
+            return retreat_done(s, self.config, phase_start, joined_late)
+        raise ValueError(f"phase_end is for a transfer or retreat, not {phase.value}")
 
     def segment_sorted(self, trajectory: Trajectory, partial: bool = False) -> list[Segment]:
         s = self.signals(trajectory, partial)

@@ -13,6 +13,12 @@ signed speed is ``dD/dt``, as ``(D(t + h) - D(t - h)) / 2h`` with ``h = seed_spe
 have been above ``v_1 v_max`` first (it starts at zero). The seed splits single giving motions:
 one handover per recording; a boundary never reached leaves its phase open to the data end.
 Missing samples are skipped.
+
+Our one addition (not in the seed): a giving motion moves the hand at least
+``seed_min_motion`` (0.10 m) from its start. The published thresholds are fractions of the
+recording's own maxima, so on a hand that never moved ``d_max`` is the marker noise and the
+rule splits noise into phantom phases (three segments on a still hand with 1 mm of noise);
+such a recording has no giving motion and gives no segments.
 """
 
 from __future__ import annotations
@@ -50,6 +56,8 @@ class Seed443Segmenter(Segmenter):
         p = trajectory.giver_hand[ok]
         dist = np.linalg.norm(p - p[0], axis=1)
         v = signed_speed(t, dist, c.seed_speed_half_window)
+        if not float(dist.max()) >= c.seed_min_motion:
+            return []  # no giving motion (our addition, see the module docstring)
         d_lim = c.seed_d1 * float(dist.max())
         v_lim = c.seed_v1 * float(np.nanmax(v, initial=0.0))
         if not d_lim > 0 or not v_lim > 0:

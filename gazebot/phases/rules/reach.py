@@ -12,12 +12,11 @@ under way when the data end (no transfer yet) is one where the hands have closed
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals
+from gazebot.phases.rules.onset import min_jerk_span
 
 
 def reach_start(s: Signals, c: PhaseConfig, lo: int, hi: int) -> float:
@@ -59,12 +58,11 @@ def _onset(
     rest = np.flatnonzero(speed[lo:i_c] < c.rest_speed)
     i_r = lo + int(rest[-1]) if rest.size else lo
     x = float(np.linalg.norm(pos[i_c] - pos[i_r]))
-    vc = float(speed[i_c])
-    back = 3.0 * x / vc if math.isfinite(x) and vc > 0 else 0.0
+    back = min_jerk_span(x, float(speed[i_c]), c.max_refine)
     floor = float(s.t[lo])
     if i_c - i_r > 1 and not np.isfinite(speed[i_r + 1 : i_c]).all():
         floor = max(floor, float(s.t[i_r]))
-    return max(float(s.t[i_c]) - min(back, c.max_refine), floor)
+    return max(float(s.t[i_c]) - back, floor)
 
 
 def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:

@@ -1,15 +1,18 @@
 """Transfer -> retreat: when the giver lets go.
 
-The held pose is the median relative position (receiver - giver) over the last samples of the
-hold where the hands were still together (relative speed within ``settle_floor_factor`` times
-the hold's floor); its RMS jitter there measures the tracking noise. The release is not before
-that last still sample. The
-release is seen once the relative position has left the held pose by ``release_distance``, or
+The hands are still together while their relative speed *against their common motion*
+(``Signals.hold_speed``) stays within ``settle_floor_factor`` times the hold's floor: hands
+carrying an object together turn with it, so the marker frames behind the hands swing at a
+constant distance (issue 20: 0.02-0.10 m/s of relative motion through a 1 s joint carry), and
+judged against stillness that hold would end at its first turn. The held pose is the median
+relative position (receiver - giver) over the last samples still together; its RMS jitter
+there measures the tracking noise. The release is not before that last still sample. It is seen
+once the relative position has left the held pose by ``release_distance``, or
 ``release_noise_factor`` times that jitter if larger, and is back-dated with the minimum-jerk
-start ``t0 = t - 3 x / v`` (the hands leave rest along ``x ~ (t - t0)^3``; at most
-``max_refine``). A release hidden in a tracking gap is dated from the separation seen before
-the gap, else from the giver's own motion onset after it. If the hands never part before the
-data end, the transfer is still open.
+start (:func:`~gazebot.phases.rules.onset.min_jerk_span`, at most ``max_refine``). A release
+hidden in a tracking gap is dated from the separation seen before the gap, else from the
+giver's own motion onset after it. If the hands never part before the data end, the transfer
+is still open.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals
+from gazebot.phases.rules.onset import min_jerk_span
 from gazebot.phases.rules.transfer import TransferCore, hold_floor
 
 
@@ -34,9 +38,10 @@ def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np
 def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float, bool]:
     """``(t_end, open_end)``: the release time, and whether the data end before it.
 
-    The held pose is taken at the end of the hold (the last settled samples of the core): both
-    hands carry the object during a transfer, so the relative pose drifts slowly, and a pose
-    from the start of the hold would date the release early.
+    The held pose is taken at the end of the hold (the last samples still together, judged by
+    ``hold_speed``): both hands carry the object during a transfer, and may turn with it, so
+    the relative pose drifts, and a pose from the start of the hold would date the release
+    early.
     """
     a, b = core.start, core.end
     t_start = core.t_start if math.isfinite(core.t_start) else float(s.t[a])
@@ -44,7 +49,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # not before it.
     v_still = c.settle_floor_factor * hold_floor(s, c, a, b)
     i0 = min(max(a, int(np.searchsorted(s.t, t_start))), b)
-    still = np.flatnonzero(s.rel_speed[i0 : b + 1] <= v_still) + i0
+    still = np.flatnonzero(s.hold_speed[i0 : b + 1] <= v_still) + i0
     i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)
@@ -57,9 +62,9 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     while j + 1 < n and not np.linalg.norm(s.rel[j] - held) >= sep_min:
         if not np.isfinite(s.rel_speed[j + 1]):
             sep = float(np.linalg.norm(s.rel[j] - held))
-            v = float(s.rel_speed[j])
-            if sep >= 0.5 * sep_min and v > 1e-6:
-                return max(float(s.t[j]) - min(3.0 * sep / v, c.max_refine), t_start), False
+            if sep >= 0.5 * sep_min and s.rel_speed[j] > 1e-6:
+                back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
+                return max(float(s.t[j]) - back, t_start), False
             onset = giver_onset_after(s, c, j)
             if onset is None and not np.isfinite(s.rel_speed[j + 1 :]).any():
                 return float(s.t[-1]), True  # tracking lost until the end, nothing moved
@@ -68,9 +73,8 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     if j == n - 1 and not np.linalg.norm(s.rel[j] - held) >= sep_min:
         return float(s.t[-1]), True
     sep = float(np.linalg.norm(s.rel[j] - held))
-    v = float(s.rel_speed[j])
-    back = 3.0 * sep / v if v > 1e-6 and math.isfinite(sep) else 0.0
-    return max(float(s.t[j]) - min(back, c.max_refine), t_start, float(s.t[i_h])), False
+    back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
+    return max(float(s.t[j]) - back, t_start, float(s.t[i_h])), False
 
 
 def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
@@ -81,7 +85,7 @@ def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
         return None
     i = j + int(fast[0])
     x = float(np.linalg.norm(s.giver[i] - s.giver[j]))
-    back = 3.0 * x / float(v[fast[0]]) if math.isfinite(x) else 0.0
     # Across a tracking gap the motion may have started anywhere in it.
     unseen = float(np.count_nonzero(~np.isfinite(v[: fast[0]]))) / c.analysis_rate
-    return max(float(s.t[i]) - min(back, c.max_refine + unseen), float(s.t[j]))
+    back = min_jerk_span(x, float(v[fast[0]]), c.max_refine + unseen)
+    return max(float(s.t[i]) - back, float(s.t[j]))

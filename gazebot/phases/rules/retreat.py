@@ -14,6 +14,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals
+from gazebot.phases.rules.onset import min_jerk_span
 
 
 def rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> tuple[float, bool]:
@@ -32,10 +33,9 @@ def rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> tuple[float, boo
     moving = np.flatnonzero(s.giver_speed[lo + int(fast[0]) : i_r + 1] >= c.reach_onset_speed)
     i_c = lo + int(fast[0]) + int(moving[-1])
     x = float(np.linalg.norm(s.giver[i_r] - s.giver[i_c]))
-    speed = float(s.giver_speed[i_c])
-    fwd = 3.0 * x / speed if math.isfinite(x) and speed > 0 else 0.0
+    fwd = min_jerk_span(x, float(s.giver_speed[i_c]), c.max_refine)
     seen = rest.size > 0 or hi < s.t.shape[0] - 1
-    return min(float(s.t[i_c]) + min(fwd, c.max_refine), float(s.t[hi])), seen
+    return min(float(s.t[i_c]) + fwd, float(s.t[hi])), seen
 
 
 def far_after(s: Signals, c: PhaseConfig, i_end: int) -> float:

@@ -12,6 +12,10 @@ tracking gaps merge. The giver's hand must have moved (``reach_onset_speed``) be
 a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
 more than the giver.
 
+A dip with no such run at least ``min_transfer`` long is a handover on the move when the
+hands pass the object without stopping (:func:`pass_core`): its core is the short stretch
+under ``transfer_exit_speed`` at the closest, slowest point, once the hands are seen parting.
+
 The seed's 15 cm/s is crossed on the tail of the approach, before contact. The transfer starts
 where the approach has stopped: the relative speed falls below ``settle_fraction`` of the
 approach's own peak relative speed (scale-free: fast and slow approaches alike), or below
@@ -29,6 +33,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import Signals
+from gazebot.phases.rules.onset import min_jerk_span
 
 
 @dataclass(frozen=True)
@@ -109,7 +114,10 @@ def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
         near = np.zeros(n, dtype=bool)
         near[lo : hi + 1] = d[lo : hi + 1] <= d[p] + c.transfer_distance_margin
         rule_runs = runs(near & (rs < c.transfer_speed_max))
-        if not rule_runs:
+        if not any(b - a + 1 >= min_len for a, b in rule_runs):
+            passed = pass_core(s, c, near, rs, lo, p, hi)
+            if passed is not None and (not out or passed[0] > out[-1].end):
+                out.append(TransferCore(lo, passed[0], passed[1], hi, float(s.t[passed[0]])))
             continue
         soft = near & (rs < c.transfer_exit_speed)
         merged: list[list[int]] = [list(rule_runs[0])]
@@ -128,15 +136,53 @@ def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
         a, b = core
         if b - a + 1 < min_len:
             continue
-        top = float(np.nanmax(d[lo : p + 1]))
-        if top - d[p] < c.approach_fraction * top:
-            continue  # the hands paused while still far apart (relative to where they started)
-        if not np.nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed:
-            continue  # only the receiver moved: not a handover
+        if not is_handover_dip(s, c, lo, p, a):
+            continue  # a pause far apart, or only the receiver moved: not a handover
         if out and a <= out[-1].end:
             continue  # the same transfer seen from a neighbouring dip
         out.append(TransferCore(lo, a, b, hi, transfer_start(s, c, lo, a, b)))
     return out
+
+
+def is_handover_dip(s: Signals, c: PhaseConfig, lo: int, p: int, a: int) -> bool:
+    """The dip ``[lo .. p]`` closes ``approach_fraction`` of where the hands started and the
+    giver's hand moved (``reach_onset_speed``) before grid index ``a``."""
+    d = s.distance
+    top = float(np.nanmax(d[lo : p + 1]))
+    if top - d[p] < c.approach_fraction * top:
+        return False  # the hands paused while still far apart (relative to where they started)
+    return bool(np.nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed)
+
+
+def pass_core(
+    s: Signals, c: PhaseConfig, near: np.ndarray, rs: np.ndarray, lo: int, p: int, hi: int
+) -> tuple[int, int] | None:
+    """A handover without a hold (a quick or on-the-move pass: the hands never slow under the
+    seed's 15 cm/s for ``min_transfer``): the object changes hands where they are closest and
+    slowest. The core is the run under ``transfer_exit_speed`` around the slowest sample of
+    the near run holding the minimum ``p`` (at least ``pass_min_samples`` grid samples), only
+    once the hands are seen parting after it (the dip's far side rises ``min_approach``)."""
+    n = s.t.shape[0]
+    d = s.distance
+    a = p
+    while a > lo and near[a - 1]:
+        a -= 1
+    b = p
+    while b < hi and near[b + 1]:
+        b += 1
+    if b >= n - 1 or not np.nanmax(d[p:], initial=-np.inf) >= d[p] + c.min_approach:
+        return None  # not yet seen parting
+    k = a + int(np.argmin(rs[a : b + 1]))
+    if not rs[k] < c.transfer_exit_speed:
+        return None
+    i, j = k, k
+    while i > a and rs[i - 1] < c.transfer_exit_speed:
+        i -= 1
+    while j < b and rs[j + 1] < c.transfer_exit_speed:
+        j += 1
+    if j - i + 1 < c.pass_min_samples or not is_handover_dip(s, c, lo, p, i):
+        return None
+    return i, j
 
 
 def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
@@ -231,4 +277,4 @@ def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
     v = float(s.rel_speed[i])
     if not (math.isfinite(x) and v > 1e-6):
         return t_a
-    return min(float(s.t[i]) + 3.0 * x / v, t_a)
+    return min(float(s.t[i]) + min_jerk_span(x, v), t_a)

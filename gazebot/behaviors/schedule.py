@@ -1,0 +1,81 @@
+"""The behavior's gaze timing as pure functions: when each segment of a phase starts, the
+phase's expected end, and which segment the gaze follows at a time.
+
+The behavior machine (:mod:`gazebot.behaviors.machine`) calls these from its ``timer``
+transitions' conditions; they keep no state, so each rule is unit-tested on its own.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from gazebot.behaviors.segment import AtEvent, AtFraction, AtNever
+from gazebot.types import Phase
+
+
+def expected_end(
+    phase: Phase, start: float, estimates: Sequence[float], default_s: float
+) -> float:
+    """The current phase's expected end (s), for fraction timings ("halfway").
+
+    ``estimates`` are, in order of trust: the tracking's prediction (the phase detector's), the
+    phase event's own ``expected_end``, the robot's motion plan (its start + planned duration).
+    Only finite ends after ``start`` count; with none, ``start + default_s`` (the behavior's
+    ``phase_durations_s``). A reach ends when both hands have arrived: the latest estimate
+    wins. Any other phase (a retreat ends when the giver's hand is back at rest, usually before
+    the robot is home) takes the first known estimate.
+    """
+    known = [end for end in estimates if math.isfinite(end) and end > start]
+    if not known:
+        return start + default_s
+    if phase is Phase.REACH:
+        return max(known)
+    return known[0]
+
+
+def end_rule(phase: Phase, default_s: float) -> str:
+    """:func:`expected_end`'s rule for ``phase`` in words (the diagram's label)."""
+    pick = "latest" if phase is Phase.REACH else "first known"
+    return f"end: {pick} of tracking, event, robot plan; else {default_s:g} s"
+
+
+def segment_start(
+    at: AtFraction | AtEvent | AtNever, phase_start: float, end: float, anchor: float
+) -> float:
+    """When a segment starts (s): ``phase_start`` plus its fraction of the phase up to
+    ``end``, or its anchor event's time (``anchor``, NaN if it did not happen yet) plus its
+    delay; NaN for ``never`` or an anchor not yet seen."""
+    if isinstance(at, AtFraction):
+        return phase_start + at.fraction * (end - phase_start)
+    if isinstance(at, AtEvent):
+        return anchor + at.delay
+    return math.nan
+
+
+def due_segments(
+    starts: Sequence[float], started: Sequence[bool], t: float, latest: float
+) -> tuple[list[int], int | None]:
+    """Which segments start by ``t`` and which one the gaze follows.
+
+    Args:
+        starts: Each segment's start (s; NaN: not known yet, or never).
+        started: Whether each segment already started (a started segment stays started: a
+            revised estimate never moves the gaze back).
+        t: Now (s).
+        latest: Start (s) of the segment the gaze follows now.
+
+    Returns:
+        The indices that start now, and the one the gaze follows among them: **the latest start
+        wins** (a tie: the later segment), or ``None`` when none starts or all of them start
+        before ``latest``.
+    """
+    fired: list[int] = []
+    best, best_t = None, latest
+    for i, (start, done) in enumerate(zip(starts, started, strict=True)):
+        if done or not start <= t:  # (NaN compares false: not yet)
+            continue
+        fired.append(i)
+        if start >= best_t:
+            best, best_t = i, start
+    return fired, best

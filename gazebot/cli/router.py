@@ -1,0 +1,48 @@
+"""``gazebot router``: a Zenoh router for machines without ``zenohd`` or rmw_zenoh's
+``rmw_zenohd``. gazebot nodes and ROS 2 nodes (rmw_zenoh) join it with
+``--connect tcp/HOST:7447``; it routes their data and liveliness (the ROS graph)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+
+from gazebot.cli.bus import positive
+from gazebot.cli.errors import UsageError
+from gazebot.drivers.session import ROUTER_ENDPOINT, BusConfig, open_session
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "router",
+        help="run a Zenoh router that gazebot and ROS 2 (rmw_zenoh) nodes connect to",
+        description="Start a router-mode Zenoh session: nodes started with --connect "
+        "tcp/HOST:7447 meet through it, as rmw_zenoh deployments do with rmw_zenohd.",
+    )
+    p.add_argument("--listen", action="append", metavar="EP",
+                   help=f"endpoint to listen on, repeatable (default: {ROUTER_ENDPOINT})")
+    p.add_argument("--connect", action="append", default=[], metavar="EP",
+                   help="another router to connect to, repeatable")
+    p.add_argument("--duration", type=positive, default=None,
+                   help="seconds to run (default: until Ctrl-C)")
+    p.set_defaults(func=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    try:
+        cfg = BusConfig(listen=tuple(args.listen or [ROUTER_ENDPOINT]),
+                        connect=tuple(args.connect), mode="router")
+        session = open_session(cfg)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    try:
+        print(f"gazebot router: listening on {list(cfg.listen)} (zid {session.info.zid()})",
+              file=sys.stderr, flush=True)
+        try:
+            threading.Event().wait(args.duration)
+        except KeyboardInterrupt:
+            pass
+    finally:
+        session.close()
+    return 0

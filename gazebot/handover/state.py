@@ -1,0 +1,306 @@
+"""The one handover state: the phase the engine reports is the phase the behavior runs.
+
+:class:`HandoverState` merges two evidence streams into one phase stream:
+
+- the **tracking**: the phase detector's events (``reach_started`` ... ``handover_done``; the
+  detector's own gripper/load-share evidence arrives as its events with ``source`` ``gripper``
+  or ``load_share``);
+- the **robot**: its events (``robot_reach_started``, ``robot_grasped``, ``robot_released``, ...).
+
+The rules are the table :data:`RULES` (drawn in ``gazebot behaviors show NAME --diagram``):
+
+- **the first reach wins**: a ``robot_reach_started`` in idle/done starts the reach (the robot
+  set off first, seed 6.3); the other party's reach start of the same handover only moves the
+  reach start to the earlier of the two;
+- **grasp and release are transfer evidence**: ``robot_grasped`` starts the transfer (from idle,
+  reach or done), ``robot_released`` (robot-to-human) ends it (the retreat starts);
+- **stale events**: a phase-changing event older than the last phase change, a duplicate of the
+  current phase's event, or one the phase graph does not allow from the current phase is ignored
+  (counted in :attr:`HandoverState.ignored`);
+- a phase move backwards (``reach_started`` in transfer/retreat: the previous ``handover_done``
+  was missed) or from idle/done starts a **new handover**: the robot events of the previous one
+  stop counting.
+
+Besides the phase, the state keeps what the behavior's timing reads: the robot events of the
+current handover (anchors of ``{after: EVENT}`` segments and their ``planned_duration``), and the
+estimates of the phase's end (the phase event's ``expected_end``, the robot's motion plan).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from gazebot.types import EVENT_OF_PHASE, PHASE_OF_EVENT, Event, EventKind, Phase, PhaseSource
+
+_ORDER = {Phase.IDLE: 0, Phase.REACH: 1, Phase.TRANSFER: 2, Phase.RETREAT: 3, Phase.DONE: 4}
+_BETWEEN = (Phase.IDLE, Phase.DONE)
+# Robot motions whose planned duration estimates the end of a phase.
+_ROBOT_MOTION = {
+    Phase.REACH: EventKind.ROBOT_REACH_STARTED,
+    Phase.RETREAT: EventKind.ROBOT_RETREAT_STARTED,
+}
+# Phase-event sources the detector reports that are the robot's gripper / load-share sensors.
+_GRIPPER_SOURCES = frozenset({"gripper", "load_share"})
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One row of the handover state's table.
+
+    ``trigger`` in a phase of ``sources`` moves to ``dest`` (``dest`` equal to the source phase:
+    the phase stays and only its start may move earlier), when ``condition`` holds.
+    """
+
+    trigger: EventKind
+    sources: tuple[Phase, ...]
+    dest: Phase | None  # None: stays in the source phase
+    condition: str
+
+
+_NEWER = "not older than the last phase change"
+_SAME = "same handover: the reach starts with the first"
+#: Every rule of the handover state (the running lookup and the diagram are built from it).
+RULES: tuple[Rule, ...] = (
+    Rule(EventKind.REACH_STARTED, (Phase.IDLE, Phase.DONE), Phase.REACH, _NEWER),
+    Rule(
+        EventKind.REACH_STARTED,
+        (Phase.TRANSFER, Phase.RETREAT),
+        Phase.REACH,
+        _NEWER + " (handover_done was missed: a new handover)",
+    ),
+    Rule(EventKind.REACH_STARTED, (Phase.REACH,), None, _SAME + " (the robot's started it)"),
+    Rule(EventKind.ROBOT_REACH_STARTED, (Phase.IDLE, Phase.DONE), Phase.REACH, _NEWER),
+    Rule(EventKind.ROBOT_REACH_STARTED, (Phase.REACH,), None, _SAME + " (the giver's started it)"),
+    Rule(
+        EventKind.TRANSFER_STARTED, (Phase.IDLE, Phase.REACH, Phase.DONE), Phase.TRANSFER, _NEWER
+    ),
+    Rule(
+        EventKind.ROBOT_GRASPED,
+        (Phase.IDLE, Phase.REACH, Phase.DONE),
+        Phase.TRANSFER,
+        _NEWER + ": the grasp is transfer evidence",
+    ),
+    Rule(
+        EventKind.RETREAT_STARTED,
+        (Phase.IDLE, Phase.REACH, Phase.TRANSFER, Phase.DONE),
+        Phase.RETREAT,
+        _NEWER + " (a missed phase is skipped)",
+    ),
+    Rule(
+        EventKind.ROBOT_RELEASED,
+        (Phase.TRANSFER,),
+        Phase.RETREAT,
+        _NEWER + ": the release ends the transfer",
+    ),
+    Rule(
+        EventKind.HANDOVER_DONE,
+        (Phase.REACH, Phase.TRANSFER, Phase.RETREAT),
+        Phase.DONE,
+        _NEWER,
+    ),
+)
+_LOOKUP: dict[tuple[EventKind, Phase], Rule] = {
+    (rule.trigger, source): rule for rule in RULES for source in rule.sources
+}
+_PHASE_TRIGGERS = frozenset(rule.trigger for rule in RULES)
+
+
+@dataclass(frozen=True)
+class PhaseChange:
+    """The handover state moved to ``phase`` at ``t`` (from ``previous``).
+
+    Attributes:
+        phase: The new phase.
+        t: Its start (s).
+        previous: The phase it left.
+        source: What decided it (``tracking``, ``robot``, ``gripper``).
+        new_handover: A new handover began (its gaze starts afresh; ``done`` is never one).
+        rule: The :class:`Rule` that applied.
+    """
+
+    phase: Phase
+    t: float
+    previous: Phase
+    source: PhaseSource
+    new_handover: bool
+    rule: Rule
+
+
+def _finite(x: object) -> bool:
+    try:
+        return math.isfinite(x)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return False
+
+
+def _parse(event: Event) -> tuple[EventKind, float] | None:
+    """``(kind, time)`` of an event (its ``t``, else ``detected_at``); ``None`` when the kind is
+    unknown or no time is finite."""
+    try:
+        kind = EventKind(getattr(event, "kind", None))
+    except ValueError:
+        return None
+    for value in (getattr(event, "t", None), getattr(event, "detected_at", None)):
+        if _finite(value):
+            return kind, float(value)
+    return None
+
+
+def event_source(event: Event) -> PhaseSource:
+    """What an event is evidence from: the robot's gripper (a grasp, a release, or the
+    detector's gripper/load-share evidence), the robot's motion, or the tracking."""
+    kind = event.kind
+    if kind in (EventKind.ROBOT_GRASPED, EventKind.ROBOT_RELEASED):
+        return "gripper"
+    if kind not in PHASE_OF_EVENT:
+        return "robot"
+    info = event.info if isinstance(event.info, dict) else {}
+    return "gripper" if info.get("source") in _GRIPPER_SOURCES else "tracking"
+
+
+@dataclass
+class HandoverState:
+    """The current handover's phase and the evidence its timing reads (see the module docs).
+
+    Feed every phase and robot event with :meth:`apply` (phase changes come back); read
+    :attr:`phase`, :attr:`phase_start` and :attr:`source`.
+    """
+
+    phase: Phase = Phase.IDLE
+    phase_start: float = -math.inf
+    source: PhaseSource = "tracking"
+    #: Index of the current (or last) handover, -1 before the first.
+    handover: int = -1
+    #: Events ignored as stale, duplicated or not allowed from the current phase.
+    ignored: int = 0
+    #: The phase event's own ``expected_end`` (s), NaN when it gave none.
+    event_end: float = math.nan
+    #: Events at or after this belong to the current handover (s).
+    handover_t0: float = -math.inf
+    _last_change: float = -math.inf
+    _reach_by: set[str] = field(default_factory=set)  # "robot" / "giver": who started the reach
+    _robot: dict[EventKind, Event] = field(default_factory=dict)
+
+    def reset(self) -> None:
+        """Back to idle before any handover."""
+        self.__init__()  # type: ignore[misc]
+
+    # ----------------------------------------------------------------- input
+    def apply(self, event: Event) -> PhaseChange | None:
+        """Apply one phase or robot event; the phase change it caused, else ``None``.
+
+        Events with an unknown kind or no finite time are ignored (counted); tracking events
+        are not the handover state's (returns ``None`` without counting).
+        """
+        parsed = _parse(event)
+        if parsed is None:
+            self.ignored += 1
+            return None
+        kind, t = parsed
+        if kind not in PHASE_OF_EVENT and kind.value.startswith("robot_"):
+            if not self._keep_robot(kind, t, event):
+                self.ignored += 1
+                return None
+        rule = self._rule(kind, t)
+        if rule is None:
+            if kind in PHASE_OF_EVENT:  # stale, duplicate or not allowed from this phase
+                self.ignored += 1
+            return None
+        if rule.dest is None:
+            return self._earlier_reach(kind, t)
+        return self._enter(rule, t, event)
+
+    def would_move(self, event: Event) -> float | None:
+        """The time (s) at which ``event`` would change the phase, ``None`` if it would not
+        (nothing changes: the behavior first brings its gaze up to that time)."""
+        parsed = _parse(event)
+        if parsed is None:
+            return None
+        rule = self._rule(*parsed)
+        return parsed[1] if rule is not None and rule.dest is not None else None
+
+    def _rule(self, kind: EventKind, t: float) -> Rule | None:
+        """The rule ``kind`` at ``t`` meets in the current phase (``None``: none, or stale)."""
+        rule = _LOOKUP.get((kind, self.phase))
+        if rule is None or (rule.dest is not None and t < self._last_change):
+            return None
+        return rule
+
+    # ----------------------------------------------------------------- timing evidence
+    def anchor(self, kind: EventKind) -> float:
+        """When ``kind`` happened in the current handover (s): the phase's start for the event
+        that started the current phase, else the robot's latest such event; NaN if not yet."""
+        if EVENT_OF_PHASE.get(self.phase) is kind:
+            return self.phase_start
+        ev = self._robot.get(kind)
+        if ev is None or ev.t < self.handover_t0:
+            return math.nan
+        return ev.t
+
+    def robot_motion_end(self) -> float:
+        """End of the robot's own reach/retreat in the current phase (start + planned
+        duration, s), NaN if unknown."""
+        motion = _ROBOT_MOTION.get(self.phase)
+        ev = self._robot.get(motion) if motion is not None else None
+        if ev is None or ev.t < self.handover_t0:
+            return math.nan
+        planned = ev.info.get("planned_duration")
+        return ev.t + float(planned) if _finite(planned) and planned > 0 else math.nan
+
+    # ----------------------------------------------------------------- internals
+    def _keep_robot(self, kind: EventKind, t: float, event: Event) -> bool:
+        old = self._robot.get(kind)
+        if old is not None and old.t > t:
+            return False  # an older copy arriving late
+        info: Any = getattr(event, "info", None)
+        self._robot[kind] = Event(kind, t, t, dict(info) if isinstance(info, dict) else {})
+        return True
+
+    def _earlier_reach(self, kind: EventKind, t: float) -> None:
+        """The other party's reach start of the current handover: the reach starts with the
+        first (a duplicate of the same party's is ignored)."""
+        party = "robot" if kind is EventKind.ROBOT_REACH_STARTED else "giver"
+        if t < self.handover_t0 or (party in self._reach_by and kind in PHASE_OF_EVENT):
+            if kind in PHASE_OF_EVENT:
+                self.ignored += 1
+            return None
+        self._reach_by.add(party)
+        if t < self.phase_start:
+            self.phase_start = t
+            if party == "robot":
+                self.source = "robot"
+        return None
+
+    def _enter(self, rule: Rule, t: float, event: Event) -> PhaseChange:
+        previous, phase = self.phase, rule.dest
+        assert phase is not None
+        new = phase is not Phase.DONE and (
+            previous in _BETWEEN or _ORDER[phase] <= _ORDER[previous]
+        )
+        if new:
+            # Keep only what belongs to this handover: events since its start, and a robot
+            # reach that began between the previous handover's end and this start.
+            if previous is Phase.DONE:
+                self.handover_t0 = self.phase_start
+            elif previous is not Phase.IDLE:
+                self.handover_t0 = t  # the previous handover_done was missed
+            self._robot = {
+                k: e
+                for k, e in self._robot.items()
+                if e.t >= t or (k is EventKind.ROBOT_REACH_STARTED and e.t >= self.handover_t0)
+            }
+            self.handover += 1
+            self._reach_by = set()
+        if phase is Phase.REACH:
+            by_robot = rule.trigger is EventKind.ROBOT_REACH_STARTED
+            self._reach_by.add("robot" if by_robot else "giver")
+        self.phase = phase
+        self.phase_start = t
+        self._last_change = t
+        self.source = event_source(event)
+        info = event.info if isinstance(event.info, dict) else {}
+        expected = info.get("expected_end", math.nan)
+        self.event_end = float(expected) if _finite(expected) else math.nan
+        return PhaseChange(phase, t, previous, self.source, new, rule)

@@ -1,0 +1,104 @@
+"""The one handover state: the phase stream merged from the detector's and the robot's events."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from gazebot.handover import RULES, HandoverState
+from gazebot.types import Event, EventKind, Phase
+
+
+def ev(kind: str, t: float, **info) -> Event:
+    return Event(EventKind(kind), t, t, dict(info))
+
+
+def test_the_robots_reach_starts_the_reach_and_the_givers_later_one_only_joins_it():
+    s = HandoverState()
+    change = s.apply(ev("robot_reach_started", 0.5, planned_duration=1.2))
+    assert change is not None and change.new_handover and change.source == "robot"
+    assert (s.phase, s.phase_start, s.source) == (Phase.REACH, 0.5, "robot")
+    assert s.apply(ev("reach_started", 1.0)) is None  # the giver responds: same handover
+    assert (s.phase, s.phase_start, s.handover, s.ignored) == (Phase.REACH, 0.5, 0, 0)
+
+
+def test_the_first_reach_wins_even_when_reported_late():
+    s = HandoverState()
+    s.apply(ev("reach_started", 1.0))
+    s.apply(ev("robot_reach_started", 0.8, planned_duration=1.2))  # started first, told later
+    assert (s.phase_start, s.source) == (0.8, "robot")
+    assert s.robot_motion_end() == pytest.approx(2.0)
+
+
+def test_a_duplicate_reach_of_the_same_party_keeps_the_first_time():
+    s = HandoverState()
+    s.apply(ev("reach_started", 1.0))
+    s.apply(ev("reach_started", 1.4))
+    assert s.phase_start == 1.0 and s.ignored == 1
+
+
+@pytest.mark.parametrize("start", [Phase.IDLE, Phase.REACH, Phase.DONE])
+def test_the_grasp_is_transfer_evidence(start):
+    s = HandoverState()
+    if start is not Phase.IDLE:
+        s.apply(ev("reach_started", 1.0))
+    if start is Phase.DONE:
+        s.apply(ev("handover_done", 1.5))
+    change = s.apply(ev("robot_grasped", 2.0))
+    assert change is not None and change.phase is Phase.TRANSFER and change.source == "gripper"
+    assert change.new_handover is (start is not Phase.REACH)
+    # The detector's transfer, seen later, is the same phase: nothing changes.
+    assert s.apply(ev("transfer_started", 2.1)) is None and s.phase_start == 2.0
+
+
+def test_the_robots_release_ends_the_transfer():
+    s = HandoverState()
+    s.apply(ev("robot_reach_started", 1.0))
+    s.apply(ev("robot_grasped", 2.0))
+    change = s.apply(ev("robot_released", 2.6))
+    assert change is not None and change.phase is Phase.RETREAT and not change.new_handover
+    assert s.apply(ev("robot_released", 5.0)) is None  # not in a transfer: no phase move
+
+
+def test_the_detectors_gripper_evidence_is_reported_as_the_gripper():
+    s = HandoverState()
+    s.apply(ev("reach_started", 1.0, source="gripper"))
+    s.apply(ev("transfer_started", 1.0, source="load_share"))
+    assert s.source == "gripper"
+    s.apply(ev("retreat_started", 2.0, source="motion"))
+    assert s.source == "tracking"
+
+
+def test_stale_and_disallowed_phase_events_are_ignored_and_counted():
+    s = HandoverState()
+    s.apply(ev("transfer_started", 2.0))
+    assert s.apply(ev("retreat_started", 1.5)) is None  # older than the transfer
+    assert s.apply(ev("transfer_started", 2.5)) is None  # duplicate
+    assert s.apply(Event(EventKind.REACH_STARTED, math.nan, math.nan)) is None
+    assert s.apply(Event("nope", 3.0, 3.0)) is None  # type: ignore[arg-type]
+    assert s.phase is Phase.TRANSFER and s.ignored == 4
+
+
+def test_a_reach_after_a_missed_done_starts_a_new_handover_without_the_old_robot_events():
+    s = HandoverState()
+    s.apply(ev("reach_started", 1.0))
+    s.apply(ev("robot_reach_ended", 1.8))
+    s.apply(ev("retreat_started", 2.5))
+    change = s.apply(ev("reach_started", 6.0))
+    assert change is not None and change.new_handover and s.handover == 1
+    assert math.isnan(s.anchor(EventKind.ROBOT_REACH_ENDED))
+    assert s.anchor(EventKind.REACH_STARTED) == 6.0
+
+
+def test_would_move_tells_the_time_of_a_phase_change_without_changing_anything():
+    s = HandoverState()
+    assert s.would_move(ev("reach_started", 1.0)) == 1.0
+    assert s.would_move(ev("robot_reach_ended", 1.0)) is None
+    assert s.phase is Phase.IDLE and s.ignored == 0
+
+
+def test_every_rule_is_reachable_from_its_sources():
+    for rule in RULES:
+        for source in rule.sources:
+            assert rule.dest is None or rule.dest is not source, rule

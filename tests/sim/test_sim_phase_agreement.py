@@ -1,0 +1,116 @@
+"""Issue 19's done-when: over every seed behavior x scene x robot-first/giver-first, no tick's
+target comes from a phase's rule while the command reports another phase.
+
+Each (scene, initiator) is one simulated handover; every seed behavior's own
+:class:`~gazebot.runtime.GazeLoop` sees the same frames and robot events tick for tick (the gaze
+moves neither the giver nor the arm). The behavior names the rule behind its current target
+(:attr:`~gazebot.behaviors.BehaviorMachine.origin`: a segment of a phase, the ``before``/``after``
+target, or the gaze carried into a phase); that phase must be the command's.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from gazebot.sim.scene_config import Initiator, load_scene, scene_names
+from gazebot.types import Phase
+
+pytest.importorskip("mujoco")
+
+SEED_BEHAVIORS = (
+    "face",
+    "hand",
+    "short-face-hand",
+    "long-face-hand",
+    "hand-face",
+    "face-hand-face",
+    "face-hand-face-as-studied",
+    "hand-face-as-studied",
+)
+
+
+class _SharedDetector:
+    """The first loop's phase detector; the other loops get its answer to each sample (the
+    detector only reads frames, and costs most of a tick)."""
+
+    def __init__(self, detector) -> None:
+        self._detector = detector
+        self.last: list = []
+
+    def update_all(self, frame):
+        self.last = list(self._detector.update_all(frame))
+        return list(self.last)
+
+    def __getattr__(self, name):
+        return getattr(self._detector, name)
+
+
+class _Replay:
+    def __init__(self, shared: _SharedDetector, own) -> None:
+        self._shared = shared
+        self._own = own  # keeps what adopt() tells it, like a detector of its own would
+
+    def update_all(self, frame):
+        return list(self._shared.last)
+
+    def adopt(self, phase, t0) -> None:
+        self._own.adopt(phase, t0)
+
+    def __getattr__(self, name):
+        return getattr(self._shared, name)
+
+
+class _AllBehaviors:
+    """A ``record_handover`` loop ticking one GazeLoop per seed behavior; records, per tick and
+    behavior, (t, reported phase, target, the phase of the rule behind the target)."""
+
+    def __init__(self, robot) -> None:
+        from gazebot.runtime import GazeLoop
+
+        self.loops = {n: GazeLoop.from_config(robot=robot, behavior=n) for n in SEED_BEHAVIORS}
+        first, *rest = self.loops.values()
+        shared = _SharedDetector(first.engine.detector)
+        first.engine.detector = shared
+        for loop in rest:
+            loop.engine.detector = _Replay(shared, loop.engine.detector)
+        self.ticks: dict[str, list[tuple[float, Phase, str, Phase, str]]] = {
+            n: [] for n in SEED_BEHAVIORS
+        }
+
+    def notify(self, events) -> None:
+        for loop in self.loops.values():
+            loop.notify(events)
+
+    def tick(self, frame, *, t=None, joints=None):
+        out = None
+        for name, loop in self.loops.items():
+            cmd = loop.tick(frame, t=t, joints=joints)
+            assert cmd is not None, f"{name}: unsafe command"
+            phase, rule = loop.engine.behavior.origin
+            self.ticks[name].append((cmd.t, cmd.phase, cmd.target, phase, rule))
+            out = out or cmd
+        return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("initiator", [Initiator.ROBOT, Initiator.GIVER])
+@pytest.mark.parametrize("scene", scene_names())
+def test_no_target_comes_from_another_phase_than_the_one_reported(scene, initiator):
+    from gazebot.sim.record import record_handover
+    from gazebot.sim.robot import load_sim_robot
+
+    config = load_scene(scene)
+    if config.giver_motion is not None:
+        pytest.skip(f"{scene}: replays a recorded giver")
+    config = config.model_copy(update={"initiator": initiator})
+    loop = _AllBehaviors(load_sim_robot("sawyer").spec)
+    rec = record_handover(
+        robot="sawyer", behavior=SEED_BEHAVIORS[0], scene=config, out_path=None,
+        progress=False, loop=loop,
+    )
+    assert rec.completed
+    for name, ticks in loop.ticks.items():
+        phases = {p for _, p, _, _, _ in ticks}
+        assert Phase.REACH in phases, f"{name}: the handover's reach was never reported"
+        wrong = [tick for tick in ticks if tick[1] is not tick[3]]
+        assert not wrong, f"{name}: (t, reported, target, rule phase, rule) {wrong[0]}"

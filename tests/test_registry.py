@@ -1,0 +1,56 @@
+"""One registry per extension kind: CLI choices, config validation and the README's tables come
+from it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from gazebot.config import ConfigError
+from gazebot.controllers import CONTROLLERS, make_controller
+from gazebot.phases import PhaseConfig, load_phase_config
+from gazebot.phases.methods import PHASE_METHODS
+from gazebot.registry import Registry, registries
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def test_every_extension_kind_has_one_registry_with_its_builtins():
+    regs = registries()
+    assert set(regs) == {"robots", "behaviors", "phase methods", "controllers", "eye styles",
+                         "scenes"}
+    assert {"sawyer", "jaco2"} <= set(regs["robots"].names())
+    assert "face-hand-face" in regs["behaviors"].names()
+    assert regs["phase methods"].names()[:3] == ("gazebot", "seed-7.2.5", "seed-4.4.3")
+    assert regs["controllers"].names()[:4] == ("pv", "mcj", "mce", "stl")
+    assert "cartoon" in regs["eye styles"].names() and "default" in regs["scenes"].names()
+    for reg in regs.values():
+        with pytest.raises(ValueError, match=r"unknown .* 'nope' \(known: "):
+            reg.check("nope")
+
+
+def test_a_name_registers_once_unless_replaced_and_loads_lazily():
+    reg: Registry[object] = Registry("thing")
+    reg.register("a", "collections:OrderedDict", "lazy")
+    with pytest.raises(ValueError, match="already registered"):
+        reg.register("a", dict)
+    reg.register("a", dict, replace=True)
+    assert reg.make("a", x=1) == {"x": 1}
+    reg.unregister("a")
+    assert reg.names() == ()
+
+
+def test_an_unknown_controller_or_phase_method_is_one_clear_error(tmp_path):
+    with pytest.raises(ValueError, match=r"unknown controller 'gps2' \(known: pv, mcj"):
+        make_controller("gps2")
+    path = tmp_path / "phases.yaml"
+    path.write_text("method: nope\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match="method"):
+        load_phase_config(path)
+    assert PhaseConfig(method="seed-4.4.3").method == "seed-4.4.3"
+
+
+@pytest.mark.parametrize("registry", [CONTROLLERS, PHASE_METHODS], ids=lambda r: r.kind)
+def test_the_readme_table_is_the_registrys(registry):
+    assert registry.table() in README.read_text(encoding="utf-8")
