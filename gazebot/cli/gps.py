@@ -75,7 +75,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     e = gsub.add_parser("evaluate", help="test a trained policy on the shell")
     e.add_argument("policy", help="directory written by `gazebot gps train`")
-    e.add_argument("--tester", choices=("static", "moving"), default="static")
+    e.add_argument("--tester", choices=("static", "moving"), default="static",
+                   help="the tester holds its hand at each location or reaches it (eq. 5.12)")
     e.add_argument("--mass", type=_positive_float, default=None,
                    help="end-effector mass in kg (default: the training's, 2 kg)")
     e.add_argument("--grid", type=_grid, default=None,
@@ -90,7 +91,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     d = gsub.add_parser("demo", help="render the learned reach to a video")
     d.add_argument("policy", help="directory written by `gazebot gps train`")
     d.add_argument("--out", default="out/gps-demo.mp4", help="output MP4")
-    d.add_argument("--tester", choices=("static", "moving"), default="moving")
+    d.add_argument("--tester", choices=("static", "moving"), default="moving",
+                   help="the tester holds its hand at the target or reaches it (eq. 5.12)")
     d.add_argument("--target", type=float, nargs=3, metavar=("X", "Y", "Z"), default=None,
                    help="the tester hand's final position, m in the learner's base frame "
                    "(default: the middle of the test shell)")
