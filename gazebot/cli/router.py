@@ -8,7 +8,7 @@ import argparse
 import sys
 import threading
 
-from gazebot.cli.bus import positive
+from gazebot.cli.bus import add_zenoh_config_argument, positive, zenoh_file_settings
 from gazebot.cli.errors import UsageError
 from gazebot.drivers.session import ROUTER_ENDPOINT, BusConfig, open_session
 
@@ -26,13 +26,16 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="another router to connect to, repeatable")
     p.add_argument("--duration", type=positive, default=None,
                    help="seconds to run (default: until Ctrl-C)")
+    add_zenoh_config_argument(p)
     p.set_defaults(func=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
+    _, file_listen, file_connect = zenoh_file_settings(args.zenoh_config, "router")
     try:
-        cfg = BusConfig(listen=tuple(args.listen or [ROUTER_ENDPOINT]),
-                        connect=tuple(args.connect), mode="router")
+        cfg = BusConfig(listen=tuple(args.listen or file_listen or [ROUTER_ENDPOINT]),
+                        connect=tuple(args.connect or file_connect), mode="router",
+                        config_file=args.zenoh_config)
         session = open_session(cfg)
     except ValueError as exc:
         raise UsageError(str(exc)) from None

@@ -44,6 +44,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="warn on stderr if no robot data arrived after S seconds (default 3)")
     p.add_argument("--no-resync", action="store_true",
                    help="do not catch up with a handover under way at start")
+    p.add_argument("--standby", action="store_true",
+                   help="if another engine already commands this robot, wait and take over "
+                   "when it stops (default: exit with status 3)")
     p.add_argument("--no-eye-frames", action="store_true",
                    help="never render eye frames (eye state is always published)")
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
@@ -53,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
-    from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
+    from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig, EngineRefused
     from gazebot.drivers.zenoh_driver import ZenohRobotDriver
 
     cfg = bus_config(args, listens_by_default=False, base_frame=robot_base_frame(args.robot))
@@ -61,6 +64,7 @@ def handle(args: argparse.Namespace) -> int:
         silence_after=args.silence_after,
         resync=not args.no_resync,
         no_robot_warning=args.no_robot_warning,
+        standby=args.standby,
     )
     # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
     from gazebot.runtime import GazeLoop
@@ -90,6 +94,9 @@ def handle(args: argparse.Namespace) -> int:
             node.run(duration=args.duration)
         except KeyboardInterrupt:
             pass
+        except EngineRefused as exc:
+            print(f"gazebot run: error: {exc}", file=sys.stderr, flush=True)
+            return 3
         summary = {
             "frames": node.frames_processed,
             "commands": node.commands_sent,

@@ -26,6 +26,7 @@ from gazebot.drivers.rmw.qos import DEFAULT, QosProfile
 from gazebot.ros2.codec import MAX_PAYLOAD_BYTES, Codec
 from gazebot.ros2.errors import MessageError
 from gazebot.ros2.names import ros_type_name
+from gazebot.ros2.topics import max_bytes_of
 
 if TYPE_CHECKING:
     import zenoh
@@ -204,8 +205,10 @@ class Subscription:
             self.handler(msg, Received(self.topic, codec.info.name, att))
         except MessageError as exc:  # the handler found a value it cannot use (NaN, ...)
             drops.drop(self.topic, exc.reason)
-        except Exception:  # a bug in a handler must not kill Zenoh's thread
-            log.exception("handler for %s failed", self.topic)
+        except Exception as exc:  # a bug in a handler must not kill Zenoh's thread
+            self.node.faults.drop(self.topic, f"{type(exc).__name__}: {exc}")
+            if self.node.faults.counts().get(self.topic, 0) <= self.node.faults.log_first:
+                log.exception("handler for %s failed", self.topic)
 
     def undeclare(self) -> None:
         for entity in (self._token, self._sub):
@@ -223,7 +226,8 @@ class RosNode:
         names: Namespace, remapping and domain id.
         name: The node's name.
         store: The type system (default: gazebot's, :func:`gazebot.ros2.typestore.typestore`).
-        max_bytes: Largest payload a subscription decodes, by resolved topic (default
+        max_bytes: Largest payload a subscription decodes, by resolved topic (default: the
+            topic's cap in :mod:`gazebot.ros2.topics`, else
             :data:`~gazebot.ros2.codec.MAX_PAYLOAD_BYTES`).
         on_graph: Called with ``(entity, alive)`` for each token change (on Zenoh's thread).
     """
@@ -250,6 +254,8 @@ class RosNode:
         self.node_id = next(_entity_ids)
         self.graph = Graph(names.domain_id)
         self.drops = DropCounter()
+        # Handler failures (bugs or inputs a handler did not expect), by topic.
+        self.faults = DropCounter()
         self.closed = False
         self.on_graph = on_graph
         self._codecs: dict[tuple[str, int], Codec] = {}
@@ -291,9 +297,10 @@ class RosNode:
             self._token = self.session.liveliness().declare_token(self.node_entity.token())
 
     # -- endpoints -------------------------------------------------------------------------
-    def codec(self, ros_type: str, topic: str = "") -> Codec:
-        """The codec of ``ros_type`` with ``topic``'s size cap."""
-        cap = self.max_bytes.get(topic, MAX_PAYLOAD_BYTES)
+    def codec(self, ros_type: str, topic: str = "", name: str = "") -> Codec:
+        """The codec of ``ros_type`` with the size cap of ``topic`` (resolved; ``name``: as
+        the topic table names it)."""
+        cap = self.max_bytes.get(topic, max_bytes_of(name) if name else MAX_PAYLOAD_BYTES)
         key = (ros_type, cap)
         if key not in self._codecs:
             self._codecs[key] = Codec.for_type(self.store, ros_type, cap)
@@ -302,7 +309,7 @@ class RosNode:
     def publisher(self, name: str, ros_type: str, qos: QosProfile = DEFAULT) -> Publisher:
         """A publisher of ``ros_type`` on topic ``name`` (resolved: namespace, remapping)."""
         topic = self.names.resolve(name)
-        pub = Publisher(self, topic, self.codec(ros_type, topic), qos)
+        pub = Publisher(self, topic, self.codec(ros_type, topic, name), qos)
         self._entities.append(pub)
         return pub
 
@@ -313,7 +320,8 @@ class RosNode:
         with the CDR bytes as received instead of the message)."""
         topic = self.names.resolve(name)
         types = [ros_types] if isinstance(ros_types, str) else list(ros_types)
-        sub = Subscription(self, topic, [self.codec(t, topic) for t in types], handler, qos, raw)
+        sub = Subscription(self, topic, [self.codec(t, topic, name) for t in types], handler, qos,
+                           raw)
         self._entities.append(sub)
         return sub
 
