@@ -27,7 +27,7 @@ $(STAMP): pyproject.toml $(LOCK)
 	touch $@
 
 $(TEST_STAMP): $(STAMP) pyproject.toml $(LOCK)
-	$(PY) -m pip install --quiet -c $(LOCK) -e ".[test]"
+	$(PY) -m pip install --quiet -c $(LOCK) -e ".[test,gps]"
 	touch $@
 
 $(LOW_STAMP): pyproject.toml $(LOWEST)
