@@ -46,7 +46,7 @@ lock lock-upgrade:
 	rm -rf .venv-lock
 	$(PYTHON) -m venv .venv-lock
 	.venv-lock/bin/python -m pip install --quiet --upgrade pip
-	.venv-lock/bin/python -m pip install --quiet $(if $(filter lock,$@),-c constraints.txt) ".[test]"
+	.venv-lock/bin/python -m pip install --quiet $(if $(filter lock,$@),-c constraints.txt) ".[test,gps]"
 	{ sed -n '/^#/p;/^#/!q' constraints.txt; .venv-lock/bin/python -m pip freeze --exclude-editable \
 		| grep -v '^gazebot'; } > constraints.txt.new
 	mv constraints.txt.new constraints.txt
