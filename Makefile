@@ -1,21 +1,56 @@
 # The two commands a new user runs: `make demo` and `make test`. Each sets up .venv itself.
+# pyproject.toml declares version ranges; make installs the exact versions of the lock
+# constraints.txt (resolved on Python 3.11; on Python 3.10, where NumPy 2.4 and SciPy 1.17 do not
+# install, the lowest allowed versions that CI tests there). `make test-lowest` runs the suite on
+# the lowest allowed versions (constraints-lowest.txt) in a venv of its own, on Python 3.10 when
+# one is installed.
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
+LOWEST := constraints-lowest.txt
+LOCK := $(if $(filter 3.10,$(shell $(PYTHON) -c 'import sys; print("%d.%d" % sys.version_info[:2])' \
+	2>/dev/null)),$(LOWEST),constraints.txt)
+LOW_VENV := .venv-lowest
+LOW_STAMP := $(LOW_VENV)/.installed-test
+# The lowest supported Python: python3.10 on PATH, else pyenv's 3.10, else $(PYTHON).
+PYTHON_LOWEST ?= $(shell for p in python3.10 $$HOME/.pyenv/versions/3.10*/bin/python3.10; do \
+	"$$p" -c "" >/dev/null 2>&1 && { echo "$$p"; exit 0; }; done; echo $(PYTHON))
 
-.PHONY: demo test bench lint check-gl browser-deps clean
+.PHONY: demo test test-lowest bench lint lock lock-upgrade check-gl browser-deps clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml $(LOCK)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e .
+	$(PY) -m pip install --quiet -c $(LOCK) -e .
 	touch $@
 
-$(TEST_STAMP): $(STAMP) pyproject.toml
-	$(PY) -m pip install --quiet -e ".[test]"
+$(TEST_STAMP): $(STAMP) pyproject.toml $(LOCK)
+	$(PY) -m pip install --quiet -c $(LOCK) -e ".[test,gps]"
 	touch $@
+
+$(LOW_STAMP): pyproject.toml $(LOWEST)
+	rm -rf $(LOW_VENV)
+	$(PYTHON_LOWEST) -m venv $(LOW_VENV)
+	$(LOW_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(LOW_VENV)/bin/python -m pip install --quiet --prefer-binary -c $(LOWEST) -e ".[test]"
+	$(LOW_VENV)/bin/python -m pip check
+	touch $@
+
+# Rewrite the lock from a scratch venv: `lock` keeps every locked version and resolves only what
+# is new in pyproject.toml; `lock-upgrade` takes the newest versions the ranges allow.
+lock lock-upgrade:
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' \
+		|| { echo "make lock: the lock is resolved on Python >= 3.11 (PYTHON=python3.11)"; exit 1; }
+	rm -rf .venv-lock
+	$(PYTHON) -m venv .venv-lock
+	.venv-lock/bin/python -m pip install --quiet --upgrade pip
+	.venv-lock/bin/python -m pip install --quiet $(if $(filter lock,$@),-c constraints.txt) ".[test,gps]"
+	{ sed -n '/^#/p;/^#/!q' constraints.txt; .venv-lock/bin/python -m pip freeze --exclude-editable \
+		| grep -v '^gazebot'; } > constraints.txt.new
+	mv constraints.txt.new constraints.txt
+	rm -rf .venv-lock
 
 check-gl: $(STAMP)
 	$(PY) -m gazebot.sim.gl_check
@@ -39,6 +74,10 @@ demo: $(STAMP) check-gl
 test: $(TEST_STAMP) check-gl browser-deps
 	$(PY) -m pytest
 
+test-lowest: $(LOW_STAMP) browser-deps
+	$(LOW_VENV)/bin/python -m gazebot.sim.gl_check
+	$(LOW_VENV)/bin/python -m pytest
+
 bench: $(TEST_STAMP)
 	$(PY) -m benchmarks
 
@@ -46,4 +85,4 @@ lint: $(TEST_STAMP)
 	$(VENV)/bin/ruff check gazebot tests benchmarks examples
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) $(LOW_VENV) .venv-lock out .pytest_cache

@@ -7,6 +7,8 @@ of a session page."""
 
 from __future__ import annotations
 
+import csv
+import html
 import http.client
 import itertools
 import os
@@ -17,11 +19,14 @@ import tempfile
 import threading
 import time
 import urllib.parse
+from dataclasses import dataclass
+from http.cookies import SimpleCookie
 from pathlib import Path
 
 import numpy as np
 
 from benchmarks.common import Result, median_time
+from gazebot.study.web.app import VISITOR_COOKIE
 
 # Seed Table 6.1, likability (video study; rows Face, Hand, L-FH, S-FH; averaged, fractional).
 TABLE_6_1_LIKABILITY = np.array(
@@ -44,8 +49,10 @@ def _comparisons(g: int, participants: int, seed: int = 0) -> list[tuple[int, in
 # The peers: the same server (waitress, same threads) with an app that parses the answer form
 # and redirects. The fair peer also stores each answer as gazebot does, durably: one committed
 # SQLite transaction per answer (WAL, synchronous=FULL, a connection per request, the primary
-# key keeping a resend once), but without Flask and without reading the participant's place.
-# With no database argument it stores nothing: the floor of HTTP and the server alone.
+# key keeping a resend once), but without Flask, without the cookie, Origin and CSRF checks and
+# without reading the participant's place. With no database argument it stores nothing: the
+# floor of HTTP and the server alone. Both get the very requests gazebot gets (same paths,
+# cookies, Origin header and form with its CSRF token).
 _BARE_SERVER = """
 import sqlite3, sys, threading, urllib.parse
 from waitress import create_server
@@ -58,7 +65,7 @@ def connect():
 if DB:
     con = connect()
     con.execute("PRAGMA journal_mode=WAL")
-    con.execute("CREATE TABLE IF NOT EXISTS answers (participant INTEGER, session INTEGER, "
+    con.execute("CREATE TABLE IF NOT EXISTS answers (participant TEXT, session INTEGER, "
                 "q1, q2, q3, q4, q5, comment, submitted_at REAL DEFAULT (julianday('now')), "
                 "PRIMARY KEY (participant, session))")
     con.close()
@@ -66,54 +73,109 @@ def app(environ, start_response):
     n = int(environ.get("CONTENT_LENGTH") or 0)
     form = urllib.parse.parse_qs(environ["wsgi.input"].read(n).decode(), keep_blank_values=True)
     ok = all(form.get(q) in (["1"], ["2"]) for q in ("q1", "q2", "q3", "q4", "q5"))
+    _, _, token, _, k = environ["PATH_INFO"].split("/")
     if ok and DB:
-        _, _, pid, _, k = environ["PATH_INFO"].split("/")
         with LOCK:
             con = connect()
             try:
                 con.execute("BEGIN IMMEDIATE")
                 con.execute("INSERT INTO answers (participant, session, q1, q2, q3, q4, q5, "
                             "comment) VALUES (?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT DO NOTHING",
-                            (int(pid), int(k), *(int(form[q][0]) for q in
+                            (token, int(k), *(int(form[q][0]) for q in
                              ("q1", "q2", "q3", "q4", "q5")), form["comment"][0]))
                 con.execute("COMMIT")
             finally:
                 con.close()
     start_response("303 See Other" if ok else "400 Bad Request",
-                   [("Location", "/p/1"), ("Content-Length", "0")])
+                   [("Location", "/p/" + token), ("Content-Length", "0")])
     return [b""]
 server = create_server(app, host="127.0.0.1", port=0, threads=4)
-print(f"serving at http://127.0.0.1:{server.effective_port}/p/N", flush=True)
+print(f"serving at http://127.0.0.1:{server.effective_port}/p/TOKEN", flush=True)
 server.run()
 """
-ANSWERS = urllib.parse.urlencode({"q1": 1, "q2": 2, "q3": 1, "q4": 2, "q5": 1, "comment": ""})
+ANSWERS = {"q1": 1, "q2": 2, "q3": 1, "q4": 2, "q5": 1, "comment": ""}
 BATCH = 120  # submissions per timed batch
 BATCHES = 5
+ADMIN_TOKEN = "benchmark-admin-token"  # from the environment, as the server wants it
+
+
+@dataclass(frozen=True)
+class Participant:
+    """What a participant's browser holds once it opened its link: the link path, its visitor
+    cookie and the CSRF token of its forms (bound to that cookie and that link)."""
+
+    link: str
+    cookie: str
+    csrf: str
 
 
 def _start(cmd: list[str]) -> tuple[subprocess.Popen, int]:
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    env = {
+        **os.environ,
+        "PYTHONPATH": str(Path(__file__).resolve().parents[1]),
+        "GAZEBOT_STUDY_ADMIN_TOKEN": ADMIN_TOKEN,
+    }
     proc = subprocess.Popen(
         cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env
     )
+    line = ""
     for _ in range(20):
         line = proc.stdout.readline()
-        m = re.search(r"at http://127\.0\.0\.1:(\d+)/p/N", line)
+        m = re.search(r"at http://127\.0\.0\.1:(\d+)/p/TOKEN", line)
         if m:
             return proc, int(m.group(1))
     proc.kill()
     raise RuntimeError(f"server did not start: {line}")
 
 
-def _submit(port: int, paths: list[str], clients: int) -> float:
-    """Seconds to POST the answers to every path, over ``clients`` keep-alive connections."""
-    chunks = [paths[k::clients] for k in range(clients)]
-    headers = {"Content-Type": "application/x-www-form-urlencoded"}
+def _read_links(study_dir: Path) -> dict[int, str]:
+    """Participant -> link path, from the ``participant-links.csv`` that ``study serve`` wrote."""
+    with (study_dir / "participant-links.csv").open(newline="") as fh:
+        return {int(r["participant"]): urllib.parse.urlsplit(r["url"]).path
+                for r in csv.DictReader(fh)}
 
-    def worker(chunk: list[str]) -> None:
+
+def _open_link(port: int, link: str) -> tuple[Participant, bytes]:
+    """A participant's first visit, as a browser makes it: GET the link, keep the visitor cookie
+    the server sets and the CSRF token of the page's form."""
+    con = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+    con.request("GET", link)
+    resp = con.getresponse()
+    page = resp.read()
+    con.close()
+    if resp.status != 200:
+        raise RuntimeError(f"GET {link}: HTTP {resp.status}")
+    cookie = SimpleCookie(resp.getheader("Set-Cookie", ""))
+    if VISITOR_COOKIE not in cookie:
+        raise RuntimeError(f"GET {link}: no {VISITOR_COOKIE} cookie set")
+    m = re.search(rb'name="csrf_token" value="([^"]+)"', page)
+    if m is None:
+        raise RuntimeError(f"GET {link}: the page has no form with a CSRF token")
+    visitor = f"{VISITOR_COOKIE}={cookie[VISITOR_COOKIE].value}"
+    return Participant(link, visitor, html.unescape(m.group(1).decode())), page
+
+
+def _submit(port: int, posts: list[tuple[Participant, int]], clients: int) -> float:
+    """Seconds to POST the answers of every (participant, session), over ``clients`` keep-alive
+    connections, each request with the participant's cookie, the page's ``Origin`` and the
+    form's CSRF token (what a browser sends)."""
+    chunks = [posts[k::clients] for k in range(clients)]
+    origin = f"http://127.0.0.1:{port}"
+    bodies = {}
+    for who, _ in posts:
+        if who.link not in bodies:
+            bodies[who.link] = urllib.parse.urlencode({**ANSWERS, "csrf_token": who.csrf})
+
+    def worker(chunk: list[tuple[Participant, int]]) -> None:
         con = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
-        for path in chunk:
-            con.request("POST", path, ANSWERS, headers)
+        for who, k in chunk:
+            path = f"{who.link}/session/{k}"
+            headers = {
+                "Content-Type": "application/x-www-form-urlencoded",
+                "Cookie": who.cookie,
+                "Origin": origin,
+            }
+            con.request("POST", path, bodies[who.link], headers)
             resp = con.getresponse()
             resp.read()
             if resp.status != 303:
@@ -154,10 +216,6 @@ def _web_results() -> list[Result]:
             store.give_consent(p)
             store.read_instructions(p)
             store.submit(p, 0, {f"q{k}": 1 for k in range(1, 6)})
-        sessions = [
-            f"/p/{s.participant}/session/{s.session}"
-            for s in sorted(study.plan, key=lambda s: (s.session, s.participant))
-        ]
         ours, port = _start(
             [sys.executable, "-m", "gazebot", "study", "serve", str(root), "--port", "0"]
         )
@@ -165,16 +223,21 @@ def _web_results() -> list[Result]:
         durable, durable_port = _start([sys.executable, "-c", _BARE_SERVER, str(peer_db)])
         bare, bare_port = _start([sys.executable, "-c", _BARE_SERVER])
         try:
-            con = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
-            con.request("GET", f"/p/{study.participants[-1]}")
-            page = con.getresponse().read()
-            con.close()
+            # Every participant opens their link once (untimed): cookie and form token.
+            links = _read_links(root)
+            visits = {p: _open_link(port, links[p]) for p in study.participants}
+            who = {p: v[0] for p, v in visits.items()}
+            page = visits[study.participants[-1]][1]
+            # Answers in plan order per participant: each request is the current step.
+            posts = [
+                (who[s.participant], s.session)
+                for s in sorted(study.plan, key=lambda s: (s.session, s.participant))
+            ]
             pos = 0
             for clients in clients_list:
                 rates, peer_rates, floor_rates = [], [], []
                 for b in range(BATCHES + 1):  # the first batch warms up
-                    # Answers in plan order per participant: each request is the current step.
-                    batch = sessions[pos : pos + BATCH]
+                    batch = posts[pos : pos + BATCH]
                     pos += BATCH
                     t_ours = _submit(port, batch, clients)
                     t_peer = _submit(durable_port, batch, clients)
@@ -191,8 +254,9 @@ def _web_results() -> list[Result]:
                         "req/s",
                         "bare waitress app committing the same answer to SQLite, same pragmas",
                         higher_is_better=True,
-                        note="each answer a committed SQLite transaction (WAL, synchronous=FULL); "
-                        f"storing nothing: {statistics.median(floor_rates):.0f} req/s",
+                        note="each answer a committed SQLite transaction (WAL, synchronous=FULL), "
+                        "with the visitor cookie, Origin and CSRF checks; storing nothing: "
+                        f"{statistics.median(floor_rates):.0f} req/s",
                     )
                 )
         finally:

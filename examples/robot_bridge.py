@@ -26,12 +26,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--namespace", default="/gazebot", help="ROS namespace of the topics")
     parser.add_argument("--listen", default="tcp/127.0.0.1:7447")
     parser.add_argument("--duration", type=float, default=10.0, help="wall seconds")
+    parser.add_argument("--zenoh-config", default=None, metavar="FILE",
+                        help="Zenoh JSON5 configuration (TLS, authentication), as gazebot's nodes")
     args = parser.parse_args(argv)
 
     frames = generate(seed=2, options=SyntheticOptions(rate=120.0)).trajectory.frames()
     head = {"head_pan": 0.0}
     applied = 0
-    bus = BusConfig(names=Names(args.namespace), listen=(args.listen,))
+    bus = BusConfig(names=Names(args.namespace), listen=(args.listen,),
+                    config_file=args.zenoh_config)
     robot = ZenohRobotEndpoint.open(bus, node="sim")
     try:
         start = time.monotonic()

@@ -347,7 +347,9 @@ class GazeEngine:
             state = self.gaze.update(t, point, arm=arm)
             head, yaw, pitch = state.head, state.eye_yaw, state.eye_pitch
             residual, shift = state.residual, state.shift_amplitude
-            ok = all(math.isfinite(v) for v in (yaw, pitch, residual, shift, *head.values()))
+            # One float sum instead of a check per value: finite values of these sizes (angles,
+            # rad) cannot overflow, so the sum is finite exactly when every value is.
+            ok = math.isfinite(yaw + pitch + residual + shift + sum(head.values()))
         except Exception as err:  # noqa: BLE001 - e.g. a joint reading that is no number
             faults.append(self._fault(t, "kinematics", err))
             events = (*events, faults[-1])
@@ -360,19 +362,26 @@ class GazeEngine:
             shift = 0.0
         self._last_target = (kind, point)
         status: Status = "degraded" if faults or not ok else "ok"
-        cmd = GazeCommand(
+        handover = self.handover
+        # Every field given, so the frozen dataclass is filled directly: its generated
+        # ``__init__`` sets each field through ``object.__setattr__`` (microseconds per tick).
+        cmd = object.__new__(GazeCommand)
+        cmd.__dict__.update(
             t=t,
-            phase=self.handover.phase,
-            phase_source=self.handover.source,
+            phase=handover.phase,
             target=kind,
             target_point=np.asarray(point, float),
             head=head,
             eye_yaw=yaw,
             eye_pitch=pitch,
             residual=residual,
+            phase_source=handover.source,
             gaze_shift=shift,
-            tracking=self.behavior.tracking,  # type: ignore[arg-type]
+            tracking=self.behavior.tracking,
             status=status,
+            blink=0.0,
+            distance=None,
+            answers_sample=True,
             events=events,
         )
         if ok:

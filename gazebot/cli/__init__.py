@@ -29,6 +29,7 @@ COMMAND_MODULES = (
     "display",
     "router",
     "study",
+    "gps",
 )
 
 

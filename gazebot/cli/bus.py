@@ -39,7 +39,8 @@ def _domain_id(value: str) -> int:
 
 def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool) -> None:
     """``--namespace``, ``--remap``, ``--domain-id``, ``--base-frame``, ``--tf-frame``,
-    ``--listen``, ``--connect``, ``--multicast``: how the node joins the bus.
+    ``--listen``, ``--connect``, ``--multicast``, ``--zenoh-config``: how the node joins the
+    bus.
 
     By default the robot side (``gazebot sim``) listens on ``tcp/127.0.0.1:7447`` and engine
     nodes (``gazebot run``) connect to it, listening on an ephemeral port so that other
@@ -77,6 +78,39 @@ def add_bus_arguments(parser: argparse.ArgumentParser, listens_by_default: bool)
     parser.add_argument(
         "--multicast", action="store_true", help="enable multicast scouting (off by default)"
     )
+    add_zenoh_config_argument(parser)
+
+
+def add_zenoh_config_argument(parser: argparse.ArgumentParser) -> None:
+    """``--zenoh-config FILE``: a Zenoh JSON5 configuration as the base of the session's."""
+    parser.add_argument(
+        "--zenoh-config", metavar="FILE", default=None,
+        help="Zenoh JSON5 configuration file the session starts from: TLS certificates "
+        "(transport.link.tls), user/password authentication (transport.auth.usrpwd), access "
+        "control; its listen/connect endpoints are used unless --listen/--connect are given",
+    )
+
+
+def zenoh_file_settings(path: str | None, mode: str
+                        ) -> tuple[str, tuple[str, ...], tuple[str, ...]]:
+    """``(mode, listen, connect)`` of a ``--zenoh-config`` file: its ``peer`` or ``client``
+    mode if it sets one (else ``mode``) and the endpoints it sets (empty when it sets none, or
+    without a file). A bad file is a :class:`UsageError` naming it."""
+    if path is None:
+        return mode, (), ()
+    import json
+
+    from gazebot.drivers.session import file_endpoints, load_zenoh_config
+
+    try:
+        cfg = load_zenoh_config(path)
+    except ValueError as exc:
+        raise UsageError(f"--zenoh-config {exc}") from None
+    file_mode = json.loads(cfg.get_json("mode"))
+    if mode != "router" and file_mode in ("peer", "client"):
+        mode = file_mode
+    return (mode, file_endpoints(cfg, "listen/endpoints", mode),
+            file_endpoints(cfg, "connect/endpoints", mode))
 
 
 def add_record_argument(parser: argparse.ArgumentParser) -> None:
@@ -108,16 +142,19 @@ def bus_config(args: argparse.Namespace, listens_by_default: bool,
                base_frame: str = "world") -> BusConfig:
     """The :class:`BusConfig` of parsed ``add_bus_arguments`` options (``base_frame``: the
     robot's, see :func:`bus_names`)."""
-    listen = args.listen if args.listen is not None else (
-        [DEFAULT_ENDPOINT] if listens_by_default else [EPHEMERAL_ENDPOINT])
-    connect = args.connect if args.connect is not None else (
-        [] if listens_by_default else [DEFAULT_ENDPOINT])
+    mode, file_listen, file_connect = zenoh_file_settings(args.zenoh_config, "peer")
+    listen = args.listen if args.listen is not None else (file_listen or (
+        [DEFAULT_ENDPOINT] if listens_by_default else [EPHEMERAL_ENDPOINT]))
+    connect = args.connect if args.connect is not None else (file_connect or (
+        [] if listens_by_default else [DEFAULT_ENDPOINT]))
     try:
         return BusConfig(
             names=bus_names(args, base_frame),
             listen=tuple(listen),
             connect=tuple(connect),
             multicast_scouting=args.multicast,
+            mode=mode,  # type: ignore[arg-type]
+            config_file=args.zenoh_config,
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from None

@@ -8,7 +8,7 @@ import argparse
 import sys
 import threading
 
-from gazebot.cli.bus import positive
+from gazebot.cli.bus import add_zenoh_config_argument, positive, zenoh_file_settings
 from gazebot.cli.errors import UsageError
 from gazebot.drivers.session import ROUTER_ENDPOINT, BusConfig, open_session
 
@@ -21,18 +21,32 @@ def register(sub: argparse._SubParsersAction) -> None:
         "tcp/HOST:7447 meet through it, as rmw_zenoh deployments do with rmw_zenohd.",
     )
     p.add_argument("--listen", action="append", metavar="EP",
-                   help=f"endpoint to listen on, repeatable (default: {ROUTER_ENDPOINT})")
+                   help=f"endpoint to listen on, repeatable (default: {ROUTER_ENDPOINT}, this "
+                   "machine only; e.g. tcp/0.0.0.0:7447 opens it to the network, without "
+                   "authentication unless --zenoh-config sets it up)")
     p.add_argument("--connect", action="append", default=[], metavar="EP",
                    help="another router to connect to, repeatable")
     p.add_argument("--duration", type=positive, default=None,
                    help="seconds to run (default: until Ctrl-C)")
+    add_zenoh_config_argument(p)
     p.set_defaults(func=handle)
 
 
-def handle(args: argparse.Namespace) -> int:
+def router_config(args: argparse.Namespace) -> BusConfig:
+    """The router's bus: ``--listen`` endpoints, else the ``--zenoh-config`` file's, else
+    :data:`~gazebot.drivers.session.ROUTER_ENDPOINT` (loopback only)."""
+    _, file_listen, file_connect = zenoh_file_settings(args.zenoh_config, "router")
     try:
-        cfg = BusConfig(listen=tuple(args.listen or [ROUTER_ENDPOINT]),
-                        connect=tuple(args.connect), mode="router")
+        return BusConfig(listen=tuple(args.listen or file_listen or [ROUTER_ENDPOINT]),
+                         connect=tuple(args.connect or file_connect), mode="router",
+                         config_file=args.zenoh_config)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def handle(args: argparse.Namespace) -> int:
+    cfg = router_config(args)
+    try:
         session = open_session(cfg)
     except ValueError as exc:
         raise UsageError(str(exc)) from None

@@ -4,8 +4,12 @@ topics on the Zenoh bus (the simulator of ``gazebot sim`` or a real robot's brid
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import signal
 import sys
+import threading
+from collections.abc import Iterator
 
 from gazebot.cli.bus import (
     add_bus_arguments,
@@ -44,16 +48,21 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="warn on stderr if no robot data arrived after S seconds (default 3)")
     p.add_argument("--no-resync", action="store_true",
                    help="do not catch up with a handover under way at start")
+    p.add_argument("--standby", action="store_true",
+                   help="if another engine already commands this robot, wait and take over "
+                   "when it stops (default: exit with status 3)")
     p.add_argument("--no-eye-frames", action="store_true",
                    help="never render eye frames (eye state is always published)")
-    p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
+    p.add_argument("--json", action="store_true",
+                   help="print a JSON summary at the end (also when stopped by Ctrl-C or "
+                   "SIGTERM)")
     add_bus_arguments(p, listens_by_default=False)
     add_record_argument(p)
     p.set_defaults(func=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
-    from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
+    from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig, EngineRefused
     from gazebot.drivers.zenoh_driver import ZenohRobotDriver
 
     cfg = bus_config(args, listens_by_default=False, base_frame=robot_base_frame(args.robot))
@@ -61,6 +70,7 @@ def handle(args: argparse.Namespace) -> int:
         silence_after=args.silence_after,
         resync=not args.no_resync,
         no_robot_warning=args.no_robot_warning,
+        standby=args.standby,
     )
     # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
     from gazebot.runtime import GazeLoop
@@ -81,15 +91,16 @@ def handle(args: argparse.Namespace) -> int:
 
         node = (EngineNode.with_eye_frames(loop, driver, node_cfg, warn=warn)
                 if not args.no_eye_frames else EngineNode(loop, driver, node_cfg, warn=warn))
-        print(
-            f"gazebot run: {args.behavior} on {node.engine.robot.name} under {cfg.names.namespace} "
-            f"({endpoints})",
-            file=sys.stderr,
-        )
         try:
-            node.run(duration=args.duration)
+            with _stop_on_sigterm() as stop:  # before saying it runs: SIGTERM from then on
+                print(f"gazebot run: {args.behavior} on {node.engine.robot.name} under "
+                      f"{cfg.names.namespace} ({endpoints})", file=sys.stderr, flush=True)
+                node.run(duration=args.duration, stop=stop)
         except KeyboardInterrupt:
             pass
+        except EngineRefused as exc:
+            print(f"gazebot run: error: {exc}", file=sys.stderr, flush=True)
+            return 3
         summary = {
             "frames": node.frames_processed,
             "commands": node.commands_sent,
@@ -110,3 +121,19 @@ def handle(args: argparse.Namespace) -> int:
         driver.close()
     print(json.dumps(summary) if args.json else "\n".join(f"{k}: {v}" for k, v in summary.items()))
     return 0
+
+
+@contextlib.contextmanager
+def _stop_on_sigterm() -> Iterator[threading.Event]:
+    """An event SIGTERM sets while the block runs (as a process manager or launch file stops a
+    node), so the run ends like Ctrl-C: shut down, then the summary. The previous handler is
+    restored after; only the main thread can take signals (elsewhere: an event never set)."""
+    stop = threading.Event()
+    if threading.current_thread() is not threading.main_thread():
+        yield stop
+        return
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: stop.set())
+    try:
+        yield stop
+    finally:
+        signal.signal(signal.SIGTERM, previous)

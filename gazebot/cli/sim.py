@@ -101,6 +101,16 @@ def handle(args: argparse.Namespace) -> int:
     view = sim = endpoint = driver = engine_node = thread = recorder = None
     stop = threading.Event()
     summary: dict[str, Any] = {}
+    engine_error: list[str] = []  # why the in-process engine stopped, if it did
+
+    def run_engine(node: Any) -> None:
+        # The engine node survives what its inputs cause; if it stops anyway, the simulation
+        # must not run on without gaze: stop it and say why.
+        try:
+            node.run(stop=stop)
+        except Exception as exc:
+            engine_error.append(" ".join(f"{type(exc).__name__}: {exc}".split())[:300])
+            stop.set()
     try:
         view = None if args.headless else PygameView()
         sim = HandoverSimulation(args.robot, args.scene, seed=args.seed)
@@ -121,11 +131,14 @@ def handle(args: argparse.Namespace) -> int:
             robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
             loop = GazeLoop.from_config(robot, args.behavior, seed=args.seed)
             engine_node = EngineNode.with_eye_frames(loop, driver)
-            thread = threading.Thread(target=engine_node.run, kwargs={"stop": stop},
+            thread = threading.Thread(target=run_engine, args=(engine_node,),
                                       name="engine-node", daemon=True)
             thread.start()
             # Start the handover once the engine listens (and has taken the head pose).
-            if not engine_node.ready.wait(60.0):
+            for _ in range(600):
+                if engine_node.ready.wait(0.1) or not thread.is_alive():
+                    break
+            else:
                 raise TimeoutError("the in-process engine node did not start within 60 s")
         print(
             f"gazebot sim: robot {sim.robot.name} scene {args.scene} under {cfg.names.namespace} "
@@ -135,7 +148,7 @@ def handle(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         try:
-            rtf = node.run(duration=args.duration)
+            rtf = node.run(duration=args.duration, stop=stop)
         except KeyboardInterrupt:
             rtf = float("nan")
         summary = {
@@ -166,8 +179,11 @@ def handle(args: argparse.Namespace) -> int:
         for closable in (driver, endpoint, sim, view):  # sim before the window: shared GL
             if closable is not None:
                 closable.close()
+    if engine_error:
+        print(f"gazebot sim: error: the in-process engine stopped ({engine_error[0]}); "
+              "the simulation stopped with it", file=sys.stderr)
     print(json.dumps(summary) if args.json else _text(summary))
-    return 0
+    return 1 if engine_error else 0
 
 
 def _text(summary: dict[str, Any]) -> str:

@@ -34,6 +34,30 @@ class RobotDriver(ABC):
 
     node: str = "engine"
 
+    # -- ownership (one engine per robot) ------------------------------------------------
+    def claim(self, timeout: float = 0.5) -> None:  # noqa: B027 - nothing to claim by default
+        """Claim the robot's command topics (see :mod:`gazebot.drivers.ownership`), waiting
+        up to ``timeout`` s to learn the other engines' claims."""
+
+    def owns_robot(self) -> bool:
+        """Whether this engine owns the robot (a driver without rivals always does)."""
+        return True
+
+    def rival_engines(self) -> list[str]:
+        """The other engines claiming the robot, the earliest first."""
+        return []
+
+    # -- tracking sources --------------------------------------------------------------------
+    def tracking_sources(self) -> dict[str, str]:
+        """Tracking group -> the source whose samples are used (see
+        :mod:`gazebot.drivers.tracking_source`); empty when the driver has one source."""
+        return {}
+
+    def tracking_rivals(self, new_only: bool = False) -> list[Any]:
+        """Sources whose tracking is ignored (:class:`~gazebot.drivers.tracking_source.Rival`;
+        ``new_only``: those not returned before)."""
+        return []
+
     # -- commands --------------------------------------------------------------------------
     @abstractmethod
     def send_head(self, msg: HeadCommandMsg) -> None:

@@ -27,6 +27,22 @@ Faults (each pinned by ``tests/drivers``):
   the driver, counted by topic in the status' ``dropped``.
 * a robot speaking another message type (or another version of it) on a topic: dropped, and
   reported at once as ``type_mismatch`` (topic, expected and received type with their hashes).
+* another engine on the same robot (:mod:`gazebot.drivers.ownership`): at start the node claims
+  the robot; if an earlier engine owns it, the node reports ``competing_engine`` (``info.role``
+  ``refused``) and stops with :class:`EngineRefused`, or with ``standby`` waits (``info.role``
+  ``standby``, no commands) until the owner's claim vanishes, then takes over
+  (``engine_took_over``, resynchronised). The owner reports each rival as ``competing_engine``
+  (``info.role`` ``owner``); the status carries ``info.role`` and ``info.rivals`` and is
+  ``degraded`` while rivals exist.
+* a second tracking source (another tracker, with its own clock): its samples are ignored by
+  the driver (:mod:`gazebot.drivers.tracking_source`; counted by topic) while the first one keeps
+  publishing; reported once per rival as ``competing_tracking`` (``info.source``,
+  ``info.owner``, ``info.group``), the status carries ``info.tracking_sources`` and
+  ``info.tracking_rivals`` and is ``degraded`` while a rival publishes. No clock reset follows.
+* anything a sample, an event or a peer's message makes fail (in the loop, the engine or a
+  subscription callback): caught, counted (status ``info.faults``), reported as a ``node_fault``
+  event (``info.stage``, ``info.error``; the first three, then every 100th) and the status is
+  ``degraded`` for ``fault_hold`` s; the node goes on with the next sample.
 """
 
 from __future__ import annotations
@@ -57,6 +73,12 @@ from gazebot.types import Event, EventKind
 log = logging.getLogger("gazebot.drivers")
 
 TrackingState = Literal["waiting", "ok", "hold", "lost"]
+Role = Literal["owner", "standby", "refused"]
+
+
+class EngineRefused(RuntimeError):
+    """Another engine owns the robot and this one does not wait: it must stop (``gazebot run``
+    exits with status 3 and this one-line message)."""
 
 
 @dataclass(frozen=True)
@@ -76,6 +98,9 @@ class EngineNodeConfig:
             clock restarted: the engine is reset and resynchronised.
         no_robot_warning: Warn once when no tracking sample or joint state arrived this long
             (s) after the start.
+        fault_hold: The status stays ``degraded`` this long (s) after a caught fault.
+        standby: When another engine owns the robot, wait as standby instead of stopping.
+        claim_timeout: How long (s) the claim at start waits to learn the other engines'.
     """
 
     silence_after: float = 0.15
@@ -86,10 +111,14 @@ class EngineNodeConfig:
     eye_frame_rate: float = 30.0
     clock_reset: float = 0.5
     no_robot_warning: float = 3.0
+    fault_hold: float = 5.0
+    standby: bool = False
+    claim_timeout: float = 0.5
 
     def __post_init__(self) -> None:
-        for name in ("silence_after", "silence_rate", "heartbeat_period",
-                     "resync_timeout", "eye_frame_rate", "clock_reset", "no_robot_warning"):
+        for name in ("silence_after", "silence_rate", "heartbeat_period", "resync_timeout",
+                     "eye_frame_rate", "clock_reset", "no_robot_warning", "fault_hold",
+                     "claim_timeout"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(
@@ -176,6 +205,12 @@ class EngineNode:
         self._phase_sent: tuple[str, float] | None = None
         self._peers: dict[str, bool] = {}
         self._skip_events: set[tuple[str, str, int, int]] = set()
+        self.role: Role = "owner"
+        self._rivals_reported: set[str] = set()
+        self.faults = 0
+        self.last_fault: str | None = None
+        self._last_fault_at = -math.inf
+        self._callback_faults: dict[str, int] = {}
         self.ready = threading.Event()  # set once started (and resynchronised)
 
     @classmethod
@@ -228,13 +263,73 @@ class EngineNode:
 
     # -- start -----------------------------------------------------------------------------
     def start(self) -> int:
-        """Announce the node and, if configured, resynchronise with a handover under way.
-        Returns the number of events replayed."""
+        """Announce the node, claim the robot and, if configured, resynchronise with a
+        handover under way. Returns the number of events replayed.
+
+        Raises:
+            EngineRefused: Another engine owns the robot and ``standby`` is off.
+        """
         self._run_started = self.clock()  # the no-robot delay counts from here
         self.emit("node_started", category="node", robot=getattr(self.engine.robot, "name", ""))
-        replayed = self.resync() if self.config.resync else 0
+        self.driver.claim(self.config.claim_timeout)
+        if not self.driver.owns_robot():
+            self._yield_robot()
+        replayed = self._catch_up() if self.role == "owner" else 0
         self.ready.set()
         return replayed
+
+    def _catch_up(self) -> int:
+        replayed = 0
+        if self.config.resync:
+            try:
+                replayed = self.resync()
+            except Exception as exc:  # a history the engine cannot replay: start afresh
+                self.fault("resync", exc)
+                self.loop.reset(None)
+        return replayed
+
+    # -- ownership -------------------------------------------------------------------------
+    def _yield_robot(self) -> None:
+        """An earlier engine owns the robot: wait as standby, or stop."""
+        rivals = self.driver.rival_engines()
+        owner = rivals[0] if rivals else "another engine"
+        self.role = "standby" if self.config.standby else "refused"
+        self._report_rivals(rivals)
+        if self.role == "refused":
+            raise EngineRefused(
+                f"another engine, {owner}, already commands the robot under "
+                f"{getattr(getattr(self.driver, 'names', None), 'namespace', '?')}: stop it "
+                "first, or start this one with --standby to take over when it stops")
+
+    def _report_rivals(self, rivals: Sequence[str]) -> None:
+        new = [r for r in rivals if r not in self._rivals_reported]
+        if not new and self.role == "owner":
+            return
+        self._rivals_reported.update(new)
+        text = {"owner": f"another engine ({', '.join(new)}) claims this robot: it is "
+                         "refused or waits as standby",
+                "standby": f"another engine ({', '.join(rivals)}) commands this robot: "
+                           "standing by until it stops"}
+        info = {"role": self.role, "rivals": list(rivals), "new": new}
+        if self.role == "refused":  # the node stops and says why itself
+            self.emit("competing_engine", **info)
+        else:
+            self._warn("competing_engine", text[self.role], **info)
+
+    def _check_ownership(self) -> None:
+        """Report rivals; yield to an earlier engine; take over when the owner went away."""
+        rivals = self.driver.rival_engines()
+        owns = self.driver.owns_robot()
+        if self.role == "owner":
+            if any(r not in self._rivals_reported for r in rivals):
+                self._report_rivals(rivals)
+            if not owns and rivals:
+                self._yield_robot()
+        elif self.role == "standby" and owns:
+            self.role = "owner"
+            self.emit("engine_took_over", category="node", rivals=rivals)
+            self._catch_up()
+        self._rivals_reported.intersection_update(rivals)
 
     def resync(self) -> int:
         """Take the head pose from the joint state and replay the current handover's events
@@ -268,10 +363,14 @@ class EngineNode:
 
     # -- loop ------------------------------------------------------------------------------
     def run(self, duration: float | None = None, stop: threading.Event | None = None) -> None:
-        """:meth:`start`, then :meth:`tick` until ``stop`` is set or ``duration`` s passed."""
-        self.start()
-        end = math.inf if duration is None else self.clock() + duration
+        """:meth:`start`, then :meth:`tick` until ``stop`` is set or ``duration`` s passed.
+
+        Raises:
+            EngineRefused: Another engine owns the robot (and ``standby`` is off).
+        """
         try:
+            self.start()
+            end = math.inf if duration is None else self.clock() + duration
             while not (stop is not None and stop.is_set()) and self.clock() < end:
                 self.tick()
         finally:
@@ -295,22 +394,73 @@ class EngineNode:
         return budget
 
     def tick(self) -> None:
-        """Wait briefly for a tracking sample and answer it, or handle the silence."""
+        """Wait briefly for a tracking sample and answer it, or handle the silence. Nothing a
+        sample, an event or a peer causes stops the node: each stage's failure is a
+        :meth:`fault` and the next stage runs."""
+        self._check_ownership()
         msg = self.driver.wait_tracking(self._wait_budget())
+        if self.role != "owner":  # standby: nothing is commanded; the resync catches up later
+            self.driver.poll_events()
+            if self.clock() - self._last_beat >= self.config.heartbeat_period:
+                self._guarded("heartbeat", self._heartbeat)
+            return
         for ev in self.driver.poll_events():
             if ev.identity in self._skip_events:
                 continue
             if ev.category == "robot" and (event := ev.to_event()) is not None:
-                self.loop.notify(event)
+                self._guarded("event", self.loop.notify, event)
         if msg is not None:
-            self.on_tracking(msg)
+            self._guarded("tracking", self.on_tracking, msg)
         else:
-            self.on_silence()
+            self._guarded("silence", self.on_silence)
+        self._guarded("checks", self._checks)
+        if self.clock() - self._last_beat >= self.config.heartbeat_period:
+            self._guarded("heartbeat", self._heartbeat)
+
+    def _checks(self) -> None:
         self._check_peers()
         self._check_mismatches()
         self._check_robot_seen()
-        if self.clock() - self._last_beat >= self.config.heartbeat_period:
-            self._heartbeat()
+        self._check_callback_faults()
+        self._check_tracking_sources()
+
+    def _check_tracking_sources(self) -> None:
+        for r in self.driver.tracking_rivals(new_only=True):
+            self._warn("competing_tracking", f"a second tracking source, {r.source}, publishes "
+                       f"the {r.group} beside {r.owner}: ignored while {r.owner} publishes",
+                       source=r.source, owner=r.owner, group=r.group)
+
+    def _guarded(self, stage: str, fn: Callable[..., Any], *args: Any) -> None:
+        try:
+            fn(*args)
+        except Exception as exc:
+            self.fault(stage, exc)
+
+    def fault(self, stage: str, exc: BaseException | str) -> None:
+        """Count and report a failure the node survives: a ``node_fault`` event (the first
+        three, then every 100th), ``degraded`` status for ``fault_hold`` s."""
+        self.faults += 1
+        self._last_fault_at = self.clock()
+        text = exc if isinstance(exc, str) else f"{type(exc).__name__}: {exc}"
+        text = " ".join(str(text).split())[:300]
+        self.last_fault = f"{stage}: {text}"
+        if self.faults <= 3 or self.faults % 100 == 0:
+            if isinstance(exc, BaseException):
+                log.error("engine node fault #%d in %s", self.faults, stage, exc_info=exc)
+            try:
+                self.emit("node_fault", stage=stage, error=text, faults=self.faults)
+            except Exception:  # the bus itself failing: the count and the status remain
+                log.debug("could not report a fault", exc_info=True)
+
+    def _check_callback_faults(self) -> None:
+        """Report handler failures in the driver's subscription callbacks (Zenoh's threads)."""
+        counts = getattr(self.driver, "callback_faults", dict)()
+        for topic, n in sorted(counts.items()):
+            new = n - self._callback_faults.get(topic, 0)
+            if new > 0:
+                self._callback_faults[topic] = n
+                reason = getattr(self.driver, "callback_fault_reasons", dict)().get(topic, "")
+                self.fault(f"callback {topic}", f"{new} failed: {reason}")
 
     def on_tracking(self, msg: TrackingMsg) -> None:
         """Tick the loop with one sample and send the command."""
@@ -325,8 +475,8 @@ class EngineNode:
         self._last_t = msg.t
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
-        cmd = self.loop.tick(msg.to_frame(),
-                             joints=joints.position if joints is not None else None)
+        cmd = self._tick_loop("tracking", msg.to_frame(),
+                              joints=joints.position if joints is not None else None)
         self.frames_processed += 1
         if cmd is not None:
             self._send(cmd)
@@ -341,9 +491,18 @@ class EngineNode:
                 or now - self._last_silence_tick < 1 / self.config.silence_rate):
             return
         self._last_silence_tick = now
-        cmd = self.loop.tick(None, t=self._now_t())
+        cmd = self._tick_loop("silence", None, t=self._now_t())
         if cmd is not None:
             self._send(cmd)
+
+    def _tick_loop(self, stage: str, *args: Any, **kwargs: Any) -> LoopCommand | None:
+        """``loop.tick``; a tick the engine raised on (the loop answers it with nothing) is
+        reported as a fault of ``stage``."""
+        before = getattr(self.loop, "faults", 0)
+        cmd = self.loop.tick(*args, **kwargs)
+        if getattr(self.loop, "faults", 0) > before:
+            self.fault(stage, "the engine raised on this tick; nothing was sent")
+        return cmd
 
     @property
     def unsafe_commands(self) -> int:
@@ -370,7 +529,10 @@ class EngineNode:
     def _send(self, cmd: LoopCommand) -> None:
         self._track(cmd)
         for event in cmd.events:
-            if category_of(event.kind.value) == "phase":
+            if event.kind is EventKind.FAULT:  # caught inside the engine; the command is safe
+                info = event.info or {}
+                self.fault(f"engine {info.get('stage', '?')}", str(info.get("error", "")))
+            elif category_of(event.kind.value) == "phase":
                 self.driver.publish_event(
                     EventMsg.from_event(event, self.driver.node, self._next("event"), time.time())
                 )
@@ -473,7 +635,11 @@ class EngineNode:
             self._send_phase(self._now_t(), again=True)
         peers = self.driver.peers()
         no_robot = self._no_robot_warned and not self.robot_seen
-        degraded = not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
+        faulty = self.clock() - self._last_fault_at < self.config.fault_hold
+        rivals = self.driver.rival_engines()
+        tracking_rivals = sorted({r.source for r in self.driver.tracking_rivals()})
+        degraded = (not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
+                    or faulty or bool(rivals) or self.role != "owner" or bool(tracking_rivals))
         msg = StatusMsg(
             node=self.driver.node,
             seq=self._next("status"),
@@ -492,6 +658,12 @@ class EngineNode:
                 "target": self._target,
                 "robot_seen": self.robot_seen,
                 "warnings": list(self.warnings),
+                "role": self.role,
+                "rivals": rivals,
+                "tracking_sources": self.driver.tracking_sources(),
+                "tracking_rivals": tracking_rivals,
+                "faults": self.faults,
+                "last_fault": self.last_fault,
             },
         )
         self.driver.publish_status(msg)

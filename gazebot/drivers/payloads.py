@@ -23,6 +23,8 @@ from pydantic import (
     model_validator,
 )
 
+from gazebot.ros2 import convert
+from gazebot.ros2.errors import MessageError
 from gazebot.types import (
     PHASE_OF_EVENT,
     Event,
@@ -215,25 +217,17 @@ class EyeFrameMsg(Msg):
     ) -> EyeFrameMsg:
         """Encode an (H, W, 3) uint8 RGB image (JPEG by default: several times faster to
         encode than PNG at display sizes; PNG is lossless)."""
-        import cv2
+        return cls(seq=seq, t=float(t), stamp=float(stamp), format=fmt,
+                   data=convert.encode_image(img, fmt))
 
-        if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8:
-            raise ValueError(f"expected an (H, W, 3) uint8 RGB image, got {img.shape} {img.dtype}")
-        ok, buf = cv2.imencode(".png" if fmt == "png" else ".jpg", img[:, :, ::-1])
-        if not ok:
-            raise ValueError(f"could not encode the eye frame as {fmt}")
-        return cls(seq=seq, t=float(t), stamp=float(stamp), format=fmt, data=buf.tobytes())
-
-    def image(self) -> np.ndarray:
-        """Decode to an (H, W, 3) uint8 RGB image; :class:`PayloadError` if it does not
-        decode."""
-        import cv2
-
-        img = cv2.imdecode(np.frombuffer(self.data, np.uint8), cv2.IMREAD_COLOR) \
-            if self.data else None
-        if img is None:
-            raise PayloadError("EyeFrameMsg", f"data: not a decodable {self.format} image")
-        return np.ascontiguousarray(img[:, :, ::-1])
+    def image(self, max_size: tuple[int, int] | None = None) -> np.ndarray:
+        """Decode to an (H, W, 3) uint8 RGB image of at most ``max_size`` (width, height;
+        default :data:`gazebot.ros2.convert.MAX_IMAGE_SIZE`), checked from the header before
+        decoding; :class:`PayloadError` if it is larger or does not decode."""
+        try:
+            return convert.decode_image(self.data, max_size or convert.MAX_IMAGE_SIZE)
+        except MessageError as exc:
+            raise PayloadError("EyeFrameMsg", f"data: {exc.reason}") from None
 
 
 class ArmCommandMsg(Msg):

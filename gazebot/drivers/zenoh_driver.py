@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from gazebot.drivers.base import RobotDriver
+from gazebot.drivers.ownership import Ownership
 from gazebot.drivers.payloads import (
     ArmCommandMsg,
     EyeFrameMsg,
@@ -22,10 +23,13 @@ from gazebot.drivers.payloads import (
     Point,
     TrackingMsg,
 )
+from gazebot.drivers.rmw.attachment import gid_of
+from gazebot.drivers.rmw.graph import Entity
 from gazebot.drivers.rmw.names import Names
 from gazebot.drivers.rmw.node import Received
-from gazebot.drivers.tracking_assembly import SampleAssembler
-from gazebot.drivers.zenoh_node import ZenohNode
+from gazebot.drivers.tracking_assembly import IDLE_FLUSH, REORDER, SampleAssembler
+from gazebot.drivers.tracking_source import Rival, SourceArbiter, group_of
+from gazebot.drivers.zenoh_node import HISTORY_BYTES, ZenohNode
 from gazebot.ros2 import convert, topics
 from gazebot.ros2.errors import MessageError
 from gazebot.types import Phase
@@ -51,8 +55,14 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         peer_timeout: Heartbeat timeout (s) after which a peer counts as lost.
         tracking_backlog: Unread tracking samples kept (oldest dropped beyond, counted in
             ``tracking_skipped``): 12 = 0.1 s at 120 Hz, the most the engine may lag.
-        assemble_timeout: Wall time (s) after which a tracking sample missing a part is
-            complete anyway (see :mod:`gazebot.drivers.tracking_assembly`).
+        assemble_idle: Time (s) without any tracking part after which pending samples are
+            complete anyway; completeness is otherwise decided from the stamps (see
+            :mod:`gazebot.drivers.tracking_assembly`).
+        assemble_reorder: Newer samples after which a part missing from a sample counts as
+            not tracked at its stamp (how far one tracking topic may run ahead of another).
+        source_timeout: A tracking source silent this long (s) gives way to the next one
+            (see :mod:`gazebot.drivers.tracking_source`); until then another source's samples
+            are dropped, counted by topic and reported as rivals.
     """
 
     default_node: ClassVar[str] = "engine"
@@ -66,19 +76,27 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         owns_session: bool = False,
         peer_timeout: float = 2.0,
         tracking_backlog: int = 12,
-        assemble_timeout: float = 0.05,
+        assemble_idle: float = IDLE_FLUSH,
+        assemble_reorder: int = REORDER,
         clock: Callable[[], float] = time.monotonic,
         max_bytes: dict[str, int] | None = None,
+        history_bytes: int = HISTORY_BYTES,
+        source_timeout: float = 1.0,
     ) -> None:
         super().__init__(session, names, node, owns_session=owns_session,
-                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes)
+                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes,
+                         history_bytes=history_bytes)
         self._cond = threading.Condition(threading.Lock())
         self._queue: deque[TrackingMsg] = deque()
         self.tracking_backlog = tracking_backlog
         self.tracking_received = 0
         self.tracking_skipped = 0
         self._joints: JointStateMsg | None = None
-        self._assembler = SampleAssembler(self._expected_parts, assemble_timeout, clock=clock)
+        self._ownership: Ownership | None = None
+        self._sources = SourceArbiter(source_timeout, clock)
+        self._gid_labels: dict[bytes, str] = {}
+        self._assembler = SampleAssembler(self._expected_parts, assemble_idle,
+                                          assemble_reorder, clock=clock)
         ros = self.ros
         self._head_pub = ros.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
         self._target_pub = ros.publisher(topics.GAZE_TARGET.name, topics.GAZE_TARGET.type)
@@ -90,7 +108,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self._part_topics: dict[str, str] = {}
         for body, t in topics.TRACKING.items():
             sub = ros.subscription(t.name, (t.type, convert.POSE_STAMPED),
-                                   lambda m, rx, b=body: self._on_point(b, m))
+                                   lambda m, rx, b=body: self._on_point(b, m, rx))
             self._part_topics[body] = sub.topic
         if names.tf_frames:
             sub = ros.subscription(topics.TF.name, topics.TF.type, self._on_tf)
@@ -104,9 +122,46 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
 
     # -- tracking in -----------------------------------------------------------------------
     def _expected_parts(self) -> set[str]:
-        """The sample parts whose topic has a publisher now."""
-        published = {e.topic for e in self.ros.graph.entities() if e.kind == "MP"}
-        return {part for part, topic in self._part_topics.items() if topic in published}
+        """The sample parts whose topic has a publisher now (of the group's owning source,
+        once there is one)."""
+        owners = self._sources.owners()
+        published = set()
+        for e in self.ros.graph.entities():
+            if e.kind == "MP":
+                published.add((e.topic, source_label(e)))
+        out = set()
+        for part, topic in self._part_topics.items():
+            owner = owners.get(group_of(part))
+            if any(t == topic and (owner is None or owner == src) for t, src in published):
+                out.add(part)
+        return out
+
+    def _source(self, rx: Received) -> str:
+        """The node that published a received part: the publisher whose token hashes to the
+        GID of the attachment (as rmw_zenoh computes GIDs), else the topic's only publisher
+        (implementations with random GIDs), else one unidentified source."""
+        gid = rx.attachment.gid if rx.attachment is not None else None
+        label = self._gid_labels.get(gid) if gid is not None else None
+        if label is not None:
+            return label
+        publishers = self.ros.graph.endpoints(rx.topic, "MP")
+        for e in publishers:
+            if gid is not None and gid_of(e.token()) == gid:
+                if len(self._gid_labels) > 1000:  # publishers come and go: stay bounded
+                    self._gid_labels.clear()
+                label = self._gid_labels[gid] = source_label(e)
+                return label
+        if len({source_label(e) for e in publishers}) == 1:
+            return source_label(publishers[0])
+        return "unidentified publisher"
+
+    def tracking_sources(self) -> dict[str, str]:
+        """Tracking group (``points``, ``gripper``, ``load_share``) -> its source now."""
+        return self._sources.owners()
+
+    def tracking_rivals(self, new_only: bool = False) -> list[Rival]:
+        """Sources whose tracking was ignored lately (``new_only``: not returned before)."""
+        return self._sources.new_rivals() if new_only else self._sources.rivals()
 
     def _point(self, ros: Any) -> tuple[float, Any]:
         t, p = convert.point_of(ros)
@@ -116,9 +171,9 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                                f"frame {self.names.base_frame!r}")
         return t, p
 
-    def _on_point(self, body: str, ros: Any) -> None:
+    def _on_point(self, body: str, ros: Any, rx: Received) -> None:
         t, p = self._point(ros)
-        self._add(body, t, p)
+        self._add(body, t, p, rx)
 
     def _on_tf(self, ros: Any, rx: Received) -> None:
         by_child = {child.lstrip("/"): body for body, child in self.names.tf_frames.items()}
@@ -126,18 +181,23 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
             body = by_child.get(str(tf.child_frame_id).lstrip("/"))
             if body is not None and self.names.is_base_frame(str(tf.header.frame_id)):
                 t, p = convert.point_of(tf)
-                self._add(body, t, p)
+                self._add(body, t, p, rx)
 
     def _on_gripper(self, ros: Any, rx: Received) -> None:
-        self._add("gripper", convert.stamp_of(ros), bool(ros.closed))
+        self._add("gripper", convert.stamp_of(ros), bool(ros.closed), rx)
 
     def _on_share(self, ros: Any, rx: Received) -> None:
         t, share = convert.share_of(ros)
-        self._add("load_share", t, share)
+        self._add("load_share", t, share, rx)
 
-    def _add(self, part: str, t: float, value: Any) -> None:
+    def _add(self, part: str, t: float, value: Any, rx: Received) -> None:
         if not math.isfinite(t):
             raise MessageError(part, f"stamp is not finite: {t}")
+        source = self._source(rx)
+        owner = self._sources.admit(part, source)
+        if owner is not None:
+            raise MessageError(rx.type, f"second tracking source {source} ignored: {owner} "
+                               f"publishes the {group_of(part)}")
         with self._cond:
             self._enqueue(self._assembler.add(part, t, value))
 
@@ -160,6 +220,18 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
     def tracking_late(self) -> int:
         """Tracking parts that arrived after their sample was complete (dropped)."""
         return self._assembler.late
+
+    # -- ownership -------------------------------------------------------------------------
+    def claim(self, timeout: float = 0.5) -> None:
+        if self._ownership is None and not self.closed:
+            self._ownership = self.ros.declare(Ownership(self.session, self.names, self.node))
+            self._ownership.declare(timeout)
+
+    def owns_robot(self) -> bool:
+        return self._ownership is not None and self._ownership.is_owner()
+
+    def rival_engines(self) -> list[str]:
+        return [] if self._ownership is None else [str(c) for c in self._ownership.rivals()]
 
     # -- RobotDriver -----------------------------------------------------------------------
     def wait_tracking(self, timeout: float) -> TrackingMsg | None:
@@ -220,6 +292,11 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         super().close()
         with self._cond:
             self._cond.notify_all()  # wake a wait_tracking() in progress
+
+
+def source_label(entity: Entity) -> str:
+    """A tracking source's name: its node's name and its session."""
+    return f"{entity.node} (session {entity.zid})"
 
 
 class _EyeCommand:

@@ -20,10 +20,10 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar, Literal, TypeVar
 
+from gazebot.drivers.event_log import EventLog
 from gazebot.drivers.payloads import EventMsg, Msg, StatusMsg
 from gazebot.drivers.rmw.attachment import Attachment, AttachmentError
 from gazebot.drivers.rmw.graph import Entity
@@ -42,6 +42,8 @@ _Node = TypeVar("_Node", bound="ZenohNode")
 M = TypeVar("M", bound=Msg)
 
 HISTORY_SPACE = "@gazebot_history"
+#: Bytes of events a node keeps in its history (and in its inbox) by default.
+HISTORY_BYTES = 2 * 1024 * 1024
 
 
 def event_to_ros(msg: EventMsg) -> Any:
@@ -93,6 +95,8 @@ class ZenohNode:
             ``source`` of its events and the name of its ``/diagnostics`` status.
         owns_session: Close ``session`` in :meth:`close` (set by :meth:`open`).
         history_len: Events kept for the history queryable and the inbox.
+        history_bytes: Bytes of events kept in each (see :mod:`gazebot.drivers.event_log`;
+            an event above the event topics' size cap is not kept).
         peer_timeout: A peer whose heartbeats stop for this long (s) counts as lost even if its
             session (and token) lingers.
         clock: Monotonic clock (s).
@@ -110,6 +114,7 @@ class ZenohNode:
         *,
         owns_session: bool = False,
         history_len: int = 1000,
+        history_bytes: int = HISTORY_BYTES,
         peer_timeout: float = 2.0,
         clock: Callable[[], float] = time.monotonic,
         max_bytes: dict[str, int] | None = None,
@@ -125,9 +130,9 @@ class ZenohNode:
         self.started = clock()
         self._lock = threading.Lock()
         self._closed = False
-        self._inbox: deque[EventMsg] = deque(maxlen=history_len)
-        self._history: deque[EventMsg] = deque(maxlen=history_len)
-        self._history_keys: set[tuple[str, str, int, int]] = set()
+        event_cap = topics.max_bytes_of(topics.EVENTS.name)
+        self._inbox = EventLog(history_len, history_bytes, event_cap)
+        self._history = EventLog(history_len, history_bytes, event_cap, unique=True)
         self._last_beat: dict[str, float] = {}
         self._status_seq = 0
         self._event_seq = 0
@@ -179,13 +184,7 @@ class ZenohNode:
                 self._inbox.append(msg)
 
     def _remember(self, msg: EventMsg) -> None:
-        key = msg.identity
-        if key in self._history_keys:
-            return
-        if len(self._history) == self._history.maxlen:
-            self._history_keys.discard(self._history[0].identity)
         self._history.append(msg)
-        self._history_keys.add(key)
 
     def _on_graph(self, entity: Entity, alive: bool) -> None:
         if entity.kind == "NN" and alive and entity.namespace == self.names.namespace:
@@ -236,16 +235,16 @@ class ZenohNode:
     def poll_events(self) -> list[EventMsg]:
         """Events other nodes published since the last call, oldest first."""
         with self._lock:
-            out = list(self._inbox)
-            self._inbox.clear()
-        return out
+            return self._inbox.drain()
 
     def event_history(self, timeout: float = 1.0) -> list[EventMsg]:
         """Ask every other node for the events it has seen; merged, de-duplicated, sorted by
-        time. Malformed replies are counted and skipped; no answer gives ``[]``."""
+        time. Malformed replies are counted and skipped; no answer gives ``[]``. What is
+        kept is bounded as the node's own history is (the replies received last are kept)."""
         selector = self._history_key("*")
         codec = self._event_pubs["other"].codec
-        merged: dict[tuple[str, str, int, int], EventMsg] = {}
+        merged = EventLog(self._history.max_events, self._history.max_bytes,
+                          self._history.max_event_bytes, unique=True)
         import zenoh
 
         # One reply per event from each node: no consolidation (by default Zenoh keeps only
@@ -266,8 +265,8 @@ class ZenohNode:
             except (MessageError, AttachmentError) as exc:
                 self.drops.drop(selector, str(exc))
                 continue
-            merged.setdefault(msg.identity, msg)
-        return sorted(merged.values(), key=lambda m: (m.t, m.detected_at, m.stamp))
+            merged.append(msg)
+        return sorted(merged, key=lambda m: (m.t, m.detected_at, m.stamp))
 
     # -- status ----------------------------------------------------------------------------
     def peers(self) -> dict[str, bool]:
@@ -291,6 +290,15 @@ class ZenohNode:
     def dropped(self) -> dict[str, int]:
         return self.drops.counts()
 
+    def callback_faults(self) -> dict[str, int]:
+        """Subscription callbacks that raised (the message is lost, the node goes on), by
+        topic."""
+        return self.ros.faults.counts()
+
+    def callback_fault_reasons(self) -> dict[str, str]:
+        """The last exception of each topic's failing callback, one line."""
+        return self.ros.faults.reasons()
+
     def type_mismatches(self) -> dict[str, TypeMismatch]:
         """Topics on which a publisher of another type (or type version) was heard."""
         return self.drops.mismatches()
@@ -301,11 +309,12 @@ class ZenohNode:
         phase: str | None = None,
         info: dict[str, Any] | None = None,
         stopping: bool = False,
+        degraded: bool = False,
     ) -> StatusMsg:
         """Publish and return this node's heartbeat; ``state`` is ``degraded`` when a peer is
-        lost or tracking is not flowing."""
+        lost, tracking is not flowing or the caller says so."""
         peers = self.peers()
-        degraded = not all(peers.values()) or tracking in ("hold", "lost")
+        degraded = degraded or not all(peers.values()) or tracking in ("hold", "lost")
         with self._lock:
             seq = self._status_seq
             self._status_seq += 1

@@ -214,7 +214,10 @@ class GazeController:
                 self._eyes = (yaw, pitch)
                 self._residual = eyes.residual(yaw, pitch, v)
         names = self._names
-        return HeadEyeState(
+        # Every field given, so the frozen dataclass is filled directly: its generated
+        # ``__init__`` sets each field through ``object.__setattr__`` (microseconds per tick).
+        state = object.__new__(HeadEyeState)
+        state.__dict__.update(
             head=dict(zip(names, self._q, strict=True)),
             eye_yaw=float(self._eyes[0]),
             eye_pitch=float(self._eyes[1]),
@@ -226,6 +229,7 @@ class GazeController:
             target_valid=valid,
             eyes_saturated=eyes_saturated,
         )
+        return state
 
     def _advance(self, t: float) -> float:
         """Step the internal clock; returns dt >= 0 (0 for the first call, NaN or backward time)."""

@@ -155,9 +155,7 @@ def _pointing_error(
     n2 = rho2 + c * c
     d_az: list[float] = []
     d_el: list[float] = []
-    for j in range(len(rows[0])):
-        vx, vy, vz = rows[0][j], rows[1][j], rows[2][j]
-        wx, wy, wz = rows[3][j], rows[4][j], rows[5][j]
+    for vx, vy, vz, wx, wy, wz in zip(*rows, strict=True):  # columns
         # Origin velocity v and angular velocity w in F. F turns with w about b1 and b2 (that
         # moves the line of sight); about x it turns so that b1 stays horizontal (o0 = o2 xz /
         # |up x x|), or with the head when b1 is the display's axis.

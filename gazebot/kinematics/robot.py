@@ -145,6 +145,10 @@ class RobotModel:
         self._arm_revision = 0
         # (head vector, arm revision) whose forward kinematics :attr:`data` holds, or None.
         self._kinematics_of: tuple[tuple[float, ...], int] | None = None
+        # The last gaze frame :meth:`gaze_frame_lists` computed and its key: the gaze controller
+        # computes the frame at the head command and the runtime loop asks for the same one
+        # (the vergence distance) in the same tick.
+        self._last_frame: tuple[tuple[tuple[float, ...], int], list[list[float]]] | None = None
 
     @classmethod
     def load(cls, name_or_yaml: str | Path | RobotConfig = "sawyer") -> RobotModel:
@@ -248,14 +252,21 @@ class RobotModel:
         R_i2, p_i]`` (rotation columns = x, y, z; origin ``p``).
 
         The hot paths (look-at solver, gaze controller) use lists: with 3-vectors and <= 4 joints,
-        numpy's per-call overhead would dominate.
+        numpy's per-call overhead would dominate. The last frame is kept and returned again for
+        the same head vector and arm pose (the same list: callers must not change it).
         """
+        key = (tuple(q_head), self._arm_revision)
+        last = self._last_frame
+        if last is not None and last[0] == key:
+            return last[1]
         q = self._q_work
         q[self._head_sel] = q_head
         pin.forwardKinematics(self.model, self.data, q)
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
-        self._kinematics_of = (tuple(q_head), self._arm_revision)
-        return M.homogeneous[:3].tolist()
+        self._kinematics_of = key
+        rows = M.homogeneous[:3].tolist()
+        self._last_frame = (key, rows)
+        return rows
 
     def gaze_jacobian_rows(self, q_head: Sequence[float]) -> list[list[float]]:
         """The 6 rows (linear, angular; LOCAL_WORLD_ALIGNED) of the gaze frame Jacobian over the

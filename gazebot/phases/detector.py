@@ -21,7 +21,9 @@ robot has not grasped are a giver waiting).
 
 A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
 back about as far apart as when it started (taken back before any transfer), ends as
-``handover_done`` with ``source = "aborted"``. A reach that was an earlier movement (the giver
+``handover_done`` with ``source = "aborted"`` (a reach adopted by :meth:`PhaseDetector.resync`
+that began before the first sample: once the hands are ``transfer_distance_margin`` farther
+apart than the closest seen). A reach that was an earlier movement (the giver
 lifted the object, rested ``reach_stall``, then set off toward the receiver) ends with
 ``source = "stalled"`` when the final approach shows, and that approach is the reach (a new
 ``reach_started``); a retreat longer
@@ -110,7 +112,9 @@ class PhaseDetector:
         self._last_t = -math.inf
         self._last_analysis = -math.inf
         self._seen_g = self._seen_r = math.nan  # last valid sample of each hand
-        self._prev_evidence = False
+        # Robot evidence at the previous frame; None: not known (after a resync the first frame
+        # sets it, so a gripper already closed is no rising edge).
+        self._prev_evidence: bool | None = False
         self._robot_reports = False
         self._signals: Signals | None = None
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
@@ -147,7 +151,8 @@ class PhaseDetector:
         transfer start when the detector is idle, done or in a reach. Tracking and other robot
         events are ignored. No event is emitted, and queued events are dropped. A new handover
         is counted when a reach (or a transfer without a reach) follows ``idle``, ``done`` or
-        ``retreat``.
+        ``retreat``. The robot evidence of the next frame is a baseline, not an edge (a gripper
+        still closed after a finished handover starts no new one).
         """
         kind = event.kind
         if kind is EventKind.ROBOT_GRASPED:
@@ -163,6 +168,7 @@ class PhaseDetector:
             self.handover += 1
         self._enter(phase, event.t)
         self._joined_late = True
+        self._prev_evidence = None
         self._queue.clear()
 
     def adopt(self, phase: Phase, t0: float) -> None:
@@ -290,7 +296,7 @@ class PhaseDetector:
         if frame.gripper_closed is not None or load_ok:
             self._robot_reports = True
         evidence = grip or (load_ok and load > c.load_share_shared)  # type: ignore[operator]
-        rising = evidence and not self._prev_evidence
+        rising = evidence and self._prev_evidence is False
         self._prev_evidence = evidence
         source = "gripper" if grip else "load_share"
         if rising and self.phase in (Phase.IDLE, Phase.DONE, Phase.REACH):
@@ -477,6 +483,11 @@ class PhaseDetector:
         ok = np.flatnonzero(np.isfinite(d))
         if ok.size == 0:
             return True
+        if self._joined_late and not (ok.size and s.t[ok[0]] < self.phase_start):
+            # The reach began before the first sample seen (a resync): its start distance is
+            # unknown, so taken back means the hands left the region around the closest seen.
+            near = float(np.min(d[ok]))
+            return float(d[ok[-1]]) >= near + self.config.transfer_distance_margin
         i0 = int(np.searchsorted(s.t, self.phase_start))
         before = ok[ok <= i0]
         d0 = float(d[before[-1]] if before.size else d[ok[0]])

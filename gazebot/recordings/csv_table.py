@@ -44,7 +44,12 @@ def read_csv(
     names = names or PointNames()
     try:
         with path.open(newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.reader(fh))
+            reader = csv.reader(fh)
+            try:
+                rows = list(reader)
+            except csv.Error as exc:  # Python 3.10's reader rejects a NUL byte (3.11 reads it)
+                where = f"line {reader.line_num}"
+                raise RecordingError(path, f"{where}: not CSV text ({exc})") from None
     except UnicodeDecodeError as exc:
         byte = exc.object[exc.start]
         raise RecordingError(

@@ -489,14 +489,41 @@ def info_text(value: Any) -> str:
     return plain if isinstance(plain, str) else json.dumps(plain, allow_nan=False)
 
 
-def info_value(text: str) -> Any:
+#: Deepest nesting of lists/objects an info value may have (gazebot's own are at most 2 deep;
+#: a crafted ``[[[[...`` would otherwise exhaust the interpreter's recursion).
+MAX_INFO_DEPTH = 16
+
+
+def _depth(value: Any) -> int:
+    """Nesting depth of parsed JSON (0 for a scalar), without recursion."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, (list, dict)):
+            deepest = max(deepest, d + 1)
+            stack.extend((c, d + 1) for c in (v.values() if isinstance(v, dict) else v))
+    return deepest
+
+
+def info_value(text: str, type_name: str = HANDOVER_EVENT) -> Any:
     """Inverse of :func:`info_text`: JSON numbers, booleans, null, lists and objects are
-    parsed; any other text is a string."""
+    parsed; any other text is a string.
+
+    Raises:
+        MessageError: JSON nested deeper than :data:`MAX_INFO_DEPTH` (``type_name`` names the
+            message it came in).
+    """
     try:
         value = json.loads(text)
+    except RecursionError:
+        raise MessageError(type_name, f"info value nested deeper than {MAX_INFO_DEPTH}") from None
     except ValueError:
         return text
-    return text if isinstance(value, str) else value
+    if isinstance(value, str):
+        return text
+    if _depth(value) > MAX_INFO_DEPTH:
+        raise MessageError(type_name, f"info value nested deeper than {MAX_INFO_DEPTH}")
+    return value
 
 
 def handover_event(
@@ -654,23 +681,67 @@ def health_of(msg: Any) -> list[NodeHealth]:
         if str(st.name).startswith("gazebot: "):
             out.append(NodeHealth(
                 str(st.name)[len("gazebot: "):], int(st.level), str(st.message),
-                {kv.key: info_value(kv.value) for kv in st.values},
+                {kv.key: info_value(kv.value, DIAGNOSTIC_ARRAY) for kv in st.values},
             ))
     return out
 
 
 # -- eye frames ---------------------------------------------------------------------------------
 
+#: Largest image (width, height) :func:`decode_image` decodes by default: the eye display
+#: is 1024x600; a 4096x4096 RGB image is 48 MiB decoded. A few hundred kB of PNG can claim
+#: 20000x20000 (1.2 GB decoded): the header is read and such an image refused undecoded.
+MAX_IMAGE_SIZE = (4096, 4096)
 
-def compressed_image(
-    img: np.ndarray,
-    t: float,
-    frame_id: str,
-    fmt: Literal["jpeg", "png"] = "jpeg",
-    store: Typestore | None = None,
-) -> object:
-    """``sensor_msgs/CompressedImage`` of an (H, W, 3) uint8 RGB image (JPEG by default: several
-    times faster to encode than PNG at display sizes; PNG is lossless)."""
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+# JPEG start-of-frame markers (baseline, progressive, lossless, arithmetic); not C4/C8/CC.
+_JPEG_SOF = frozenset({0xC0, 0xC1, 0xC2, 0xC3, 0xC5, 0xC6, 0xC7, 0xC9, 0xCA, 0xCB, 0xCD, 0xCE,
+                       0xCF})
+
+
+def image_size(data: bytes) -> tuple[str, int, int]:
+    """``(format, width, height)`` of PNG or JPEG ``data``, read from its header only.
+
+    Raises:
+        MessageError: Neither a PNG nor a JPEG, or a header that is cut short.
+    """
+    if data.startswith(_PNG_SIGNATURE):
+        if len(data) < 24 or data[12:16] != b"IHDR":
+            raise MessageError(COMPRESSED_IMAGE, "PNG without an IHDR header")
+        return "png", int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    if data.startswith(b"\xff\xd8"):
+        i = 2
+        while i + 4 <= len(data):
+            if data[i] != 0xFF:
+                raise MessageError(COMPRESSED_IMAGE, f"JPEG: no segment marker at byte {i}")
+            marker = data[i + 1]
+            if marker == 0xFF:  # fill byte
+                i += 1
+                continue
+            if marker == 0x01 or 0xD0 <= marker <= 0xD8:  # segments without a length
+                i += 2
+                continue
+            length = int.from_bytes(data[i + 2:i + 4], "big")
+            if marker in _JPEG_SOF:
+                if i + 9 > len(data):
+                    break
+                height = int.from_bytes(data[i + 5:i + 7], "big")
+                width = int.from_bytes(data[i + 7:i + 9], "big")
+                return "jpeg", width, height
+            if marker in (0xD9, 0xDA) or length < 2:  # end of image / scan before a frame
+                break
+            i += 2 + length
+        raise MessageError(COMPRESSED_IMAGE, "JPEG without a frame header")
+    raise MessageError(COMPRESSED_IMAGE, "data is not a decodable image (neither PNG nor JPEG)")
+
+
+def encode_image(img: np.ndarray, fmt: Literal["jpeg", "png"] = "jpeg") -> bytes:
+    """JPEG (default: several times faster to encode than PNG at display sizes) or PNG
+    (lossless) bytes of an (H, W, 3) uint8 RGB image.
+
+    Raises:
+        MessageError: Not an (H, W, 3) uint8 image, or the encoder failed.
+    """
     import cv2
 
     if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8:
@@ -680,25 +751,56 @@ def compressed_image(
     ok, buf = cv2.imencode(".png" if fmt == "png" else ".jpg", img[:, :, ::-1])
     if not ok:
         raise MessageError(COMPRESSED_IMAGE, f"could not encode the image as {fmt}")
-    s = _store(store)
-    return s.types[COMPRESSED_IMAGE](
-        header=header(t, frame_id, s), format=fmt, data=np.asarray(buf, np.uint8).reshape(-1)
-    )
+    return buf.tobytes()
 
 
-def image_of(msg: Any) -> np.ndarray:
-    """The (H, W, 3) uint8 RGB image of a ``CompressedImage`` (JPEG or PNG).
+def decode_image(
+    data: bytes | np.ndarray, max_size: tuple[int, int] = MAX_IMAGE_SIZE
+) -> np.ndarray:
+    """The (H, W, 3) uint8 RGB image of PNG or JPEG ``data``: the one image decoder of gazebot's
+    wire. The header's dimensions are checked against ``max_size`` (width, height) before
+    anything is decoded.
 
     Raises:
-        MessageError: The data does not decode as an image.
+        MessageError: Not a PNG or JPEG, larger than ``max_size``, or it does not decode.
     """
     import cv2
 
-    data = np.asarray(msg.data, dtype=np.uint8).reshape(-1)
-    img = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
-    if img is None:
-        raise MessageError(COMPRESSED_IMAGE, f"data is not a decodable image ({msg.format!r})")
+    raw = data.tobytes() if isinstance(data, np.ndarray) else bytes(data)
+    fmt, width, height = image_size(raw)
+    if not (0 < width <= max_size[0] and 0 < height <= max_size[1]):
+        raise MessageError(COMPRESSED_IMAGE, f"{fmt} image is {width}x{height}, at most "
+                           f"{max_size[0]}x{max_size[1]} is decoded")
+    img = cv2.imdecode(np.frombuffer(raw, np.uint8), cv2.IMREAD_COLOR)
+    if img is None or img.shape[:2] != (height, width):
+        raise MessageError(COMPRESSED_IMAGE, f"data is not a decodable image ({fmt})")
     return np.ascontiguousarray(img[:, :, ::-1])
+
+
+def compressed_image(
+    img: np.ndarray,
+    t: float,
+    frame_id: str,
+    fmt: Literal["jpeg", "png"] = "jpeg",
+    store: Typestore | None = None,
+) -> object:
+    """``sensor_msgs/CompressedImage`` of an (H, W, 3) uint8 RGB image (see
+    :func:`encode_image`)."""
+    buf = encode_image(img, fmt)
+    s = _store(store)
+    return s.types[COMPRESSED_IMAGE](
+        header=header(t, frame_id, s), format=fmt, data=np.frombuffer(buf, np.uint8)
+    )
+
+
+def image_of(msg: Any, max_size: tuple[int, int] = MAX_IMAGE_SIZE) -> np.ndarray:
+    """The (H, W, 3) uint8 RGB image of a ``CompressedImage`` (JPEG or PNG, at most
+    ``max_size``; see :func:`decode_image`).
+
+    Raises:
+        MessageError: The data is not a PNG or JPEG of at most ``max_size``.
+    """
+    return decode_image(np.asarray(msg.data, dtype=np.uint8).reshape(-1), max_size)
 
 
 def command_messages(

@@ -196,12 +196,17 @@ class GazeLoop:
     def _finish(
         self, cmd: GazeCommand, answers: bool, joints: Mapping[str, float] | None
     ) -> GazeCommand | None:
-        if not (cmd.is_finite() and math.isfinite(cmd.gaze_shift)):
-            self.unsafe += 1
-            return None
+        # What GazeCommand.is_finite() checks, in one pass with the limits: a NaN or infinite
+        # head goal fails its limit comparison and non-finite eyes are clipped.
+        isfinite = math.isfinite
         head = cmd.head
-        if not (self._within_limits(head) and not self.robot.eyes.clip(cmd.eye_yaw,
-                                                                        cmd.eye_pitch)[2]):
+        if not (
+            isfinite(cmd.t)
+            and isfinite(cmd.blink)
+            and isfinite(cmd.gaze_shift)
+            and self._within_limits(head)
+            and not self.robot.eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]
+        ):
             self.unsafe += 1
             return None
         distance = None

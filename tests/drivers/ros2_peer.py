@@ -1,12 +1,14 @@
 """An independent ROS 2 node on the rmw_zenoh wire, built with ``zenoh-ros2-sdk`` (not gazebot):
 the other side of the interoperability tests. Run as a script, in its own process (the SDK
-keeps one Zenoh session per process); prints one JSON object on stdout.
+keeps one Zenoh session per process); prints one JSON object on the last line of stdout.
 
-``listen``: list the ROS graph's topics with types and hashes, then record the gaze targets,
+``listen``: subscribe, print ``ready`` on a line of its own once the router lists the
+subscriptions, list the ROS graph's topics with types and hashes, then record the gaze targets,
 head commands, tracked face and hand and phases until the phase is ``done``.
 
 ``drive``: publish a recorded handover's tracking topics, gripper, load share and joint states
-(paced at ``--speed`` x real time) and record what the engine answers.
+(paced at ``--speed`` x real time) and record what the engine answers, until the phase is
+``done`` and the engine answered the last sample (a gaze target with its stamp).
 
 The SDK reads message definitions from ``--msgdir`` (``<pkg>/msg/<Name>.msg``); it cannot
 download them here.
@@ -78,6 +80,11 @@ class Record:
         with self.lock:
             return "done" in self.phases
 
+    def answered(self, t: float) -> bool:
+        """Whether a gaze target stamped ``t`` (or later) arrived."""
+        with self.lock:
+            return any(target[0] >= t for target in self.targets)
+
     def result(self) -> dict:
         with self.lock:
             return {"targets": self.targets, "heads": self.heads, "phases": self.phases,
@@ -108,16 +115,32 @@ def graph(port: int, ns: str, wait: float) -> dict:
         time.sleep(0.2)
     topics = {k: sorted(v) for k, v in topics.items()}
     out = {}
+    # The topics the peer records have publishers while the handover runs: a reply without
+    # one came back short (its own subscription answers first).
+    published = {f"{ns}/{t}" for t in (*TOPICS, *(f"tracking/{b}" for b in BODIES))}
     for name, types in topics.items():
         for _ in range(10):  # a liveliness query on a busy machine may come back short
             info = get_topic_info(name, router_port=port, timeout=1.0, verbose=True)
             endpoints = (info.publishers + info.subscribers) if info else []
-            if endpoints:
+            if endpoints and (name not in published or info.publishers):
                 break
         out[name] = {"types": types,
                      "hashes": sorted({e.type_hash for e in endpoints}),
                      "publishers": sorted({e.node_name for e in info.publishers}) if info else []}
     return out
+
+
+def subscribed(port: int, ns: str, wait: float) -> None:
+    """Until the router lists a subscription on each topic the peer records (its own)."""
+    from zenoh_ros2_sdk import get_topic_info
+
+    deadline = time.monotonic() + wait
+    while time.monotonic() < deadline:
+        infos = [get_topic_info(f"{ns}/{t}", router_port=port, timeout=1.0) for t in TOPICS]
+        if all(i is not None and i.subscriber_count > 0 for i in infos):
+            return
+        time.sleep(0.1)
+    raise SystemExit(f"the router never listed the peer's subscriptions in {wait} s")
 
 
 def listen(args) -> dict:
@@ -132,6 +155,8 @@ def listen(args) -> dict:
         rec.subs.append(ROS2Subscriber(f"{args.ns}/tracking/{body}",
                                        "geometry_msgs/msg/PointStamped", on_point,
                                        node_name="sdk_listener", router_port=args.port))
+    subscribed(args.port, args.ns, args.wait)
+    print("ready", flush=True)
     topics = graph(args.port, args.ns, args.wait)
     deadline = time.monotonic() + args.duration
     while not rec.done() and time.monotonic() < deadline:
@@ -179,10 +204,12 @@ def drive(args) -> dict:
                 pubs[body].publish(header=header(t, "world"), point=Point(x=p[0], y=p[1], z=p[2]))
         gripper.publish(header=header(t), closed=bool(tick["gripper_closed"]))
         share.publish(header=header(t), share=float(tick["load_share"]))
+    # The last sample's answer: its gaze target, stamped with the sample's time (as sent).
+    last = round(ticks[-1]["t"] * 1e9) * 1e-9
     deadline = time.monotonic() + args.duration
-    while not rec.done() and time.monotonic() < deadline:
+    while not (rec.done() and rec.answered(last - 1e-9)) and time.monotonic() < deadline:
         time.sleep(0.05)
-    return {"topics": topics, "published": len(ticks), **rec.result()}
+    return {"topics": topics, **rec.result()}
 
 
 def main() -> int:

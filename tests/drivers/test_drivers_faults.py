@@ -6,6 +6,7 @@ Each test has its own namespace and port; the robot side listens, the engine con
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 
 import numpy as np
@@ -414,3 +415,75 @@ def test_pose_stamped_and_tf_frames_are_tracking_too_and_remapped_topics_are_use
     node.on_tracking(got[-1])
     assert wait_until(lambda: targets.msgs)
     assert targets.msgs[-1][1].tolist() == [1.1, 0.2, 1.6]  # the fake engine looks at the face
+
+
+class FragileEngine(FakeEngine):
+    """Fails on a sample whose hand is beyond 1e100 m (what killed the engine in issue 21)."""
+
+    def step(self, frame, arm=None):
+        if frame.giver_hand is not None and abs(frame.giver_hand[0]) > 1e100:
+            raise OverflowError("(34, 'Numerical result out of range')")
+        return super().step(frame, arm)
+
+
+def test_a_sample_that_makes_the_engine_fail_is_reported_and_the_node_goes_on(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus, engine=FragileEngine())
+    events = events_of(ep)
+    status = health_of(ep)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(30)
+    ep.publish_tracking(frame(0.0, hand_x=1e155))
+    assert wait_until(lambda: events.where(kind="node_fault"))
+    [fault] = events.where(kind="node_fault")
+    assert fault.category == "fault" and fault.source == "engine"
+    assert fault.info["stage"] == "tracking" and "engine raised" in fault.info["error"]
+    assert wait_until(lambda: any(s.node == "engine" and s.state == "degraded"
+                                  and s.values.get("faults") == 1 for s in status.msgs))
+    # the node goes on: the next sample is answered
+    ep.publish_tracking(frame(0.1))
+    assert wait_until(lambda: ep.head.peek() is not None)
+    assert th.is_alive() and node.faults == 1
+
+
+class FaultyEngine(FakeEngine):
+    """Reports a fault it caught itself (as GazeEngine does) with a safe command."""
+
+    def step(self, frame, arm=None):
+        cmd = super().step(frame, arm)
+        fault = Event(EventKind.FAULT, frame.t, frame.t,
+                      {"stage": "phases", "error": "OverflowError: too big"})
+        return dataclasses.replace(cmd, events=(*cmd.events, fault))
+
+
+def test_a_fault_the_engine_caught_is_reported_by_the_node_and_the_command_sent(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus, engine=FaultyEngine())
+    events = events_of(ep)
+    assert wait_until(lambda: connected(ep, drv))
+    th.start()
+    assert node.ready.wait(30)
+    ep.publish_tracking(frame(0.0))
+    assert wait_until(lambda: events.where(kind="node_fault"))
+    fault = events.where(kind="node_fault")[0]
+    assert fault.info == {"stage": "engine phases", "error": "OverflowError: too big",
+                          "faults": 1}
+    assert wait_until(lambda: ep.head.peek() is not None) and th.is_alive()
+
+
+def test_a_failing_subscription_callback_is_counted_and_reported_as_a_fault(bus):
+    ep = robot_side(bus)
+    node, drv, _, th = engine_side(bus)
+    events = events_of(ep)
+    drv.ros.subscription("probe", "std_msgs/msg/String", lambda msg, rx: 1 / 0)
+    probe = ep.ros.publisher("probe", "std_msgs/msg/String")
+    assert wait_until(lambda: connected(ep, drv) and probe.subscribed())
+    th.start()
+    assert node.ready.wait(30)
+    probe.publish(ep.ros.store.types["std_msgs/msg/String"](data="boom"))
+    assert wait_until(lambda: events.where(kind="node_fault"))
+    [fault] = events.where(kind="node_fault")
+    assert fault.info["stage"] == "callback " + ep.names.resolve("probe")
+    assert "ZeroDivisionError" in fault.info["error"]
+    assert drv.callback_faults() == {ep.names.resolve("probe"): 1} and th.is_alive()

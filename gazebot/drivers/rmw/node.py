@@ -6,7 +6,8 @@ node keeps the graph the other tokens describe.
 Subscriptions listen to their topic whatever the type (``<domain>/<topic>/*/*``) so that a
 publisher of another type or another version of the type is reported, not silently unheard.
 Zenoh runs callbacks on its own threads: a subscription callback never raises; anything
-malformed is counted by topic (:class:`DropCounter`) and dropped.
+malformed is counted by topic (:class:`DropCounter`) and dropped, and so is a message whose
+handler fails in any other way (one rate-limited log line, never a traceback per message).
 """
 
 from __future__ import annotations
@@ -24,8 +25,9 @@ from gazebot.drivers.rmw.graph import ADMIN_SPACE, Entity, Graph, Kind
 from gazebot.drivers.rmw.names import Names, check_namespace, check_node_name
 from gazebot.drivers.rmw.qos import DEFAULT, QosProfile
 from gazebot.ros2.codec import MAX_PAYLOAD_BYTES, Codec
-from gazebot.ros2.errors import MessageError
+from gazebot.ros2.errors import MessageError, one_line
 from gazebot.ros2.names import ros_type_name
+from gazebot.ros2.topics import max_bytes_of
 
 if TYPE_CHECKING:
     import zenoh
@@ -55,21 +57,23 @@ class DropCounter:
     ``log_every``-th, so a flood of garbage cannot flood the log. Keeps the last reason and the
     type mismatches seen."""
 
-    def __init__(self, log_first: int = 3, log_every: int = 100) -> None:
+    def __init__(self, log_first: int = 3, log_every: int = 100, logs: bool = True) -> None:
         self.log_first = log_first
         self.log_every = log_every
+        self.logs = logs
         self._counts: dict[str, int] = {}
         self._reasons: dict[str, str] = {}
         self._mismatches: dict[str, TypeMismatch] = {}
         self._lock = threading.Lock()
 
     def drop(self, topic: str, reason: str, mismatch: TypeMismatch | None = None) -> None:
+        reason = one_line(reason)
         with self._lock:
             n = self._counts[topic] = self._counts.get(topic, 0) + 1
             self._reasons[topic] = reason
             if mismatch is not None:
                 self._mismatches[topic] = mismatch
-        if n <= self.log_first or n % self.log_every == 0:
+        if self.logs and (n <= self.log_first or n % self.log_every == 0):
             log.warning("dropped message #%d on %s: %s", n, topic, reason)
 
     def counts(self) -> dict[str, int]:
@@ -204,8 +208,13 @@ class Subscription:
             self.handler(msg, Received(self.topic, codec.info.name, att))
         except MessageError as exc:  # the handler found a value it cannot use (NaN, ...)
             drops.drop(self.topic, exc.reason)
-        except Exception:  # a bug in a handler must not kill Zenoh's thread
-            log.exception("handler for %s failed", self.topic)
+        except Exception as exc:  # noqa: BLE001 - whatever a message causes, it is a drop
+            # A crafted message must not kill Zenoh's thread nor flood the log with a
+            # traceback per message: a drop of the topic (one rate-limited line, like malformed
+            # CDR), and a callback fault the node reports (``faults``, quiet).
+            reason = f"handler failed: {type(exc).__name__}: {exc}"
+            drops.drop(self.topic, reason)
+            self.node.faults.drop(self.topic, reason)
 
     def undeclare(self) -> None:
         for entity in (self._token, self._sub):
@@ -223,7 +232,8 @@ class RosNode:
         names: Namespace, remapping and domain id.
         name: The node's name.
         store: The type system (default: gazebot's, :func:`gazebot.ros2.typestore.typestore`).
-        max_bytes: Largest payload a subscription decodes, by resolved topic (default
+        max_bytes: Largest payload a subscription decodes, by resolved topic (default: the
+            topic's cap in :mod:`gazebot.ros2.topics`, else
             :data:`~gazebot.ros2.codec.MAX_PAYLOAD_BYTES`).
         on_graph: Called with ``(entity, alive)`` for each token change (on Zenoh's thread).
     """
@@ -250,6 +260,8 @@ class RosNode:
         self.node_id = next(_entity_ids)
         self.graph = Graph(names.domain_id)
         self.drops = DropCounter()
+        # Handler failures (bugs or inputs a handler did not expect), by topic.
+        self.faults = DropCounter(logs=False)  # each is in ``drops`` too, logged there
         self.closed = False
         self.on_graph = on_graph
         self._codecs: dict[tuple[str, int], Codec] = {}
@@ -291,9 +303,10 @@ class RosNode:
             self._token = self.session.liveliness().declare_token(self.node_entity.token())
 
     # -- endpoints -------------------------------------------------------------------------
-    def codec(self, ros_type: str, topic: str = "") -> Codec:
-        """The codec of ``ros_type`` with ``topic``'s size cap."""
-        cap = self.max_bytes.get(topic, MAX_PAYLOAD_BYTES)
+    def codec(self, ros_type: str, topic: str = "", name: str = "") -> Codec:
+        """The codec of ``ros_type`` with the size cap of ``topic`` (resolved; ``name``: as
+        the topic table names it)."""
+        cap = self.max_bytes.get(topic, max_bytes_of(name) if name else MAX_PAYLOAD_BYTES)
         key = (ros_type, cap)
         if key not in self._codecs:
             self._codecs[key] = Codec.for_type(self.store, ros_type, cap)
@@ -302,7 +315,7 @@ class RosNode:
     def publisher(self, name: str, ros_type: str, qos: QosProfile = DEFAULT) -> Publisher:
         """A publisher of ``ros_type`` on topic ``name`` (resolved: namespace, remapping)."""
         topic = self.names.resolve(name)
-        pub = Publisher(self, topic, self.codec(ros_type, topic), qos)
+        pub = Publisher(self, topic, self.codec(ros_type, topic, name), qos)
         self._entities.append(pub)
         return pub
 
@@ -313,7 +326,8 @@ class RosNode:
         with the CDR bytes as received instead of the message)."""
         topic = self.names.resolve(name)
         types = [ros_types] if isinstance(ros_types, str) else list(ros_types)
-        sub = Subscription(self, topic, [self.codec(t, topic) for t in types], handler, qos, raw)
+        sub = Subscription(self, topic, [self.codec(t, topic, name) for t in types], handler, qos,
+                           raw)
         self._entities.append(sub)
         return sub
 

@@ -1,0 +1,91 @@
+"""A second tracking source with another clock (issue 21): reported as ``competing_tracking``
+and ignored while the first source publishes; not a clock reset per interleaved sample."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+from drivers_fakes import FakeEngine, wait_until
+from test_drivers_faults import FAST, events_of
+
+from gazebot.drivers.engine_node import EngineNode
+from gazebot.drivers.rmw.node import RosNode
+from gazebot.drivers.tracking_source import SourceArbiter
+from gazebot.drivers.zenoh_driver import ZenohRobotDriver
+from gazebot.ros2 import convert, topics
+from gazebot.runtime import GazeLoop
+
+pytestmark = pytest.mark.zenoh
+
+
+class Tracker:
+    """A tracking node publishing the giver's hand and face with its own clock."""
+
+    def __init__(self, bus, name: str) -> None:
+        self.ros = RosNode(bus.connector(), bus.names, name)
+        bus.closers.append(self.ros.close)
+        self.hand = self.ros.publisher(topics.GIVER_HAND.name, topics.GIVER_HAND.type)
+        self.face = self.ros.publisher(topics.GIVER_FACE.name, topics.GIVER_FACE.type)
+        self.ros.announce()
+
+    def publish(self, t: float) -> None:
+        self.hand.publish(convert.point_stamped(t, [1.0, 0.0, 1.0], "world"))
+        self.face.publish(convert.point_stamped(t, [1.0, 0.3, 1.5], "world"))
+
+
+def test_arbiter_keeps_the_first_source_until_it_is_silent():
+    now = [0.0]
+    arb = SourceArbiter(timeout=1.0, clock=lambda: now[0])
+    assert arb.admit("giver_hand", "a") is None
+    assert arb.admit("giver_face", "b") == "a"  # the points are one group
+    assert arb.admit("gripper", "b") is None  # the gripper is its own group
+    assert [(r.source, r.owner, r.ignored) for r in arb.new_rivals()] == [("b", "a", 1)]
+    assert arb.new_rivals() == []  # reported once
+    now[0] = 0.5
+    assert arb.admit("giver_hand", "a") is None and arb.admit("giver_hand", "b") == "a"
+    now[0] = 1.6  # a silent for 1.1 s: b takes over
+    assert arb.admit("giver_hand", "b") is None
+    assert arb.owners() == {"points": "b"} and arb.admit("giver_hand", "a") == "b"
+
+
+def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset_per_sample(bus):
+    drv = ZenohRobotDriver(bus.listener(), bus.names, "engine", source_timeout=0.3)
+    engine = FakeEngine()
+    node = EngineNode(GazeLoop(engine), drv, FAST)
+    stop = threading.Event()
+    th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
+    bus.closers.append(drv.close)
+    bus.closers.append(lambda: (stop.set(), th.is_alive() and th.join(timeout=5)))
+    events = events_of(drv)
+    a, b = Tracker(bus, "tracker_a"), Tracker(bus, "tracker_b")
+    hand = bus.names.resolve(topics.GIVER_HAND.name)
+    assert wait_until(lambda: drv._expected_parts() == {"giver_hand", "giver_face"}
+                      and len(drv.ros.graph.endpoints(hand, "MP")) == 2)
+    th.start()
+    assert node.ready.wait(30)
+    a.publish(100.0)
+    assert wait_until(lambda: node.frames_processed == 1)
+    for i in range(1, 61):  # interleaved: robot time 100 s on one clock, 5 s on the other
+        b.publish(5.0 + i / 120)
+        a.publish(100.0 + i / 120)
+    assert wait_until(lambda: drv.dropped().get(hand) == 60)
+    assert wait_until(lambda: any(f.t == pytest.approx(100.5) for f in engine.frames))
+    assert all(f.t >= 100.0 for f in engine.frames)
+    assert not events.where(kind="tracking_clock_reset")
+    assert wait_until(lambda: events.where(kind="competing_tracking"))
+    [report] = events.where(kind="competing_tracking")
+    assert report.info["source"].startswith("tracker_b ")
+    assert report.info["owner"].startswith("tracker_a ") and report.info["group"] == "points"
+    assert "second tracking source tracker_b" in drv.drops.reasons()[hand]
+    # tracker a goes silent: tracker b takes over, with one clock reset for its clock
+    state = {"t": 6.0}
+
+    def b_used() -> bool:
+        state["t"] += 1 / 120
+        b.publish(state["t"])
+        return any(f.t < 100.0 for f in engine.frames)
+
+    assert wait_until(b_used)
+    assert len(events.where(kind="tracking_clock_reset")) == 1
+    assert th.is_alive()
