@@ -93,6 +93,20 @@ class PhaseConfig(BaseModel):
             started (a lift; a hand held out at the handover place has come farther).
         reach_lookback: Online, in a reach the analysis reads this many ``reach_duration``
             before the reach's start (the rest before it dates the onset).
+        predict_window: Online, ``gazebot``'s predictive reach rule
+            (:mod:`~gazebot.phases.rules.directed`) fits the giver's hand over this long (s) ...
+        predict_min_samples: ... and over at least this many samples (low rates widen it).
+        predict_gap_factor: ... with no gap in the window longer than this many sampling
+            intervals (the newest sample seen) ...
+        predict_rest_window: ... against its mean position over this long (s) before that.
+        predict_noise_window: ... measuring the marker noise over this long (s) before it ...
+        predict_distance: ... a reach is confirmed once the hand moved this far (m) toward the
+            receiver's hand, faster than ``reach_onset_speed``, still accelerating ...
+        predict_cos: ... within ``acos`` of this of the line to the receiver's hand ...
+        predict_sigmas: ... and each of distance, speed and acceleration above this many
+            standard errors of the fit (the measured noise floor) ...
+        predict_horizon: ... and the model, extrapolated this far ahead (s), closes ...
+        predict_gap_share: ... this share of the gap the hands started from.
         trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
             the distances its rules need (loose: it fires before the rule can).
         trigger_speed_baseline: ... speeds from mean positions this far apart (s).
@@ -156,6 +170,16 @@ class PhaseConfig(BaseModel):
     reach_stall: float = Field(1.0, gt=0)
     stall_travel: float = Field(0.18, gt=0)
     reach_lookback: float = Field(2.0, ge=1)
+    predict_window: float = Field(0.2, gt=0)
+    predict_min_samples: int = Field(5, ge=4)
+    predict_rest_window: float = Field(0.2, gt=0)
+    predict_gap_factor: float = Field(3.0, ge=1)
+    predict_noise_window: float = Field(1.0, gt=0)
+    predict_distance: float = Field(0.016, gt=0)
+    predict_cos: float = Field(0.3, ge=-1, le=1)
+    predict_sigmas: float = Field(3.0, ge=0)
+    predict_horizon: float = Field(0.3, ge=0)
+    predict_gap_share: float = Field(0.15, ge=0, lt=1)
     trigger_distance_factor: float = Field(0.5, gt=0, le=1)
     trigger_speed_baseline: float = Field(0.1, gt=0)
     trigger_deep_fraction: float = Field(0.8, gt=0, le=1)

@@ -20,6 +20,7 @@ import numpy as np
 from gazebot.phases.filtering import Signals, compute_signals
 from gazebot.phases.methods.base import OnlineTrigger, Segmenter
 from gazebot.phases.methods.gazebot_trigger import GazebotTrigger
+from gazebot.phases.rules.directed import directed_reach
 from gazebot.phases.rules.reach import reach_start, trailing_reach
 from gazebot.phases.rules.release import transfer_end
 from gazebot.phases.rules.retreat import far_after, rest_after, retreat_done
@@ -58,7 +59,18 @@ class GazebotSegmenter(Segmenter):
         return self.signals(trajectory, partial=True)
 
     def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
-        return self.segment_signals(s, now, True)
+        """The segments the signals show so far; with no phase under way at their end, a reach
+        the raw samples predict (:mod:`~gazebot.phases.rules.directed`: the giver's hand
+        accelerating toward the receiver) before the signals can show it."""
+        segs = self.segment_signals(s, now, True)
+        if segs and (segs[-1].open or segs[-1].phase is not Phase.RETREAT):
+            return segs
+        after = segs[-1].end if segs else -math.inf
+        onset = directed_reach(trajectory, self.config, after)
+        if onset is not None:
+            k = segs[-1].handover + 1 if segs else 0
+            segs.append(Segment(Phase.REACH, min(onset, now), now, k, open=True))
+        return segs
 
     def phase_end(
         self, s: Signals, phase: Phase, phase_start: float, joined_late: bool

@@ -139,7 +139,8 @@ class GazebotTrigger:
             return False
         da = d[after[0] :]
         closed = float(np.nanmax(da)) - d[-1]
-        if not closed >= loose * c.reach_confirm_distance:
+        # (the predictive rule confirms a reach from predict_distance of the giver's own travel)
+        if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
             return False
         i_max = after[0] + int(np.nanargmax(da))
         own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(float(d[-1]), 1e-9)
