@@ -92,7 +92,9 @@ def _sample_moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _update_policy(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, seed: int) -> None:
-    """Eq. 5.5: regress the network on all conditions' samples."""
+    """Eq. 5.5's policy step: regress the network on all conditions' samples, towards
+    mu_p - C_t lambda_t / nu_t with weight nu_t C_t^-1 (the mean part of nu_t KL(pi || p) plus
+    mu' lambda; the seed writes KL(p || pi), see the README's "where we differ")."""
     g = cfg.gps
     c, m, horizon, dx = Xs.shape
     xs, tgts, wts, precs = [], [], [], []
