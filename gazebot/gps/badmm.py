@@ -17,7 +17,7 @@ from threadpoolctl import threadpool_limits
 
 from gazebot.gps.config import GPSFileConfig
 from gazebot.gps.cost import ReachCost
-from gazebot.gps.dynamics import GMMPrior, fit_dynamics, transitions
+from gazebot.gps.dynamics import GMMPrior, LinearDynamics, fit_dynamics, transitions
 from gazebot.gps.lingauss import LinearGaussian, pd_controller
 from gazebot.gps.lqg import PolicyLinearization, kl_per_step, lqg_update
 from gazebot.gps.policy import PolicyParams, init_policy, jacobians, train_policy
@@ -75,12 +75,13 @@ def policy_act(policy: PolicyParams) -> Callable[[int, np.ndarray], np.ndarray]:
 def _policy_linearization(policy: PolicyParams, X: np.ndarray) -> PolicyLinearization:
     """Linearise the network at one condition's sample states X (M, T, dX)."""
     m, horizon, dx = X.shape
+    du = policy.cov.shape[0]
     flat = X.reshape(-1, dx)
-    J = jacobians(policy, flat).reshape(m, horizon, DU, dx)
-    mu = policy.mean(flat).reshape(m, horizon, DU)
+    J = jacobians(policy, flat).reshape(m, horizon, du, dx)
+    mu = policy.mean(flat).reshape(m, horizon, du)
     K = J.mean(axis=0)
     k = (mu - np.einsum("mtux,mtx->mtu", J, X)).mean(axis=0)
-    cov = np.broadcast_to(policy.cov, (horizon, DU, DU)).copy()
+    cov = np.broadcast_to(policy.cov, (horizon, du, du)).copy()
     return PolicyLinearization(K, k, cov)
 
 
@@ -91,29 +92,98 @@ def _sample_moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mu, sig
 
 
+def policy_targets(ctrl: LinearGaussian, X: np.ndarray, lam: np.ndarray,
+                   nu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 5.5's regression for one condition at its sample states X (M, T, dX): the targets
+    mu_p(x) - C_t lambda_t / nu_t (M, T, dU) and the weights nu_t C_t^-1 (T, dU, dU).
+
+    They make the loss nu_t/2 (mu - target)' C_t^-1 (mu - target) equal, up to a constant, to
+    mu' lambda_t plus the mean part of nu_t KL(pi || p) (the seed writes KL(p || pi); see the
+    README's "where we differ")."""
+    prec = ctrl.precision  # (T, dU, dU)
+    mu_p = np.einsum("tux,mtx->mtu", ctrl.K, X) + ctrl.k
+    # nu/2 (mu - mu_p)' P (mu - mu_p) + mu' lam
+    #   = nu/2 (mu - (mu_p - P^-1 lam / nu))' P (...) + const
+    shift = np.linalg.solve(prec, lam[..., None])[..., 0] / nu[:, None]
+    return mu_p - shift, nu[:, None, None] * prec
+
+
 def _update_policy(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, seed: int) -> None:
-    """Eq. 5.5: regress the network on all conditions' samples."""
+    """Eq. 5.5's policy step: regress the network on all conditions' samples (see
+    :func:`policy_targets`)."""
     g = cfg.gps
     c, m, horizon, dx = Xs.shape
+    du = st.lam.shape[-1]
     xs, tgts, wts, precs = [], [], [], []
     for i, ctrl in enumerate(st.controllers):
-        prec = ctrl.precision  # (T, dU, dU)
-        mu_p = np.einsum("tux,mtx->mtu", ctrl.K, Xs[i]) + ctrl.k
-        # nu/2 (mu - mu_p)' P (mu - mu_p) + mu' lam
-        #   = nu/2 (mu - (mu_p - P^-1 lam / nu))' P (...) + const
-        shift = np.linalg.solve(prec, st.lam[i][..., None])[..., 0] / st.nu[i][:, None]
+        target, w = policy_targets(ctrl, Xs[i], st.lam[i], st.nu[i])
         xs.append(Xs[i].reshape(-1, dx))
-        tgts.append((mu_p - shift).reshape(-1, DU))
-        w = st.nu[i][:, None, None] * prec
-        wts.append(np.broadcast_to(w, (m,) + w.shape).reshape(-1, DU, DU))
-        precs.append(prec)
+        tgts.append(target.reshape(-1, du))
+        wts.append(np.broadcast_to(w, (m,) + w.shape).reshape(-1, du, du))
+        precs.append(ctrl.precision)
     W = np.concatenate(wts)
-    W = W / np.mean(np.trace(W, axis1=1, axis2=2)) * DU  # normalised as Levine et al. do
+    W = W / np.mean(np.trace(W, axis1=1, axis2=2)) * du  # normalised as Levine et al. do
     policy = train_policy(st.policy, np.concatenate(xs), np.concatenate(tgts), W,
                           g.policy_steps, g.batch, g.learning_rate, seed)
     mean_prec = np.mean(np.concatenate(precs), axis=0)
     cov = np.linalg.inv(mean_prec)
     st.policy = PolicyParams(**{**policy.__dict__, "cov": 0.5 * (cov + cov.T)})
+
+
+def dual_step(lam: np.ndarray, nu: np.ndarray, mu_pi: np.ndarray, mu_p: np.ndarray,
+              pol_cov: np.ndarray, rate: float) -> np.ndarray:
+    """Eq. 5.7 for one condition: lambda_t + alpha nu_t Sigma_pi^-1 (E[pi u] - E[p u]), the
+    expectations over the sample states (mu_pi, mu_p: (M, T, dU) mean actions there).
+
+    The difference is in N m and N while lambda is in cost per action unit: we take alpha's units
+    from the policy's action precision (Sigma_pi^-1, our departure from the literal eq. 5.7),
+    which makes the shift lambda induces in eq. 5.5's target alpha times the difference instead
+    of overshooting."""
+    gap = (mu_pi - mu_p).mean(axis=0) @ np.linalg.inv(pol_cov).T
+    return lam + rate * nu[:, None] * gap
+
+
+def adapt_nu(nu: np.ndarray, kl_t: np.ndarray, target: float, lo: float,
+             hi: float) -> np.ndarray:
+    """nu_t doubles where E KL(p || pi) exceeds ``target``, halves where it is below a quarter of
+    it, and stays within [lo, hi]."""
+    nu = np.where(kl_t > target, nu * 2.0, np.where(kl_t < target / 4, nu / 2.0, nu))
+    return np.clip(nu, lo, hi)
+
+
+def inner_loop(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, dyns: list[LinearDynamics],
+               expansions: list[tuple[np.ndarray, np.ndarray]],
+               iteration: int) -> tuple[list[float], list[float]]:
+    """BADMM's alternation on one iteration's samples Xs (C, M, T, dX), ``inner_iterations``
+    times: policy step (eq. 5.5), dual step (eq. 5.7), nu adaptation, LQG step (eq. 5.6) from the
+    controllers that produced the samples. Updates ``st``; returns the last pass's eta and mean
+    KL(p || pi) per condition."""
+    g = cfg.gps
+    sampled = list(st.controllers)
+    etas: list[float] = []
+    kls: list[float] = []
+    for inner in range(g.inner_iterations):
+        _update_policy(cfg, st, Xs, g.seed + 1000 * iteration + inner)
+        new_ctrls = []
+        kls = []
+        etas = []
+        for i, (dyn, (Cm, cv)) in enumerate(zip(dyns, expansions, strict=True)):
+            X = Xs[i]
+            lin = _policy_linearization(st.policy, X)
+            ctrl = st.controllers[i]
+            mu_pi = st.policy.mean(X)
+            mu_p = np.einsum("tux,mtx->mtu", ctrl.K, X) + ctrl.k
+            st.lam[i] = dual_step(st.lam[i], st.nu[i], mu_pi, mu_p, st.policy.cov, g.dual_rate)
+            # nu_t grows where the local controller and the policy disagree, shrinks where not.
+            mu_x, sig_x = _sample_moments(X)
+            kl_t = kl_per_step(mu_x, sig_x, ctrl, lin)
+            st.nu[i] = adapt_nu(st.nu[i], kl_t, g.kl_policy_target, g.nu_init, g.nu_max)
+            new, eta, _ = lqg_update(dyn, Cm, cv, sampled[i], lin, st.nu[i], st.lam[i], g.kl_step)
+            new_ctrls.append(new)
+            etas.append(eta)
+            kls.append(float(kl_t.mean()))
+        st.controllers = new_ctrls
+    return etas, kls
 
 
 def initial_state(cfg: GPSFileConfig, scene: HandoverScene, motions: list[TesterMotion],
@@ -152,36 +222,7 @@ def iterate(cfg: GPSFileConfig, scene: HandoverScene, motions: list[TesterMotion
     prior.fit(np.concatenate(buffer))
     dyns = [fit_dynamics(X, U, prior, g.prior_strength) for X, U in zip(Xs, Us, strict=True)]
     expansions = [cost.expand(X, U) for X, U in zip(Xs, Us, strict=True)]
-    sampled = list(st.controllers)
-    etas, kls = [], []
-    for inner in range(g.inner_iterations):
-        _update_policy(cfg, st, Xs, g.seed + 1000 * iteration + inner)
-        new_ctrls = []
-        kls = []
-        etas = []
-        for i, (dyn, (Cm, cv)) in enumerate(zip(dyns, expansions, strict=True)):
-            X = Xs[i]
-            lin = _policy_linearization(st.policy, X)
-            ctrl = st.controllers[i]
-            # Eq. 5.7: lambda_t += alpha nu_t (E[pi u] - E[p u]) over the sampled states. The
-            # difference is in N m and N while lambda is in cost per action unit: we take alpha's
-            # units from the policy's action precision (alpha Sigma_pi^-1), which makes the shift
-            # lambda induces in eq. 5.5's target alpha times the difference instead of overshooting.
-            mu_pi = st.policy.mean(X)
-            mu_p = np.einsum("tux,mtx->mtu", ctrl.K, X) + ctrl.k
-            gap = (mu_pi - mu_p).mean(axis=0) @ np.linalg.inv(st.policy.cov).T
-            st.lam[i] += g.dual_rate * st.nu[i][:, None] * gap
-            # nu_t grows where the local controller and the policy disagree, shrinks where not.
-            mu_x, sig_x = _sample_moments(X)
-            kl_t = kl_per_step(mu_x, sig_x, ctrl, lin)
-            st.nu[i] = np.where(kl_t > g.kl_policy_target, st.nu[i] * 2.0,
-                                np.where(kl_t < g.kl_policy_target / 4, st.nu[i] / 2.0, st.nu[i]))
-            st.nu[i] = np.clip(st.nu[i], g.nu_init, g.nu_max)
-            new, eta, _ = lqg_update(dyn, Cm, cv, sampled[i], lin, st.nu[i], st.lam[i], g.kl_step)
-            new_ctrls.append(new)
-            etas.append(eta)
-            kls.append(float(kl_t.mean()))
-        st.controllers = new_ctrls
+    etas, kls = inner_loop(cfg, st, Xs, dyns, expansions, iteration)
     pol_err = float(np.mean([run_trial(scene, mo, kind, policy_act(st.policy)).final_error()
                              for mo in motions]))
     entry = IterationLog(iteration, local_cost, local_err, pol_err, float(np.mean(kls)),

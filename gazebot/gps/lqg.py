@@ -7,8 +7,12 @@ multiplier eta on the step bound this is an LQR on the cost
 
     (l - u' lambda + eta (-log p_prev) + nu (-log pi_lin)) / (eta + nu),
 
-whose maximum-entropy solution has C_t = Q_uu^-1 (Levine et al.'s BADMM GPS; the KL terms appear
-in this order in their implementation, which the seed builds upon). eta is found by bisection.
+whose maximum-entropy solution has C_t = Q_uu^-1. eta is found by bisection.
+
+Two departures from the seed's eq. 5.6, as in Levine et al.'s BADMM GPS (the seed's [92]): the
+policy term is nu_t KL(p || pi_lin), where eq. 5.6 writes nu_t KL(pi_theta || p); and the step
+bound KL(p || p_prev) <= kl_step is added (eq. 5.6 has none). The README's "where we differ"
+says why.
 """
 
 from __future__ import annotations

@@ -2,11 +2,13 @@
 5.4) and a Gaussian action noise, trained by supervised learning on the local controllers'
 samples (eq. 5.5) with JAX and optax (the optional ``gps`` extra).
 
-The network's loss on sample (x, t) of condition i is
-nu_t [1/2 (mu(x) - mu_i(x))' P (mu(x) - mu_i(x)) + mu(x)' lambda_t / nu_t]: the mean part of
-nu_t KL(p_i || pi) plus the Lagrange term of eq. 5.5; P is the local controller's action precision.
-Its covariance is the inverse of the local controllers' mean precision (as in Levine et al.'s
-implementation).
+The network's loss on sample (x, t) of condition i (built in ``badmm._update_policy``) is
+nu_t 1/2 (mu(x) - mu_i(x))' P (mu(x) - mu_i(x)) + mu(x)' lambda_t, with P = C_t^-1 the local
+controller's action precision: the Lagrange term of eq. 5.5 plus the mean part of
+nu_t KL(pi || p_i), NOT of the seed's KL(p_i || pi) (whose mean part would be weighted by the
+policy's precision). Its covariance is the inverse of the local controllers' mean precision, the
+minimiser of the covariance part of that same KL(pi || p_i). This is the direction of Levine et
+al.'s BADMM (the seed's reference [92]); the README's "where we differ" says why.
 """
 
 from __future__ import annotations
