@@ -308,16 +308,8 @@ class GazeEngine:
         is followed by that phase's event (``info.source`` ``robot`` or ``gripper``,
         ``info.evidence`` the robot event). A grasp or a release the detector cannot see moves
         its phase too."""
-        state = self.handover
-        before = (state.phase, state.phase_start, state.handover)
         change: PhaseChange | None = self.behavior.handle(event)
         kind = getattr(event, "kind", None)
-        if change is None and (state.phase, state.handover) == (before[0], before[2]) and (
-            state.phase_start < before[1]
-        ):
-            # The other party's earlier reach moved the reach's start (and source) back: the
-            # phase stream re-sends the reach event so subscribers agree with the commands.
-            return ([event] if kind not in PHASE_OF_EVENT else []) + [self._revised(event)]
         if kind in PHASE_OF_EVENT:
             return [event] if change is not None else []
         out = [event]
@@ -332,20 +324,6 @@ class GazeEngine:
             detected = getattr(event, "detected_at", change.t)
             out.append(Event(EVENT_OF_PHASE[change.phase], change.t, detected, info))
         return out
-
-    def _revised(self, event: Event) -> Event:
-        """The current phase's event again, with the handover state's (earlier) start and
-        source; ``info.revised`` marks it, ``info.evidence`` names the event that moved it."""
-        state = self.handover
-        info = dict(event.info) if isinstance(getattr(event, "info", None), dict) else {}
-        info.update(
-            handover=state.handover,
-            source=state.source,
-            evidence=event.kind.value,
-            revised=True,
-        )
-        detected = getattr(event, "detected_at", state.phase_start)
-        return Event(EVENT_OF_PHASE[state.phase], state.phase_start, detected, info)
 
     def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
         points = dict(self._fixed_points)

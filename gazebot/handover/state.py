@@ -11,9 +11,9 @@ The rules are the table :data:`RULES` (drawn in ``gazebot behaviors show NAME --
 
 - **the first reach wins**: a ``robot_reach_started`` in idle/done starts the reach (the robot
   set off first, seed 6.3); the other party's reach start of the same handover only moves the
-  reach start to the earlier of the two, and then the reach's source with it (the engine
-  re-sends the reach event with the earlier start, ``info.revised``, so the phase stream on
-  the bus agrees with the commands);
+  reach start to the earlier of the two, and then the reach's source with it. No second reach
+  event follows (the phase stream keeps one event per phase, which restarts and recorders
+  count on); the commands' ``phase_source`` and ``handover/phase`` say the revised source;
 - **grasp and release are transfer evidence**: ``robot_grasped`` starts the transfer (from idle,
   reach or done), ``robot_released`` (robot-to-human) ends it (the retreat starts);
 - **stale events**: a phase-changing event older than the last phase change, a duplicate of the
