@@ -25,7 +25,13 @@ import numpy as np
 from gazebot.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
 from gazebot.config import ConfigError
 from gazebot.handover import HandoverState, PhaseChange
-from gazebot.kinematics import GazeController, GazeShiftConfig, RobotConfig, RobotModel
+from gazebot.kinematics import (
+    GazeController,
+    GazeShiftConfig,
+    IKConfig,
+    RobotConfig,
+    RobotModel,
+)
 from gazebot.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.types import (
     EVENT_OF_PHASE,
@@ -80,7 +86,8 @@ class GazeEngine:
         robot: The robot's kinematic model (head joints, limits, gaze frame, eye range).
         behavior: The gaze behavior to run.
         phases: Phase detection thresholds.
-        shifts: Gaze shift timing (neck and eye durations); ``None`` for the defaults.
+        shifts: Gaze shift timing (neck and eye durations); ``None``: the robot YAML's.
+        ik: Look-at solver settings; ``None``: the robot YAML's ``ik``.
         seed: Seed for behaviors that draw random timings (reproducible runs).
     """
 
@@ -91,6 +98,7 @@ class GazeEngine:
         phases: PhaseConfig | None = None,
         shifts: GazeShiftConfig | None = None,
         seed: int = 0,
+        ik: IKConfig | None = None,
     ) -> None:
         missing = behavior.targets() - set(robot.points) - _TRACKED_TARGETS
         if missing:
@@ -104,7 +112,7 @@ class GazeEngine:
         self.robot = robot
         self.behavior_spec = behavior
         self._phase_config = phases or PhaseConfig()
-        self.gaze = GazeController(robot, shifts)
+        self.gaze = GazeController(robot, shifts, ik)
         self._fixed_points = {k: np.asarray(v, float) for k, v in robot.points.items()}
         fixed = self._fixed_points
         # A tracked point never seen yet: the robot's default for it.

@@ -11,6 +11,15 @@ Two kinds of registry:
       from gazebot.controllers import CONTROLLERS
       CONTROLLERS.register("mine", MyController, "what it does")
 
+  An installed package reaches the registry (and so the real ``gazebot`` command) through an
+  entry point: group ``gazebot.controllers`` or ``gazebot.phase_methods``, the entry's name the
+  extension's name, its value the ``module:attribute`` that builds it. Entry points are read
+  when the registry is first read (no import until the extension is chosen); a built-in or an
+  earlier registration keeps its name (the entry point is skipped with a warning)::
+
+      [project.entry-points."gazebot.controllers"]
+      mine = "my_package.controllers:MyController"
+
 - :class:`FolderRegistry`, for YAML: **robots**, **behaviors**, **eye styles** and **scenes**
   are files in ``configs/<kind>/`` (behaviors also in user folders); the folder is the registry.
 
@@ -20,6 +29,8 @@ Two kinds of registry:
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Generic, Protocol, TypeVar
@@ -39,7 +50,10 @@ class Entry(Generic[T]):
     def load(self) -> Callable[..., T]:
         if isinstance(self.factory, str):
             module, _, attr = self.factory.partition(":")
-            return getattr(importlib.import_module(module), attr)
+            obj: object = importlib.import_module(module)
+            for part in attr.split(".") if attr else ():
+                obj = getattr(obj, part)
+            return obj  # type: ignore[return-value]
         return self.factory
 
 
@@ -59,11 +73,44 @@ def unknown(kind: str, name: object, known: tuple[str, ...]) -> ValueError:
 
 
 class Registry(Generic[T]):
-    """Names -> factories of one code extension kind, in registration order."""
+    """Names -> factories of one code extension kind, in registration order.
 
-    def __init__(self, kind: str) -> None:
+    Args:
+        kind: What an entry is (``controller``), for messages and the table's heading.
+        group: The entry-point group installed packages register in (e.g.
+            ``gazebot.controllers``), read when the registry is first read; ``None``: none.
+    """
+
+    def __init__(self, kind: str, group: str | None = None) -> None:
         self.kind = kind
+        self.group = group
         self._entries: dict[str, Entry[T]] = {}
+        self._installed: set[str] = set()  # names that came from entry points
+        self._read_entry_points = group is None
+
+    def _ensure(self) -> None:
+        if not self._read_entry_points:
+            self._read_entry_points = True
+            self._add_entry_points()
+
+    def _add_entry_points(self) -> None:
+        for ep in importlib.metadata.entry_points(group=self.group):
+            if ep.name in self._entries:
+                warnings.warn(f"{self.kind} {ep.name!r} of entry point {ep.value!r} ignored: "
+                              "the name is already registered", stacklevel=3)
+                continue
+            dist = getattr(ep, "dist", None)
+            where = f"{dist.name}, {ep.value}" if dist is not None else ep.value
+            self.register(ep.name, ep.value, f"installed extension ({where})")
+            self._installed.add(ep.name)
+
+    def reload_entry_points(self) -> None:
+        """Forget the entries that came from entry points and read the group again (after
+        installing a package into a running process; tests)."""
+        for name in self._installed:
+            self._entries.pop(name, None)
+        self._installed.clear()
+        self._read_entry_points = self.group is None
 
     def register(
         self,
@@ -83,12 +130,16 @@ class Registry(Generic[T]):
     def unregister(self, name: str) -> None:
         """Remove ``name`` (e.g. a test's own extension)."""
         self._entries.pop(self.check(name))
+        self._installed.discard(name)
 
     def names(self) -> tuple[str, ...]:
+        """Every registered name: the built-ins, then installed and user extensions."""
+        self._ensure()
         return tuple(self._entries)
 
     def check(self, name: str) -> str:
         """``name`` if registered, else the one ``ValueError`` listing the known names."""
+        self._ensure()
         if name not in self._entries:
             raise unknown(self.kind, name, self.names())
         return name
@@ -97,12 +148,25 @@ class Registry(Generic[T]):
         return self._entries[self.check(name)]
 
     def make(self, name: str, *args: object, **kwargs: object) -> T:
-        """Build the extension ``name`` with the given arguments."""
-        return self.entry(name).load()(*args, **kwargs)
+        """Build the extension ``name`` with the given arguments.
 
-    def table(self) -> str:
-        """The registry as a Markdown table (the README's is this text)."""
-        rows = [f"| `{e.name}` | {e.description} |" for e in self._entries.values()]
+        Raises:
+            ValueError: ``name`` is unknown, or its ``module:attribute`` cannot be imported.
+        """
+        entry = self.entry(name)
+        try:
+            factory = entry.load()
+        except (ImportError, AttributeError) as exc:
+            raise ValueError(f"{self.kind} {name!r}: cannot load {entry.factory!r} "
+                             f"({type(exc).__name__}: {exc})") from None
+        return factory(*args, **kwargs)
+
+    def table(self, builtin_only: bool = False) -> str:
+        """The registry as a Markdown table (the README's is this text, ``builtin_only``:
+        without installed extensions)."""
+        self._ensure()
+        rows = [f"| `{e.name}` | {e.description} |" for e in self._entries.values()
+                if not (builtin_only and e.name in self._installed)]
         return "\n".join([f"| {self.kind} | what it is |", "| --- | --- |", *rows])
 
 

@@ -86,6 +86,11 @@ PHASE_OF_EVENT: dict[EventKind, Phase] = {
 }
 #: The event that starts each phase (the inverse of :data:`PHASE_OF_EVENT`).
 EVENT_OF_PHASE: dict[Phase, EventKind] = {p: k for k, p in PHASE_OF_EVENT.items()}
+#: Events of the engine's phase stream (category ``phase`` on the bus and in payloads): the
+#: phase events and the tracking's loss and return.
+PHASE_STREAM_KINDS: frozenset[EventKind] = frozenset(
+    {*PHASE_OF_EVENT, EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED}
+)
 
 #: What the current phase was last decided by: the tracked hands (the phase detector), the
 #: robot's own motion events, or its gripper / load-share sensors.

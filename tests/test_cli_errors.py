@@ -106,3 +106,17 @@ def test_modules_of_a_package_import_each_other_without_a_circle(package):
 
     for m in graph:
         visit(m, [])
+
+
+def test_run_and_display_share_the_silent_after_name_and_the_old_run_spelling_warns(capsys):
+    from gazebot.cli import build_parser
+
+    parser = build_parser()
+    run = parser.parse_args(["run", "--robot", "sawyer", "--silent-after", "0.3"])
+    display = parser.parse_args(["display", "--robot", "sawyer", "--silent-after", "0.3"])
+    assert run.silent_after == display.silent_after == 0.3
+    assert "deprecated" not in capsys.readouterr().err
+    old = parser.parse_args(["run", "--robot", "sawyer", "--silence-after", "0.4"])
+    assert old.silent_after == 0.4
+    assert "--silence-after is deprecated, use --silent-after" in capsys.readouterr().err
+    assert parser.parse_args(["run", "--robot", "sawyer"]).silent_after == 0.15

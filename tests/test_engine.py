@@ -264,3 +264,18 @@ def test_the_command_reports_the_gripper_as_the_source_of_a_grasped_transfer():
     cmd = eng.step(TrackingFrame.make(0.2))
     assert (cmd.phase, cmd.phase_source) == (Phase.TRANSFER, "gripper")
     assert eng.detector.phase is Phase.TRANSFER  # the detector adopted what it cannot see
+
+
+def test_an_earlier_giver_reach_told_late_takes_the_source_without_a_second_reach_event():
+    # Review finding 10a: the commands report the reach's revised start and source when the
+    # giver's earlier reach arrives after the robot's; the phase stream keeps one reach event.
+    eng = GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
+    eng.notify(Event(EventKind.ROBOT_REACH_STARTED, 0.8, 0.8, {"planned_duration": 1.0}))
+    first = eng.step(TrackingFrame.make(0.8))
+    reach = [e for e in first.events if e.kind is EventKind.REACH_STARTED]
+    assert [(e.t, e.info["source"]) for e in reach] == [(0.8, "robot")]
+    assert (first.phase, first.phase_source) == (Phase.REACH, "robot")
+    eng.notify(Event(EventKind.REACH_STARTED, 0.5, 0.85))
+    cmd = eng.step(TrackingFrame.make(0.85))
+    assert (cmd.phase, cmd.phase_source, eng.handover.phase_start) == (Phase.REACH, "tracking", 0.5)
+    assert not [e for e in cmd.events if e.kind is EventKind.REACH_STARTED]

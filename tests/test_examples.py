@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import importlib.util
 import json
@@ -101,12 +100,48 @@ def test_register_extensions_example_adds_a_phase_method_and_a_controller_from_o
         # Registered names are accepted wherever the built-ins are: configs and the CLI.
         scene = SceneConfig.model_validate({"controller": {"reach_controller": "straight"}})
         assert scene.controller.reach_controller == "straight"
-        parser = argparse.ArgumentParser()
-        sub = parser.add_subparsers()
-        importlib.import_module("gazebot.cli.reach_plan").register(sub)
-        importlib.import_module("gazebot.cli.phases").register(sub)
-        args = parser.parse_args(["phases", "x.csv", "--method", "closest-approach"])
+        from gazebot.cli import build_parser
+
+        args = build_parser().parse_args(["phases", "x.csv", "--method", "closest-approach"])
         assert args.method == "closest-approach"
     finally:
         PHASE_METHODS.unregister("closest-approach")
         CONTROLLERS.unregister("straight")
+
+
+def test_an_installed_extension_reaches_the_real_gazebot_cli_through_its_entry_points(
+    monkeypatch, capsys
+):
+    """A package that declares the example's classes as entry points (groups
+    ``gazebot.phase_methods`` and ``gazebot.controllers``) is usable by name in the real
+    ``gazebot`` command, with no code of its own run first."""
+    import importlib.metadata as md
+
+    from gazebot.cli import build_parser, main
+    from gazebot.controllers import CONTROLLERS
+    from gazebot.phases.methods import PHASE_METHODS
+
+    installed = [
+        md.EntryPoint("closest-approach", "register_extensions:ClosestApproach",
+                      "gazebot.phase_methods"),
+        md.EntryPoint("straight", "register_extensions:Straight", "gazebot.controllers"),
+    ]
+    monkeypatch.syspath_prepend(str(EXAMPLES))
+    monkeypatch.setattr("gazebot.registry.importlib.metadata.entry_points",
+                        lambda group=None: [ep for ep in installed if ep.group == group])
+    PHASE_METHODS.reload_entry_points()
+    CONTROLLERS.reload_entry_points()
+    try:
+        parser = build_parser()
+        assert parser.parse_args(["demo", "--controller", "straight"]).controller == "straight"
+        assert main(["phases", str(EXAMPLES / "sample-handover.csv"),
+                     "--method", "closest-approach", "--json"]) == 0
+        segments = json.loads(capsys.readouterr().out)["segments"]
+        assert [s["phase"] for s in segments] == ["reach", "transfer", "retreat"]
+        with pytest.raises(SystemExit):
+            parser.parse_args(["demo", "--controller", "curved"])  # not installed
+    finally:
+        monkeypatch.undo()
+        PHASE_METHODS.reload_entry_points()
+        CONTROLLERS.reload_entry_points()
+    assert "straight" not in CONTROLLERS.names()

@@ -53,4 +53,43 @@ def test_an_unknown_controller_or_phase_method_is_one_clear_error(tmp_path):
 
 @pytest.mark.parametrize("registry", [CONTROLLERS, PHASE_METHODS], ids=lambda r: r.kind)
 def test_the_readme_table_is_the_registrys(registry):
-    assert registry.table() in README.read_text(encoding="utf-8")
+    assert registry.table(builtin_only=True) in README.read_text(encoding="utf-8")
+
+
+def _fake_entry_points(monkeypatch, *eps):
+    import importlib.metadata as md
+
+    def entry_points(group=None):
+        return [md.EntryPoint(name, value, g) for name, value, g in eps if g == group]
+
+    monkeypatch.setattr("gazebot.registry.importlib.metadata.entry_points", entry_points)
+
+
+def test_installed_extensions_are_read_from_entry_points_on_first_read_and_load_lazily(
+    monkeypatch,
+):
+    _fake_entry_points(monkeypatch, ("ordered", "collections:OrderedDict", "demo.things"),
+                       ("other", "json:dumps", "demo.elsewhere"))
+    reg: Registry[object] = Registry("thing", group="demo.things")
+    reg.register("builtin", dict, "a built-in")
+    assert reg.names() == ("builtin", "ordered")  # other groups are not this registry's
+    assert reg.entry("ordered").factory == "collections:OrderedDict"  # not imported yet
+    assert reg.make("ordered", a=1) == {"a": 1}
+    assert "installed extension" in reg.table() and "ordered" not in reg.table(builtin_only=True)
+
+
+def test_an_entry_point_cannot_take_a_registered_name_and_a_broken_one_is_a_clear_error(
+    monkeypatch,
+):
+    _fake_entry_points(monkeypatch, ("builtin", "json:dumps", "demo.things"),
+                       ("broken", "no_such_module_xyz:Thing", "demo.things"))
+    reg: Registry[object] = Registry("thing", group="demo.things")
+    reg.register("builtin", dict)
+    with pytest.warns(UserWarning, match="'builtin' of entry point 'json:dumps' ignored"):
+        assert reg.names() == ("builtin", "broken")
+    assert reg.make("builtin") == {}
+    with pytest.raises(ValueError, match=r"thing 'broken': cannot load 'no_such_module_xyz:Thing'"):
+        reg.make("broken")
+    _fake_entry_points(monkeypatch)
+    reg.reload_entry_points()
+    assert reg.names() == ("builtin",)

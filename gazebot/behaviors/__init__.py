@@ -11,7 +11,7 @@
   YAML; fitted by :mod:`gazebot.annotations.fit`, so this package never imports annotations).
 """
 
-from gazebot.behaviors.machine import BehaviorMachine
+from gazebot.behaviors.machine import BehaviorMachine, GazeOrigin
 from gazebot.behaviors.registry import BehaviorInfo, behavior_path, list_behaviors, load_behavior
 from gazebot.behaviors.spec import AtEvent, AtFraction, AtNever, BehaviorSpec, Segment
 
@@ -21,6 +21,7 @@ __all__ = [
     "AtNever",
     "BehaviorInfo",
     "BehaviorMachine",
+    "GazeOrigin",
     "BehaviorSpec",
     "Segment",
     "behavior_path",

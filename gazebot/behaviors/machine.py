@@ -29,8 +29,10 @@ rule table (:data:`gazebot.handover.RULES`: first reach wins, grasp/release, sta
 third region, from the same definitions that run (:func:`diagram`).
 
 :meth:`BehaviorMachine.state` reads e.g. ``reach_hand`` (the handover state's phase, the gaze
-state, and ``_hold``/``_lost`` while tracking is lost). :attr:`BehaviorMachine.origin` names the
-rule behind the current target and the phase it decided it in.
+state, and ``_hold``/``_lost`` while tracking is lost). :attr:`BehaviorMachine.origin`
+(:class:`GazeOrigin`) names the rule that picked the current gaze state and the phase of that
+rule, recorded when it picked it; a gaze carried into a later phase unchanged keeps that phase
+and says which phase it was carried into.
 
 Fraction timings need the phase's end online: :func:`gazebot.behaviors.schedule.expected_end`
 combines the tracking's prediction (``GazeContext.tracking_end``), the phase event's
@@ -49,6 +51,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -140,6 +143,50 @@ def _slots(spec: BehaviorSpec) -> dict[Phase, list[tuple[int, str, str]]]:
             if not isinstance(at, AtNever):
                 out[phase].append((i, seg.target, _describe(spec, at, phase)))
     return out
+
+
+_PHASE_ORDER = {p: i for i, p in enumerate(Phase)}
+
+
+@dataclass(frozen=True)
+class GazeOrigin:
+    """The rule that picked the gaze region's current state, recorded when it picked it.
+
+    Attributes:
+        phase: The phase of the rule: a segment's own phase, or the phase a new handover
+            (``before``) or the end (``after``) was entered with.
+        rule: ``before``, ``after`` or ``segment N`` (N: its index in that phase's segments).
+        target: The target kind the rule picked.
+        t: When it picked it (s; NaN before any).
+        carried_into: The phase the gaze has since been carried into unchanged (a phase change
+            that is no new handover keeps the gaze); ``None`` while the rule's phase is current.
+    """
+
+    phase: Phase
+    rule: str
+    target: str
+    t: float = math.nan
+    carried_into: Phase | None = None
+
+    def disagreement(self, phase: Phase, target: str) -> str | None:
+        """Why a command reporting ``phase`` and ``target`` (tracking ok) disagrees with this
+        origin: the target is not the one the rule picked, a phase's own rule is not the
+        reported phase's, or a carried gaze was carried into another phase (or backwards);
+        ``None`` when they agree."""
+        if target != self.target:
+            return (f"target {target!r}, but {self.rule} of {self.phase.value} picked "
+                    f"{self.target!r}")
+        if self.carried_into is None:
+            if self.phase is not phase:
+                return (f"reported {phase.value}, but the target is {self.rule} of "
+                        f"{self.phase.value}")
+            return None
+        if self.carried_into is not phase:
+            return (f"reported {phase.value}, but the gaze was carried into "
+                    f"{self.carried_into.value}")
+        if _PHASE_ORDER[self.phase] >= _PHASE_ORDER[phase]:
+            return f"gaze carried from {self.phase.value} back into {phase.value}"
+        return None
 
 
 #: Builds a transition condition from its key and label: ``("segment", phase, index, target)``,
@@ -366,7 +413,6 @@ class BehaviorMachine:
             self.handover.reset()
         self._ignored = 0  # tracking events ignored as stale or duplicated
         self.pattern = ""  # name of the drawn pattern (data-driven behaviors)
-        self.origin: tuple[Phase, str] = (Phase.IDLE, "before")
         self._rng = np.random.default_rng(self.seed)
         self._plan: dict[Phase, list[Segment]] = self._draw_plan()
         self._active: list[list[Any]] = []  # [segment, started] of the current phase
@@ -380,6 +426,7 @@ class BehaviorMachine:
         self._last_target: GazeTarget | None = None
         self._known: dict[str, np.ndarray] = {}
         self._machine.set_state([f"{_GAZE}_{_state_name(self.spec.before)}", _TRACKING_OK])
+        self.origin = GazeOrigin(Phase.IDLE, "before", self.gaze)
 
     def _draw_plan(self) -> dict[Phase, list[Segment]]:
         """The segments of the next handover (drawn from the data model for ``human``)."""
@@ -407,6 +454,19 @@ class BehaviorMachine:
         combos = [("idle", before), ("done", after)]
         combos += [(p.value, g) for p in SEGMENT_PHASES for g in self._target_of]
         return [f"{p}_{g}{s}" for p, g in combos for s in ("", "_hold", "_lost")]
+
+    def origin_disagreement(self, phase: Phase, target: str) -> str | None:
+        """Why a command reporting ``phase`` and ``target`` now (tracking ok) disagrees with the
+        rule that picked the gaze (:meth:`GazeOrigin.disagreement`, and a ``segment N`` origin
+        must be segment N of its phase's plan, with that target); ``None`` when it agrees."""
+        origin = self.origin
+        why = origin.disagreement(phase, target)
+        if why is None and origin.rule.startswith("segment "):
+            plan = self._plan.get(origin.phase, [])
+            index = int(origin.rule.split()[1])
+            if index >= len(plan) or plan[index].target != origin.target:
+                why = f"{origin.phase.value} has no {origin.rule} looking at {origin.target!r}"
+        return why
 
     @property
     def ignored(self) -> int:
@@ -478,11 +538,11 @@ class BehaviorMachine:
         self._change = None
         phase = change.phase
         if change.phase is Phase.DONE:
-            self.origin = (phase, "after")
+            self.origin = GazeOrigin(phase, "after", self.gaze, change.t)
         elif change.new_handover:
-            self.origin = (phase, "before")
-        else:
-            self.origin = (phase, f"carried from {change.previous.value}")
+            self.origin = GazeOrigin(phase, "before", self.gaze, change.t)
+        else:  # the gaze state stays: its rule is still the earlier phase's
+            self.origin = replace(self.origin, carried_into=phase)
         self._active_phase = phase
         self._active = [[s, False] for s in self._plan.get(phase, [])]
         self._latest = -math.inf
@@ -528,7 +588,7 @@ class BehaviorMachine:
             self._latest = starts[best]
             self._firing = (phase, best)
             if self._trigger("timer"):
-                self.origin = (phase, f"segment {best}")
+                self.origin = GazeOrigin(phase, f"segment {best}", self.gaze, t)
             self._firing = (Phase.IDLE, -1)
 
     def target(self, ctx: GazeContext) -> GazeTarget:

@@ -21,6 +21,16 @@ from gazebot.cli.bus import (
 from gazebot.cli.errors import robot_with_gaze_mode, seed_value
 
 
+class DeprecatedAlias(argparse.Action):
+    """An option's old spelling: stores like the new one and warns once on stderr."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:  # type: ignore[no-untyped-def]
+        new = "--" + self.dest.replace("_", "-")
+        print(f"gazebot: {option_string} is deprecated, use {new} (the old name goes in the "
+              "next release)", file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "run",
@@ -41,9 +51,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=seed_value, default=0, help="seed of behavior timings and blinks")
     p.add_argument("--duration", type=positive, default=None,
                    help="seconds to run (default: until Ctrl-C)")
-    p.add_argument("--silence-after", type=positive, default=0.15, metavar="S",
-                   help="s without tracking before the engine ticks without samples, so the "
-                   "behavior's tracking-loss policy applies (default 0.15)")
+    p.add_argument("--silent-after", type=positive, default=0.15, metavar="S",
+                   help="s without tracking before it counts as silent: the engine ticks "
+                   "without samples, so the behavior's tracking-loss policy applies "
+                   "(default 0.15)")
+    # Deprecated spelling (one release): the same option as `gazebot display --silent-after`.
+    p.add_argument("--silence-after", type=positive, dest="silent_after", metavar="S",
+                   action=DeprecatedAlias, help=argparse.SUPPRESS)
     p.add_argument("--no-robot-warning", type=positive, default=3.0, metavar="S",
                    help="warn on stderr if no robot data arrived after S seconds (default 3)")
     p.add_argument("--no-resync", action="store_true",
@@ -67,7 +81,7 @@ def handle(args: argparse.Namespace) -> int:
 
     cfg = bus_config(args, listens_by_default=False, base_frame=robot_base_frame(args.robot))
     node_cfg = EngineNodeConfig(
-        silence_after=args.silence_after,
+        silence_after=args.silent_after,
         resync=not args.no_resync,
         no_robot_warning=args.no_robot_warning,
         standby=args.standby,

@@ -23,7 +23,7 @@ from gazebot.registry import Registry
 
 #: The reach controllers by name: CLI choices, scene validation and the README's table come from
 #: here. A new controller is one file plus one line (imported on first use).
-CONTROLLERS: Registry[ReachController] = Registry("controller")
+CONTROLLERS: Registry[ReachController] = Registry("controller", group="gazebot.controllers")
 CONTROLLERS.register(
     "pv", "gazebot.controllers.pv:PVController", "proportional velocity baseline (eq. 3.6)"
 )

@@ -26,7 +26,6 @@ from pydantic import (
 from gazebot.ros2 import convert
 from gazebot.ros2.errors import MessageError
 from gazebot.types import (
-    PHASE_OF_EVENT,
     Event,
     EventKind,
     GazeCommand,
@@ -43,9 +42,6 @@ NonNeg = Annotated[float, Field(ge=0.0)]
 Seq = Annotated[int, Field(ge=0)]
 Name = Annotated[str, Field(min_length=1, max_length=64)]
 
-PHASE_KINDS = frozenset(
-    {*PHASE_OF_EVENT, EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED}
-)
 
 
 class PayloadError(ValueError):
@@ -257,19 +253,9 @@ class ArmCommandMsg(Msg):
         return self
 
 
-EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]
-
-
-def category_of(kind: str) -> EventCategory:
-    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` for the
-    engine's ``fault`` and any other kind."""
-    try:
-        ek = EventKind(kind)
-    except ValueError:
-        return "fault"
-    if ek is EventKind.FAULT:
-        return "fault"
-    return "phase" if ek in PHASE_KINDS else "robot"
+# One category rule for the wire and the payloads (the phase stream: types.PHASE_STREAM_KINDS).
+EventCategory = convert.EventCategory
+category_of = convert.category_of
 
 
 class EventMsg(Msg):

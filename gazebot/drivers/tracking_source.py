@@ -7,9 +7,10 @@ Sources are told apart by the publisher GID in each sample's attachment, resolve
 publishing node (name and Zenoh session) through the ROS graph, so the hands and the face of one
 tracker are one source. An implementation whose GIDs are not rmw_zenoh's hash of the token
 (e.g. random ones) is identified by the topic's only publisher; failing that, its samples count
-as one unidentified source. Parts are arbitrated in groups: the tracked points (hands, face,
-from their topics or ``/tf``) are one group, the gripper and the load share one each, since a
-robot bridge may publish those while a motion-capture node publishes the points.
+as one unidentified source. Each part (``giver_hand``, ``receiver_hand``, ``giver_face``,
+``gripper``, ``load_share``, from their topics or ``/tf``) is arbitrated on its own: a
+motion-capture node may publish the hands while a separate face tracker publishes the face and a
+robot bridge the gripper and the load share; only a second publisher of the same part is a rival.
 """
 
 from __future__ import annotations
@@ -19,13 +20,10 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-#: The group each tracking part is arbitrated in.
-POINTS = "points"
-
 
 def group_of(part: str) -> str:
-    """``points`` for the tracked bodies, the part's own name for robot evidence."""
-    return part if part in ("gripper", "load_share") else POINTS
+    """The unit a part is arbitrated in: the part itself (each part has its own owner)."""
+    return part
 
 
 @dataclass
@@ -36,20 +34,22 @@ class _Owner:
 
 @dataclass(frozen=True)
 class Rival:
-    """A source whose samples were ignored: ``source``, the ``group`` it published in, the
-    ``owner`` it competed with, and how many samples were ignored (``ignored``)."""
+    """A source whose samples were ignored: ``source``, the ``owner`` it competed with, the
+    ``parts`` it was refused (``group``: the same, comma-joined, for messages) and how many of
+    its samples were ignored (``ignored``)."""
 
     source: str
     group: str
     owner: str
     ignored: int
+    parts: tuple[str, ...] = ()
 
 
 class SourceArbiter:
-    """Decides, per group, which source's samples are used (thread-safe).
+    """Decides, per part, which source's samples are used (thread-safe).
 
     Args:
-        timeout: An owner silent this long (s) loses the group to the next source heard.
+        timeout: An owner silent this long (s) loses the part to the next source heard.
         clock: Monotonic clock (s).
     """
 
@@ -61,11 +61,11 @@ class SourceArbiter:
         self._lock = threading.Lock()
         self._owners: dict[str, _Owner] = {}
         self._rivals: dict[tuple[str, str], tuple[str, int, float]] = {}
-        self._reported: set[tuple[str, str]] = set()
+        self._reported: set[tuple[str, str]] = set()  # (source, owner)
 
     def admit(self, part: str, source: str) -> str | None:
         """``None`` when ``source``'s sample of ``part`` is to be used, else the owner whose
-        source keeps the group (the sample is to be dropped)."""
+        source keeps the part (the sample is to be dropped)."""
         group = group_of(part)
         now = self.clock()
         with self._lock:
@@ -78,25 +78,31 @@ class SourceArbiter:
             return owner.source
 
     def owners(self) -> dict[str, str]:
-        """Group -> the source that owns it now (silent owners left out)."""
+        """Part -> the source that owns it now (silent owners left out)."""
         now = self.clock()
         with self._lock:
             return {g: o.source for g, o in self._owners.items()
                     if now - o.last_seen <= self.timeout}
 
     def rivals(self) -> list[Rival]:
-        """Sources ignored within the last ``timeout`` s."""
+        """Sources ignored within the last ``timeout`` s, one per (source, owner) with every
+        part it was refused."""
         now = self.clock()
+        merged: dict[tuple[str, str], tuple[list[str], int]] = {}
         with self._lock:
-            return [Rival(src, g, owner, n) for (g, src), (owner, n, seen) in
-                    sorted(self._rivals.items()) if now - seen <= self.timeout]
+            for (part, src), (owner, n, seen) in sorted(self._rivals.items()):
+                if now - seen <= self.timeout:
+                    parts, total = merged.get((src, owner), ([], 0))
+                    merged[(src, owner)] = ([*parts, part], total + n)
+        return [Rival(src, ", ".join(parts), owner, n, tuple(parts))
+                for (src, owner), (parts, n) in sorted(merged.items())]
 
     def new_rivals(self) -> list[Rival]:
-        """Rivals not returned by this method before (each reported once per group while it
+        """Rivals not returned by this method before (each reported once per owner while it
         competes; again if it comes back after going silent)."""
         current = self.rivals()
         with self._lock:
-            keys = {(r.group, r.source) for r in current}
-            new = [r for r in current if (r.group, r.source) not in self._reported]
-            self._reported = (self._reported & keys) | {(r.group, r.source) for r in new}
+            keys = {(r.source, r.owner) for r in current}
+            new = [r for r in current if (r.source, r.owner) not in self._reported]
+            self._reported = (self._reported & keys) | {(r.source, r.owner) for r in new}
         return new

@@ -156,7 +156,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         return "unidentified publisher"
 
     def tracking_sources(self) -> dict[str, str]:
-        """Tracking group (``points``, ``gripper``, ``load_share``) -> its source now."""
+        """Tracking part (``giver_hand``, ``giver_face``, ``gripper``, ...) -> its source now."""
         return self._sources.owners()
 
     def tracking_rivals(self, new_only: bool = False) -> list[Rival]:

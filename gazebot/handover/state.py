@@ -11,7 +11,9 @@ The rules are the table :data:`RULES` (drawn in ``gazebot behaviors show NAME --
 
 - **the first reach wins**: a ``robot_reach_started`` in idle/done starts the reach (the robot
   set off first, seed 6.3); the other party's reach start of the same handover only moves the
-  reach start to the earlier of the two;
+  reach start to the earlier of the two, and then the reach's source with it. No second reach
+  event follows (the phase stream keeps one event per phase, which restarts and recorders
+  count on); the commands' ``phase_source`` and ``handover/phase`` say the revised source;
 - **grasp and release are transfer evidence**: ``robot_grasped`` starts the transfer (from idle,
   reach or done), ``robot_released`` (robot-to-human) ends it (the retreat starts);
 - **stale events**: a phase-changing event older than the last phase change, a duplicate of the
@@ -209,7 +211,7 @@ class HandoverState:
                 self.ignored += 1
             return None
         if rule.dest is None:
-            return self._earlier_reach(kind, t)
+            return self._earlier_reach(kind, t, event)
         return self._enter(rule, t, event)
 
     def would_move(self, event: Event) -> float | None:
@@ -258,9 +260,10 @@ class HandoverState:
         self._robot[kind] = Event(kind, t, t, dict(info) if isinstance(info, dict) else {})
         return True
 
-    def _earlier_reach(self, kind: EventKind, t: float) -> None:
+    def _earlier_reach(self, kind: EventKind, t: float, event: Event) -> None:
         """The other party's reach start of the current handover: the reach starts with the
-        first (a duplicate of the same party's is ignored)."""
+        first (a duplicate of the same party's is ignored). An earlier start also takes over the
+        phase's source: the reach is the earlier party's, whichever was told first."""
         party = "robot" if kind is EventKind.ROBOT_REACH_STARTED else "giver"
         if t < self.handover_t0 or (party in self._reach_by and kind in PHASE_OF_EVENT):
             if kind in PHASE_OF_EVENT:
@@ -269,8 +272,7 @@ class HandoverState:
         self._reach_by.add(party)
         if t < self.phase_start:
             self.phase_start = t
-            if party == "robot":
-                self.source = "robot"
+            self.source = event_source(event)
         return None
 
     def _enter(self, rule: Rule, t: float, event: Event) -> PhaseChange:

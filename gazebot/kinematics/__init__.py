@@ -7,6 +7,7 @@ Entry points: :meth:`RobotModel.load`, :func:`solve_ik` (one look-at solve) and
 from gazebot.kinematics.config import (
     GAZE_MODES,
     GazeMode,
+    IKSettings,
     RobotConfig,
     load_robot_config,
     with_gaze_mode,
@@ -26,6 +27,7 @@ __all__ = [
     "GazeShiftConfig",
     "HeadEyeState",
     "IKConfig",
+    "IKSettings",
     "LookAtSolution",
     "MinJerkTrajectory",
     "RobotConfig",

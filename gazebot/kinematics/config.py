@@ -60,6 +60,39 @@ class EyeConfig(BaseModel):
 Point = tuple[float, float, float]
 
 
+class IKSettings(BaseModel):
+    """The look-at solver's settings (``ik:``), degrees and metres at the surface.
+
+    A field left out takes the solver's default (:class:`gazebot.kinematics.IKConfig`, the one
+    place the defaults live; it holds the same settings in SI units).
+
+    Attributes:
+        damping: Levenberg damping lambda (rad^2) of the least-squares step.
+        max_iterations: Iteration cap of one solve (a warm start typically needs 1-3).
+        tolerance_deg: Head pointing error (deg) at which a solve stops.
+        tracking_tolerance_deg: Looser stop (deg) while following a target that moved slightly.
+        max_step_deg: Largest joint change per iteration (deg); keeps far targets stable.
+        min_step_deg: A step smaller than this (deg) means the head cannot do better.
+        posture_gain: Null-space pull toward the rest posture per iteration (0..1).
+        posture_off_deg: Reducible pointing error (deg) below which the posture pull stops.
+        min_distance_m: Targets closer than this to the gaze origin (m) have no direction.
+        max_distance_m: Targets farther than this from the base origin (m) are invalid samples.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    damping: float | None = Field(None, gt=0.0)
+    max_iterations: int | None = Field(None, ge=1)
+    tolerance_deg: float | None = Field(None, gt=0.0)
+    tracking_tolerance_deg: float | None = Field(None, gt=0.0)
+    max_step_deg: float | None = Field(None, gt=0.0)
+    min_step_deg: float | None = Field(None, gt=0.0)
+    posture_gain: float | None = Field(None, ge=0.0, le=1.0)
+    posture_off_deg: float | None = Field(None, gt=0.0)
+    min_distance_m: float | None = Field(None, gt=0.0)
+    max_distance_m: float | None = Field(None, gt=0.0)
+
+
 class RobotConfig(BaseModel):
     """A robot for gazebot: its MJCF, head and arm joints, poses, eyes and default points."""
 
@@ -83,6 +116,7 @@ class RobotConfig(BaseModel):
     arm_handover_deg: dict[str, float]
     eyes: EyeConfig
     shifts: GazeShiftConfig = Field(default_factory=GazeShiftConfig)
+    ik: IKSettings = Field(default_factory=IKSettings)
     gaze_mode: GazeMode = "head-and-eyes"
     points: dict[str, Point]
     # Tracked points farther than this from the robot base are implausible (a tracker's glitch,

@@ -77,7 +77,7 @@ class GazeController:
     Args:
         robot: The robot model.
         shifts: Gaze shift timing; ``None`` uses the robot YAML's ``shifts``.
-        ik: Look-at solver settings.
+        ik: Look-at solver settings; ``None`` uses the robot YAML's ``ik``.
     """
 
     def __init__(
@@ -88,7 +88,7 @@ class GazeController:
     ) -> None:
         self.robot = robot
         self.shifts = shifts if shifts is not None else robot.config.shifts
-        self.ik = ik or IKConfig(max_iterations=25)
+        self.ik = ik if ik is not None else IKConfig.from_settings(robot.config.ik)
         # The per-tick state is kept in plain floats: with 1-4 joints numpy's per-call overhead
         # would cost more than the arithmetic (this runs at the tracking rate).
         self._names = tuple(robot.head_joints)

@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from gazebot.kinematics.config import IKSettings
 from gazebot.kinematics.eyes import angle_between
 from gazebot.kinematics.robot import GazePose, RobotModel
 
@@ -28,7 +29,8 @@ class IKConfig:
 
     Attributes:
         damping: Levenberg damping lambda (rad^2) of the least-squares step.
-        max_iterations: Iteration cap (a warm start typically needs 1-3).
+        max_iterations: Iteration cap (a warm start typically needs 1-3; a cold one on the
+            shipped robots fewer than 25).
         tolerance: Head pointing error (rad) at which the solve stops.
         max_step: Largest joint change per iteration (rad); keeps far targets stable.
         posture_gain: Null-space pull toward the rest posture per iteration (0..1).
@@ -43,7 +45,7 @@ class IKConfig:
     """
 
     damping: float = 1e-4
-    max_iterations: int = 50
+    max_iterations: int = 25
     tolerance: float = 1e-5
     max_step: float = 0.5
     posture_gain: float = 0.1
@@ -52,6 +54,19 @@ class IKConfig:
     min_step: float = 1e-9
     posture_off: float = 1e-3
     tracking_tolerance: float = 1e-4
+
+    @classmethod
+    def from_settings(cls, settings: IKSettings) -> IKConfig:
+        """The solver settings of a robot YAML's ``ik:`` block (degrees to rad); fields it
+        leaves out keep the defaults above."""
+        given = settings.model_dump(exclude_none=True)
+        values: dict[str, float | int] = {}
+        for key, value in given.items():
+            if key.endswith("_deg"):
+                values[key.removesuffix("_deg")] = math.radians(value)
+            else:
+                values[key.removesuffix("_m")] = value
+        return cls(**values)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -434,7 +449,7 @@ def solve_ik(
         target: 3D point in the base frame.
         q0: Warm start (head vector or ``{joint: rad}``); ``None`` starts from the rest posture.
             A non-finite warm start falls back to rest.
-        config: Solver settings (defaults: :class:`IKConfig`).
+        config: Solver settings (default: the robot YAML's ``ik:``).
 
     Returns:
         A :class:`LookAtSolution`; never raises for unreachable targets (joints clamp to limits,
@@ -444,7 +459,7 @@ def solve_ik(
     Raises:
         ValueError: ``target`` is not a 3-vector, or ``q0`` names unknown joints.
     """
-    cfg = config or IKConfig()
+    cfg = config or IKConfig.from_settings(robot.config.ik)
     t = np.asarray(target, dtype=float).reshape(-1)
     if t.shape != (3,):
         raise ValueError(f"target must be a 3D point, got shape {t.shape}")

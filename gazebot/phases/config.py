@@ -19,7 +19,6 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from gazebot.config import configs_dir, load_model
-from gazebot.phases.durations import REACH_S, RETREAT_S, TRANSFER_S
 
 
 class PhaseConfig(BaseModel):
@@ -91,7 +90,7 @@ class PhaseConfig(BaseModel):
             final approach is the reach ...
         stall_travel: ... if the hand rested less than this far (m) from where the reach
             started (a lift; a hand held out at the handover place has come farther).
-        reach_lookback: Online, in a reach the analysis reads this many ``reach_duration``
+        reach_lookback: Online, in a reach the analysis reads this many typical reaches
             before the reach's start (the rest before it dates the onset).
         predict_window: Online, ``gazebot``'s predictive reach rule
             (:mod:`~gazebot.phases.rules.directed`) fits the giver's hand over this long (s) ...
@@ -121,9 +120,6 @@ class PhaseConfig(BaseModel):
         trigger_landing_fraction: ... or its speed fell below this share of its peak.
         load_share_shared: Load share above which the object is shared (seed delta_1).
         load_share_robot: Load share above which the robot holds the object alone (seed delta_2).
-        reach_duration: Typical giver reach (s; :mod:`gazebot.phases.durations`).
-        transfer_duration: Typical transfer (s; same source).
-        retreat_duration: Typical retreat (s; same source).
         peak_passed_fraction: A motion is past its speed peak once its speed has fallen below
             this fraction of the peak (end-of-phase prediction).
     """
@@ -189,9 +185,6 @@ class PhaseConfig(BaseModel):
     trigger_landing_fraction: float = Field(0.5, gt=0, lt=1)
     load_share_shared: float = Field(0.1, ge=0, le=1)
     load_share_robot: float = Field(0.9, ge=0, le=1)
-    reach_duration: float = Field(REACH_S, gt=0)
-    transfer_duration: float = Field(TRANSFER_S, gt=0)
-    retreat_duration: float = Field(RETREAT_S, gt=0)
     peak_passed_fraction: float = Field(0.8, gt=0, lt=1)
 
     @field_validator("method")

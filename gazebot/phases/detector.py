@@ -49,6 +49,7 @@ from itertools import islice
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.durations import REACH_S
 from gazebot.phases.filtering import Signals
 from gazebot.phases.methods import make_segmenter
 from gazebot.phases.methods.base import OnlineState
@@ -324,7 +325,7 @@ class PhaseDetector:
             # the next reach) its rest before and what follows, not the whole window (the cost
             # grows with the samples; after a handover, re-analysing it is wasted).
             look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
-            back = c.reach_duration * look
+            back = REACH_S * look
             i0 = int(np.searchsorted(t, self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0

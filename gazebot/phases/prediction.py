@@ -3,10 +3,11 @@
 Reach and retreat follow roughly symmetric bell-shaped (minimum-jerk) speed profiles: once a
 hand's speed has fallen below ``peak_passed_fraction`` of its peak, the motion ends about as
 long after the peak as the peak came after the onset (``onset + 2 (t_peak - onset)``); before
-that, ``onset + reach_duration`` (``retreat_duration``). A reach ends at contact, so it is the
-later of the giver's and the receiver's predicted arrivals (the receiver's onset is where its
-own speed first exceeded ``reach_onset_speed``). A transfer is predicted to last
-``transfer_duration``. Never earlier than now; NaN in ``idle`` and ``done``.
+that, the onset plus the typical reach (retreat) duration of :mod:`gazebot.phases.durations`.
+A reach ends at contact, so it is the later of the giver's and the receiver's predicted
+arrivals (the receiver's onset is where its own speed first exceeded ``reach_onset_speed``). A
+transfer is predicted to last the typical transfer. Never earlier than now; NaN in ``idle``
+and ``done``.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.durations import REACH_S, RETREAT_S, TRANSFER_S
 from gazebot.phases.filtering import Signals
 from gazebot.types import Phase
 
@@ -35,10 +37,10 @@ def _mirrored(t: np.ndarray, v: np.ndarray, onset: float, nominal: float, c: Pha
 def predict_end(phase: Phase, start: float, s: Signals | None, now: float, c: PhaseConfig) -> float:
     """Predicted end of ``phase`` that started at ``start`` (s), from the signals so far."""
     if phase is Phase.TRANSFER:
-        return max(start + c.transfer_duration, now)
+        return max(start + TRANSFER_S, now)
     if phase not in (Phase.REACH, Phase.RETREAT) or not math.isfinite(start):
         return math.nan
-    nominal = c.reach_duration if phase is Phase.REACH else c.retreat_duration
+    nominal = REACH_S if phase is Phase.REACH else RETREAT_S
     if s is None or s.t.shape[0] == 0:
         return max(start + nominal, now)
     i0 = int(np.searchsorted(s.t, start))

@@ -28,15 +28,18 @@ from gazebot.recordings.base import (
     hold_values,
     sample_streams,
 )
+from gazebot.ros2 import convert as cv
+from gazebot.ros2 import topics as ros_topics
 
-_POINT = "geometry_msgs/msg/PointStamped"
-_POSE = "geometry_msgs/msg/PoseStamped"
-_TRANSFORM = "geometry_msgs/msg/TransformStamped"
-_TF = "tf2_msgs/msg/TFMessage"
-_GRIPPER = "gazebot_msgs/msg/GripperState"
-_LOAD = "gazebot_msgs/msg/LoadShare"
+_POINT = cv.POINT_STAMPED
+_POSE = cv.POSE_STAMPED
+_TRANSFORM = cv.TRANSFORM_STAMPED
+_TF = cv.TF_MESSAGE
+_GRIPPER = cv.GRIPPER_STATE
+_LOAD = cv.LOAD_SHARE
 _WANTED = (_POINT, _POSE, _TRANSFORM, _TF, _GRIPPER, _LOAD)
-_DEFAULT_SUFFIX = ("tracking/giver_hand", "tracking/receiver_hand", "tracking/giver_face")
+# gazebot's own tracking topics (the bus's names), in the trajectory's order of bodies.
+_DEFAULT_SUFFIX = tuple(ros_topics.TRACKING[body].name for body in cv.BODIES)
 
 
 def _ros2_name(name: str) -> str:

@@ -28,7 +28,14 @@ from rosbags.typesys.store import Typestore
 
 from gazebot.ros2.errors import MessageError
 from gazebot.ros2.typestore import typestore
-from gazebot.types import PHASE_OF_EVENT, Event, EventKind, Phase, PhaseSource, TrackingFrame
+from gazebot.types import (
+    PHASE_STREAM_KINDS,
+    Event,
+    EventKind,
+    Phase,
+    PhaseSource,
+    TrackingFrame,
+)
 
 POINT_STAMPED = "geometry_msgs/msg/PointStamped"
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
@@ -47,9 +54,6 @@ LOAD_SHARE = "gazebot_msgs/msg/LoadShare"
 #: The tracked bodies of a :class:`~gazebot.types.TrackingFrame`, one topic (or TF frame) each.
 BODIES = ("giver_hand", "receiver_hand", "giver_face")
 
-#: Events of the engine's phase stream (category ``phase``); the engine's ``fault`` is a fault;
-#: other EventKinds are ``robot``.
-PHASE_KINDS = frozenset({*PHASE_OF_EVENT, EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED})
 
 EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]
 _CATEGORIES = ("phase", "robot", "behavior", "fault", "node")
@@ -461,7 +465,7 @@ def category_of(kind: str) -> EventCategory:
         return "fault"
     if ek is EventKind.FAULT:
         return "fault"
-    return "phase" if ek in PHASE_KINDS else "robot"
+    return "phase" if ek in PHASE_STREAM_KINDS else "robot"
 
 
 def _plain(value: Any) -> Any:

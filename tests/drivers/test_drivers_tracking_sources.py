@@ -34,19 +34,91 @@ class Tracker:
         self.face.publish(convert.point_stamped(t, [1.0, 0.3, 1.5], "world"))
 
 
-def test_arbiter_keeps_the_first_source_until_it_is_silent():
+def test_arbiter_keeps_the_first_source_of_each_part_until_it_is_silent():
     now = [0.0]
     arb = SourceArbiter(timeout=1.0, clock=lambda: now[0])
     assert arb.admit("giver_hand", "a") is None
-    assert arb.admit("giver_face", "b") == "a"  # the points are one group
-    assert arb.admit("gripper", "b") is None  # the gripper is its own group
-    assert [(r.source, r.owner, r.ignored) for r in arb.new_rivals()] == [("b", "a", 1)]
+    assert arb.admit("giver_hand", "b") == "a"  # a second publisher of the same part
+    assert arb.admit("gripper", "b") is None  # another part: b owns it
+    assert [(r.source, r.owner, r.parts, r.ignored) for r in arb.new_rivals()] == [
+        ("b", "a", ("giver_hand",), 1)
+    ]
     assert arb.new_rivals() == []  # reported once
     now[0] = 0.5
     assert arb.admit("giver_hand", "a") is None and arb.admit("giver_hand", "b") == "a"
     now[0] = 1.6  # a silent for 1.1 s: b takes over
     assert arb.admit("giver_hand", "b") is None
-    assert arb.owners() == {"points": "b"} and arb.admit("giver_hand", "a") == "b"
+    assert arb.owners() == {"giver_hand": "b"} and arb.admit("giver_hand", "a") == "b"
+
+
+def test_hands_from_a_mocap_node_and_the_face_from_a_face_tracker_are_both_used():
+    # Review finding 10b: the face tracker is not a rival of the node publishing the hands.
+    arb = SourceArbiter(timeout=1.0, clock=lambda: 0.0)
+    for _ in range(3):
+        assert arb.admit("giver_hand", "mocap") is None
+        assert arb.admit("receiver_hand", "mocap") is None
+        assert arb.admit("giver_face", "face_tracker") is None
+        assert arb.admit("gripper", "robot") is None and arb.admit("load_share", "robot") is None
+    assert arb.rivals() == []
+    assert arb.owners() == {"giver_hand": "mocap", "receiver_hand": "mocap",
+                            "giver_face": "face_tracker", "gripper": "robot",
+                            "load_share": "robot"}
+    # a second face tracker is the face's rival only
+    assert arb.admit("giver_face", "face_2") == "face_tracker"
+    assert [(r.source, r.owner, r.parts) for r in arb.rivals()] == [
+        ("face_2", "face_tracker", ("giver_face",))
+    ]
+
+
+def test_a_rival_refused_several_parts_of_one_owner_is_one_report():
+    arb = SourceArbiter(timeout=1.0, clock=lambda: 0.0)
+    arb.admit("giver_hand", "a"), arb.admit("giver_face", "a")
+    arb.admit("giver_face", "b"), arb.admit("giver_hand", "b"), arb.admit("giver_hand", "b")
+    [rival] = arb.new_rivals()
+    assert (rival.parts, rival.group, rival.ignored) == (
+        ("giver_face", "giver_hand"), "giver_face, giver_hand", 3)
+
+
+class PartTracker:
+    """A node publishing only some of the tracked points (a mocap node's hands, a face tracker's
+    face) with the shared clock."""
+
+    def __init__(self, bus, name: str, parts: dict) -> None:
+        self.ros = RosNode(bus.connector(), bus.names, name)
+        bus.closers.append(self.ros.close)
+        self.pubs = {p: (self.ros.publisher(topic.name, topic.type), xyz)
+                     for p, (topic, xyz) in parts.items()}
+        self.ros.announce()
+
+    def publish(self, t: float) -> None:
+        for pub, xyz in self.pubs.values():
+            pub.publish(convert.point_stamped(t, xyz, "world"))
+
+
+def test_a_hand_tracker_and_a_separate_face_tracker_both_reach_the_engine(bus):
+    drv = ZenohRobotDriver(bus.listener(), bus.names, "engine", source_timeout=0.3)
+    engine = FakeEngine()
+    node = EngineNode(GazeLoop(engine), drv, FAST)
+    stop = threading.Event()
+    th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
+    bus.closers.append(drv.close)
+    bus.closers.append(lambda: (stop.set(), th.is_alive() and th.join(timeout=5)))
+    events = events_of(drv)
+    hands = PartTracker(bus, "mocap", {"giver_hand": (topics.GIVER_HAND, [1.0, 0.0, 1.0])})
+    face = PartTracker(bus, "face_tracker", {"giver_face": (topics.GIVER_FACE, [1.0, 0.3, 1.5])})
+    assert wait_until(lambda: drv._expected_parts() == {"giver_hand", "giver_face"})
+    th.start()
+    assert node.ready.wait(30)
+    for i in range(10):
+        hands.publish(10.0 + i / 120)
+        face.publish(10.0 + i / 120)
+    assert wait_until(lambda: any(f.t == pytest.approx(10.0 + 9 / 120) for f in engine.frames))
+    used = [f for f in engine.frames if f.t >= 10.0]
+    assert used and all(f.giver_face[2] == pytest.approx(1.5) for f in used)
+    assert all(f.giver_hand[2] == pytest.approx(1.0) for f in used)
+    assert drv.tracking_sources().keys() == {"giver_hand", "giver_face"}
+    assert drv.tracking_sources()["giver_face"].startswith("face_tracker ")
+    assert not drv.dropped() and not events.where(kind="competing_tracking")
 
 
 def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset_per_sample(bus):
@@ -76,7 +148,8 @@ def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset
     assert wait_until(lambda: events.where(kind="competing_tracking"))
     [report] = events.where(kind="competing_tracking")
     assert report.info["source"].startswith("tracker_b ")
-    assert report.info["owner"].startswith("tracker_a ") and report.info["group"] == "points"
+    assert report.info["owner"].startswith("tracker_a ")
+    assert report.info["group"] == "giver_face, giver_hand"  # both refused parts, one report
     assert "second tracking source tracker_b" in drv.drops.reasons()[hand]
     # tracker a goes silent: tracker b takes over, with one clock reset for its clock
     state = {"t": 6.0}

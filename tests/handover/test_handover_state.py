@@ -31,6 +31,23 @@ def test_the_first_reach_wins_even_when_reported_late():
     assert s.robot_motion_end() == pytest.approx(2.0)
 
 
+def test_the_givers_earlier_reach_told_after_the_robots_takes_the_start_and_the_source():
+    # Review finding 10a: robot 0.8 s, then the giver's reach at 0.5 s is reported.
+    s = HandoverState()
+    s.apply(ev("robot_reach_started", 0.8, planned_duration=1.2))
+    assert (s.phase_start, s.source) == (0.8, "robot")
+    assert s.apply(ev("reach_started", 0.5)) is None  # not a new phase: the reach only moves
+    assert (s.phase, s.phase_start, s.source, s.handover) == (Phase.REACH, 0.5, "tracking", 0)
+    assert s.robot_motion_end() == pytest.approx(2.0)  # the robot's plan still counts
+
+
+def test_a_later_reach_of_the_other_party_keeps_the_start_and_the_source():
+    s = HandoverState()
+    s.apply(ev("reach_started", 0.5))
+    s.apply(ev("robot_reach_started", 0.8))
+    assert (s.phase_start, s.source) == (0.5, "tracking")
+
+
 def test_a_duplicate_reach_of_the_same_party_keeps_the_first_time():
     s = HandoverState()
     s.apply(ev("reach_started", 1.0))

@@ -186,3 +186,52 @@ def test_any_target_gives_finite_within_limit_joints(x, y, z, robot_name):
     assert np.all(sol.q >= robot.lower) and np.all(sol.q <= robot.upper)
     if sol.valid:
         assert math.isfinite(sol.total_residual) and math.isfinite(sol.eye_yaw)
+
+
+@pytest.mark.parametrize("name", ["sawyer", "jaco2"])
+def test_the_robot_yamls_ik_block_is_the_solver_settings_of_engine_controller_and_look_at(name):
+    from gazebot import GazeEngine
+    from gazebot.kinematics import GazeController
+
+    robot = RobotModel.load(name)
+    from_yaml = IKConfig.from_settings(robot.config.ik)
+    assert from_yaml == IKConfig()  # the shipped values are the solver's defaults, exactly
+    assert from_yaml.max_iterations == 25 and from_yaml.tolerance == 1e-5
+    assert GazeController(robot).ik == from_yaml
+    assert GazeEngine.from_config(robot=name, behavior="face-hand-face").gaze.ik == from_yaml
+
+
+def test_an_ik_setting_in_the_robot_yaml_changes_the_solve(tmp_path):
+    import yaml
+
+    from gazebot.kinematics import GazeController
+    from gazebot.kinematics.config import robot_config_path
+
+    data = yaml.safe_load(robot_config_path("jaco2").read_text())
+    data["mjcf"] = str((robot_config_path("jaco2").parents[2] / "gazebot/assets/robots"
+                        / data["mjcf"]).resolve())
+    data["ik"] = {"max_iterations": 1, "max_step_deg": 1.0}
+    f = tmp_path / "slow.yaml"
+    f.write_text(yaml.safe_dump(data))
+    robot = RobotModel.load(f)
+    cfg = GazeController(robot).ik
+    assert cfg.max_iterations == 1 and cfg.max_step == pytest.approx(np.radians(1.0))
+    assert cfg.tolerance == IKConfig().tolerance  # left out: the solver's default
+    one_step = solve_ik(robot, [1.0, 0.8, 1.2])
+    assert not one_step.converged  # 1 deg in one iteration cannot reach a target 40 deg away
+    assert solve_ik(RobotModel.load("jaco2"), [1.0, 0.8, 1.2]).converged
+
+
+def test_a_bad_ik_setting_names_the_file_and_the_field(tmp_path):
+    import yaml
+
+    from gazebot.config import ConfigError
+    from gazebot.kinematics import load_robot_config
+    from gazebot.kinematics.config import robot_config_path
+
+    data = yaml.safe_load(robot_config_path("sawyer").read_text())
+    data["ik"] = {"max_iterations": 0}
+    f = tmp_path / "bad.yaml"
+    f.write_text(yaml.safe_dump(data))
+    with pytest.raises(ConfigError, match=r"bad\.yaml.*ik\.max_iterations"):
+        load_robot_config(f)

@@ -5,7 +5,7 @@ import re
 import pytest
 
 from gazebot.config import ConfigError
-from gazebot.phases import PhaseConfig, default_phase_config_path, load_phase_config
+from gazebot.phases import PhaseConfig, default_phase_config_path, durations, load_phase_config
 
 
 def test_defaults_are_the_seed_transfer_rule():
@@ -98,8 +98,16 @@ def test_typical_durations_match_the_human_annotations(annotations_dir):
             labels.append(str(row[2]).strip() if row[2] is not None else "")
         for k, v in counts.items():
             v.append(labels.count(k) / 8.0)
-    c = PhaseConfig()
     mean = {k: sum(v) / len(v) for k, v in counts.items()}
-    assert mean["Reach"] == pytest.approx(c.reach_duration, abs=0.05)
-    assert mean["Transfer"] == pytest.approx(c.transfer_duration, abs=0.02)
-    assert mean["Retreat"] == pytest.approx(c.retreat_duration, abs=0.02)
+    assert mean["Reach"] == pytest.approx(durations.REACH_S, abs=0.05)
+    assert mean["Transfer"] == pytest.approx(durations.TRANSFER_S, abs=0.02)
+    assert mean["Retreat"] == pytest.approx(durations.RETREAT_S, abs=0.02)
+
+
+def test_typical_durations_are_not_a_phase_setting(tmp_path):
+    # One source (gazebot.phases.durations) for the detector and the behaviors' fallback: a
+    # YAML trying to set one is refused, naming the field.
+    f = tmp_path / "p.yaml"
+    f.write_text("reach_duration: 0.8\n")
+    with pytest.raises(ConfigError, match="reach_duration"):
+        load_phase_config(f)

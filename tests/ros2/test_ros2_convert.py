@@ -217,3 +217,16 @@ def test_a_command_becomes_its_messages() -> None:
     assert cv.event_of(out["events"][0]).kind == "reach_started"
     lost = cv.command_messages(Command(target_point=np.full(3, np.nan), head={}), "w", "g", 0.05)
     assert sorted(lost) == ["events", "eyes"]
+
+
+def test_the_phase_stream_kinds_are_one_set_for_the_wire_and_the_payloads():
+    from gazebot.drivers import payloads
+    from gazebot.types import PHASE_OF_EVENT, PHASE_STREAM_KINDS
+
+    assert payloads.category_of is cv.category_of  # one rule, not a copy
+    assert set(PHASE_OF_EVENT) < PHASE_STREAM_KINDS
+    for kind in EventKind:
+        expected = ("fault" if kind is EventKind.FAULT
+                    else "phase" if kind in PHASE_STREAM_KINDS else "robot")
+        assert cv.category_of(kind.value) == expected, kind
+    assert cv.category_of("tracking_lost") == "phase"

@@ -3,15 +3,20 @@ target comes from a phase's rule while the command reports another phase.
 
 Each (scene, initiator) is one simulated handover; every seed behavior's own
 :class:`~gazebot.runtime.GazeLoop` sees the same frames and robot events tick for tick (the gaze
-moves neither the giver nor the arm). The behavior names the rule behind its current target
-(:attr:`~gazebot.behaviors.BehaviorMachine.origin`: a segment of a phase, the ``before``/``after``
-target, or the gaze carried into a phase); that phase must be the command's.
+moves neither the giver nor the arm). The behavior records the rule that picked its gaze state
+when it picked it (:attr:`~gazebot.behaviors.BehaviorMachine.origin`: a segment of a phase, the
+``before``/``after`` target, with that rule's phase; a gaze carried unchanged into a later phase
+says so). Every tick with tracking ok must agree with it
+(:meth:`~gazebot.behaviors.GazeOrigin.disagreement`): the target is the one the rule picked, a
+phase's own rule is the reported phase's, a carried gaze was carried into the reported phase.
+That the check catches a stale origin is pinned in ``tests/behaviors/test_behavior_origin.py``.
 """
 
 from __future__ import annotations
 
 import pytest
 
+from gazebot.behaviors import GazeOrigin
 from gazebot.sim.scene_config import Initiator, load_scene, scene_names
 from gazebot.types import Phase
 
@@ -62,7 +67,8 @@ class _Replay:
 
 class _AllBehaviors:
     """A ``record_handover`` loop ticking one GazeLoop per seed behavior; records, per tick and
-    behavior, (t, reported phase, target, the phase of the rule behind the target)."""
+    behavior, (t, reported phase, target, the behavior's gaze origin, its tracking state, and
+    why they disagree, ``None`` if they agree)."""
 
     def __init__(self, robot) -> None:
         from gazebot.runtime import GazeLoop
@@ -73,7 +79,7 @@ class _AllBehaviors:
         first.engine.detector = shared
         for loop in rest:
             loop.engine.detector = _Replay(shared, loop.engine.detector)
-        self.ticks: dict[str, list[tuple[float, Phase, str, Phase, str]]] = {
+        self.ticks: dict[str, list[tuple[float, Phase, str, GazeOrigin, str, str | None]]] = {
             n: [] for n in SEED_BEHAVIORS
         }
 
@@ -86,16 +92,23 @@ class _AllBehaviors:
         for name, loop in self.loops.items():
             cmd = loop.tick(frame, t=t, joints=joints)
             assert cmd is not None, f"{name}: unsafe command"
-            phase, rule = loop.engine.behavior.origin
-            self.ticks[name].append((cmd.t, cmd.phase, cmd.target, phase, rule))
+            behavior = loop.engine.behavior
+            why = behavior.origin_disagreement(cmd.phase, cmd.target)
+            self.ticks[name].append((cmd.t, cmd.phase, cmd.target, behavior.origin,
+                                     behavior.tracking, why))
             out = out or cmd
         return out
 
 
+CASES = [("sawyer", scene, initiator) for scene in scene_names()
+         for initiator in (Initiator.ROBOT, Initiator.GIVER)]
+# Jaco-2 (a head that pans and tilts, other timings): one scene, both initiators.
+CASES += [("jaco2", "default", Initiator.ROBOT), ("jaco2", "default", Initiator.GIVER)]
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("initiator", [Initiator.ROBOT, Initiator.GIVER])
-@pytest.mark.parametrize("scene", scene_names())
-def test_no_target_comes_from_another_phase_than_the_one_reported(scene, initiator):
+@pytest.mark.parametrize(("robot", "scene", "initiator"), CASES)
+def test_no_target_comes_from_another_phase_than_the_one_reported(robot, scene, initiator):
     from gazebot.sim.record import record_handover
     from gazebot.sim.robot import load_sim_robot
 
@@ -103,14 +116,20 @@ def test_no_target_comes_from_another_phase_than_the_one_reported(scene, initiat
     if config.giver_motion is not None:
         pytest.skip(f"{scene}: replays a recorded giver")
     config = config.model_copy(update={"initiator": initiator})
-    loop = _AllBehaviors(load_sim_robot("sawyer").spec)
+    loop = _AllBehaviors(load_sim_robot(robot).spec)
     rec = record_handover(
-        robot="sawyer", behavior=SEED_BEHAVIORS[0], scene=config, out_path=None,
+        robot=robot, behavior=SEED_BEHAVIORS[0], scene=config, out_path=None,
         progress=False, loop=loop,
     )
     assert rec.completed
     for name, ticks in loop.ticks.items():
-        phases = {p for _, p, _, _, _ in ticks}
+        phases = {tick[1] for tick in ticks}
         assert Phase.REACH in phases, f"{name}: the handover's reach was never reported"
-        wrong = [tick for tick in ticks if tick[1] is not tick[3]]
-        assert not wrong, f"{name}: (t, reported, target, rule phase, rule) {wrong[0]}"
+        checked = [tick for tick in ticks if tick[4] == "ok"]
+        assert len(checked) > len(ticks) // 2, f"{name}: tracking lost most of the time"
+        rules = {(tick[3].phase, tick[3].rule) for tick in checked}
+        assert any(rule.startswith("segment") for _, rule in rules) or name in ("face", "hand"), (
+            f"{name}: no segment ever picked the gaze ({sorted(rules)})"
+        )
+        for t, _, _, origin, _, why in checked:
+            assert why is None, f"{name} at t={t:.3f}: {why} ({origin})"

@@ -18,7 +18,7 @@ from gazebot.registry import Registry
 
 #: The phase methods by name: ``method:`` validation, CLI choices and the README's table come
 #: from here. A new method is one file plus one line.
-PHASE_METHODS: Registry[Segmenter] = Registry("phase method")
+PHASE_METHODS: Registry[Segmenter] = Registry("phase method", group="gazebot.phase_methods")
 PHASE_METHODS.register("gazebot", GazebotSegmenter, "the robust default")
 PHASE_METHODS.register(
     "seed-7.2.5", Seed725Segmenter, "the seed's annotation rule as published (section 7.2.5)"
