@@ -134,6 +134,17 @@ def run_display(
                 time.sleep(delay)
     except KeyboardInterrupt:
         pass
+    if writer is not None and duration is not None and slots and now >= end:
+        # Ended by --duration: the video is exactly that long. The last slots may have begun
+        # while the loop was late (a busy machine); they repeat the last image like any other
+        # missed slot, so the recording keeps its length whatever the load.
+        total = math.ceil(duration / period - 1e-9)
+        if total > slots:
+            image = screen.image()
+            for _ in range(total - slots):
+                writer.append(image)
+            repeated += total - slots
+            slots = total
     elapsed = max(clock() - start, 1e-9)
     return {
         "frames": drawn,

@@ -179,3 +179,59 @@ def test_display_records_30_frames_a_second_of_sim_with_engine_and_pupils_follow
     pitches = [pitch for _, pitch in good]
     # the pupils were seen up at the face and down at the hand, as the engine sent them
     assert min(pitches) < -0.05 and max(pitches) > 0.2, matched
+
+
+class _StubNode:
+    """A display node that never heard the engine."""
+
+    received = 0
+
+    def latest(self):
+        return None, float("inf")
+
+    def status(self, eyes, info) -> None:
+        pass
+
+
+class _CountingScreen:
+    closed_after: int | None = None
+
+    def __init__(self) -> None:
+        self.size = (4, 4)
+        self.shown = 0
+
+    def show(self, pose, status) -> None:
+        self.shown += 1
+
+    def image(self):
+        return np.full((4, 4, 3), self.shown, np.uint8)
+
+    def closed(self) -> bool:
+        return False
+
+
+class _ListWriter(list):
+    append = list.append
+
+
+def _stepping_clock(times):
+    """A clock returning ``times`` one after the other: where the display loop finds itself
+    each time it looks, as on a machine too busy to keep its slots."""
+    it = iter(times)
+    return lambda: next(it)
+
+
+def test_a_recording_ended_by_duration_lasts_that_long_even_when_the_loop_ran_late():
+    from gazebot.cli.display import run_display
+    from gazebot.render.head_display import EyeAnimator, EyeAnimatorConfig
+
+    screen, writer = _CountingScreen(), _ListWriter()
+    # start 0; iterations at 0.0, 0.5 and 0.75 s (each looking twice: slot, then sleep);
+    # then woken only at 1.4 s, past the 1 s end: the loop itself never began the last slots.
+    clock = _stepping_clock([0.0, 0.0, 0.0, 0.5, 0.5, 0.75, 0.75, 1.4, 1.4])
+    summary = run_display(_StubNode(), screen, EyeAnimator(EyeAnimatorConfig()), 10.0, 1.0,
+                          writer, clock=clock)
+    assert len(writer) == summary["video_frames"] == 10  # 1 s at 10 frames/s
+    assert summary["frames"] == 3 and summary["repeated_frames"] == 7
+    # each slot shows the image drawn when it began (or the newest one before it)
+    assert [int(f[0, 0, 0]) for f in writer] == [1, 2, 2, 2, 2, 2, 3, 3, 3, 3]

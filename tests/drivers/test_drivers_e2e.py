@@ -56,7 +56,14 @@ def start_engine_node(bus, behavior="face-hand-face"):
     from gazebot.engine import GazeEngine
     from gazebot.runtime import GazeLoop
 
-    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
+    # The assembler completes a sample without a part after REORDER newer samples (0.2 s of a
+    # real-time robot; at SPEED x real time only 0.2 / SPEED s of wall time) or after
+    # IDLE_FLUSH s of wall time with no part at all. A busy machine stalls this process, or
+    # one topic's callback thread, that long: the engine then sees hands missing for longer
+    # than max_gap_hold (tracking_lost), which this test is not about (the assembler's rules
+    # have their own tests). Windows of 1 s and 5 s of wall time keep it about the handover.
+    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine",
+                           assemble_reorder=round(120 * SPEED), assemble_idle=5.0)
     # No silence ticks: on a loaded machine the simulator thread may stall between samples.
     # The resync returns as soon as the joint state and the history arrived; the long deadline
     # only matters on a slow machine.
@@ -116,7 +123,9 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     robot = [m.kind for m in events.msgs if m.source == "sim"]
     assert robot[:2] == ["robot_reach_started", "robot_reach_ended"]
     # head commands answered the tracking and the simulator obeyed them: the head turned
-    assert sim_node.applied["head"] > 100 and heads.msgs
+    # (how many depends on how often a loaded machine lets the engine answer: the engine
+    # skips samples it lags behind; the turn and the last command's pan show the obeying)
+    assert 0 < sim_node.applied["head"] <= engine_node.commands_sent and heads.msgs
     assert {m.info["target"] for m in target_events()} >= {"face", "hand"}
     assert abs(pan_end - pan0) > 0.05
     assert pan_end == pytest.approx(heads.msgs[-1]["head_pan"], abs=0.05)

@@ -96,6 +96,14 @@ def test_a_multi_megabyte_event_is_dropped_unread_and_the_history_stays_bounded(
     for n in (ep, drv):
         bus.closers.append(n.close)
     assert wait_until(lambda: drv.peers().get("sim"))
+
+    def route_up() -> bool:
+        # Seeing the peer does not mean a put already reaches its subscription (it would
+        # go nowhere): a small event, sent until one arrives, shows the route is in place.
+        ep.publish_event(event(0, source="sim"))
+        return any(m.source == "sim" for m in drv.history())
+
+    assert wait_until(route_up, poll=0.05)
     codec = Codec.for_type(typestore(), convert.HANDOVER_EVENT)
     key = ep.names.key(ep.names.resolve(topics.EVENTS.name), codec.info.dds_name,
                        codec.info.hash)
@@ -126,14 +134,20 @@ def test_zenoh_drops_a_message_beyond_the_nodes_limit_before_it_is_reassembled(b
     for n in (ep, drv):
         bus.closers.append(n.close)
     assert wait_until(lambda: ep.peers().get("engine"))
+    from gazebot.drivers.payloads import HeadCommandMsg
+
+    def route_up() -> bool:
+        # Seeing the peer does not mean a put already reaches its subscription: a command,
+        # sent until one arrives, shows the route is in place.
+        drv.send_head(HeadCommandMsg(seq=0, t=0.0, stamp=0.0, head={"head_pan": 0.0}))
+        return ep.head.peek() is not None
+
+    assert wait_until(route_up, poll=0.05)
     head = ep.names.resolve(topics.HEAD_COMMAND.name)
     codec = Codec.for_type(typestore(), topics.HEAD_COMMAND.type)
     key = ep.names.key(head, codec.info.dds_name, codec.info.hash)
     drv.session.put(key, b"\x00\x01\x00\x00" + bytes(20 * 1024 * 1024),
                     congestion_control=zenoh.CongestionControl.BLOCK)
-    from gazebot.drivers.payloads import HeadCommandMsg
-
-    drv.send_head(HeadCommandMsg(seq=0, t=0.0, stamp=0.0, head={"head_pan": 0.3}))
-    assert wait_until(lambda: ep.head.peek() is not None)
-    assert ep.head.peek().head == {"head_pan": 0.3}
+    drv.send_head(HeadCommandMsg(seq=1, t=0.0, stamp=0.0, head={"head_pan": 0.3}))
+    assert wait_until(lambda: ep.head.peek().head == {"head_pan": 0.3})
     assert head not in ep.dropped()  # never reached the subscription
