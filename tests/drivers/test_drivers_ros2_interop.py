@@ -258,9 +258,12 @@ def test_a_handover_driven_from_a_ros2_node_ends_the_same_way(router, msgdir, re
     assert _face_hand_face(_labels(out["targets"], points)), out["phases"]
     assert out["phases"][-1] == "done" and "reach" in out["phases"]
     assert out["heads"]
-    # what the engine received: one sample per tick (processed, or skipped when it lagged),
-    # nothing dropped on the tracking topics
+    # What the engine received: one sample per tick (processed, or skipped when it lagged),
+    # nothing dropped on the tracking topics. The peer's first puts may precede the router's
+    # route to the engine (the graph lists a subscription before its route is in place, and a
+    # volatile ROS 2 publisher loses them the same way): at most 0.1 s of samples at 120 Hz.
     summary = json.loads(run_out.strip().splitlines()[-1])
-    assert summary["frames"] + summary["tracking_skipped"] == len(ticks), summary
+    received = summary["frames"] + summary["tracking_skipped"]
+    assert len(ticks) - 12 <= received <= len(ticks), summary
     assert not any("/tracking/" in topic for topic in summary["dropped"]), summary["dropped"]
     assert summary["phase"] in (None, "done")
