@@ -397,6 +397,11 @@ def test_pose_stamped_and_tf_frames_are_tracking_too_and_remapped_topics_are_use
     assert targets.key.startswith("0/robot/look_at/")
     node = EngineNode(GazeLoop(FakeEngine()), drv, FAST)
     assert wait_until(lambda: connected(ep, drv))
+    # The engine waits for a sample's parts whose topics it knows a publisher of: until its
+    # graph lists the mocap's two publishers, a face could complete a sample without its hand.
+    hand_topic, tf_topic = names.resolve(topics.GIVER_HAND.name), names.resolve(topics.TF.name)
+    assert wait_until(lambda: drv.ros.graph.endpoints(hand_topic, "MP")
+                      and drv.ros.graph.endpoints(tf_topic, "MP"))
     for i in range(3):
         t = 0.5 + i / 120
         sample = TrackingFrame.make(t, giver_hand=[0.9, 0.0, 1.0], giver_face=[1.1, 0.2, 1.6])

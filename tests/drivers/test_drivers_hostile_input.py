@@ -13,6 +13,7 @@ import zlib
 
 import numpy as np
 import pytest
+import zenoh
 from drivers_fakes import Recorder, wait_until
 
 from gazebot.drivers.payloads import EyeFrameMsg, PayloadError
@@ -24,7 +25,7 @@ from gazebot.ros2 import convert, topics
 from gazebot.ros2.codec import Codec
 from gazebot.ros2.errors import MessageError
 from gazebot.ros2.typestore import typestore
-from gazebot.types import TrackingFrame
+from gazebot.types import Event, EventKind, TrackingFrame
 
 pytestmark = pytest.mark.zenoh
 
@@ -61,11 +62,18 @@ def test_a_crafted_event_on_a_topic_is_counted_as_a_drop_without_a_traceback(bus
     bus.closers.append(drv.close)
     topic = drv.names.resolve(topics.ROBOT_EVENTS.name)
     assert wait_until(lambda: any(e.topic == topic for e in ep.ros.graph.endpoints(topic, "MS")))
+    # The graph may list the subscriber before the route to it is in place (puts then go
+    # nowhere): send well-formed events until one arrives, then the route is there.
+    probe = Event(EventKind.ROBOT_REACH_ENDED, 0.1, 0.1, {})
+    assert wait_until(lambda: ep.publish_robot_event(probe) and drv.poll_events(), poll=0.05)
     with caplog.at_level(logging.WARNING, logger="gazebot.drivers"):
         for _ in range(20):
-            ep.session.put(_key(ep, topics.ROBOT_EVENTS), _bomb_event())
+            # BLOCK: a burst of 100 kB puts must not be shed by Zenoh's congestion control
+            ep.session.put(_key(ep, topics.ROBOT_EVENTS), _bomb_event(),
+                           congestion_control=zenoh.CongestionControl.BLOCK)
         assert wait_until(lambda: drv.dropped().get(topic, 0) == 20)
-    assert drv.poll_events() == []
+    # no crafted event got through (probes still on their way may)
+    assert [e.kind for e in drv.poll_events() if e.kind != "robot_reach_ended"] == []
     records = [r for r in caplog.records if topic in r.getMessage()]
     assert records and all(r.exc_info is None for r in records)
     # rate-limited: the first few per topic and node (both nodes hear robot/events), not 40
