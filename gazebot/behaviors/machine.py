@@ -4,29 +4,43 @@ The machine keeps **no phase of its own**: it reads the one
 :class:`~gazebot.handover.HandoverState` (the engine's, or its own when run alone) and reacts to
 its phase changes. :func:`machine_definition` builds one ``transitions`` hierarchical machine
 with two parallel regions under the root state ``behavior``; every rule that decides the gaze
-target is one of its transitions, with a named condition:
+target is one of its transitions, with a named condition, and runs in it:
 
 - ``gaze``: one state per gaze target (``behavior_gaze_face``, ``behavior_gaze_hand``, ...).
   Its transitions:
 
-  * ``phase`` (the handover state changed phase) ``[new handover]`` -> the behavior's ``before``
-    target (the reach of a new handover starts afresh), ``[handover done]`` -> its ``after``
-    target, ``[same handover: the gaze carries]`` (internal: reach -> transfer -> retreat keep
-    the target they had);
-  * ``timer`` ``[PHASE: WHEN (RULE)]`` -> a segment's target, once per segment of the behavior:
+  * ``phase`` (the handover state changed phase; the trigger carries the
+    :class:`~gazebot.handover.PhaseChange`) ``[new handover]`` -> the behavior's ``before``
+    target (the reach of a new handover starts afresh; a data-driven behavior draws its
+    segments), ``[handover done]`` -> its ``after`` target, ``[same handover: the gaze
+    carries]`` (internal: reach -> transfer -> retreat keep the target they had); each then
+    enters the new phase's segments (its ``after`` callbacks);
+  * ``timer`` (the trigger carries the :class:`Tick`: the time and the tracking's end estimate)
+    ``[PHASE: WHEN (RULE)]`` -> a segment's target, once per segment of the behavior:
     ``0.5 of the reach (end: latest of tracking, event, robot plan; else 1.01 s)`` or
-    ``robot_reach_ended + 0.2 s``; when several start by the same tick the latest start wins
-    (:func:`gazebot.behaviors.schedule.due_segments`).
+    ``robot_reach_ended + 0.2 s``. Their ``prepare`` callback schedules the phase at the tick
+    with the pure :func:`gazebot.behaviors.schedule.schedule` (the expected end, each
+    segment's start, the due ones); the condition holds for the segment the gaze follows:
+    when several start by the same tick the latest start wins. ``timer [due, but before the
+    followed segment's start ...]`` (internal) starts segments that do not take the gaze
+    back. Their ``after`` callbacks mark the due segments started and record the origin.
 
 - ``tracking``: ``ok`` -> ``hold`` on ``tracking_lost`` (the gaze point is held), ``hold`` ->
-  ``lost`` on ``timer [held HOLD s]`` (then the policy's target, by default the last known
-  face), back to ``ok`` on ``tracking_restored [after the loss]`` (an older restore is stale).
-  Phases and gaze shifts keep advancing meanwhile, so on restore the gaze resumes where the
-  behavior now is.
+  ``lost`` on ``timer [held HOLD s]`` (:func:`~gazebot.behaviors.schedule.hold_over`; then the
+  policy's target, by default the last known face), back to ``ok`` on ``tracking_restored
+  [after the loss]`` (an older restore is stale). Phases and gaze shifts keep advancing
+  meanwhile, so on restore the gaze resumes where the behavior now is.
+
+:meth:`BehaviorMachine.advance` only feeds the tick; it skips the ``timer`` trigger when the
+machine could not fire anything: before the hold's end and before the earliest start its last
+schedule found (:attr:`~gazebot.behaviors.schedule.Schedule.wake`) while that schedule's
+evidence is unchanged (the handover state's ``revision``; the end estimate when a waiting start
+depends on it). A machine fed every tick decides the same (a property test).
 
 ``gazebot behaviors show NAME --diagram FILE`` draws this machine, with the handover state's own
-rule table (:data:`gazebot.handover.RULES`: first reach wins, grasp/release, stale events) as a
-third region, from the same definitions that run (:func:`diagram`).
+machine (built from its rule table :data:`gazebot.handover.RULES`: first reach wins,
+grasp/release, stale events) as a third region, from the definitions a :class:`BehaviorMachine`
+runs on, live conditions included (:func:`diagram`).
 
 :meth:`BehaviorMachine.state` reads e.g. ``reach_hand`` (the handover state's phase, the gaze
 state, and ``_hold``/``_lost`` while tracking is lost). :attr:`BehaviorMachine.origin`
@@ -36,9 +50,9 @@ and says which phase it was carried into.
 
 Fraction timings need the phase's end online: :func:`gazebot.behaviors.schedule.expected_end`
 combines the tracking's prediction (``GazeContext.tracking_end``), the phase event's
-``expected_end`` and the robot's motion plan, else the spec's ``phase_durations_s``. It is
-re-read every tick; a segment that has started stays started, so a revised estimate never moves
-the gaze back.
+``expected_end`` and the robot's motion plan, else the spec's ``phase_durations_s``. Each
+schedule re-reads them; a segment that has started stays started, so a revised estimate never
+moves the gaze back.
 
 Points: the returned point is ``ctx.points[kind]`` (the hand moves: it is read every call). When
 that point is missing (NaN or an unknown named point) the last finite position of that kind is
@@ -252,7 +266,9 @@ def machine_definition(
     def leaf(name: str) -> str:
         return f"{_GAZE}_{name}"
 
-    def transition(trigger: str, source: Any, dest: str | None, key: tuple, label: str | None):
+    def transition(
+        trigger: str, source: Any, dest: str | None, key: tuple, label: str | None
+    ) -> dict[str, Any]:
         out: dict[str, Any] = {"trigger": trigger, "source": source, "dest": dest}
         if label is not None:
             out["conditions"] = [condition(key, label)]
@@ -652,7 +668,9 @@ class BehaviorMachine:
     def on_tracking(self, event: Event) -> None:
         """Apply ``tracking_lost`` / ``tracking_restored`` (stale or duplicate ones ignored)."""
         t = self._time(event)
-        if t is None or not self._model.trigger(event.kind.value, t):
+        lost = event.kind is EventKind.TRACKING_LOST
+        trigger = (EventKind.TRACKING_LOST if lost else EventKind.TRACKING_RESTORED).value
+        if t is None or not self._model.trigger(trigger, t):
             self._ignored += 1  # no time, a duplicate loss, or a restore older than the loss
 
     def on_phase(self, change: PhaseChange) -> None:
