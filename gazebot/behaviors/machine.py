@@ -571,7 +571,7 @@ class BehaviorMachine:
         self._schedule = Schedule((), (), None, math.inf, False, False)
         self._scheduled: Tick | None = None
         self._wake = math.inf
-        self._wake_revision: int | None = None
+        self._wake_revision: int | None = None  # the evidence wake holds for; None: any
         self._wake_end: float | None = None
         self._tracking_end = math.nan
         self._lost_since = math.nan
@@ -690,15 +690,16 @@ class BehaviorMachine:
         if tracking_end is not None:
             self._tracking_end = tracking_end
         end = self._tracking_end
-        if t < self._hold_until and t < self._wake and self._same_evidence(end):
+        if (
+            t < self._hold_until
+            and t < self._wake
+            and (self._wake_revision is None or self._same_evidence(end))
+        ):
             return
         self._model.trigger("timer", Tick(t, end))
 
     def _same_evidence(self, end: float) -> bool:
-        """Whether the evidence the last schedule's ``wake`` holds for is unchanged (``None``:
-        it holds for any)."""
-        if self._wake_revision is None:
-            return True
+        """Whether the evidence the last schedule's ``wake`` holds for is unchanged."""
         if self._wake_revision != self.handover.revision:
             return False
         seen = self._wake_end
