@@ -12,7 +12,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode, seed_value
+from gazebot.cli.argtypes import seed_value
+from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode
 
 if TYPE_CHECKING:
     from gazebot.kinematics.config import RobotConfig
