@@ -1,5 +1,5 @@
-"""The ``panda`` robot of the handover scene: the chapter-5 learner (:mod:`gazebot.gps.panda`, the one
-MJCF source of its arm) on a pedestal, with a pan-tilt display head beside it, written to
+"""The ``panda`` robot of the handover scene: the chapter-5 learner (:mod:`gazebot.gps.panda`, the
+one MJCF source of its arm) on a pedestal, with a pan-tilt display head beside it, written to
 ``gazebot/assets/robots/panda.xml`` so the gaze engine (Pinocchio IK), the eye renderer and the
 simulation load it like the other robots.
 
@@ -14,8 +14,8 @@ puts a standing giver's hand (about 1.0 m) inside the GPS training shell around 
 
 Position goals (home, the retreat, holding still) reach a torque arm through the joint impedance
 law of :mod:`gazebot.sim.torque_arm`; its gains are the model's custom numerics
-``arm_impedance_kp`` / ``arm_impedance_kd`` (ours, below Franka's joint-impedance example gains so
-the law is stable at the scene's 2 ms step).
+``arm_impedance_kp`` / ``arm_impedance_kd`` (ours, soft enough for the law to be stable at the
+scene's 2 ms step).
 
 The head (ours: a small servo pan-tilt unit, as labs mount a face screen beside an arm) stands on
 the pedestal at ``HEAD_MOUNT_M``: ``head_pan`` about +z, ``head_tilt`` about +y (+ = looking
@@ -38,8 +38,11 @@ HEAD_POST_M = 0.42  # foot to the pan axis' top
 PAN_RANGE_RAD = (-2.6, 2.6)
 TILT_RANGE_RAD = (-0.7854, 1.0472)  # 45 deg up, 60 deg down
 # Joint impedance gains (N m/rad, N m s/rad) for position goals on the torque arm.
-IMPEDANCE_KP = (300.0, 300.0, 300.0, 300.0, 60.0, 40.0, 15.0)
-IMPEDANCE_KD = (30.0, 30.0, 30.0, 20.0, 4.0, 2.5, 1.0)
+# Explicit at each 2 ms step: K_d dt stays well below the smallest effective joint inertia
+# (about 0.045 kg m^2 for joints 1 and 3 at the handover pose, 0.01 for joint 7), damping ratio
+# about 0.7 at home.
+IMPEDANCE_KP = (120.0, 120.0, 120.0, 120.0, 20.0, 20.0, 8.0)
+IMPEDANCE_KD = (8.0, 8.0, 8.0, 8.0, 1.2, 1.2, 0.4)
 GRIPPER_KP = 600.0  # N/m on the finger tendon, within the hand's force bound
 GRIPPER_KV = 20.0
 ASSET = Path(__file__).resolve().parents[1] / "assets" / "robots" / "panda.xml"

@@ -145,8 +145,8 @@ def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: flo
 
 def fingers_tendon() -> str:
     """The tendon ``fingers`` (the mean of the two finger slides) the gripper actuates."""
-    return ('<fixed name="fingers"><joint joint="finger_left" coef="0.5"/><joint joint="finger_right"\n'
-            '      coef="0.5"/></fixed>')
+    return ('<fixed name="fingers"><joint joint="finger_left" coef="0.5"/>'
+            '<joint joint="finger_right"\n      coef="0.5"/></fixed>')
 
 
 def arm_motors() -> list[str]:
