@@ -21,7 +21,12 @@ if TYPE_CHECKING:
 EXIT_INFEASIBLE = 3  # the reach controller found no feasible reach and the robot stopped
 
 # The scene's controller fields the command line sets, for error messages.
-_OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
+_OPTIONS = {
+    "reach_time_s": "--reach-time",
+    "stall_time_s": "--stall-time",
+    "retreat": "--retreat",
+    "policy": "--policy",
+}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -60,6 +65,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--controller",
         choices=reach_controller_names(),
         help="the robot's reach controller (default: the scene's; seed chapters 3-4)",
+    )
+    parser.add_argument(
+        "--policy",
+        type=Path,
+        metavar="DIR",
+        help="--controller gps: the learned policy (`gazebot gps train --out DIR`); "
+        "needs --robot panda",
     )
     parser.add_argument(
         "--reach-time", type=float, help="'Reach before', s from the handover's start"
@@ -112,6 +124,7 @@ def scene_with_overrides(args: argparse.Namespace):
             ("reach_time_s", getattr(args, "reach_time", None)),
             ("stall_time_s", getattr(args, "stall_time", None)),
             ("retreat", getattr(args, "retreat", None)),
+            ("policy", None if getattr(args, "policy", None) is None else str(args.policy)),
         )
         if value is not None
     }
@@ -142,14 +155,52 @@ def scene_with_overrides(args: argparse.Namespace):
         raise UsageError(f"--reach-time/--stall-time need --controller {need}")
     if "stall_time_s" in overrides and controller != "mce":
         raise UsageError("--stall-time ('Don't move until') is the mce controller's")
+    if controller == "gps" and data["controller"].get("policy") is None:
+        raise UsageError("--controller gps needs --policy DIR (written by `gazebot gps train "
+                         "--out DIR`)")
+    if "policy" in overrides and controller != "gps":
+        raise UsageError("--policy is the learned controller's: it needs --controller gps")
     try:
         scene = SceneConfig.model_validate(data)
-        if scene.controller.reach_controller != JOINT_REACH:
+        if scene.controller.reach_controller not in (JOINT_REACH, "gps"):
             # The reach and stall times against the controllers YAML, as the simulation will.
             scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field
         raise option_error(exc, _OPTIONS, "invalid controller options") from exc
+    if scene.controller.reach_controller == "gps":
+        check_policy(scene.controller.policy, args)
     return scene
+
+
+def check_policy(policy: str | None, args: argparse.Namespace) -> None:
+    """Before any simulation: the ``gps`` policy loads and fits ``--robot`` (one-line errors)."""
+    import mujoco
+
+    from gazebot.config import ConfigError
+    from gazebot.controllers import CONTROLLERS
+    from gazebot.sim.policy_reach import PolicyReach
+    from gazebot.sim.robot import load_sim_robot
+    from gazebot.sim.torque_arm import arm_actuator, is_torque_motor
+
+    try:
+        controller = CONTROLLERS.make("gps", None, policy=policy)
+    except (ConfigError, ValueError) as exc:
+        raise UsageError(f"--policy {policy}: {exc}") from None
+    robot = getattr(args, "robot", "panda")
+    try:
+        sim_robot = load_sim_robot(robot)
+    except (FileNotFoundError, ConfigError):
+        return  # the robot's own error comes later, from its loader
+    model = mujoco.MjModel.from_xml_path(str(sim_robot.mjcf))
+    acts = [arm_actuator(model, j) for j in sim_robot.arm_joints]
+    if len(acts) != 7 or not all(a >= 0 and is_torque_motor(model, a) for a in acts):
+        raise UsageError(f"--controller gps drives the Panda learner's seven joint torques: "
+                         f"--robot {robot} has no such arm (use --robot panda)")
+    try:
+        PolicyReach(controller, model, mujoco.MjData(model), sim_robot.arm_joints,
+                    sim_robot.gripper_site)
+    except (KeyError, ValueError) as exc:
+        raise UsageError(f"--robot {robot}: {exc}") from None
 
 
 def run_demo(args: argparse.Namespace) -> int:
