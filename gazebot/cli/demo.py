@@ -135,6 +135,11 @@ def scene_with_overrides(args: argparse.Namespace):
     else:
         base = args.scene
     if not overrides:
+        from gazebot.sim.scene_config import load_scene
+
+        ctrl = load_scene(base).controller  # a scene YAML may ask for the learned reach itself
+        if ctrl.reach_controller == "gps":
+            check_policy(ctrl.policy, args)
         return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
     from gazebot.sim.scene_config import (
@@ -223,11 +228,18 @@ def run_demo(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    from gazebot.sim.policy_reach import PolicyReachLog
     from gazebot.sim.stl_monitor import HandoverMonitor
 
     monitor = HandoverMonitor()  # the seed's Table 4.2 specs over the run (4.2.1 robustness)
+    learned = PolicyReachLog()  # what a learned (gps) reach did, if one ran
+
+    def on_tick(sim, tick) -> None:
+        monitor.on_tick(sim, tick)
+        learned.on_tick(sim, tick)
+
     try:
-        rec = _record(args, out, monitor)
+        rec = _record(args, out, on_tick)
     except OffscreenRenderingError as exc:
         print(f"gazebot: error: {exc}", file=sys.stderr)
         return 2
@@ -260,6 +272,8 @@ def run_demo(args: argparse.Namespace) -> int:
         "stl_robustness": {k: round(v, 4) for k, v in monitor.robustness().items()},
         "wall_time_s": round(time.perf_counter() - t0, 2),
     }
+    if learned.summary() is not None:
+        summary["gps"] = learned.summary()
     if args.json:
         print(json.dumps(summary))
     else:
@@ -270,6 +284,11 @@ def run_demo(args: argparse.Namespace) -> int:
         )
         rob = ", ".join(f"{k} {v:+.3f}" for k, v in summary["stl_robustness"].items())
         print(f"STL robustness (Table 4.2, positive = met): {rob}")
+        if "gps" in summary:
+            g = summary["gps"]
+            print(f"learned reach ({g['policy_state']} state): gripper to the object "
+                  f"{g['object_gap_start_m']} -> {g['object_gap_end_m']} m in {g['reach_s']} s, "
+                  f"max |torque| {g['max_torque_nm']} N m, fallbacks {g['fallbacks']}")
         for path in (rec.video, csv_path, png_path, out / "handover.mcap"):
             print(f"wrote {path}")
     if infeasible:
@@ -295,7 +314,7 @@ def _last_reach_start_time(ticks) -> float | None:
     return None if math.isnan(value) else round(value, 4)
 
 
-def _record(args: argparse.Namespace, out: Path, monitor=None):
+def _record(args: argparse.Namespace, out: Path, on_tick=None):
     from gazebot.sim.record import record_handover
 
     robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
@@ -305,7 +324,7 @@ def _record(args: argparse.Namespace, out: Path, monitor=None):
             robot=robot,
             behavior=args.behavior,
             scene=scene_with_overrides(args),
-            on_tick=None if monitor is None else monitor.on_tick,
+            on_tick=on_tick,
             out_path=out / "handover.mp4",
             seed=args.seed,
             width=args.width,

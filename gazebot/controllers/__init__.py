@@ -47,6 +47,16 @@ CONTROLLERS.register(
 )
 
 
+#: Registered controllers that command joint torques and plan no Cartesian velocities: they run
+#: only in the simulator, on a robot with their arm, and ``gazebot reach-plan`` does not offer them.
+TORQUE_CONTROLLERS: tuple[str, ...] = ("gps",)
+
+
+def planner_names() -> tuple[str, ...]:
+    """The registered controllers that plan Cartesian end-effector velocities."""
+    return tuple(n for n in CONTROLLERS.names() if n not in TORQUE_CONTROLLERS)
+
+
 def controller_names() -> tuple[str, ...]:
     """The registered controllers' names (the built-ins and any registered since)."""
     return CONTROLLERS.names()
@@ -64,9 +74,11 @@ __all__ = [
     "ReachController",
     "ReachObservation",
     "VelocityPlan",
+    "TORQUE_CONTROLLERS",
     "controller_names",
     "load_controllers_config",
     "make_controller",
+    "planner_names",
 ]
 
 

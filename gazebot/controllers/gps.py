@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gazebot.controllers.config import ControllersConfig
+from gazebot.controllers.config import ControllersConfig, load_controllers_config
 
 #: The state fields the handover scene cannot give (FULL, eq. 5.8).
 MISSING_IN_HANDOVER = "theta_h, dtheta_h (the 2-DoF tester's joint angles and velocities)"
@@ -46,7 +46,8 @@ class GPSController:
     """A trained GPS policy with its state building.
 
     Args:
-        config: The controllers YAML (unused by the policy; the registry passes it to all).
+        config: The controllers YAML (default ``configs/controllers.yaml``); its ``reach_time_s``
+            becomes the policy's trial length (``config.reach_time_s``).
         policy: The directory ``gazebot gps train --out`` wrote.
 
     Raises:
@@ -71,7 +72,6 @@ class GPSController:
             raise ValueError(
                 f"controller 'gps' needs the optional extra: pip install 'gazebot[gps]' ({exc})"
             ) from None
-        self.config = config
         self.trained = load(policy)
         self.kind = self.trained.kind
         if self.kind is StateKind.FULL:
@@ -81,6 +81,10 @@ class GPSController:
                 "train with --state reduced or relative"
             )
         self.scene_cfg = self.trained.cfg.scene
+        # The policy was trained to reach within one trial ("Each trial runs for 2 seconds",
+        # seed 5.4): that is its "reach before", what the robot's reach events announce.
+        base = config if config is not None else load_controllers_config()
+        self.config = base.model_copy(update={"reach_time_s": float(self.scene_cfg.trial_s)})
         self._tester = HandoverScene(self.scene_cfg)  # poses the tester's cylinder (p_o)
         self._tau_max = self._tester.u_bounds[1][:7]
         self._prev: tuple[float, np.ndarray, np.ndarray] | None = None

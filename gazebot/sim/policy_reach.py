@@ -142,3 +142,54 @@ class PolicyReach:
     def hold(self) -> np.ndarray:
         """The joints to hold once the reach is over: the posture it ended in."""
         return (self._hold_q if self._hold_q is not None else self._q_last).copy()
+
+
+class PolicyReachLog:
+    """What a learned reach did over a run (pass :meth:`on_tick` as ``record_handover``'s
+    ``on_tick``): the gripper's distance to the reach goal (the object in the giver's hand) and
+    to the giver's hand when the reach started and when it ended (the grasp distance reached, or
+    the run's end), the largest arm torque applied, and the fallbacks."""
+
+    def __init__(self) -> None:
+        self._start: tuple[float, float] | None = None
+        self._end: tuple[float, float] | None = None
+        self._reach_s = 0.0
+        self._t0: float | None = None
+        self.max_torque_nm = 0.0
+        self._reach: PolicyReach | None = None
+
+    def on_tick(self, sim, _tick=None) -> None:
+        from gazebot.sim.controller import ControllerState
+
+        reach = sim.controller.reach
+        if not isinstance(reach, PolicyReach):
+            return
+        self._reach = reach
+        self.max_torque_nm = max(self.max_torque_nm,
+                                 float(np.abs(sim.data.ctrl[sim._arm_act]).max()))
+        if sim.controller.state not in (ControllerState.REACHING, ControllerState.AT_HANDOVER):
+            return
+        gripper = sim.data.site_xpos[sim._gripper_site]
+        gaps = (float(np.linalg.norm(gripper - sim.data.mocap_pos[sim.scene.object_mocap])),
+                float(np.linalg.norm(gripper - sim.giver.hand)))
+        if self._start is None:
+            self._start, self._t0 = gaps, sim.t
+        self._end, self._reach_s = gaps, sim.t - (self._t0 or sim.t)
+
+    def summary(self) -> dict | None:
+        """The JSON summary (m, s, N m), None when no learned reach ran."""
+        if self._reach is None:
+            return None
+        r = self._reach
+        gaps = {}
+        for key, value in (("start", self._start), ("end", self._end)):
+            gaps[f"object_gap_{key}_m"] = None if value is None else round(value[0], 4)
+            gaps[f"hand_gap_{key}_m"] = None if value is None else round(value[1], 4)
+        return {
+            "policy_state": r.controller.kind.value,
+            **gaps,
+            "reach_s": round(self._reach_s, 3),
+            "max_torque_nm": round(self.max_torque_nm, 3),
+            "fallbacks": r.fallbacks,
+            "fallback_reason": r.fallback_reason,
+        }
