@@ -14,18 +14,10 @@ import pytest
 
 from gazebot.cli import main
 from gazebot.gps import panda
-from gazebot.gps.config import load_gps_config
-from gazebot.gps.handover_robot import ASSET, handover_robot_mjcf
 from gazebot.sim.scene_config import SceneConfig, load_scene
 
 pytest.importorskip("jax", reason="gazebot gps needs the optional extra gazebot[gps]")
 pytest.importorskip("sklearn", reason="gazebot gps needs the optional extra gazebot[gps]")
-
-
-def test_the_panda_asset_is_the_gps_learner_as_generated():
-    assert ASSET.read_text(encoding="utf-8") == handover_robot_mjcf(load_gps_config().scene), (
-        "regenerate it: python -m gazebot.gps.handover_robot"
-    )
 
 
 def _scene(policy) -> SceneConfig:
