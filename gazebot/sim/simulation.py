@@ -121,8 +121,9 @@ class HandoverSimulation:
     """One simulated handover.
 
     Args:
-        robot: Robot name (``sawyer``, ``jaco2``), robot YAML path, parsed
-            :class:`~gazebot.kinematics.config.RobotConfig` or a :class:`SimRobot`.
+        robot: Robot name (``sawyer``, ``jaco2``, ``panda``: a torque-motor arm whose position
+            goals go through joint impedance, :mod:`gazebot.sim.torque_arm`), robot YAML path,
+            parsed :class:`~gazebot.kinematics.config.RobotConfig` or a :class:`SimRobot`.
         scene: Scene name (``configs/scenes/<name>.yaml``), YAML path or a :class:`SceneConfig`.
         seed: Seeds the giver's timing and the tracking noise (same seed, same handover).
         tracking_noise: Overrides the scene's tracking noise (``None``: the scene's).
