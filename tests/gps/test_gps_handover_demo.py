@@ -132,3 +132,30 @@ def test_a_policy_without_the_gps_controller_is_refused(trained, tmp_path, capsy
     assert main(["demo", "--robot", "panda", "--controller", "pv", "--policy", str(trained),
                  "--out", str(tmp_path)]) == 2
     assert "--policy is the learned controller's" in capsys.readouterr().err
+
+
+def test_a_policy_trained_on_other_dynamics_is_refused(trained, tmp_path, capsys):
+    other = tmp_path / "other"
+    shutil.copytree(trained, other)
+    meta = json.loads((other / "meta.json").read_text())
+    meta["config"]["scene"]["joint_damping"] = [4.0] * 7
+    (other / "meta.json").write_text(json.dumps(meta))
+    assert main(["demo", "--robot", "panda", "--controller", "gps", "--policy", str(other),
+                 "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "scene.joint_damping" in err and err.count("\n") == 1
+
+
+def test_a_hand_the_tester_cannot_hold_its_cylinder_at_holds_the_posture(trained):
+    from gazebot.sim.simulation import HandoverSimulation
+
+    sim = HandoverSimulation("panda", _scene(trained))
+    reach = sim.controller.reach
+    q = sim.data.qpos[sim._arm_qpos].copy()
+    reach.start(0.0, q)
+    step = reach.update(0.0, 0.0, np.array([4.0, 0.0, 1.0]))  # 4 m away: beyond the tester
+    assert step.torque is None and reach.fallbacks == 1
+    assert reach.fallback_reason.startswith("state: tester hand cannot reach")
+    np.testing.assert_allclose(step.q, q)
+    step = reach.update(0.05, 0.05, sim.data.mocap_pos[sim.scene.object_mocap])
+    assert step.torque is not None and np.all(np.isfinite(step.torque))  # back to the policy

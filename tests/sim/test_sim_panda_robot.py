@@ -60,3 +60,16 @@ def test_the_joint_space_handover_completes_on_the_torque_arm_within_its_bounds(
     assert np.all(np.abs(torques) <= np.array(panda.TAU_MAX_NM) + 1e-9)
     # Back home at the end: the impedance tracked the retreat's goal.
     np.testing.assert_allclose(sim.data.qpos[sim._arm_qpos], sim.home, atol=0.02)
+
+
+def test_the_impedance_holds_the_measured_posture_for_a_non_finite_goal():
+    from gazebot.sim.torque_arm import JointImpedance
+
+    imp = JointImpedance(np.full(7, 100.0), np.full(7, 10.0), np.array(panda.TAU_MAX_NM))
+    q, dq = np.linspace(-1, 1, 7), np.zeros(7)
+    goal = q + 0.5
+    goal[2] = np.nan
+    tau = imp.torque(goal, q, dq)
+    assert np.all(np.isfinite(tau)) and tau[2] == 0.0
+    assert np.all(np.abs(tau) <= np.array(panda.TAU_MAX_NM))  # 50 N m asked, 12 on the wrist
+    assert tau[6] == panda.TAU_MAX_NM[6]
