@@ -134,11 +134,11 @@ def scene_with_overrides(args: argparse.Namespace):
         base = with_inset(args.scene, False)
     else:
         base = args.scene
-    if not overrides:
-        from gazebot.sim.scene_config import load_scene
+    from gazebot.sim.scene_config import GPS_REACH, load_scene
 
+    if not overrides:
         ctrl = load_scene(base).controller  # a scene YAML may ask for the learned reach itself
-        if ctrl.reach_controller == "gps":
+        if ctrl.reach_controller == GPS_REACH:
             check_policy(ctrl.policy, args)
         return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
@@ -146,7 +146,6 @@ def scene_with_overrides(args: argparse.Namespace):
         JOINT_REACH,
         Direction,
         SceneConfig,
-        load_scene,
         reach_controller_names,
     )
 
@@ -160,19 +159,19 @@ def scene_with_overrides(args: argparse.Namespace):
         raise UsageError(f"--reach-time/--stall-time need --controller {need}")
     if "stall_time_s" in overrides and controller != "mce":
         raise UsageError("--stall-time ('Don't move until') is the mce controller's")
-    if controller == "gps" and data["controller"].get("policy") is None:
+    if controller == GPS_REACH and data["controller"].get("policy") is None:
         raise UsageError("--controller gps needs --policy DIR (written by `gazebot gps train "
                          "--out DIR`)")
-    if "policy" in overrides and controller != "gps":
+    if "policy" in overrides and controller != GPS_REACH:
         raise UsageError("--policy is the learned controller's: it needs --controller gps")
     try:
         scene = SceneConfig.model_validate(data)
-        if scene.controller.reach_controller not in (JOINT_REACH, "gps"):
+        if scene.controller.reach_controller not in (JOINT_REACH, GPS_REACH):
             # The reach and stall times against the controllers YAML, as the simulation will.
             scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field
         raise option_error(exc, _OPTIONS, "invalid controller options") from exc
-    if scene.controller.reach_controller == "gps":
+    if scene.controller.reach_controller == GPS_REACH:
         check_policy(scene.controller.policy, args)
     return scene
 
@@ -185,10 +184,11 @@ def check_policy(policy: str | None, args: argparse.Namespace) -> None:
     from gazebot.controllers import CONTROLLERS
     from gazebot.sim.policy_reach import PolicyReach
     from gazebot.sim.robot import load_sim_robot
+    from gazebot.sim.scene_config import GPS_REACH
     from gazebot.sim.torque_arm import arm_actuator, is_torque_motor
 
     try:
-        controller = CONTROLLERS.make("gps", None, policy=policy)
+        controller = CONTROLLERS.make(GPS_REACH, None, policy=policy)
     except (ConfigError, ValueError) as exc:
         raise UsageError(f"--policy {policy}: {exc}") from None
     robot = getattr(args, "robot", "panda")

@@ -49,7 +49,7 @@ CONTROLLERS.register(
 
 #: Registered controllers that command joint torques and plan no Cartesian velocities: they run
 #: only in the simulator, on a robot with their arm, and ``gazebot reach-plan`` does not offer them.
-TORQUE_CONTROLLERS: tuple[str, ...] = ("gps",)
+TORQUE_CONTROLLERS: tuple[str, ...] = ("gps",)  # gazebot.sim.scene_config.GPS_REACH
 
 
 def planner_names() -> tuple[str, ...]:
