@@ -38,7 +38,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="simulate a handover with gaze and write a video, a timeline CSV and a plot",
         description=__doc__,
     )
-    parser.add_argument("--robot", default="sawyer", help="robot name or YAML (default: sawyer)")
+    parser.add_argument(
+        "--robot",
+        default=None,
+        help="robot name or YAML (default: panda with --controller gps, else sawyer)",
+    )
     parser.add_argument(
         "--behavior",
         default="face-hand-face",
@@ -72,7 +76,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=Path,
         metavar="DIR",
         help="--controller gps: the learned policy (`gazebot gps train --out DIR`); "
-        "needs --robot panda",
+        "runs on --robot panda",
     )
     parser.add_argument(
         "--reach-time", type=float, help="'Reach before', s from the handover's start"
@@ -209,8 +213,18 @@ def check_policy(policy: str | None, args: argparse.Namespace) -> None:
         raise UsageError(f"--robot {robot}: {exc}") from None
 
 
+def default_robot(args: argparse.Namespace) -> str:
+    """``--robot``, else the robot the controller runs on: the learned ``gps`` policy drives
+    the Panda it was trained on; every other controller defaults to the Sawyer."""
+    if args.robot is not None:
+        return str(args.robot)
+    return "panda" if getattr(args, "controller", None) == "gps" else "sawyer"
+
+
 def run_demo(args: argparse.Namespace) -> int:
     from gazebot.kinematics.config import GAZE_MODES
+
+    args.robot = default_robot(args)
     from gazebot.render.timeline import phase_spans, plot_timeline, write_timeline_csv
     from gazebot.sim.gl_check import OffscreenRenderingError
 

@@ -159,3 +159,20 @@ def test_a_hand_the_tester_cannot_hold_its_cylinder_at_holds_the_posture(trained
     np.testing.assert_allclose(step.q, q)
     step = reach.update(0.05, 0.05, sim.data.mocap_pos[sim.scene.object_mocap])
     assert step.torque is not None and np.all(np.isfinite(step.torque))  # back to the policy
+
+
+@pytest.mark.parametrize(
+    ("argv", "robot"),
+    [
+        (["--controller", "gps", "--policy", "p"], "panda"),  # the arm the policy was trained on
+        (["--controller", "gps", "--policy", "p", "--robot", "jaco2"], "jaco2"),  # refused later
+        (["--controller", "pv"], "sawyer"),
+        ([], "sawyer"),
+    ],
+)
+def test_the_demo_robot_defaults_to_the_panda_only_for_the_learned_reach(argv, robot):
+    from gazebot.cli import build_parser
+    from gazebot.cli.demo import default_robot
+
+    args = build_parser().parse_args(["demo", *argv])
+    assert default_robot(args) == robot
