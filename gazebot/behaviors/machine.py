@@ -223,24 +223,10 @@ ConditionFactory = Callable[[tuple, str], Callable[[Any], bool]]
 CallbackFactory = Callable[[tuple], dict[str, list[Callable[[Any], None]]]]
 
 
-def _label_only(key: tuple, label: str) -> Callable[[Any], bool]:
-    """A condition that only carries its label (for drawing; never evaluated)."""
-
-    def condition(arg: Any) -> bool:
-        raise RuntimeError("a drawn machine is not run")
-
-    condition.__name__ = label
-    return condition
-
-
-def _no_callbacks(key: tuple) -> dict[str, list[Callable[[Any], None]]]:
-    return {}
-
-
 def machine_definition(
     spec: BehaviorSpec,
-    condition: ConditionFactory = _label_only,
-    callbacks: CallbackFactory = _no_callbacks,
+    condition: ConditionFactory,
+    callbacks: CallbackFactory | None = None,
 ) -> dict[str, Any]:
     """The states, transitions and initial state of ``spec``'s machine (``transitions``
     keyword arguments).
@@ -249,7 +235,8 @@ def machine_definition(
         spec: The behavior.
         condition: Builds each transition's condition (see :data:`ConditionFactory`).
         callbacks: Builds each transition's ``prepare``/``after`` callbacks, by the same keys
-            (see :data:`CallbackFactory`; the tracking-loss transition's key is ``("lost",)``).
+            (see :data:`CallbackFactory`; the tracking-loss transition's key is ``("lost",)``);
+            ``None``: none.
     """
     gaze = [_state_name(t) for t in _gaze_targets(spec)]
     before, after = _state_name(spec.before), _state_name(spec.after)
@@ -272,7 +259,8 @@ def machine_definition(
         out: dict[str, Any] = {"trigger": trigger, "source": source, "dest": dest}
         if label is not None:
             out["conditions"] = [condition(key, label)]
-        out.update(callbacks(key))
+        if callbacks is not None:
+            out.update(callbacks(key))
         return out
 
     transitions: list[dict[str, Any]] = [

@@ -68,7 +68,7 @@ class Rule:
 
 _NEWER = "not older than the last phase change"
 _SAME = "same handover: the reach starts with the first"
-#: Every rule of the handover state (the running lookup and the diagram are built from it).
+#: Every rule of the handover state (its machine, and so the diagram, is built from it).
 RULES: tuple[Rule, ...] = (
     Rule(EventKind.REACH_STARTED, (Phase.IDLE, Phase.DONE), Phase.REACH, _NEWER),
     Rule(
@@ -172,18 +172,8 @@ ConditionFactory = Callable[[Rule], Callable[[float, Event], bool]]
 CallbackFactory = Callable[[Rule], Callable[[float, Event], None]]
 
 
-def _label_only(rule: Rule) -> Callable[[float, Event], bool]:
-    """A condition that only carries the rule's label (a drawn machine is never run)."""
-
-    def condition(t: float, event: Event) -> bool:
-        raise RuntimeError("a drawn machine is not run")
-
-    condition.__name__ = rule.condition
-    return condition
-
-
 def machine_definition(
-    condition: ConditionFactory = _label_only,
+    condition: ConditionFactory,
     callback: CallbackFactory | None = None,
     rules: tuple[Rule, ...] = RULES,
 ) -> dict[str, Any]:
@@ -194,7 +184,7 @@ def machine_definition(
     Args:
         condition: Builds each rule's condition (see :data:`ConditionFactory`).
         callback: Builds what each rule's transition does (its ``before`` callback: the state
-            is still the source phase); ``None`` for a drawing.
+            is still the source phase); ``None``: none.
         rules: The table (default :data:`RULES`).
 
     Returns:
