@@ -43,7 +43,7 @@ CONTROLLERS.register(
 )
 CONTROLLERS.register(
     "gps", "gazebot.controllers.gps:GPSController",
-    "learned GPS policy (chapter 5): Panda joint torques; needs `--robot panda --policy DIR`",
+    "learned GPS policy (chapter 5): Panda joint torques; needs `--policy DIR`, runs on `panda`",
 )
 
 
