@@ -8,14 +8,20 @@
 3. Zero-lag Gaussian smoothing (``smoothing``, never narrower than two input samples) and
    velocities by central differences, unknown next to a tracking gap (where the window is
    one-sided and would flatten the motion into a false rest).
+
+Both hands go through each step together (one array of six columns): the online detector runs
+this every few ticks on a few hundred samples, where numpy's per-call overhead, not the
+arithmetic, sets the cost. The result is, bit for bit, what the steps give one hand at a time
+(``tests/phases/signals_reference.py`` keeps that form and the tests compare the two).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d
+from scipy.ndimage import correlate1d, gaussian_filter1d
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.trajectory import Trajectory
@@ -71,106 +77,147 @@ class Signals:
         return float(self.t[1] - self.t[0]) if self.t.shape[0] > 1 else 0.0
 
 
-def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float) -> np.ndarray:
-    """``p`` with stale repeats set to NaN: a sample exactly equal to the previous valid one,
-    while the hand moved faster than ``moving_speed`` between the two valid samples before."""
-    out = p.copy()
-    ok = np.flatnonzero(np.isfinite(p).all(axis=1))
-    if ok.size < 3:
-        return out
-    same = np.all(p[ok[1:]] == p[ok[:-1]], axis=1)
+def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarray) -> np.ndarray:
+    """Which rows of ``p`` are stale repeats (a bool mask): a sample exactly equal to the
+    previous valid one (``ok``: the valid rows), while the hand moved faster than
+    ``moving_speed`` between the two valid samples before."""
+    stale = np.zeros(p.shape[0], dtype=bool)
+    idx = np.flatnonzero(ok)
+    if idx.size < 3:
+        return stale
+    pv = p[idx]
+    same = (pv[1:] == pv[:-1]).all(axis=1)
     if not same.any():
-        return out
-    last_fresh = -1  # index into ok of the last sample that was not a repeat
+        return stale
+    last_fresh = -1  # index into idx of the last sample that was not a repeat
     prev_fresh = -1
-    for k in range(1, ok.size):
-        if not same[k - 1]:
+    for k, rep in enumerate(same.tolist(), start=1):
+        if not rep:
             prev_fresh, last_fresh = last_fresh, k
             continue
         if last_fresh < 0 or prev_fresh < 0:
             continue
-        i0, i1 = ok[prev_fresh], ok[last_fresh]
+        i0, i1 = idx[prev_fresh], idx[last_fresh]
         dt = t[i1] - t[i0]
         v = float(np.linalg.norm(p[i1] - p[i0]) / dt) if dt > 0 else 0.0
         if v > moving_speed:
-            out[ok[k]] = np.nan
-    return out
+            stale[idx[k]] = True
+    return stale
 
 
-def resample(t: np.ndarray, p: np.ndarray, grid: np.ndarray, max_gap: float) -> np.ndarray:
-    """Linear interpolation of the valid rows of ``p`` onto ``grid``; NaN inside long gaps."""
-    ok = np.isfinite(p).all(axis=1)
-    out = np.full((grid.shape[0], 3), np.nan)
+def _far_from_samples(tv: np.ndarray, grid: np.ndarray, max_gap: float) -> np.ndarray:
+    """Grid points inside a gap longer than ``max_gap`` between the valid sample times ``tv``
+    (or outside them), unless the point is a sample itself."""
+    j = np.searchsorted(tv, grid, side="right")
+    gap = np.full(grid.shape[0], np.inf)
+    inside = (j > 0) & (j < tv.shape[0])
+    ji = j[inside]
+    gap[inside] = tv[ji] - tv[ji - 1]
+    # grid points that are samples (both sorted: a searchsorted, not np.isin's sort)
+    k = np.minimum(np.searchsorted(tv, grid), tv.shape[0] - 1)
+    return (gap > max_gap + 1e-9) & (tv[k] != grid)
+
+
+def resample(
+    t: np.ndarray, p: np.ndarray, ok: np.ndarray, grid: np.ndarray, max_gap: float
+) -> np.ndarray:
+    """Linear interpolation of the valid rows (``ok``) of ``p`` (N, 3 or 6: two hands that
+    share ``ok``) onto ``grid``; NaN inside gaps longer than ``max_gap``."""
+    out = np.full((grid.shape[0], p.shape[1]), np.nan)
     if np.count_nonzero(ok) < 2:
         return out
     tv, pv = t[ok], p[ok]
-    for k in range(3):
+    for k in range(p.shape[1]):
         out[:, k] = np.interp(grid, tv, pv[:, k])
-    j = np.searchsorted(tv, grid, side="right")
-    inside = (j > 0) & (j < tv.shape[0])
-    gap = np.full(grid.shape[0], np.inf)
-    gap[inside] = tv[j[inside]] - tv[j[inside] - 1]
-    # grid points that are samples (both sorted: a searchsorted, not np.isin's sort)
-    k = np.minimum(np.searchsorted(tv, grid), tv.shape[0] - 1)
-    exact = tv[k] == grid
-    out[(gap > max_gap + 1e-9) & ~exact] = np.nan
+    out[_far_from_samples(tv, grid, max_gap)] = np.nan
     return out
 
 
-def _gauss(x: np.ndarray, sigma: float) -> np.ndarray:
-    """Gaussian smoothing along axis 0, edges padded with the end values (scipy.ndimage)."""
-    return gaussian_filter1d(x, sigma, axis=0, mode="nearest", truncate=3.0)
+@lru_cache(maxsize=16)
+def gaussian_weights(sigma: float) -> np.ndarray:
+    """The weights ``scipy.ndimage.gaussian_filter1d(x, sigma, truncate=3.0)`` correlates with
+    (its response to a unit impulse: a sum of one product and zeros, so exactly its weights),
+    computed once per ``sigma``."""
+    radius = int(3.0 * float(sigma) + 0.5)
+    impulse = np.zeros(2 * radius + 1)
+    impulse[radius] = 1.0
+    w = gaussian_filter1d(impulse, sigma, mode="nearest", truncate=3.0)
+    w.setflags(write=False)
+    return w
 
 
-def smooth(x: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
-    """NaN-aware Gaussian smoothing along axis 0 (normalised convolution), zero lag.
+def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """NaN-aware Gaussian smoothing along axis 0 (normalised convolution), zero lag, edges
+    padded with the end values. ``x`` holds one hand per three columns, ``m`` (N, hands) which
+    rows of each hand hold data.
 
-    Returns the smoothed rows and, per row, the share of the smoothing window that held data
-    (1 away from tracking gaps)."""
-    m = np.isfinite(x).all(axis=1)
+    Returns the smoothed rows and, per row and hand, the share of the smoothing window that
+    held data (1 away from tracking gaps)."""
+    hands = m.shape[1]
     if sigma <= 0 or x.shape[0] < 2:
         return x, m.astype(float)
-    num = _gauss(np.where(m[:, None], x, 0.0), sigma)
-    den = _gauss(m.astype(float), sigma)
-    out = num / np.maximum(den, 1e-12)[:, None]
-    out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
+    mask = np.repeat(m, 3, axis=1)
+    stack = np.empty((x.shape[0], 4 * hands))
+    np.copyto(stack[:, : 3 * hands], np.where(mask, x, 0.0))
+    stack[:, 3 * hands :] = m
+    both = correlate1d(stack, gaussian_weights(sigma), axis=0, mode="nearest")
+    num, den = both[:, : 3 * hands], both[:, 3 * hands :]
+    out = num / np.repeat(np.maximum(den, 1e-12), 3, axis=1)
+    out[np.repeat((den < 0.5) | ~m, 3, axis=1)] = np.nan  # do not invent samples in long gaps
     return out, den
+
+
+def _norms(x: np.ndarray) -> np.ndarray:
+    """Row norms of real ``x``: what ``np.linalg.norm(x, axis=1)`` computes, without its
+    argument handling."""
+    return np.sqrt(np.add.reduce(x * x, axis=1))
 
 
 def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     """Frozen samples out, resample, smooth and differentiate the hands of ``trajectory``
     (sorted by time, see :meth:`Trajectory.cleaned`)."""
     t = trajectory.t
+    n = t.shape[0]
     dt = 1.0 / config.analysis_rate
-    grid = t.copy() if t.shape[0] < 2 else np.arange(t[0], t[-1] + 0.5 * dt, dt)
-    g = drop_frozen(t, trajectory.giver_hand, config.frozen_speed)
-    r = drop_frozen(t, trajectory.receiver_hand, config.frozen_speed)
-    g = resample(t, g, grid, config.max_gap_hold)
-    r = resample(t, r, grid, config.max_gap_hold)
+    grid = t.copy() if n < 2 else np.arange(t[0], t[-1] + 0.5 * dt, dt)
+    p = np.concatenate((trajectory.giver_hand, trajectory.receiver_hand), axis=1)
+    fin = np.isfinite(p)
+    ok_g, ok_r = fin[:, :3].all(axis=1), fin[:, 3:].all(axis=1)
+    ok_g &= ~drop_frozen(t, p[:, :3], config.frozen_speed, ok_g)
+    ok_r &= ~drop_frozen(t, p[:, 3:], config.frozen_speed, ok_r)
+    if np.array_equal(ok_g, ok_r):  # the usual case: both hands seen at the same samples
+        x = resample(t, p, ok_g, grid, config.max_gap_hold)
+    else:
+        x = np.concatenate(
+            (
+                resample(t, p[:, :3], ok_g, grid, config.max_gap_hold),
+                resample(t, p[:, 3:], ok_r, grid, config.max_gap_hold),
+            ),
+            axis=1,
+        )
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
     # corners at every sample that would otherwise show up as speed spikes.
-    med_dt = float(np.median(np.diff(t))) if t.shape[0] > 1 else dt
+    med_dt = float(np.median(np.diff(t))) if n > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
-    g, g_full = smooth(g, sigma_s / dt)
-    r, r_full = smooth(r, sigma_s / dt)
+    m = np.isfinite(x).reshape(x.shape[0], 2, 3).all(axis=2)  # (rows, hands)
+    x, full = smooth(x, m, sigma_s / dt)
     if grid.shape[0] >= 2:
-        gv = np.gradient(g, dt, axis=0)
-        rv = np.gradient(r, dt, axis=0)
+        v = np.gradient(x, dt, axis=0)
         # Next to a tracking gap the window is one-sided and flattens the motion: velocities
         # there are unknown, not slow.
-        gv[g_full < FULL_WINDOW] = np.nan
-        rv[r_full < FULL_WINDOW] = np.nan
+        v[np.repeat(full < FULL_WINDOW, 3, axis=1)] = np.nan
     else:
-        gv = np.full_like(g, np.nan)
-        rv = np.full_like(r, np.nan)
+        v = np.full_like(x, np.nan)
+    g, r = x[:, :3], x[:, 3:]
+    gv, rv = v[:, :3], v[:, 3:]
     rel = r - g
     rel_v = rv - gv
-    distance = np.linalg.norm(rel, axis=1)
-    rel_speed = np.linalg.norm(rel_v, axis=1)
+    distance = _norms(rel)
+    rel_speed = _norms(rel_v)
     closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
-    common = 0.5 * np.linalg.norm(gv + rv, axis=1)
-    g_speed = np.linalg.norm(gv, axis=1)
-    r_speed = np.linalg.norm(rv, axis=1)
+    common = 0.5 * _norms(gv + rv)
+    g_speed = _norms(gv)
+    r_speed = _norms(rv)
     return Signals(
         t=grid,
         giver=g,
