@@ -79,3 +79,36 @@ def test_cached_weights_are_the_gaussian_filters_own() -> None:
         correlate1d(x, w, axis=0, mode="nearest"),
         gaussian_filter1d(x, 4.7, axis=0, mode="nearest", truncate=3.0),
     )
+
+
+def test_trigger_rows_hold_the_period_means_and_numpys_distances() -> None:
+    """The gazebot trigger keeps per-period means, relative positions and distances in plain
+    floats; they equal numpy's mean and ``np.linalg.norm`` of the same samples bit for bit (the
+    summation order is the one numpy uses for 3-vectors)."""
+    from gazebot.phases.methods.base import OnlineState
+    from gazebot.phases.methods.gazebot_trigger import GazebotTrigger
+    from gazebot.types import Phase
+
+    traj = _damaged(generate(seed=4, options=CASES[1]).trajectory, 3)
+    config = PhaseConfig()
+    trig = GazebotTrigger(config)
+    state = OnlineState(Phase.IDLE, float("nan"), -np.inf, True, False, -np.inf)
+    period: list[tuple[np.ndarray, np.ndarray]] = []
+    expected = []
+    for t, g, r in zip(traj.t, traj.giver_hand, traj.receiver_hand, strict=True):
+        g_ok, r_ok = bool(np.isfinite(g).all()), bool(np.isfinite(r).all())
+        trig.add(g, g_ok, r, r_ok)
+        period.append((g, r))
+        if len(period) == 3:
+            gs = [a for a, _ in period if np.isfinite(a).all()]
+            rs = [b for _, b in period if np.isfinite(b).all()]
+            gm = np.sum(gs, axis=0) / len(gs) if gs else np.full(3, np.nan)
+            rm = np.sum(rs, axis=0) / len(rs) if rs else np.full(3, np.nan)
+            expected.append(np.concatenate([[t], gm, rm, rm - gm, [0.0]]))
+            trig.decide(float(t), state)
+            period.clear()
+    rows = trig.rows()
+    want = np.array(expected)[-rows.shape[0] :]
+    want[:, 10] = np.linalg.norm(want[:, 7:10], axis=1)  # as the trigger computed it before
+    np.testing.assert_array_equal(rows, want)
+    assert np.isnan(rows[:, 10]).any() and np.isfinite(rows[:, 10]).any()
