@@ -20,6 +20,9 @@ from gazebot.phases.methods.base import OnlineState, TriggerMode
 from gazebot.types import Phase
 
 _COLUMNS = 11  # t, giver xyz, receiver xyz, relative xyz, distance
+# What np.nanmax computes for a float array (the largest value that is not NaN; NaN if all
+# are), without its argument handling and all-NaN warning: it runs every period.
+_nanmax = np.fmax.reduce
 
 
 class GazebotTrigger:
@@ -122,7 +125,7 @@ class GazebotTrigger:
             # either way the hands are no longer closing fast.
             since = ts[-1] - (c.min_transfer + c.edge_guard + c.online_period)
             recent = d[int(np.searchsorted(ts, since)) :]  # (ts increases)
-            return float(np.nanmax(recent)) - d[-1] <= c.trigger_still_factor * c.still_closing
+            return float(_nanmax(recent)) - d[-1] <= c.trigger_still_factor * c.still_closing
         since = slice(int(np.searchsorted(ts, state.phase_start)), None)  # (ts increases)
         if ph is Phase.TRANSFER:
             # A release moves the hands' relative position off the held pose.
@@ -146,7 +149,7 @@ class GazebotTrigger:
                 return True
             if not math.isfinite(float(step[-1])):
                 return True
-            return bool(step[-1] <= c.trigger_landing_fraction * np.nanmax(step))
+            return bool(step[-1] <= c.trigger_landing_fraction * _nanmax(step))
         return True
 
     def _reach_possible(
@@ -160,7 +163,7 @@ class GazebotTrigger:
         if ts.shape[0] - first <= k:
             return False
         da = d[first:]
-        closed = float(np.nanmax(da)) - d[-1]
+        closed = float(_nanmax(da)) - d[-1]
         # (the predictive rule confirms a reach from predict_distance of the giver's own travel)
         if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
             return False
@@ -177,4 +180,4 @@ class GazebotTrigger:
         if gm.shape[0] <= k:
             return True
         v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * c.online_period)
-        return bool(np.nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)
+        return bool(_nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)
