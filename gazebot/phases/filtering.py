@@ -17,6 +17,7 @@ arithmetic, sets the cost. The result is, bit for bit, what the steps give one h
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -156,15 +157,29 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     hands = m.shape[1]
     if sigma <= 0 or x.shape[0] < 2:
         return x, m.astype(float)
-    mask = np.repeat(m, 3, axis=1)
-    stack = np.empty((x.shape[0], 4 * hands))
-    np.copyto(stack[:, : 3 * hands], np.where(mask, x, 0.0))
-    stack[:, 3 * hands :] = m
+    rows = x.shape[0]
+    # per row and hand: x, y, z (0 where unseen) and whether seen; smoothed in one call
+    stack = np.empty((rows, hands, 4))
+    stack[:, :, :3] = x.reshape(rows, hands, 3)
+    np.copyto(stack[:, :, :3], 0.0, where=~m[:, :, None])
+    stack[:, :, 3] = m
     both = correlate1d(stack, gaussian_weights(sigma), axis=0, mode="nearest")
-    num, den = both[:, : 3 * hands], both[:, 3 * hands :]
-    out = num / np.repeat(np.maximum(den, 1e-12), 3, axis=1)
-    out[np.repeat((den < 0.5) | ~m, 3, axis=1)] = np.nan  # do not invent samples in long gaps
-    return out, den
+    den = both[:, :, 3]
+    out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
+    out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
+    return out.reshape(rows, 3 * hands), den
+
+
+def _median(x: np.ndarray) -> float:
+    """``np.median`` of a non-empty 1-D float array (the middle value, or the mean of the two
+    middle ones; NaN if any is NaN), without its generic machinery."""
+    n = x.shape[0]
+    h = n // 2
+    kth = [h, n - 1] if n % 2 else [h - 1, h, n - 1]
+    part = np.partition(x, kth)
+    if math.isnan(part[-1]):
+        return math.nan
+    return float(part[h]) if n % 2 else (float(part[h - 1]) + float(part[h])) / 2.0
 
 
 def _norms(x: np.ndarray) -> np.ndarray:
@@ -183,9 +198,14 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     p = np.concatenate((trajectory.giver_hand, trajectory.receiver_hand), axis=1)
     fin = np.isfinite(p)
     ok_g, ok_r = fin[:, :3].all(axis=1), fin[:, 3:].all(axis=1)
-    ok_g &= ~drop_frozen(t, p[:, :3], config.frozen_speed, ok_g)
-    ok_r &= ~drop_frozen(t, p[:, 3:], config.frozen_speed, ok_r)
-    if np.array_equal(ok_g, ok_r):  # the usual case: both hands seen at the same samples
+    all_seen = bool(ok_g.all()) and bool(ok_r.all())
+    # A stale repeat equals the sample before; with every sample seen and no coordinate equal
+    # to the one before, there is none (the usual case: no per-hand search).
+    if not (all_seen and not (p[1:] == p[:-1]).any()):
+        ok_g &= ~drop_frozen(t, p[:, :3], config.frozen_speed, ok_g)
+        ok_r &= ~drop_frozen(t, p[:, 3:], config.frozen_speed, ok_r)
+        all_seen = False
+    if all_seen or np.array_equal(ok_g, ok_r):  # both hands seen at the same samples
         x = resample(t, p, ok_g, grid, config.max_gap_hold)
     else:
         x = np.concatenate(
@@ -197,7 +217,7 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
         )
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
     # corners at every sample that would otherwise show up as speed spikes.
-    med_dt = float(np.median(np.diff(t))) if n > 1 else dt
+    med_dt = _median(np.diff(t)) if n > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
     m = np.isfinite(x).reshape(x.shape[0], 2, 3).all(axis=2)  # (rows, hands)
     x, full = smooth(x, m, sigma_s / dt)
@@ -205,7 +225,9 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
         v = np.gradient(x, dt, axis=0)
         # Next to a tracking gap the window is one-sided and flattens the motion: velocities
         # there are unknown, not slow.
-        v[np.repeat(full < FULL_WINDOW, 3, axis=1)] = np.nan
+        v = v.reshape(v.shape[0], 2, 3)
+        v[full < FULL_WINDOW] = np.nan
+        v = v.reshape(v.shape[0], 6)
     else:
         v = np.full_like(x, np.nan)
     g, r = x[:, :3], x[:, 3:]
