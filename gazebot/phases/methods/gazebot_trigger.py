@@ -163,11 +163,12 @@ class GazebotTrigger:
         if ts.shape[0] - first <= k:
             return False
         da = d[first:]
-        closed = float(_nanmax(da)) - d[-1]
+        d_max = _nanmax(da)
+        closed = float(d_max) - d[-1]
         # (the predictive rule confirms a reach from predict_distance of the giver's own travel)
         if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
             return False
-        i_max = first + int(np.nanargmax(da))
+        i_max = first + int(np.argmax(da == d_max))  # np.nanargmax: the first largest
         own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(float(d[-1]), 1e-9)
         deep = closed >= c.trigger_deep_fraction * c.min_approach
         if not deep and not own >= c.trigger_own_fraction * c.reach_confirm_distance:
