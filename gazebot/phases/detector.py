@@ -491,7 +491,8 @@ class PhaseDetector:
             return None
         # the last sample of the last rest at least reach_stall long
         edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
-        runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+        bounds = edges.tolist()  # (plain ints: iterating the array would box each element)
+        runs = [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
         runs = [(a, b) for a, b in runs if b - a + 1 >= need and b < rest.size - 1]
         if not runs:
             return None
