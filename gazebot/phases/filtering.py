@@ -182,6 +182,27 @@ def _median(x: np.ndarray) -> float:
     return float(part[h]) if n % 2 else (float(part[h - 1]) + float(part[h])) / 2.0
 
 
+def quantile(x: np.ndarray, q: float) -> float:
+    """``np.quantile(x, q)`` (its default ``linear`` method) of a non-empty 1-D float array
+    without NaN: the two order statistics around ``(n - 1) q`` and numpy's interpolation
+    between them, without its generic machinery (the transfer rule reads one per analysis)."""
+    n = x.shape[0]
+    vi = (n - 1) * q
+    if vi >= n - 1:
+        lo = hi = n - 1
+    elif vi < 0:
+        lo = hi = 0
+    else:
+        lo = math.floor(vi)
+        hi = lo + 1
+    part = np.partition(x, [lo, hi] if hi != lo else [lo])
+    a, b = float(part[lo]), float(part[hi])
+    gamma = vi - lo
+    # numpy's _lerp: from the nearer end
+    diff = b - a
+    return b - diff * (1.0 - gamma) if gamma >= 0.5 else a + diff * gamma
+
+
 def _norms(x: np.ndarray) -> np.ndarray:
     """Row norms of real ``x``: what ``np.linalg.norm(x, axis=1)`` computes, without its
     argument handling."""

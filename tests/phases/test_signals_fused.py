@@ -123,3 +123,14 @@ def test_median_of_the_sample_steps_is_numpys() -> None:
         assert _median(x) == float(np.median(x))
         x[n // 2] = np.nan
         assert np.isnan(_median(x))
+
+
+def test_quantile_is_numpys_linear_quantile() -> None:
+    from gazebot.phases.filtering import quantile
+
+    rng = np.random.default_rng(2)
+    for n in (1, 2, 3, 5, 8, 33, 200):
+        x = rng.gamma(2.0, 0.02, size=n)
+        x[rng.random(n) < 0.1] = 0.05  # ties
+        for q in (0.0, 0.1, 0.25, 0.3333, 0.5, 0.75, 0.9, 1.0, float(rng.random())):
+            assert quantile(x, q) == float(np.quantile(x, q)), (n, q)
