@@ -108,7 +108,15 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
 
 def _far_from_samples(tv: np.ndarray, grid: np.ndarray, max_gap: float) -> np.ndarray:
     """Grid points inside a gap longer than ``max_gap`` between the valid sample times ``tv``
-    (or outside them), unless the point is a sample itself."""
+    (at least two; or outside them), unless the point is a sample itself."""
+    bar = max_gap + 1e-9
+    if float(np.max(np.diff(tv))) <= bar:
+        # No gap between the samples is that long (the usual case): only the grid points
+        # before the first sample or after the last one.
+        far = np.zeros(grid.shape[0], dtype=bool)
+        far[: int(np.searchsorted(grid, tv[0], side="left"))] = True
+        far[int(np.searchsorted(grid, tv[-1], side="right")) :] = True
+        return far
     j = np.searchsorted(tv, grid, side="right")
     gap = np.full(grid.shape[0], np.inf)
     inside = (j > 0) & (j < tv.shape[0])
@@ -116,7 +124,7 @@ def _far_from_samples(tv: np.ndarray, grid: np.ndarray, max_gap: float) -> np.nd
     gap[inside] = tv[ji] - tv[ji - 1]
     # grid points that are samples (both sorted: a searchsorted, not np.isin's sort)
     k = np.minimum(np.searchsorted(tv, grid), tv.shape[0] - 1)
-    return (gap > max_gap + 1e-9) & (tv[k] != grid)
+    return (gap > bar) & (tv[k] != grid)
 
 
 def resample(
@@ -132,6 +140,13 @@ def resample(
         out[:, k] = np.interp(grid, tv, pv[:, k])
     out[_far_from_samples(tv, grid, max_gap)] = np.nan
     return out
+
+
+@lru_cache(maxsize=16)
+def _seen_share(sigma: float) -> float:
+    """The smoothed "seen" mask of a hand seen at every row: the same value everywhere (the
+    filter sums the same products at each row), computed once per ``sigma``."""
+    return float(correlate1d(np.ones(1), gaussian_weights(sigma), mode="nearest")[0])
 
 
 @lru_cache(maxsize=16)
@@ -158,12 +173,22 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     if sigma <= 0 or x.shape[0] < 2:
         return x, m.astype(float)
     rows = x.shape[0]
+    w = gaussian_weights(sigma)
+    if m.all():
+        # Every row seen (the usual case): only the positions need smoothing; the seen share
+        # is the same at every row.
+        share = _seen_share(sigma)
+        den = np.full((rows, hands), share)
+        out = correlate1d(x, w, axis=0, mode="nearest") / max(share, 1e-12)
+        if share < 0.5:
+            out[:] = np.nan
+        return out, den
     # per row and hand: x, y, z (0 where unseen) and whether seen; smoothed in one call
     stack = np.empty((rows, hands, 4))
     stack[:, :, :3] = x.reshape(rows, hands, 3)
     np.copyto(stack[:, :, :3], 0.0, where=~m[:, :, None])
     stack[:, :, 3] = m
-    both = correlate1d(stack, gaussian_weights(sigma), axis=0, mode="nearest")
+    both = correlate1d(stack, w, axis=0, mode="nearest")
     den = both[:, :, 3]
     out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
     out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
@@ -243,7 +268,12 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     m = np.isfinite(x).reshape(x.shape[0], 2, 3).all(axis=2)  # (rows, hands)
     x, full = smooth(x, m, sigma_s / dt)
     if grid.shape[0] >= 2:
-        v = np.gradient(x, dt, axis=0)
+        # np.gradient's central differences inside, one-sided at the ends (its arithmetic,
+        # without its generic set-up)
+        v = np.empty_like(x)
+        v[1:-1] = (x[2:] - x[:-2]) / (2.0 * dt)
+        v[0] = (x[1] - x[0]) / dt
+        v[-1] = (x[-1] - x[-2]) / dt
         # Next to a tracking gap the window is one-sided and flattens the motion: velocities
         # there are unknown, not slow.
         v = v.reshape(v.shape[0], 2, 3)
