@@ -106,17 +106,9 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
     return stale
 
 
-def _far_from_samples(tv: np.ndarray, grid: np.ndarray, max_gap: float) -> np.ndarray:
-    """Grid points inside a gap longer than ``max_gap`` between the valid sample times ``tv``
-    (at least two; or outside them), unless the point is a sample itself."""
-    bar = max_gap + 1e-9
-    if float(np.max(np.diff(tv))) <= bar:
-        # No gap between the samples is that long (the usual case): only the grid points
-        # before the first sample or after the last one.
-        far = np.zeros(grid.shape[0], dtype=bool)
-        far[: int(np.searchsorted(grid, tv[0], side="left"))] = True
-        far[int(np.searchsorted(grid, tv[-1], side="right")) :] = True
-        return far
+def _far_from_samples(tv: np.ndarray, grid: np.ndarray, bar: float) -> np.ndarray:
+    """Grid points inside a gap longer than ``bar`` between the valid sample times ``tv`` (or
+    outside them), unless the point is a sample itself."""
     j = np.searchsorted(tv, grid, side="right")
     gap = np.full(grid.shape[0], np.inf)
     inside = (j > 0) & (j < tv.shape[0])
@@ -128,17 +120,24 @@ def _far_from_samples(tv: np.ndarray, grid: np.ndarray, max_gap: float) -> np.nd
 
 
 def resample(
-    t: np.ndarray, p: np.ndarray, ok: np.ndarray, grid: np.ndarray, max_gap: float
+    t: np.ndarray, p: np.ndarray, ok: np.ndarray | None, grid: np.ndarray, max_gap: float
 ) -> np.ndarray:
-    """Linear interpolation of the valid rows (``ok``) of ``p`` (N, 3 or 6: two hands that
-    share ``ok``) onto ``grid``; NaN inside gaps longer than ``max_gap``."""
+    """Linear interpolation of the valid rows (``ok``; ``None``: all) of ``p`` (N, 3 or 6: two
+    hands that share ``ok``) onto ``grid``; NaN inside gaps longer than ``max_gap``."""
     out = np.full((grid.shape[0], p.shape[1]), np.nan)
-    if np.count_nonzero(ok) < 2:
+    tv, pv = (t, p) if ok is None else (t[ok], p[ok])
+    if tv.shape[0] < 2:
         return out
-    tv, pv = t[ok], p[ok]
     for k in range(p.shape[1]):
         out[:, k] = np.interp(grid, tv, pv[:, k])
-    out[_far_from_samples(tv, grid, max_gap)] = np.nan
+    bar = max_gap + 1e-9
+    if float(np.max(np.diff(tv))) <= bar:
+        # No gap between the samples is that long (the usual case): only the grid points
+        # before the first sample or after the last one are far from them.
+        out[: int(np.searchsorted(grid, tv[0], side="left"))] = np.nan
+        out[int(np.searchsorted(grid, tv[-1], side="right")) :] = np.nan
+    else:
+        out[_far_from_samples(tv, grid, bar)] = np.nan
     return out
 
 
@@ -251,7 +250,9 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
         ok_g &= ~drop_frozen(t, p[:, :3], config.frozen_speed, ok_g)
         ok_r &= ~drop_frozen(t, p[:, 3:], config.frozen_speed, ok_r)
         all_seen = False
-    if all_seen or np.array_equal(ok_g, ok_r):  # both hands seen at the same samples
+    if all_seen:
+        x = resample(t, p, None, grid, config.max_gap_hold)
+    elif np.array_equal(ok_g, ok_r):  # both hands seen at the same samples
         x = resample(t, p, ok_g, grid, config.max_gap_hold)
     else:
         x = np.concatenate(
