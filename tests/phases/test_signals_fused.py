@@ -134,3 +134,19 @@ def test_quantile_is_numpys_linear_quantile() -> None:
         x[rng.random(n) < 0.1] = 0.05  # ties
         for q in (0.0, 0.1, 0.25, 0.3333, 0.5, 0.75, 0.9, 1.0, float(rng.random())):
             assert quantile(x, q) == float(np.quantile(x, q)), (n, q)
+
+
+def test_two_row_nanmean_is_numpys() -> None:
+    import warnings
+
+    from gazebot.phases.methods.gazebot_trigger import _nanmean2
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        ab = rng.normal(size=(2, 3))
+        ab[rng.random((2, 3)) < 0.3] = np.nan
+        ab[rng.random((2, 3)) < 0.05] = -0.0
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # numpy warns on an all-NaN column
+            want = np.nanmean(ab, axis=0)
+        np.testing.assert_array_equal(_nanmean2(ab[0], ab[1]), want)

@@ -25,6 +25,18 @@ _COLUMNS = 11  # t, giver xyz, receiver xyz, relative xyz, distance
 _nanmax = np.fmax.reduce
 
 
+def _nanmean2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.nanmean([a, b], axis=0)`` of two 3-vectors: per coordinate the sum of the values
+    that are not NaN (NaN counted as 0) over their count, NaN if none (numpy's arithmetic,
+    without its generic machinery and warning)."""
+    out = []
+    for u, w in zip(a.tolist(), b.tolist(), strict=True):
+        u_ok, w_ok = u == u, w == w
+        n = u_ok + w_ok
+        out.append(((u if u_ok else 0.0) + (w if w_ok else 0.0)) / n if n else math.nan)
+    return np.array(out)
+
+
 class GazebotTrigger:
     """Per-period mean positions of both hands, and the loosened rule of the current phase.
 
@@ -134,7 +146,7 @@ class GazebotTrigger:
             if held.shape[0] < 2:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
-            off = float(np.linalg.norm(np.nanmean(rel[-2:], axis=0) - held.mean(axis=0)))
+            off = float(np.linalg.norm(_nanmean2(rel[-2], rel[-1]) - held.mean(axis=0)))
             return off >= loose * c.release_distance
         if ph is Phase.RETREAT:
             if state.joined_late:
