@@ -327,6 +327,10 @@ class PhaseDetector:
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
         """Gripper / load-share evidence; True if it started a phase on this frame."""
+        if frame.gripper_closed is None and frame.load_share is None:
+            # No evidence (tracking alone, the usual frame): what the checks below conclude.
+            self._prev_evidence = False
+            return False
         c = self.config
         grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
         load = frame.load_share
