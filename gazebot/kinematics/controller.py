@@ -357,7 +357,7 @@ class GazeController:
             duration = max(remaining, cfg.tracking_duration_s, need)
         if new_shift or goal_change > _REPLAN_EPS or traj is None:
             if move > _REPLAN_EPS or speed > 0.0:
-                self._traj = MinJerkTrajectory(t_start, duration, q, goal, vel, acc)
+                self._traj = MinJerkTrajectory.of_floats(t_start, duration, q, goal, vel, acc)
         self._goal = goal
 
         # Eyes: a saccade from where they are now toward the target (re-aimed every tick).
