@@ -208,8 +208,17 @@ class GazeController:
                         self._saccade = None
                 limit = self.robot.eye_velocity_limit * dt
                 e0, e1 = self._eyes
-                yaw = min(max(yaw, e0 - limit), e0 + limit)
-                pitch = min(max(pitch, e1 - limit), e1 + limit)
+                # min(max(v, lo), hi) as comparisons (the same result, NaN included)
+                lo, hi = e0 - limit, e0 + limit
+                if yaw < lo:
+                    yaw = lo
+                if yaw > hi:
+                    yaw = hi
+                lo, hi = e1 - limit, e1 + limit
+                if pitch < lo:
+                    pitch = lo
+                if pitch > hi:
+                    pitch = hi
                 yaw, pitch, _ = eyes.clip(yaw, pitch)
                 self._eyes = (yaw, pitch)
                 self._residual = eyes.residual(yaw, pitch, v)

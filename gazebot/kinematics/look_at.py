@@ -164,7 +164,9 @@ def _pointing_error(
     a = ux * xx + uy * xy + uz * xz
     b = ux * b1x + uy * b1y + uz * b1z
     c = ux * b2x + uy * b2y + uz * b2z
-    rho2 = max(a * a + b * b, 1e-18)
+    rho2 = a * a + b * b
+    if rho2 < 1e-18:  # max(rho2, 1e-18) without the call
+        rho2 = 1e-18
     rho = math.sqrt(rho2)
     n2 = rho2 + c * c
     d_az: list[float] = []
