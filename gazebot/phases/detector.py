@@ -372,7 +372,9 @@ class PhaseDetector:
             if n - i0 < 3:
                 i0 = 0
         window = rows[i0:]
-        traj = Trajectory(window[:, 0].copy(), window[:, 1:4].copy(), window[:, 4:].copy())
+        # (the rows are float64 of known shapes: no conversion or check needed)
+        traj = Trajectory.of_hands(window[:, 0].copy(), window[:, 1:4].copy(),
+                                   window[:, 4:].copy())
         s = self.segmenter.online_signals(traj)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:

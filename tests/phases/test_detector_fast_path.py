@@ -81,3 +81,15 @@ def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monk
     assert sum(len(ev) for ev, _ in fast) > 4 * len(recordings)  # the recordings do show phases
     for i, (a, b) in enumerate(zip(fast, slow, strict=True)):
         assert a == b, f"recording {i}"
+
+
+def test_of_hands_builds_the_trajectory_the_constructor_builds():
+    rng = np.random.default_rng(2)
+    t, g, r = np.sort(rng.random(40)), rng.random((40, 3)), rng.random((40, 3))
+    g[5] = np.nan
+    ref, fast = Trajectory(t, g, r), Trajectory.of_hands(t, g, r)
+    for name in ("t", "giver_hand", "receiver_hand", "giver_face", "gripper_closed",
+                 "load_share"):
+        a, b = getattr(ref, name), getattr(fast, name)
+        assert a.shape == b.shape and a.dtype == b.dtype
+        np.testing.assert_array_equal(a, b)
