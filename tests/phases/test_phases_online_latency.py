@@ -104,17 +104,19 @@ def test_a_reach_taken_back_ends_as_aborted_without_transfer(rate):
     assert events[1].info["source"] == "aborted"
 
 
-def test_the_predictive_rule_confirms_a_reach_before_the_smoothed_signals():
+def test_the_predictive_rules_confirm_a_reach_before_the_smoothed_signals():
     # The same varied handovers (120 Hz: at 8-30 Hz the model has too few samples to beat the
-    # smoothed rule) with the predictive rule out of reach (predict_distance 10 m): the rule
-    # confirms the reach earlier, and never later on any handover.
+    # smoothed rule) with the predictive rules out of reach (predict_distance 10 m, and the
+    # sequential rule's sequential_evidence 1e9): the rules confirm the reach earlier, and
+    # never later on any handover.
     from gazebot.phases import PhaseConfig
 
     cases = synthetic_set(10, seed=5, rate=120.0)
     earlier = []
     for case in cases:
         got = {}
-        for name, cfg in (("on", PhaseConfig()), ("off", PhaseConfig(predict_distance=10.0))):
+        off = PhaseConfig(predict_distance=10.0, sequential_evidence=1e9)
+        for name, cfg in (("on", PhaseConfig()), ("off", off)):
             got[name] = [
                 e.detected_at
                 for e in run_online(case.trajectory, cfg).events

@@ -139,8 +139,11 @@ class GazebotTrigger:
             return False
         da = d[after[0] :]
         closed = float(np.nanmax(da)) - d[-1]
-        # (the predictive rule confirms a reach from predict_distance of the giver's own travel)
-        if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
+        # (the predictive rule confirms a reach from predict_distance of the giver's own travel;
+        # the sequential one cannot tell a reach from a fidget before the hand went about half
+        # the largest fidget: every fidget fits a cubic start up to its midpoint)
+        bar = min(c.reach_confirm_distance, c.predict_distance, 0.5 * c.fidget_amplitude)
+        if not closed >= loose * bar:
             return False
         i_max = after[0] + int(np.nanargmax(da))
         own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(float(d[-1]), 1e-9)
