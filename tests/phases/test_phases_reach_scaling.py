@@ -1,7 +1,8 @@
 """The sequential reach rule's bar scales with the sample rate and the measured noise floor
-(issue 20; :mod:`gazebot.phases.rules.sequential`): no travel distance or speed is fixed, so at every rate and noise level a reach is
-confirmed and a fidget is not, a reach is confirmed later under more noise and sooner with more
-samples, and with no noise at all the fidget's size, not a distance bar, keeps it a fidget."""
+(issue 20; :mod:`gazebot.phases.rules.sequential`): no travel distance or speed is fixed, so at
+every rate and noise level a reach is confirmed and a fidget is not, a reach is confirmed later
+under more noise and sooner with more samples, and with no noise at all the fidget's size, not
+a distance bar, keeps it a fidget."""
 
 from __future__ import annotations
 

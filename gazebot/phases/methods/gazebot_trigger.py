@@ -140,9 +140,9 @@ class GazebotTrigger:
         da = d[after[0] :]
         closed = float(np.nanmax(da)) - d[-1]
         # (the predictive rule confirms a reach from predict_distance of the giver's own travel;
-        # the sequential one cannot tell a reach from a fidget before the hand went about half
-        # the largest fidget: every fidget fits a cubic start up to its midpoint)
-        bar = min(c.reach_confirm_distance, c.predict_distance, 0.5 * c.fidget_amplitude)
+        # the sequential one, in practice, past 1.2 cm: every fidget fits a cubic start up to
+        # its midpoint, so it waits for more than half the largest fidget)
+        bar = min(c.reach_confirm_distance, c.predict_distance)
         if not closed >= loose * bar:
             return False
         i_max = after[0] + int(np.nanargmax(da))
