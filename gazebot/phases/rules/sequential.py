@@ -170,7 +170,29 @@ def sequential_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | 
     steps = np.diff(t_all[win])
     if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
         return None  # a dropout inside the window leaves the model unconstrained there
+    # A fidget fits any cubic start up to its midpoint: a hand not yet half the largest fidget
+    # from its rest (the window before every onset tried), or not toward the receiver, cannot
+    # be told from one (cheap skips before the test).
+    tw = t_all[win]
+    rest = win[tw <= now - c.sequential_onset_span]
+    last = win[tw >= now - 0.5 * c.sequential_onset_step]
+    if rest.size:
+        moved = g[last].mean(axis=0) - g[rest].mean(axis=0)
+        toward = float(moved @ (r[-1] - g[rest].mean(axis=0)))
+        if np.linalg.norm(moved) < 0.5 * c.fidget_amplitude or toward <= 0.0:
+            return None
     noise = noise_floor(g[idx[tv <= now - c.sequential_window]])
+    # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted
+    # sideways at arm's length, closes it slower than the hand moves): a constant-acceleration
+    # model of the gap closes faster than predict_sigmas of its standard error ...
+    w0 = min(now - c.predict_window, float(t_all[win[-c.predict_min_samples]]))
+    fit = win[t_all[win] >= w0]
+    gap_fit = _fit(t_all[fit] - now, -np.linalg.norm(r[fit] - g[fit], axis=1), noise)
+    if gap_fit is None:
+        return None
+    (_, v_c, a_c, _), (_, s_v, _, _) = gap_fit
+    if not v_c >= c.predict_sigmas * s_v:
+        return None
     ev = reach_evidence(t_all[win], g[win], now, noise, c)
     if ev is None or not ev.statistic >= c.sequential_evidence:
         return None
@@ -180,18 +202,8 @@ def sequential_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | 
     amp = float(np.linalg.norm(ev.amplitude))
     if gap <= 1e-6 or amp <= 0 or float(ev.amplitude @ line) < c.predict_cos * amp * gap:
         return None
-    # ... and the hands' gap closing at a reach's pace (the receiver moving away, or a hand
-    # adjusted sideways at arm's length, closes it slower than the hand moves): over the next
-    # predict_horizon a constant-acceleration model of the gap closes a share of the gap the
-    # hands started from.
-    w0 = min(now - c.predict_window, float(t_all[win[-c.predict_min_samples]]))
-    fit = win[t_all[win] >= w0]
-    gap_fit = _fit(t_all[fit] - now, -np.linalg.norm(r[fit] - g[fit], axis=1), ev.sigma)
-    if gap_fit is None:
-        return None
-    (_, v_c, a_c, _), (_, s_v, _, _) = gap_fit
-    if not v_c >= c.predict_sigmas * s_v:
-        return None
+    # ... and, extrapolated predict_horizon ahead, closes a share of the gap the hands started
+    # from.
     h = c.predict_horizon
     closed = float(np.linalg.norm(r[-1] - ev.rest)) - float(np.linalg.norm(r[-1] - g[-1]))
     ahead = closed + v_c * h + 0.5 * max(a_c, 0.0) * h * h
