@@ -17,8 +17,8 @@ says why.
 With ``seed_directions`` the policy term is eq. 5.6's as printed, nu_t E_p(x)[KL(pi_lin || p)]
 = nu_t/2 E[tr(C_t^-1 S_t) + (mu_p - mu_pi)' C_t^-1 (mu_p - mu_pi) + log det C_t] + const. Its mean
 part is weighted by the new controller's own precision C_t^-1, which no LQR can hold; we weight
-it by the sampled controller's precision (a fixed point of the iteration) and solve the
-covariance exactly (:func:`seed_covariance`).
+it by the sampled controller's precision (exact when the step leaves C_t unchanged) and solve
+the covariance exactly (:func:`seed_covariance`).
 """
 
 from __future__ import annotations
