@@ -6,13 +6,20 @@
   whose states are the gaze decisions (phase events and timers in, gaze target out), and
   :func:`~gazebot.behaviors.machine.diagram` (its Mermaid drawing).
 - :mod:`~gazebot.behaviors.registry`: :func:`load_behavior` and :func:`list_behaviors` (built-ins in
-  ``configs/behaviors/`` plus user folders).
+  ``configs/behaviors/`` plus user folders), :func:`seed_behaviors` (the built-ins implementing
+  the seed's gaze behaviors).
 - :mod:`~gazebot.behaviors.human`: the data-driven ``human-receiver`` timing model (read from
   YAML; fitted by :mod:`gazebot.annotations.fit`, so this package never imports annotations).
 """
 
 from gazebot.behaviors.machine import BehaviorMachine, GazeOrigin
-from gazebot.behaviors.registry import BehaviorInfo, behavior_path, list_behaviors, load_behavior
+from gazebot.behaviors.registry import (
+    BehaviorInfo,
+    behavior_path,
+    list_behaviors,
+    load_behavior,
+    seed_behaviors,
+)
 from gazebot.behaviors.spec import AtEvent, AtFraction, AtNever, BehaviorSpec, Segment
 
 __all__ = [
@@ -27,4 +34,5 @@ __all__ = [
     "behavior_path",
     "list_behaviors",
     "load_behavior",
+    "seed_behaviors",
 ]

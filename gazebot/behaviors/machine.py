@@ -4,29 +4,43 @@ The machine keeps **no phase of its own**: it reads the one
 :class:`~gazebot.handover.HandoverState` (the engine's, or its own when run alone) and reacts to
 its phase changes. :func:`machine_definition` builds one ``transitions`` hierarchical machine
 with two parallel regions under the root state ``behavior``; every rule that decides the gaze
-target is one of its transitions, with a named condition:
+target is one of its transitions, with a named condition, and runs in it:
 
 - ``gaze``: one state per gaze target (``behavior_gaze_face``, ``behavior_gaze_hand``, ...).
   Its transitions:
 
-  * ``phase`` (the handover state changed phase) ``[new handover]`` -> the behavior's ``before``
-    target (the reach of a new handover starts afresh), ``[handover done]`` -> its ``after``
-    target, ``[same handover: the gaze carries]`` (internal: reach -> transfer -> retreat keep
-    the target they had);
-  * ``timer`` ``[PHASE: WHEN (RULE)]`` -> a segment's target, once per segment of the behavior:
+  * ``phase`` (the handover state changed phase; the trigger carries the
+    :class:`~gazebot.handover.PhaseChange`) ``[new handover]`` -> the behavior's ``before``
+    target (the reach of a new handover starts afresh; a data-driven behavior draws its
+    segments), ``[handover done]`` -> its ``after`` target, ``[same handover: the gaze
+    carries]`` (internal: reach -> transfer -> retreat keep the target they had); each then
+    enters the new phase's segments (its ``after`` callbacks);
+  * ``timer`` (the trigger carries the :class:`Tick`: the time and the tracking's end estimate)
+    ``[PHASE: WHEN (RULE)]`` -> a segment's target, once per segment of the behavior:
     ``0.5 of the reach (end: latest of tracking, event, robot plan; else 1.01 s)`` or
-    ``robot_reach_ended + 0.2 s``; when several start by the same tick the latest start wins
-    (:func:`gazebot.behaviors.schedule.due_segments`).
+    ``robot_reach_ended + 0.2 s``. Their ``prepare`` callback schedules the phase at the tick
+    with the pure :func:`gazebot.behaviors.schedule.schedule` (the expected end, each
+    segment's start, the due ones); the condition holds for the segment the gaze follows:
+    when several start by the same tick the latest start wins. ``timer [due, but before the
+    followed segment's start ...]`` (internal) starts segments that do not take the gaze
+    back. Their ``after`` callbacks mark the due segments started and record the origin.
 
 - ``tracking``: ``ok`` -> ``hold`` on ``tracking_lost`` (the gaze point is held), ``hold`` ->
-  ``lost`` on ``timer [held HOLD s]`` (then the policy's target, by default the last known
-  face), back to ``ok`` on ``tracking_restored [after the loss]`` (an older restore is stale).
-  Phases and gaze shifts keep advancing meanwhile, so on restore the gaze resumes where the
-  behavior now is.
+  ``lost`` on ``timer [held HOLD s]`` (:func:`~gazebot.behaviors.schedule.hold_over`; then the
+  policy's target, by default the last known face), back to ``ok`` on ``tracking_restored
+  [after the loss]`` (an older restore is stale). Phases and gaze shifts keep advancing
+  meanwhile, so on restore the gaze resumes where the behavior now is.
+
+:meth:`BehaviorMachine.advance` only feeds the tick; it skips the ``timer`` trigger when the
+machine could not fire anything: before the hold's end and before the earliest start its last
+schedule found (:attr:`~gazebot.behaviors.schedule.Schedule.wake`) while that schedule's
+evidence is unchanged (the handover state's ``revision``; the end estimate when a waiting start
+depends on it). A machine fed every tick decides the same (a property test).
 
 ``gazebot behaviors show NAME --diagram FILE`` draws this machine, with the handover state's own
-rule table (:data:`gazebot.handover.RULES`: first reach wins, grasp/release, stale events) as a
-third region, from the same definitions that run (:func:`diagram`).
+machine (built from its rule table :data:`gazebot.handover.RULES`: first reach wins,
+grasp/release, stale events) as a third region, from the definitions a :class:`BehaviorMachine`
+runs on, live conditions included (:func:`diagram`).
 
 :meth:`BehaviorMachine.state` reads e.g. ``reach_hand`` (the handover state's phase, the gaze
 state, and ``_hold``/``_lost`` while tracking is lost). :attr:`BehaviorMachine.origin`
@@ -36,9 +50,9 @@ and says which phase it was carried into.
 
 Fraction timings need the phase's end online: :func:`gazebot.behaviors.schedule.expected_end`
 combines the tracking's prediction (``GazeContext.tracking_end``), the phase event's
-``expected_end`` and the robot's motion plan, else the spec's ``phase_durations_s``. It is
-re-read every tick; a segment that has started stays started, so a revised estimate never moves
-the gaze back.
+``expected_end`` and the robot's motion plan, else the spec's ``phase_durations_s``. Each
+schedule re-reads them; a segment that has started stays started, so a revised estimate never
+moves the gaze back.
 
 Points: the returned point is ``ctx.points[kind]`` (the hand moves: it is read every call). When
 that point is missing (NaN or an unknown named point) the last finite position of that kind is
@@ -58,7 +72,7 @@ from typing import Any
 import numpy as np
 from transitions.extensions import HierarchicalMachine
 
-from gazebot.behaviors.schedule import due_segments, end_rule, expected_end, segment_start
+from gazebot.behaviors.schedule import Schedule, end_rule, hold_over, schedule
 from gazebot.behaviors.spec import (
     SEGMENT_PHASES,
     AtEvent,
@@ -67,7 +81,7 @@ from gazebot.behaviors.spec import (
     BehaviorSpec,
     Segment,
 )
-from gazebot.handover import RULES, HandoverState, PhaseChange
+from gazebot.handover import HandoverState, PhaseChange
 from gazebot.types import (
     Event,
     EventKind,
@@ -81,6 +95,7 @@ _TRACKING_STATES = ("ok", "hold", "lost")
 _TRACKING_OK, _TRACKING_HOLD = f"{_TRACKING}_ok", f"{_TRACKING}_hold"
 _NEW, _DONE, _CARRY = "new handover", "handover done", "same handover: the gaze carries"
 _RESTORED = "after the loss"
+_STAYS = "due, but before the followed segment's start: the latest start wins, the gaze stays"
 
 
 def _finite(x: object) -> bool:
@@ -189,27 +204,40 @@ class GazeOrigin:
         return None
 
 
+@dataclass(frozen=True)
+class Tick:
+    """What the ``timer`` trigger carries: the time (s) and the tracking's latest prediction of
+    the phase's end (s, NaN if none)."""
+
+    t: float
+    tracking_end: float
+
+
 #: Builds a transition condition from its key and label: ``("segment", phase, index, target)``,
-#: ``("phase", name)``, ``("held",)`` or ``("restored",)``.
-ConditionFactory = Callable[[tuple, str], Callable[[], bool]]
-
-
-def _label_only(key: tuple, label: str) -> Callable[[], bool]:
-    """A condition that only carries its label (for drawing; never evaluated)."""
-
-    def condition() -> bool:
-        raise RuntimeError("a drawn machine is not run")
-
-    condition.__name__ = label
-    return condition
+#: ``("phase", name)``, ``("stays",)``, ``("held",)`` or ``("restored",)``. The callable takes
+#: the trigger's argument (a :class:`Tick`, a :class:`PhaseChange` or an event's time) and its
+#: ``__name__`` is the label the diagram shows.
+ConditionFactory = Callable[[tuple, str], Callable[[Any], bool]]
+#: Builds a transition's callbacks from its key: ``{"prepare": [...], "after": [...]}`` (or
+#: nothing); each callable takes the trigger's argument.
+CallbackFactory = Callable[[tuple], dict[str, list[Callable[[Any], None]]]]
 
 
 def machine_definition(
-    spec: BehaviorSpec, condition: ConditionFactory = _label_only
+    spec: BehaviorSpec,
+    condition: ConditionFactory,
+    callbacks: CallbackFactory | None = None,
 ) -> dict[str, Any]:
     """The states, transitions and initial state of ``spec``'s machine (``transitions``
-    keyword arguments); ``condition`` builds each transition condition (a callable whose
-    ``__name__`` is the label the diagram shows)."""
+    keyword arguments).
+
+    Args:
+        spec: The behavior.
+        condition: Builds each transition's condition (see :data:`ConditionFactory`).
+        callbacks: Builds each transition's ``prepare``/``after`` callbacks, by the same keys
+            (see :data:`CallbackFactory`; the tracking-loss transition's key is ``("lost",)``);
+            ``None``: none.
+    """
     gaze = [_state_name(t) for t in _gaze_targets(spec)]
     before, after = _state_name(spec.before), _state_name(spec.after)
     states = [
@@ -225,94 +253,90 @@ def machine_definition(
     def leaf(name: str) -> str:
         return f"{_GAZE}_{name}"
 
+    def transition(
+        trigger: str, source: Any, dest: str | None, key: tuple, label: str | None
+    ) -> dict[str, Any]:
+        out: dict[str, Any] = {"trigger": trigger, "source": source, "dest": dest}
+        if label is not None:
+            out["conditions"] = [condition(key, label)]
+        if callbacks is not None:
+            out.update(callbacks(key))
+        return out
+
     transitions: list[dict[str, Any]] = [
-        {
-            "trigger": "phase",
-            "source": _GAZE,
-            "dest": leaf(before),
-            "conditions": [condition(("phase", _NEW), _NEW)],
-        },
-        {
-            "trigger": "phase",
-            "source": _GAZE,
-            "dest": leaf(after),
-            "conditions": [condition(("phase", _DONE), _DONE)],
-        },
-        {
-            "trigger": "phase",
-            "source": _GAZE,
-            "dest": None,  # internal: the gaze state stays
-            "conditions": [condition(("phase", _CARRY), _CARRY)],
-        },
+        transition("phase", _GAZE, leaf(before), ("phase", _NEW), _NEW),
+        transition("phase", _GAZE, leaf(after), ("phase", _DONE), _DONE),
+        # internal: the gaze state stays
+        transition("phase", _GAZE, None, ("phase", _CARRY), _CARRY),
     ]
-    for phase, slots in _slots(spec).items():
-        for index, target, when in slots:
+    slots = _slots(spec)
+    for phase, phase_slots in slots.items():
+        for index, target, when in phase_slots:
             transitions.append(
-                {
-                    "trigger": "timer",
-                    "source": _GAZE,
-                    "dest": leaf(_state_name(target)),
-                    "conditions": [
-                        condition(("segment", phase, index, target), f"{phase.value}: {when}")
-                    ],
-                }
+                transition(
+                    "timer",
+                    _GAZE,
+                    leaf(_state_name(target)),
+                    ("segment", phase, index, target),
+                    f"{phase.value}: {when}",
+                )
             )
+    if any(slots.values()):
+        transitions.append(transition("timer", _GAZE, None, ("stays",), _STAYS))
     hold = f"held {spec.tracking_lost.hold_s:g} s"
     transitions += [
-        {
-            "trigger": EventKind.TRACKING_LOST.value,
-            "source": f"{_TRACKING}_ok",
-            "dest": f"{_TRACKING}_hold",
-        },
-        {
-            "trigger": "timer",
-            "source": f"{_TRACKING}_hold",
-            "dest": f"{_TRACKING}_lost",
-            "conditions": [condition(("held",), hold)],
-        },
-        {
-            "trigger": EventKind.TRACKING_RESTORED.value,
-            "source": [f"{_TRACKING}_hold", f"{_TRACKING}_lost"],
-            "dest": f"{_TRACKING}_ok",
-            "conditions": [condition(("restored",), _RESTORED)],
-        },
+        transition(
+            EventKind.TRACKING_LOST.value, _TRACKING_OK, _TRACKING_HOLD, ("lost",), None
+        ),
+        transition("timer", _TRACKING_HOLD, f"{_TRACKING}_lost", ("held",), hold),
+        transition(
+            EventKind.TRACKING_RESTORED.value,
+            [_TRACKING_HOLD, f"{_TRACKING}_lost"],
+            _TRACKING_OK,
+            ("restored",),
+            _RESTORED,
+        ),
     ]
     return {"states": states, "transitions": transitions, "initial": _ROOT}
 
 
-def _handover_region() -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """The handover state's rule table (:data:`gazebot.handover.RULES`) as a drawn region."""
-    phases = [p.value for p in Phase]
-    region = {"name": "handover", "children": phases, "initial": Phase.IDLE.value}
-    transitions = []
-    for rule in RULES:
-        for source in rule.sources:
-            dest = rule.dest if rule.dest is not None else source
-            transitions.append(
-                {
-                    "trigger": rule.trigger.value,
-                    "source": f"{_ROOT}_handover_{source.value}",
-                    "dest": f"{_ROOT}_handover_{dest.value}",
-                    "conditions": [_label_only((), rule.condition)],
-                }
-            )
-    return region, transitions
+def _nested(definition: dict[str, Any], region: str) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """A flat machine's definition (states named by strings) as the region ``region`` of the
+    root state: the region's state and its transitions with the nested state names."""
+
+    def name(state: str | None) -> str | None:
+        return None if state is None else f"{_ROOT}_{region}_{state}"
+
+    state = {
+        "name": region,
+        "children": list(definition["states"]),
+        "initial": definition["initial"],
+    }
+    transitions = [
+        {**t, "source": name(t["source"]), "dest": name(t["dest"])}
+        for t in definition["transitions"]
+    ]
+    return state, transitions
 
 
 def diagram(spec: BehaviorSpec) -> str:
     """The machine of ``spec`` as Mermaid ``stateDiagram-v2`` text, drawn by ``transitions``' own
-    diagram support (``HierarchicalGraphMachine`` with ``graph_engine="mermaid"``) from the same
-    :func:`machine_definition` the behavior runs on, plus the handover state's rule table (the
-    phase the behavior reads) as the region ``handover``."""
+    diagram support (``HierarchicalGraphMachine`` with ``graph_engine="mermaid"``) from the
+    definitions a :class:`BehaviorMachine` of ``spec`` runs on, live conditions included: its
+    own (``gaze`` and ``tracking``) and its handover state's (:attr:`HandoverState.definition`,
+    built from :data:`gazebot.handover.RULES`), drawn as the region ``handover``."""
     from transitions.extensions import HierarchicalGraphMachine
 
     class Drawn:
         """A model for the drawing only (never triggered)."""
 
-    definition = machine_definition(spec)
-    region, rules = _handover_region()
-    definition["states"][0]["parallel"].insert(0, region)
-    definition["transitions"] = rules + definition["transitions"]
+    running = BehaviorMachine(spec)
+    definition = dict(running.definition)
+    root = dict(definition["states"][0])
+    region, rules = _nested(running.handover.definition, "handover")
+    root["parallel"] = [region, *root["parallel"]]
+    definition["states"] = [root]
+    definition["transitions"] = rules + list(definition["transitions"])
     model = Drawn()
     HierarchicalGraphMachine(
         model=model,
@@ -358,12 +382,12 @@ class BehaviorMachine:
         self._defaults = {k: np.asarray(v, float) for k, v in (defaults or {}).items()}
         self._target_of = {_state_name(t): t for t in _gaze_targets(spec)}
         self._model = _Model()
-        self._firing: tuple[Phase, int] = (Phase.IDLE, -1)
-        self._change: PhaseChange | None = None
-        self._hold_over = False
+        #: The machine's definition (``transitions`` keyword arguments) with the conditions and
+        #: callbacks that run; :func:`diagram` draws it.
+        self.definition = machine_definition(spec, self._condition, self._callbacks)
         self._machine = HierarchicalMachine(
             model=self._model,
-            **machine_definition(spec, self._condition),
+            **self.definition,
             auto_transitions=False,
             ignore_invalid_triggers=True,
         )
@@ -371,39 +395,151 @@ class BehaviorMachine:
         self._tracking_leaf = {f"{_TRACKING}_{s}": s for s in _TRACKING_STATES}
         self.reset(seed)
 
-    def _condition(self, key: tuple, label: str) -> Callable[[], bool]:
+    # ----------------------------------------------------------------- the machine's rules
+    def _condition(self, key: tuple, label: str) -> Callable[[Any], bool]:
         """The runtime condition of a transition (see :data:`ConditionFactory`)."""
-        if key[0] == "segment":
+        kind = key[0]
+        if kind == "segment":
             _, phase, index, target = key
 
-            def condition() -> bool:
-                # The segment the timer fires for, with this target (the drawn pattern's).
-                return self._firing == (phase, index) and self._active[index][0].target == target
+            def condition(tick: Tick) -> bool:
+                # The segment the gaze follows now (the tick's schedule: the latest due start),
+                # with this target (the drawn pattern's).
+                return (
+                    self._schedule.follow == index
+                    and self._active_phase is phase
+                    and self._segments[index].target == target
+                )
 
-        elif key[0] == "phase":
+        elif kind == "stays":
+
+            def condition(tick: Tick) -> bool:
+                return bool(self._schedule.fired) and self._schedule.follow is None
+
+        elif kind == "phase":
             rule = key[1]
 
-            def condition() -> bool:
-                change = self._change
-                if change is None:
-                    return False
+            def condition(change: PhaseChange) -> bool:
                 if rule == _DONE:
                     return change.phase is Phase.DONE
                 return change.new_handover is (rule == _NEW) and change.phase is not Phase.DONE
 
-        elif key[0] == "held":
+        elif kind == "held":
+            hold_s = self.spec.tracking_lost.hold_s
 
-            def condition() -> bool:
-                return self._hold_over
+            def condition(tick: Tick) -> bool:
+                return hold_over(self._lost_since, hold_s, tick.t)
 
-        else:
+        else:  # restored
 
-            def condition() -> bool:
-                return self._restore_t >= self._lost_since
+            def condition(t: float) -> bool:
+                return t >= self._lost_since  # an older restore is stale
 
         condition.__name__ = label
         return condition
 
+    def _callbacks(self, key: tuple) -> dict[str, list[Callable[[Any], None]]]:
+        """A transition's ``prepare``/``after`` callbacks (see :data:`CallbackFactory`)."""
+        kind = key[0]
+        if kind == "segment":
+            return {
+                "prepare": [self._plan_tick],
+                "after": [self._start_due, self._picked_by(key[1], key[2])],
+            }
+        if kind == "stays":
+            return {"prepare": [self._plan_tick], "after": [self._start_due]}
+        if kind == "phase":
+            first = {_NEW: self._begin, _DONE: self._finish, _CARRY: self._carry}[key[1]]
+            return {"after": [first, self._enter_phase]}
+        if kind == "lost":
+            return {"after": [self._hold]}
+        if kind in ("held", "restored"):
+            return {"after": [self._end_hold]}
+        return {}
+
+    def _plan_tick(self, tick: Tick) -> None:
+        """``prepare`` of the gaze's ``timer`` transitions: the current phase's
+        :func:`~gazebot.behaviors.schedule.schedule` at this tick (once per tick), and when the
+        next ``timer`` can start a segment with the same evidence."""
+        if self._scheduled is tick:
+            return
+        self._scheduled = tick
+        state = self.handover
+        phase = self._active_phase
+        timings = self._timings
+        anchors = [
+            state.anchor(at.after) if isinstance(at, AtEvent) else math.nan for at in timings
+        ]
+        plan = schedule(
+            timings,
+            self._started,
+            phase,
+            state.phase_start,
+            (tick.tracking_end, state.event_end, state.robot_motion_end()),
+            self.spec.phase_durations_s.of(phase),
+            anchors,
+            tick.t,
+            self._latest,
+        )
+        self._schedule = plan
+        # Nothing can start before ``wake`` unless the evidence changes (the handover state's
+        # revision; the tracking's end estimate when a waiting start depends on it).
+        self._wake = plan.wake
+        self._wake_revision = state.revision if plan.waiting else None
+        self._wake_end = tick.tracking_end if plan.needs_end else None
+
+    def _start_due(self, tick: Tick) -> None:
+        """``after`` of the gaze's ``timer`` transitions: the due segments have started (a
+        started segment stays started: a revised estimate never moves the gaze back)."""
+        plan = self._schedule
+        for i in plan.fired:
+            self._started[i] = True
+        if plan.follow is not None:
+            self._latest = plan.starts[plan.follow]
+
+    def _picked_by(self, phase: Phase, index: int) -> Callable[[Tick], None]:
+        def picked(tick: Tick) -> None:
+            self.origin = GazeOrigin(phase, f"segment {index}", self.gaze, tick.t)
+
+        return picked
+
+    def _begin(self, change: PhaseChange) -> None:
+        """A new handover: its segments (drawn anew for a data-driven behavior)."""
+        self._plan = self._draw_plan()
+        self.origin = GazeOrigin(change.phase, "before", self.gaze, change.t)
+
+    def _finish(self, change: PhaseChange) -> None:
+        self.origin = GazeOrigin(change.phase, "after", self.gaze, change.t)
+
+    def _carry(self, change: PhaseChange) -> None:
+        # The gaze state stays: its rule is still the earlier phase's.
+        self.origin = replace(self.origin, carried_into=change.phase)
+
+    def _enter_phase(self, change: PhaseChange) -> None:
+        """The phase's segments, none started yet."""
+        phase = change.phase
+        self._active_phase = phase
+        self._segments = self._plan.get(phase, [])
+        self._timings = [self.spec.resolve(s) for s in self._segments]
+        self._started = [False] * len(self._segments)
+        self._latest = -math.inf
+        self._tracking_end = math.nan
+        # The next tick schedules the phase, unless no segment of it can ever start.
+        can_start = any(not isinstance(at, AtNever) for at in self._timings)
+        self._wake = -math.inf if can_start else math.inf
+        self._wake_revision = None
+        self._wake_end = None
+
+    def _hold(self, t: float) -> None:
+        """Tracking lost at ``t``: hold the gaze point until the hold is over."""
+        self._lost_since = t
+        self._held = self._last_target
+        self._hold_until = t + self.spec.tracking_lost.hold_s
+
+    def _end_hold(self, arg: Any) -> None:
+        self._hold_until = math.inf
+
+    # ----------------------------------------------------------------- state
     def reset(self, seed: int | None = None) -> None:
         """Forget everything (back to ``idle``; a machine with its own handover state resets
         it too), optionally with a new seed; cheaper than building a new machine."""
@@ -415,13 +551,19 @@ class BehaviorMachine:
         self.pattern = ""  # name of the drawn pattern (data-driven behaviors)
         self._rng = np.random.default_rng(self.seed)
         self._plan: dict[Phase, list[Segment]] = self._draw_plan()
-        self._active: list[list[Any]] = []  # [segment, started] of the current phase
         self._active_phase = Phase.IDLE
-        self._waiting = 0
+        self._segments: list[Segment] = []
+        self._timings: list[Any] = []
+        self._started: list[bool] = []
         self._latest = -math.inf  # start time of the segment the gaze state follows
+        self._schedule = Schedule((), (), None, math.inf, False, False)
+        self._scheduled: Tick | None = None
+        self._wake = math.inf
+        self._wake_revision: int | None = None  # the evidence wake holds for; None: any
+        self._wake_end: float | None = None
         self._tracking_end = math.nan
         self._lost_since = math.nan
-        self._restore_t = math.nan
+        self._hold_until = math.inf
         self._held: GazeTarget | None = None
         self._last_target: GazeTarget | None = None
         self._known: dict[str, np.ndarray] = {}
@@ -514,82 +656,42 @@ class BehaviorMachine:
     def on_tracking(self, event: Event) -> None:
         """Apply ``tracking_lost`` / ``tracking_restored`` (stale or duplicate ones ignored)."""
         t = self._time(event)
-        if t is None:
-            self._ignored += 1
-        elif event.kind is EventKind.TRACKING_LOST:
-            if self._trigger(EventKind.TRACKING_LOST.value):
-                self._lost_since = t
-                self._held = self._last_target
-                self._hold_over = False
-            else:
-                self._ignored += 1  # duplicate: the first loss time stands
-        else:
-            self._restore_t = t
-            if not (self.lost and self._trigger(EventKind.TRACKING_RESTORED.value)):
-                self._ignored += 1
+        lost = event.kind is EventKind.TRACKING_LOST
+        trigger = (EventKind.TRACKING_LOST if lost else EventKind.TRACKING_RESTORED).value
+        if t is None or not self._model.trigger(trigger, t):
+            self._ignored += 1  # no time, a duplicate loss, or a restore older than the loss
 
     def on_phase(self, change: PhaseChange) -> None:
-        """The handover state moved (``change``): fire the ``phase`` trigger and start the new
-        phase's segments."""
-        if change.new_handover:
-            self._plan = self._draw_plan()
-        self._change = change
-        self._trigger("phase")
-        self._change = None
-        phase = change.phase
-        if change.phase is Phase.DONE:
-            self.origin = GazeOrigin(phase, "after", self.gaze, change.t)
-        elif change.new_handover:
-            self.origin = GazeOrigin(phase, "before", self.gaze, change.t)
-        else:  # the gaze state stays: its rule is still the earlier phase's
-            self.origin = replace(self.origin, carried_into=phase)
-        self._active_phase = phase
-        self._active = [[s, False] for s in self._plan.get(phase, [])]
-        self._latest = -math.inf
-        self._tracking_end = math.nan
-        # Segments that may still start; "never" ones do not count.
-        self._waiting = sum(
-            not isinstance(self.spec.resolve(s), AtNever) for s, _ in self._active
-        )
+        """The handover state moved (``change``): fire the ``phase`` trigger (its rules pick
+        the gaze and start the new phase's segments)."""
+        self._model.trigger("phase", change)
 
     def advance(self, t: float, tracking_end: float | None = None) -> None:
-        """Fire the ``timer`` trigger for what is due at ``t``: the segment the gaze follows
-        (see :func:`~gazebot.behaviors.schedule.due_segments`) and the end of a tracking-loss
-        hold. ``tracking_end``: the tracking's latest prediction of the phase's end."""
+        """Feed the tick to the machine: fire the ``timer`` trigger at ``t``, whose rules start
+        the segments due (the latest start wins) and end a tracking-loss hold.
+        ``tracking_end``: the tracking's latest prediction of the phase's end.
+
+        The trigger is skipped when it cannot fire anything: before the hold's end, and before
+        the earliest start the machine's last schedule found while its evidence is unchanged
+        (the handover state's revision, and the tracking's end estimate when a waiting start
+        depends on it); the machine then decides exactly what a trigger would have."""
         if tracking_end is not None:
             self._tracking_end = tracking_end
-        if self.lost and not self._hold_over:
-            if t >= self._lost_since + self.spec.tracking_lost.hold_s:
-                self._hold_over = True
-                self._trigger("timer")
-        if self._waiting == 0:
-            return  # every segment of the phase has started (or never will)
-        phase = self._active_phase
-        state = self.handover
-        start = state.phase_start
-        end = math.nan
-        starts = []
-        for segment, _started in self._active:
-            at = self.spec.resolve(segment)
-            if isinstance(at, AtFraction) and end != end:
-                end = expected_end(
-                    phase,
-                    start,
-                    (self._tracking_end, state.event_end, state.robot_motion_end()),
-                    self.spec.phase_durations_s.of(phase),
-                )
-            anchor = state.anchor(at.after) if isinstance(at, AtEvent) else math.nan
-            starts.append(max(segment_start(at, start, end, anchor), start))
-        fired, best = due_segments(starts, [s for _, s in self._active], t, self._latest)
-        for i in fired:
-            self._active[i][1] = True
-        self._waiting -= len(fired)
-        if best is not None:
-            self._latest = starts[best]
-            self._firing = (phase, best)
-            if self._trigger("timer"):
-                self.origin = GazeOrigin(phase, f"segment {best}", self.gaze, t)
-            self._firing = (Phase.IDLE, -1)
+        end = self._tracking_end
+        if (
+            t < self._hold_until
+            and t < self._wake
+            and (self._wake_revision is None or self._same_evidence(end))
+        ):
+            return
+        self._model.trigger("timer", Tick(t, end))
+
+    def _same_evidence(self, end: float) -> bool:
+        """Whether the evidence the last schedule's ``wake`` holds for is unchanged."""
+        if self._wake_revision != self.handover.revision:
+            return False
+        seen = self._wake_end
+        return seen is None or seen == end or (seen != seen and end != end)
 
     def target(self, ctx: GazeContext) -> GazeTarget:
         """Where to look at ``ctx.t``: a target kind and its current point."""
@@ -616,9 +718,6 @@ class BehaviorMachine:
             if _finite(value):
                 return float(value)
         return None
-
-    def _trigger(self, name: str) -> bool:
-        return bool(self._model.trigger(name))
 
     def _point(self, kind: str, ctx: GazeContext) -> np.ndarray:
         points = ctx.points if isinstance(ctx.points, dict) else {}

@@ -19,6 +19,8 @@ from gazebot.behaviors.spec import BehaviorSpec
 from gazebot.config import ConfigError, configs_dir, read_yaml, validate
 
 ENV_PATH = "GAZEBOT_BEHAVIORS_PATH"
+#: How a built-in behavior's ``source:`` starts when it implements a gaze behavior of the seed.
+SEED_SOURCE = "seed "
 # Fields a variant may set besides its parameters; segments always come from the base.
 _VARIANT_FIELDS = ("description", "source", "before", "after", "tracking_lost", "phase_durations_s")
 
@@ -82,6 +84,14 @@ def list_behaviors(dirs: Sequence[Path] | None = None) -> list[BehaviorInfo]:
         spec = load_behavior(path, dirs)
         out.append(BehaviorInfo(name, path, builtin, spec.description, spec.source, spec.extends))
     return out
+
+
+def seed_behaviors() -> tuple[str, ...]:
+    """The built-in behaviors that implement one of the seed's own gaze behaviors (chapter 6):
+    those whose YAML says ``source: seed ...``, sorted by name."""
+    return tuple(
+        b.name for b in list_behaviors([]) if b.builtin and b.source.startswith(SEED_SOURCE)
+    )
 
 
 def behavior_path(name: str, dirs: Sequence[Path] | None = None) -> Path:

@@ -1,14 +1,17 @@
 """The behavior's gaze timing as pure functions: when each segment of a phase starts, the
-phase's expected end, and which segment the gaze follows at a time.
+phase's expected end, which segment the gaze follows at a time, and when a tracking-loss hold
+is over.
 
 The behavior machine (:mod:`gazebot.behaviors.machine`) calls these from its ``timer``
-transitions' conditions; they keep no state, so each rule is unit-tested on its own.
+transitions (:func:`schedule` from their ``prepare`` callback, :func:`hold_over` as the hold's
+condition); they keep no state, so each rule is unit-tested on its own.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from gazebot.behaviors.segment import AtEvent, AtFraction, AtNever
 from gazebot.types import Phase
@@ -79,3 +82,79 @@ def due_segments(
         if start >= best_t:
             best, best_t = i, start
     return fired, best
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """The current phase's segments at one tick (:func:`schedule`).
+
+    Attributes:
+        starts: Each segment's start (s; NaN: not known yet, or never).
+        fired: The segments that start at this tick.
+        follow: The one the gaze follows among them (the latest start), ``None`` if none.
+        wake: The earliest start (s) of a segment still waiting after this tick, ``inf`` if
+            none is known: before it, with the same evidence, nothing can start.
+        waiting: Some segment may still start after this tick (a ``never`` one cannot).
+        needs_end: Some waiting segment's start depends on the phase's expected end.
+    """
+
+    starts: tuple[float, ...]
+    fired: tuple[int, ...]
+    follow: int | None
+    wake: float
+    waiting: bool
+    needs_end: bool
+
+
+def schedule(
+    timings: Sequence[AtFraction | AtEvent | AtNever],
+    started: Sequence[bool],
+    phase: Phase,
+    phase_start: float,
+    estimates: Sequence[float],
+    default_s: float,
+    anchors: Sequence[float],
+    t: float,
+    latest: float,
+) -> Schedule:
+    """The current phase's segments at ``t``: each one's start (:func:`segment_start`, never
+    before the phase's start, with the end from :func:`expected_end`), which start now and
+    which one the gaze follows (:func:`due_segments`), and the earliest time the next one can.
+
+    Args:
+        timings: Each segment's ``at``, in the phase's order.
+        started: Whether each segment already started.
+        phase: The current phase.
+        phase_start: Its start (s).
+        estimates: The estimates of its end (see :func:`expected_end`).
+        default_s: The behavior's duration of the phase (s), without an estimate.
+        anchors: Per segment, when its ``after`` event happened in this handover (s; NaN: not
+            yet, or not an event timing).
+        t: Now (s).
+        latest: Start (s) of the segment the gaze follows now.
+    """
+    fractions = [isinstance(at, AtFraction) for at in timings]
+    end = (
+        expected_end(phase, phase_start, estimates, default_s) if any(fractions) else math.nan
+    )
+    starts = tuple(
+        max(segment_start(at, phase_start, end, anchor), phase_start)  # NaN stays NaN
+        for at, anchor in zip(timings, anchors, strict=True)
+    )
+    fired, follow = due_segments(starts, started, t, latest)
+    wake, waiting, needs_end = math.inf, False, False
+    for i, at in enumerate(timings):
+        if started[i] or i in fired or isinstance(at, AtNever):
+            continue
+        waiting = True
+        needs_end = needs_end or fractions[i]
+        if starts[i] < wake:  # (NaN compares false: not known yet)
+            wake = starts[i]
+    return Schedule(starts, tuple(fired), follow, wake, waiting, needs_end)
+
+
+def hold_over(lost_since: float, hold_s: float, t: float) -> bool:
+    """Whether a tracking-loss hold that began at ``lost_since`` (s) and lasts ``hold_s`` is
+    over at ``t``: the gaze then leaves the held point for the behavior's ``tracking_lost``
+    target."""
+    return t >= lost_since + hold_s

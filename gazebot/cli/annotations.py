@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from gazebot.cli.errors import seed_value
+from gazebot.cli.argtypes import seed_value
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -1,5 +1,5 @@
 """Command-line options shared by the bus nodes (``gazebot sim``, ``gazebot run``, ``gazebot
-display``): how a node joins the Zenoh bus and names its ROS 2 topics, and positive numbers."""
+display``): how a node joins the Zenoh bus and names its ROS 2 topics."""
 
 from __future__ import annotations
 
@@ -158,16 +158,6 @@ def bus_config(args: argparse.Namespace, listens_by_default: bool,
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from None
-
-
-def positive(value: str) -> float:
-    try:
-        x = float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {value!r}") from None
-    if not x > 0 or x != x:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {value!r}")
-    return x
 
 
 def bus_failure(exc: BaseException) -> str | None:

@@ -12,7 +12,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode, seed_value
+from gazebot.cli.argtypes import seed_value
+from gazebot.cli.errors import UsageError, option_error, robot_with_gaze_mode
 
 if TYPE_CHECKING:
     from gazebot.kinematics.config import RobotConfig
@@ -21,7 +22,12 @@ if TYPE_CHECKING:
 EXIT_INFEASIBLE = 3  # the reach controller found no feasible reach and the robot stopped
 
 # The scene's controller fields the command line sets, for error messages.
-_OPTIONS = {"reach_time_s": "--reach-time", "stall_time_s": "--stall-time", "retreat": "--retreat"}
+_OPTIONS = {
+    "reach_time_s": "--reach-time",
+    "stall_time_s": "--stall-time",
+    "retreat": "--retreat",
+    "policy": "--policy",
+}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,7 +38,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="simulate a handover with gaze and write a video, a timeline CSV and a plot",
         description=__doc__,
     )
-    parser.add_argument("--robot", default="sawyer", help="robot name or YAML (default: sawyer)")
+    parser.add_argument(
+        "--robot",
+        default=None,
+        help="robot name or YAML (default: panda with --controller gps, else sawyer)",
+    )
     parser.add_argument(
         "--behavior",
         default="face-hand-face",
@@ -60,6 +70,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--controller",
         choices=reach_controller_names(),
         help="the robot's reach controller (default: the scene's; seed chapters 3-4)",
+    )
+    parser.add_argument(
+        "--policy",
+        type=Path,
+        metavar="DIR",
+        help="--controller gps: the learned policy (`gazebot gps train --out DIR`); "
+        "runs on --robot panda",
     )
     parser.add_argument(
         "--reach-time", type=float, help="'Reach before', s from the handover's start"
@@ -112,6 +129,7 @@ def scene_with_overrides(args: argparse.Namespace):
             ("reach_time_s", getattr(args, "reach_time", None)),
             ("stall_time_s", getattr(args, "stall_time", None)),
             ("retreat", getattr(args, "retreat", None)),
+            ("policy", None if getattr(args, "policy", None) is None else str(args.policy)),
         )
         if value is not None
     }
@@ -121,14 +139,18 @@ def scene_with_overrides(args: argparse.Namespace):
         base = with_inset(args.scene, False)
     else:
         base = args.scene
+    from gazebot.sim.scene_config import GPS_REACH, load_scene
+
     if not overrides:
+        ctrl = load_scene(base).controller  # a scene YAML may ask for the learned reach itself
+        if ctrl.reach_controller == GPS_REACH:
+            check_policy(ctrl.policy, args)
         return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
     from gazebot.sim.scene_config import (
         JOINT_REACH,
         Direction,
         SceneConfig,
-        load_scene,
         reach_controller_names,
     )
 
@@ -142,18 +164,67 @@ def scene_with_overrides(args: argparse.Namespace):
         raise UsageError(f"--reach-time/--stall-time need --controller {need}")
     if "stall_time_s" in overrides and controller != "mce":
         raise UsageError("--stall-time ('Don't move until') is the mce controller's")
+    if controller == GPS_REACH and data["controller"].get("policy") is None:
+        raise UsageError("--controller gps needs --policy DIR (written by `gazebot gps train "
+                         "--out DIR`)")
+    if "policy" in overrides and controller != GPS_REACH:
+        raise UsageError("--policy is the learned controller's: it needs --controller gps")
     try:
         scene = SceneConfig.model_validate(data)
-        if scene.controller.reach_controller != JOINT_REACH:
+        if scene.controller.reach_controller not in (JOINT_REACH, GPS_REACH):
             # The reach and stall times against the controllers YAML, as the simulation will.
             scene_controllers_config(scene.controller, scene.direction is Direction.ROBOT_TO_HUMAN)
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field
         raise option_error(exc, _OPTIONS, "invalid controller options") from exc
+    if scene.controller.reach_controller == GPS_REACH:
+        check_policy(scene.controller.policy, args)
     return scene
+
+
+def check_policy(policy: str | None, args: argparse.Namespace) -> None:
+    """Before any simulation: the ``gps`` policy loads and fits ``--robot`` (one-line errors)."""
+    import mujoco
+
+    from gazebot.config import ConfigError
+    from gazebot.controllers import CONTROLLERS
+    from gazebot.sim.policy_reach import PolicyReach
+    from gazebot.sim.robot import load_sim_robot
+    from gazebot.sim.scene_config import GPS_REACH
+    from gazebot.sim.torque_arm import arm_actuator, is_torque_motor
+
+    try:
+        controller = CONTROLLERS.make(GPS_REACH, None, policy=policy)
+    except (ConfigError, ValueError) as exc:
+        raise UsageError(f"--policy {policy}: {exc}") from None
+    robot = getattr(args, "robot", "panda")
+    try:
+        sim_robot = load_sim_robot(robot)
+    except (FileNotFoundError, ConfigError):
+        return  # the robot's own error comes later, from its loader
+    model = mujoco.MjModel.from_xml_path(str(sim_robot.mjcf))
+    acts = [arm_actuator(model, j) for j in sim_robot.arm_joints]
+    if len(acts) != 7 or not all(a >= 0 and is_torque_motor(model, a) for a in acts):
+        raise UsageError(f"--controller gps drives the Panda learner's seven joint torques: "
+                         f"--robot {robot} has no such arm (use --robot panda)")
+    try:
+        PolicyReach(controller, model, mujoco.MjData(model), sim_robot.arm_joints,
+                    sim_robot.gripper_site)
+    except (KeyError, ValueError) as exc:
+        raise UsageError(f"--robot {robot}: {exc}") from None
+
+
+def default_robot(args: argparse.Namespace) -> str:
+    """``--robot``, else the robot the controller runs on: the learned ``gps`` policy drives
+    the Panda it was trained on; every other controller defaults to the Sawyer."""
+    if args.robot is not None:
+        return str(args.robot)
+    return "panda" if getattr(args, "controller", None) == "gps" else "sawyer"
 
 
 def run_demo(args: argparse.Namespace) -> int:
     from gazebot.kinematics.config import GAZE_MODES
+
+    args.robot = default_robot(args)
     from gazebot.render.timeline import phase_spans, plot_timeline, write_timeline_csv
     from gazebot.sim.gl_check import OffscreenRenderingError
 
@@ -172,11 +243,18 @@ def run_demo(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    from gazebot.sim.policy_reach import PolicyReachLog
     from gazebot.sim.stl_monitor import HandoverMonitor
 
     monitor = HandoverMonitor()  # the seed's Table 4.2 specs over the run (4.2.1 robustness)
+    learned = PolicyReachLog()  # what a learned (gps) reach did, if one ran
+
+    def on_tick(sim, tick) -> None:
+        monitor.on_tick(sim, tick)
+        learned.on_tick(sim, tick)
+
     try:
-        rec = _record(args, out, monitor)
+        rec = _record(args, out, on_tick)
     except OffscreenRenderingError as exc:
         print(f"gazebot: error: {exc}", file=sys.stderr)
         return 2
@@ -209,6 +287,8 @@ def run_demo(args: argparse.Namespace) -> int:
         "stl_robustness": {k: round(v, 4) for k, v in monitor.robustness().items()},
         "wall_time_s": round(time.perf_counter() - t0, 2),
     }
+    if learned.summary() is not None:
+        summary["gps"] = learned.summary()
     if args.json:
         print(json.dumps(summary))
     else:
@@ -219,6 +299,11 @@ def run_demo(args: argparse.Namespace) -> int:
         )
         rob = ", ".join(f"{k} {v:+.3f}" for k, v in summary["stl_robustness"].items())
         print(f"STL robustness (Table 4.2, positive = met): {rob}")
+        if "gps" in summary:
+            g = summary["gps"]
+            print(f"learned reach ({g['policy_state']} state): gripper to the object "
+                  f"{g['object_gap_start_m']} -> {g['object_gap_end_m']} m in {g['reach_s']} s, "
+                  f"max |torque| {g['max_torque_nm']} N m, fallbacks {g['fallbacks']}")
         for path in (rec.video, csv_path, png_path, out / "handover.mcap"):
             print(f"wrote {path}")
     if infeasible:
@@ -244,7 +329,7 @@ def _last_reach_start_time(ticks) -> float | None:
     return None if math.isnan(value) else round(value, 4)
 
 
-def _record(args: argparse.Namespace, out: Path, monitor=None):
+def _record(args: argparse.Namespace, out: Path, on_tick=None):
     from gazebot.sim.record import record_handover
 
     robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
@@ -254,7 +339,7 @@ def _record(args: argparse.Namespace, out: Path, monitor=None):
             robot=robot,
             behavior=args.behavior,
             scene=scene_with_overrides(args),
-            on_tick=None if monitor is None else monitor.on_tick,
+            on_tick=on_tick,
             out_path=out / "handover.mp4",
             seed=args.seed,
             width=args.width,

@@ -11,8 +11,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from gazebot.cli.bus import add_bus_arguments, bus_config, positive
-from gazebot.cli.errors import UsageError, seed_value
+from gazebot.cli.argtypes import positive, seed_value
+from gazebot.cli.bus import add_bus_arguments, bus_config
+from gazebot.cli.errors import UsageError
 from gazebot.ros2 import topics
 
 

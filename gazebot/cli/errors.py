@@ -45,16 +45,3 @@ def option_error(exc: Exception, options: dict[str, str], what: str) -> UsageErr
     name = options.get(loc[-1], ".".join(loc))
     expected = msg.removeprefix("Input should be ")
     return UsageError(f"{name}: expected {expected}, got {err.get('input')!r}")
-
-
-def seed_value(value: str) -> int:
-    """argparse type of a ``--seed``: a non-negative integer, what NumPy's generators accept."""
-    import argparse
-
-    try:
-        n = int(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {value!r}") from None
-    if n < 0:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {value!r}")
-    return n

@@ -15,38 +15,9 @@ import sys
 import time
 from pathlib import Path
 
+from gazebot.cli.argtypes import int_at_least, positive
 from gazebot.cli.errors import UsageError
 from gazebot.gps.tester import UnreachableTarget
-
-
-def _positive_float(value: str) -> float:
-    try:
-        v = float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {value!r}") from None
-    if not v > 0 or v != v or v == float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {value!r}")
-    return v
-
-
-def _grid(value: str) -> int:
-    try:
-        n = int(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 2, got {value!r}") from None
-    if n < 2:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 2, got {value!r}")
-    return n
-
-
-def _iterations(value: str) -> int:
-    try:
-        n = int(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {value!r}") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {value!r}")
-    return n
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -66,7 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="the trainer holds its hand still or reaches (eq. 5.12)")
     t.add_argument("--state", choices=("reduced", "full", "relative"), default="reduced",
                    help="state representation (eqs. 5.8-5.10)")
-    t.add_argument("--iterations", type=_iterations, default=None,
+    t.add_argument("--iterations", type=int_at_least(1), default=None,
                    help="GPS iterations (default: the config's, the seed's 12)")
     t.add_argument("--config", default=None, help="GPS YAML (default: configs/gps.yaml)")
     t.add_argument("--out", required=True, help="output directory")
@@ -77,9 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     e.add_argument("policy", help="directory written by `gazebot gps train`")
     e.add_argument("--tester", choices=("static", "moving"), default="static",
                    help="the tester holds its hand at each location or reaches it (eq. 5.12)")
-    e.add_argument("--mass", type=_positive_float, default=None,
+    e.add_argument("--mass", type=positive, default=None,
                    help="end-effector mass in kg (default: the training's, 2 kg)")
-    e.add_argument("--grid", type=_grid, default=None,
+    e.add_argument("--grid", type=int_at_least(2), default=None,
                    help="n x n test grid per azimuth (default 11: 2299 locations)")
     e.add_argument("--json", action="store_true", help="print the summary as JSON")
     e.add_argument("--save", default=None,

@@ -10,6 +10,8 @@ import math
 import sys
 from typing import TYPE_CHECKING
 
+from gazebot.cli.argtypes import positive
+
 if TYPE_CHECKING:
     from gazebot.phases import Segment
 
@@ -44,7 +46,7 @@ def add_recording_options(p: argparse.ArgumentParser, prefix: str = "") -> None:
     p.add_argument(
         f"--{prefix}rate",
         default=None,
-        type=float,
+        type=positive,
         metavar="HZ",
         help="sampling rate of a pose folder (its files have no time column)",
     )

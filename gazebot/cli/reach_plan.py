@@ -28,18 +28,19 @@ MAX_DURATION_S = 120.0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from gazebot.controllers import CONTROLLERS
+    from gazebot.controllers import CONTROLLERS, planner_names
     from gazebot.controllers.config import Role, Strategy
 
+    planners = planner_names()
     p = sub.add_parser(
-        "reach-plan", help=f"plan a timed reach ({', '.join(CONTROLLERS.names())})",
+        "reach-plan", help=f"plan a timed reach ({', '.join(planners)})",
         description=__doc__,
     )
     p.add_argument(
         "--controller",
         required=True,
-        choices=CONTROLLERS.names(),
-        help="; ".join(f"{n}: {CONTROLLERS.entry(n).description}" for n in CONTROLLERS.names()),
+        choices=planners,
+        help="; ".join(f"{n}: {CONTROLLERS.entry(n).description}" for n in planners),
     )
     p.add_argument(
         "--start",

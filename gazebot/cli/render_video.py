@@ -7,7 +7,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError, robot_with_gaze_mode, seed_value
+from gazebot.cli.argtypes import seed_value
+from gazebot.cli.errors import UsageError, robot_with_gaze_mode
 
 
 def register(kinds: argparse._SubParsersAction) -> None:

@@ -8,7 +8,8 @@ import argparse
 import sys
 import threading
 
-from gazebot.cli.bus import add_zenoh_config_argument, positive, zenoh_file_settings
+from gazebot.cli.argtypes import positive
+from gazebot.cli.bus import add_zenoh_config_argument, zenoh_file_settings
 from gazebot.cli.errors import UsageError
 from gazebot.drivers.session import ROUTER_ENDPOINT, BusConfig, open_session
 

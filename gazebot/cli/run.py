@@ -11,14 +11,14 @@ import sys
 import threading
 from collections.abc import Iterator
 
+from gazebot.cli.argtypes import positive, seed_value
 from gazebot.cli.bus import (
     add_bus_arguments,
     add_record_argument,
     bus_config,
-    positive,
     robot_base_frame,
 )
-from gazebot.cli.errors import robot_with_gaze_mode, seed_value
+from gazebot.cli.errors import robot_with_gaze_mode
 
 
 class DeprecatedAlias(argparse.Action):

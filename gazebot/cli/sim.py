@@ -9,14 +9,14 @@ import sys
 import threading
 from typing import Any
 
+from gazebot.cli.argtypes import positive, seed_value
 from gazebot.cli.bus import (
     add_bus_arguments,
     add_record_argument,
     bus_config,
-    positive,
     robot_base_frame,
 )
-from gazebot.cli.errors import UsageError, robot_with_gaze_mode, seed_value
+from gazebot.cli.errors import UsageError, robot_with_gaze_mode
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -11,7 +11,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from gazebot.cli.errors import UsageError, seed_value
+from gazebot.cli.argtypes import seed_value
+from gazebot.cli.errors import UsageError
 from gazebot.config import ConfigError
 from gazebot.study.conditions import (
     CONDITION_LEVELS,

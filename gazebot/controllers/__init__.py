@@ -6,6 +6,8 @@ differential IK (:mod:`gazebot.controllers.arm_ik`).
 - ``mcj``: minimum cumulative jerk with a reach time (eqs. 3.2-3.3)
 - ``mce``: minimum cumulative error with stall and reach times (eqs. 3.4-3.5)
 - ``stl``: STL specification synthesized as a MILP in receding horizon (eqs. 4.1-4.5)
+- ``gps``: a learned Guided Policy Search policy (chapter 5): joint torques, not velocities
+  (:mod:`gazebot.controllers.gps`; the simulator's :mod:`gazebot.sim.policy_reach` runs it)
 
 Entry point: :func:`make_controller`; the registry :data:`CONTROLLERS` (one line per controller).
 """
@@ -39,6 +41,20 @@ CONTROLLERS.register(
     "stl", "gazebot.controllers.stl:STLController",
     "STL specification as a MILP in receding horizon (eqs. 4.1-4.5)",
 )
+CONTROLLERS.register(
+    "gps", "gazebot.controllers.gps:GPSController",
+    "learned GPS policy (chapter 5): Panda joint torques; needs `--policy DIR`, runs on `panda`",
+)
+
+
+#: Registered controllers that command joint torques and plan no Cartesian velocities: they run
+#: only in the simulator, on a robot with their arm, and ``gazebot reach-plan`` does not offer them.
+TORQUE_CONTROLLERS: tuple[str, ...] = ("gps",)  # gazebot.sim.scene_config.GPS_REACH
+
+
+def planner_names() -> tuple[str, ...]:
+    """The registered controllers that plan Cartesian end-effector velocities."""
+    return tuple(n for n in CONTROLLERS.names() if n not in TORQUE_CONTROLLERS)
 
 
 def controller_names() -> tuple[str, ...]:
@@ -58,9 +74,11 @@ __all__ = [
     "ReachController",
     "ReachObservation",
     "VelocityPlan",
+    "TORQUE_CONTROLLERS",
     "controller_names",
     "load_controllers_config",
     "make_controller",
+    "planner_names",
 ]
 
 

@@ -82,11 +82,14 @@ def _link_geom(i: int) -> str:
     return f'<geom type="capsule" fromto="0 0 0 {_fmt(end)}" size="0.05" class="learner"/>'
 
 
-def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: float) -> str:
-    """The Panda's kinematic tree as MJCF (child of the world), with sites ``tcp`` and ``hand``.
+def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: float,
+               pos: tuple[float, float, float] | None = None) -> str:
+    """The Panda's kinematic tree as MJCF (body ``link0``, at ``pos`` in its parent, default the
+    parent's origin), with the site ``tcp`` (fingertip centre) on the body ``hand``.
 
     ``gravcomp_hand`` is the fraction of the hand's weight the robot's own gravity compensation
     cancels (the nominal end-effector mass over the actual one); the links are fully compensated.
+    The handover scene's ``panda`` robot (:mod:`gazebot.gps.handover_robot`) mounts this same tree.
     """
     w, h, dz = 0.1, 0.2, 0.06
     hand_inertia = (
@@ -94,7 +97,8 @@ def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: flo
         ee_mass_kg * (w * w + dz * dz) / 12,
         ee_mass_kg * (w * w + h * h) / 12,
     )
-    xml = ['<body name="link0" childclass="learner">',
+    at = "" if pos is None else f' pos="{_fmt(pos)}"'
+    xml = [f'<body name="link0"{at} childclass="learner">',
            '<geom type="cylinder" size="0.09 0.07" pos="0 0 0.07" class="learner"/>',
            f'<geom type="capsule" fromto="0 0 0 0 0 {DH[0][1]}" size="0.06" class="learner"/>']
     for i, ((a, d, alpha), link) in enumerate(zip(DH, LINKS, strict=True)):
@@ -139,13 +143,24 @@ def panda_mjcf(ee_mass_kg: float, damping: tuple[float, ...], gravcomp_hand: flo
     return "\n".join(xml)
 
 
-def panda_actuators(gripper_force_n: float) -> str:
-    """Seven joint torque motors within Franka's torque limits, and the gripper's force motor
-    (positive force opens the fingers; both fingers share it through a tendon)."""
-    motors = [
+def fingers_tendon() -> str:
+    """The tendon ``fingers`` (the mean of the two finger slides) the gripper actuates."""
+    return ('<fixed name="fingers"><joint joint="finger_left" coef="0.5"/>'
+            '<joint joint="finger_right"\n      coef="0.5"/></fixed>')
+
+
+def arm_motors() -> list[str]:
+    """Seven joint torque motors ``tau1``..``tau7`` within Franka's torque limits."""
+    return [
         f'<motor name="tau{i + 1}" joint="joint{i + 1}" ctrlrange="{-t} {t}" ctrllimited="true"/>'
         for i, t in enumerate(TAU_MAX_NM)
     ]
+
+
+def panda_actuators(gripper_force_n: float) -> str:
+    """Seven joint torque motors within Franka's torque limits, and the gripper's force motor
+    (positive force opens the fingers; both fingers share it through a tendon)."""
+    motors = arm_motors()
     motors.append(
         f'<motor name="gripper" tendon="fingers" ctrlrange="{-gripper_force_n} {gripper_force_n}" '
         'ctrllimited="true"/>'

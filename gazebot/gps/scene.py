@@ -64,8 +64,7 @@ def scene_mjcf(cfg: SceneConfig, ee_mass_kg: float | None = None) -> str:
     </body>
   </worldbody>
   <tendon>
-    <fixed name="fingers"><joint joint="finger_left" coef="0.5"/><joint joint="finger_right"
-      coef="0.5"/></fixed>
+    {panda.fingers_tendon()}
   </tendon>
   <actuator>
     {panda.panda_actuators(cfg.gripper_force_n)}

@@ -3,6 +3,13 @@ detector's evidence and the robot's events, which the engine reports and the beh
 
 from __future__ import annotations
 
-from gazebot.handover.state import RULES, HandoverState, PhaseChange, Rule, event_source
+from gazebot.handover.state import (
+    RULES,
+    HandoverState,
+    PhaseChange,
+    Rule,
+    event_source,
+    machine_definition,
+)
 
-__all__ = ["RULES", "HandoverState", "PhaseChange", "Rule", "event_source"]
+__all__ = ["RULES", "HandoverState", "PhaseChange", "Rule", "event_source", "machine_definition"]

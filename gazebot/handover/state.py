@@ -7,7 +7,9 @@
   or ``load_share``);
 - the **robot**: its events (``robot_reach_started``, ``robot_grasped``, ``robot_released``, ...).
 
-The rules are the table :data:`RULES` (drawn in ``gazebot behaviors show NAME --diagram``):
+The rules are the table :data:`RULES`. The phase is the state of a ``transitions`` machine built
+from that table (:func:`machine_definition`: one transition per rule and source phase, the rule's
+condition a named condition of it), which ``gazebot behaviors show NAME --diagram`` draws:
 
 - **the first reach wins**: a ``robot_reach_started`` in idle/done starts the reach (the robot
   set off first, seed 6.3); the other party's reach start of the same handover only moves the
@@ -31,8 +33,11 @@ estimates of the phase's end (the phase event's ``expected_end``, the robot's mo
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
+
+from transitions import Machine
 
 from gazebot.types import EVENT_OF_PHASE, PHASE_OF_EVENT, Event, EventKind, Phase, PhaseSource
 
@@ -63,7 +68,7 @@ class Rule:
 
 _NEWER = "not older than the last phase change"
 _SAME = "same handover: the reach starts with the first"
-#: Every rule of the handover state (the running lookup and the diagram are built from it).
+#: Every rule of the handover state (its machine, and so the diagram, is built from it).
 RULES: tuple[Rule, ...] = (
     Rule(EventKind.REACH_STARTED, (Phase.IDLE, Phase.DONE), Phase.REACH, _NEWER),
     Rule(
@@ -103,10 +108,8 @@ RULES: tuple[Rule, ...] = (
         _NEWER,
     ),
 )
-_LOOKUP: dict[tuple[EventKind, Phase], Rule] = {
-    (rule.trigger, source): rule for rule in RULES for source in rule.sources
-}
 _PHASE_TRIGGERS = frozenset(rule.trigger for rule in RULES)
+_PHASE_OF_STATE = {p.value: p for p in Phase}
 
 
 @dataclass(frozen=True)
@@ -162,39 +165,114 @@ def event_source(event: Event) -> PhaseSource:
     return "gripper" if info.get("source") in _GRIPPER_SOURCES else "tracking"
 
 
-@dataclass
+#: Builds the condition of a rule's transitions: a callable ``(t, event) -> bool`` whose
+#: ``__name__`` is the rule's :attr:`Rule.condition` (the label the diagram shows).
+ConditionFactory = Callable[[Rule], Callable[[float, Event], bool]]
+#: Builds the callback a rule's transition runs once it applies (``(t, event) -> None``).
+CallbackFactory = Callable[[Rule], Callable[[float, Event], None]]
+
+
+def machine_definition(
+    condition: ConditionFactory,
+    callback: CallbackFactory | None = None,
+    rules: tuple[Rule, ...] = RULES,
+) -> dict[str, Any]:
+    """The ``transitions`` machine of the handover state, built from the rule table: one state
+    per phase, one transition per rule and source phase (trigger: the event's kind; ``dest``
+    ``None`` for a rule that keeps the phase, an internal transition), in the table's order.
+
+    Args:
+        condition: Builds each rule's condition (see :data:`ConditionFactory`).
+        callback: Builds what each rule's transition does (its ``before`` callback: the state
+            is still the source phase); ``None``: none.
+        rules: The table (default :data:`RULES`).
+
+    Returns:
+        ``transitions`` keyword arguments: ``states``, ``transitions`` and ``initial``.
+    """
+    transitions: list[dict[str, Any]] = []
+    for rule in rules:
+        check = condition(rule)
+        run = callback(rule) if callback is not None else None
+        for source in rule.sources:
+            transition: dict[str, Any] = {
+                "trigger": rule.trigger.value,
+                "source": source.value,
+                "dest": rule.dest.value if rule.dest is not None else None,
+                "conditions": [check],
+            }
+            if run is not None:
+                transition["before"] = [run]
+            transitions.append(transition)
+    return {
+        "states": [p.value for p in Phase],
+        "transitions": transitions,
+        "initial": Phase.IDLE.value,
+    }
+
+
+class _Model:
+    """The object whose ``state`` (a phase's value) the handover machine drives."""
+
+    state: str
+
+
 class HandoverState:
     """The current handover's phase and the evidence its timing reads (see the module docs).
 
-    Feed every phase and robot event with :meth:`apply` (phase changes come back); read
-    :attr:`phase`, :attr:`phase_start` and :attr:`source`.
+    The phase is the state of a ``transitions`` machine built from :data:`RULES`
+    (:func:`machine_definition`; :attr:`definition` is what it was built from, with the
+    conditions and callbacks that run). Feed every phase and robot event with :meth:`apply`
+    (phase changes come back); read :attr:`phase`, :attr:`phase_start` and :attr:`source`.
     """
 
-    phase: Phase = Phase.IDLE
-    phase_start: float = -math.inf
-    source: PhaseSource = "tracking"
-    #: Index of the current (or last) handover, -1 before the first.
-    handover: int = -1
-    #: Events ignored as stale, duplicated or not allowed from the current phase.
-    ignored: int = 0
-    #: The phase event's own ``expected_end`` (s), NaN when it gave none.
-    event_end: float = math.nan
-    #: Events at or after this belong to the current handover (s).
-    handover_t0: float = -math.inf
-    _last_change: float = -math.inf
-    _reach_by: set[str] = field(default_factory=set)  # "robot" / "giver": who started the reach
-    _robot: dict[EventKind, Event] = field(default_factory=dict)
+    def __init__(self) -> None:
+        self._model = _Model()
+        #: The machine's definition (``transitions`` keyword arguments), live callables included.
+        self.definition = machine_definition(self._condition, self._callback)
+        self._machine = Machine(
+            model=self._model,
+            **self.definition,
+            auto_transitions=False,
+            ignore_invalid_triggers=True,
+        )
+        #: Counts every change of what the behavior's timing reads (phase, its start, robot
+        #: events); never goes back, not even on :meth:`reset`.
+        self.revision = 0
+        self.reset()
 
     def reset(self) -> None:
-        """Back to idle before any handover."""
-        self.__init__()  # type: ignore[misc]
+        """Back to idle before any handover (the machine is kept: building one costs more)."""
+        self._machine.set_state(Phase.IDLE.value, self._model)
+        self.phase_start = -math.inf
+        self.source: PhaseSource = "tracking"
+        #: Index of the current (or last) handover, -1 before the first.
+        self.handover = -1
+        #: Events ignored as stale, duplicated or not allowed from the current phase.
+        self.ignored = 0
+        #: The phase event's own ``expected_end`` (s), NaN when it gave none.
+        self.event_end = math.nan
+        #: Events at or after this belong to the current handover (s).
+        self.handover_t0 = -math.inf
+        self._last_change = -math.inf
+        self._reach_by: set[str] = set()  # "robot" / "giver": who started the reach
+        self._robot: dict[EventKind, Event] = {}
+        self._change: PhaseChange | None = None
+        self.revision += 1
+
+    @property
+    def phase(self) -> Phase:
+        """The current phase (the machine's state)."""
+        return _PHASE_OF_STATE[self._model.state]
 
     # ----------------------------------------------------------------- input
     def apply(self, event: Event) -> PhaseChange | None:
         """Apply one phase or robot event; the phase change it caused, else ``None``.
 
         Events with an unknown kind or no finite time are ignored (counted); tracking events
-        are not the handover state's (returns ``None`` without counting).
+        are not the handover state's (returns ``None`` without counting). A phase-changing
+        event no rule of the current phase accepts (stale, duplicate, not allowed) is ignored
+        and counted.
         """
         parsed = _parse(event)
         if parsed is None:
@@ -205,30 +283,66 @@ class HandoverState:
             if not self._keep_robot(kind, t, event):
                 self.ignored += 1
                 return None
-        rule = self._rule(kind, t)
-        if rule is None:
+        if kind not in _PHASE_TRIGGERS:
+            return None
+        self._change = None
+        if not self._model.trigger(kind.value, t, event):
             if kind in PHASE_OF_EVENT:  # stale, duplicate or not allowed from this phase
                 self.ignored += 1
             return None
-        if rule.dest is None:
-            return self._earlier_reach(kind, t, event)
-        return self._enter(rule, t, event)
+        change, self._change = self._change, None
+        return change
 
     def would_move(self, event: Event) -> float | None:
         """The time (s) at which ``event`` would change the phase, ``None`` if it would not
-        (nothing changes: the behavior first brings its gaze up to that time)."""
+        (nothing changes: the behavior first brings its gaze up to that time). Asks the
+        machine which of its transitions would apply."""
         parsed = _parse(event)
-        if parsed is None:
+        if parsed is None or parsed[0] not in _PHASE_TRIGGERS:
             return None
-        rule = self._rule(*parsed)
-        return parsed[1] if rule is not None and rule.dest is not None else None
+        kind, t = parsed
+        for transition in self._machine.events[kind.value].transitions[self._model.state]:
+            if all(c.func(t, event) is c.target for c in transition.conditions):
+                return t if transition.dest is not None else None
+        return None
 
-    def _rule(self, kind: EventKind, t: float) -> Rule | None:
-        """The rule ``kind`` at ``t`` meets in the current phase (``None``: none, or stale)."""
-        rule = _LOOKUP.get((kind, self.phase))
-        if rule is None or (rule.dest is not None and t < self._last_change):
-            return None
-        return rule
+    # ----------------------------------------------------------------- the machine's rules
+    def _condition(self, rule: Rule) -> Callable[[float, Event], bool]:
+        """The runtime condition of ``rule``'s transitions (named with its label)."""
+        if rule.dest is not None:
+
+            def condition(t: float, event: Event) -> bool:
+                return t >= self._last_change  # a stale event does not move the phase
+
+        else:
+
+            party = "robot" if rule.trigger is EventKind.ROBOT_REACH_STARTED else "giver"
+            phase_event = rule.trigger in PHASE_OF_EVENT
+
+            def condition(t: float, event: Event) -> bool:
+                # The other party's reach start of this handover (a duplicate of the same
+                # party's phase event is not: it is ignored).
+                duplicate = phase_event and party in self._reach_by
+                return t >= self.handover_t0 and not duplicate
+
+        condition.__name__ = rule.condition
+        return condition
+
+    def _callback(self, rule: Rule) -> Callable[[float, Event], None]:
+        """What ``rule``'s transition does: enter its phase, or join the reach."""
+        if rule.dest is not None:
+
+            def callback(t: float, event: Event) -> None:
+                self._change = self._enter(rule, t, event)
+
+            callback.__name__ = f"enter {rule.dest.value}"
+        else:
+
+            def callback(t: float, event: Event) -> None:
+                self._earlier_reach(rule.trigger, t, event)
+
+            callback.__name__ = "join the reach"
+        return callback
 
     # ----------------------------------------------------------------- timing evidence
     def anchor(self, kind: EventKind) -> float:
@@ -258,24 +372,22 @@ class HandoverState:
             return False  # an older copy arriving late
         info: Any = getattr(event, "info", None)
         self._robot[kind] = Event(kind, t, t, dict(info) if isinstance(info, dict) else {})
+        self.revision += 1
         return True
 
     def _earlier_reach(self, kind: EventKind, t: float, event: Event) -> None:
         """The other party's reach start of the current handover: the reach starts with the
-        first (a duplicate of the same party's is ignored). An earlier start also takes over the
-        phase's source: the reach is the earlier party's, whichever was told first."""
-        party = "robot" if kind is EventKind.ROBOT_REACH_STARTED else "giver"
-        if t < self.handover_t0 or (party in self._reach_by and kind in PHASE_OF_EVENT):
-            if kind in PHASE_OF_EVENT:
-                self.ignored += 1
-            return None
-        self._reach_by.add(party)
+        first. An earlier start also takes over the phase's source: the reach is the earlier
+        party's, whichever was told first."""
+        self._reach_by.add("robot" if kind is EventKind.ROBOT_REACH_STARTED else "giver")
         if t < self.phase_start:
             self.phase_start = t
             self.source = event_source(event)
-        return None
+            self.revision += 1
 
     def _enter(self, rule: Rule, t: float, event: Event) -> PhaseChange:
+        """Enter ``rule.dest`` at ``t`` (called before the machine moves: :attr:`phase` is
+        still the one left)."""
         previous, phase = self.phase, rule.dest
         assert phase is not None
         new = phase is not Phase.DONE and (
@@ -298,11 +410,11 @@ class HandoverState:
         if phase is Phase.REACH:
             by_robot = rule.trigger is EventKind.ROBOT_REACH_STARTED
             self._reach_by.add("robot" if by_robot else "giver")
-        self.phase = phase
         self.phase_start = t
         self._last_change = t
         self.source = event_source(event)
         info = event.info if isinstance(event.info, dict) else {}
         expected = info.get("expected_end", math.nan)
         self.event_end = float(expected) if _finite(expected) else math.nan
+        self.revision += 1
         return PhaseChange(phase, t, previous, self.source, new, rule)

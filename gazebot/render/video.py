@@ -13,37 +13,34 @@ The handover recording loop (``record_handover``, ``render_handover_video``) liv
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
-from types import TracebackType
 from typing import Any
 
 import numpy as np
+
+from gazebot.atomic import AtomicWriter
 
 # One encoder thread keeps the bit stream identical run to run (same seed, same bytes) and leaves
 # the other core to physics and rendering; CRF 20 at "veryfast" is visually clean at 640x480.
 H264_OUTPUT_PARAMS = ("-preset", "veryfast", "-crf", "20", "-threads", "1")
 
 
-class H264Writer:
+class H264Writer(AtomicWriter):
     """An open H.264 MP4 being written; use :func:`open_h264_writer` to make one.
 
-    Frames go to a temporary file; :meth:`close` finishes the stream and renames it to
-    :attr:`path`; :meth:`abort` (or leaving the ``with`` block by an exception) deletes it.
+    Frames go to a temporary file (:attr:`part`); :meth:`close` finishes the stream and renames
+    it to :attr:`path`; :meth:`abort` (or leaving the ``with`` block by an exception) deletes it.
     """
 
     def __init__(self, path: Path, fps: float, size: tuple[int, int]) -> None:
         import imageio_ffmpeg
 
-        self.path = path
+        super().__init__(path)
         self.fps = fps
         self.size = size  # (width, height) px
         self.frames = 0
-        path.parent.mkdir(parents=True, exist_ok=True)
-        # Same folder (so the rename is atomic), hidden, and still ending in .mp4 for the muxer.
-        self.tmp_path = path.with_name(f".{path.stem}.part{os.getpid()}-{id(self):x}.mp4")
         self._gen: Any = imageio_ffmpeg.write_frames(
-            str(self.tmp_path),
+            str(self.part),
             size,
             fps=fps,
             codec="libx264",
@@ -88,10 +85,10 @@ class H264Writer:
         self._open = False
         try:
             self._gen.close()
-            os.replace(self.tmp_path, self.path)
-        finally:
-            self.tmp_path.unlink(missing_ok=True)
-        return self.path
+        except BaseException:
+            self.part.unlink(missing_ok=True)
+            raise
+        return self._commit()
 
     def abort(self) -> None:
         """Stop encoding and delete the partial file (the target is left untouched)."""
@@ -101,21 +98,7 @@ class H264Writer:
                 self._gen.close()
             except Exception:  # noqa: BLE001 - already failing; the partial file goes anyway
                 pass
-        self.tmp_path.unlink(missing_ok=True)
-
-    def __enter__(self) -> H264Writer:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
+        self.part.unlink(missing_ok=True)
 
 
 def open_h264_writer(path: str | Path, fps: float, size: tuple[int, int]) -> H264Writer:

@@ -11,13 +11,12 @@ renamed into place on a clean close: a failed run leaves no file behind.
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
-from types import TracebackType
 
 from mcap.writer import CompressionType, Writer
 from rosbags.typesys.store import Typestore
 
+from gazebot.atomic import AtomicWriter
 from gazebot.ros2.codec import Codec
 from gazebot.ros2.errors import MessageError
 from gazebot.ros2.typestore import typestore
@@ -25,7 +24,7 @@ from gazebot.ros2.typestore import typestore
 LIBRARY = "gazebot"
 
 
-class McapRecorder:
+class McapRecorder(AtomicWriter):
     """Writes messages of any registered type to one MCAP file.
 
     Args:
@@ -46,10 +45,9 @@ class McapRecorder:
                  "none": CompressionType.NONE}
         if compression not in kinds:
             raise ValueError(f"compression must be one of {', '.join(kinds)}, not {compression!r}")
-        self.path = Path(path)
+        super().__init__(path)
         self.store = typestore() if store is None else store
-        self._part = self.path.with_name(self.path.name + ".part")
-        self._file = open(self._part, "wb")  # noqa: SIM115 - closed in close()/abort()
+        self._file = open(self.part, "wb")  # noqa: SIM115 - closed in close()/abort()
         self._writer = Writer(self._file, chunk_size=chunk_size, compression=kinds[compression])
         self._writer.start(profile="ros2", library=LIBRARY)
         self._schemas: dict[str, int] = {}
@@ -125,25 +123,10 @@ class McapRecorder:
             return self.path
         self._writer.finish()
         self._file.close()
-        os.replace(self._part, self.path)
-        return self.path
+        return self._commit()
 
     def abort(self) -> None:
         """Drop the partial file."""
         if not self._file.closed:
             self._file.close()
-        self._part.unlink(missing_ok=True)
-
-    def __enter__(self) -> McapRecorder:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
+        self.part.unlink(missing_ok=True)

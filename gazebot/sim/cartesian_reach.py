@@ -38,11 +38,13 @@ def scene_controllers_config(ctrl: ControllerConfig, robot_gives: bool) -> Contr
 
 @dataclass(frozen=True)
 class ReachStep:
-    """One tick of a Cartesian reach: arm joint goals and what the plan said."""
+    """One tick of a reach: arm joint goals and what the plan said; a torque-level reach (the
+    learned ``gps`` policy) also gives the joint torques to apply instead of going to ``q``."""
 
     q: np.ndarray
     velocity: np.ndarray
     plan: VelocityPlan | None  # the plan made this tick, None between plans
+    torque: np.ndarray | None = None  # N m, the arm's motors apply these (None: go to q)
 
 
 class CartesianReach:

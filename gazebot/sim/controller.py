@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +26,9 @@ from gazebot.sim.cartesian_reach import CartesianReach
 from gazebot.sim.motion import PEAK_RATE, MinJerkSegment
 from gazebot.sim.scene_config import ControllerConfig, RetreatTrigger
 from gazebot.types import Event, EventKind
+
+if TYPE_CHECKING:
+    from gazebot.sim.policy_reach import PolicyReach
 
 # An infeasible reach whose arm has stood still this long (s) has given up: the handover is over
 # ("If no feasible control input is found, the robot stops", the seed's STL reach).
@@ -68,6 +72,7 @@ class Sensed:
 class ArmCommand:
     arm: np.ndarray  # joint goals, rad, in the controller's joint order
     gripper: float  # 0 open .. 1 closed
+    torque: np.ndarray | None = None  # N m: a torque-level reach's command (None: go to arm)
 
 
 class HandoverController:
@@ -77,7 +82,8 @@ class HandoverController:
         home: Arm joint positions at home (rad).
         handover: Arm joint positions at the predefined handover pose (rad).
         config: Trigger distances and motion timing.
-        reach: A Cartesian reach controller on the arm (None: the joint-space move).
+        reach: A Cartesian reach controller on the arm, or the learned policy's torque-level
+            reach (:class:`~gazebot.sim.policy_reach.PolicyReach`); None: the joint-space move.
         start_at: Start the handover at this time (s) instead of on the giver's motion
             (robot-initiated handovers).
         target: The predefined handover location (m), for ``predetermined`` STL strategies.
@@ -99,7 +105,7 @@ class HandoverController:
         home: np.ndarray,
         handover: np.ndarray,
         config: ControllerConfig,
-        reach: CartesianReach | None = None,
+        reach: CartesianReach | PolicyReach | None = None,
         start_at: float | None = None,
         target: np.ndarray | None = None,
         giver: bool = False,
@@ -148,6 +154,7 @@ class HandoverController:
         self.gripper_infeasible_at: float | None = None
         self.dropped = False  # the object was left at the drop-off
         self._last_tick_dt: float | None = None
+        self._torque: np.ndarray | None = None  # this tick's torque-level reach command
         if self.pickup is not None:
             self.state = ControllerState.PICKING_UP
             self._gripper = 0.0  # open, empty
@@ -193,6 +200,7 @@ class HandoverController:
         if not np.all(np.isfinite(goal)):  # lost the hand: hold still
             return self.reach.hold()
         step = self.reach.update(t, dt, goal, target=self.target, robot_holds_object=self.grasped)
+        self._torque = step.torque
         if step.plan is not None and not step.plan.feasible and self.infeasible_at is None:
             self.infeasible_at = t
             self._emit(
@@ -326,6 +334,7 @@ class HandoverController:
         self._last_t = t
         self._last_tick_dt = dt
         self._last_q = np.asarray(q, float)
+        self._torque = None
         arm_goal: np.ndarray | None = None
         if self._hand0 is None and np.all(np.isfinite(sensed.giver_hand)):
             self._hand0 = sensed.giver_hand.copy()
@@ -401,7 +410,9 @@ class HandoverController:
                 arm_goal = self.reach.hold()
             else:
                 arm_goal = self.home
-        return ArmCommand(arm=arm_goal, gripper=self._gripper)
+        reaching = s in (ControllerState.REACHING, ControllerState.AT_HANDOVER)
+        torque = self._torque if reaching else None
+        return ArmCommand(arm=arm_goal, gripper=self._gripper, torque=torque)
 
     @property
     def grasped(self) -> bool:

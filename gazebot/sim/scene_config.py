@@ -84,6 +84,7 @@ class GiverConfig(_Strict):
 #: The reach without a controller: a joint-space minimum-jerk move to the predefined handover
 #: pose (the gaze studies' robot).
 JOINT_REACH = "joint"
+GPS_REACH = "gps"  # the learned reach: needs controller.policy
 
 
 def reach_controller_names() -> tuple[str, ...]:
@@ -146,6 +147,9 @@ class ControllerConfig(_Strict):
     )
     controllers: str | None = Field(
         default=None, description="controllers YAML (None: configs/controllers.yaml)"
+    )
+    policy: str | None = Field(
+        default=None, description="gps: the policy directory `gazebot gps train --out` wrote"
     )
     retreat: RetreatTrigger = RetreatTrigger.AFTER_RELEASE
     robot_start_s: float = Field(
@@ -256,6 +260,15 @@ class SceneConfig(_Strict):
                 raise ValueError(f"controller.{field} needs reach_controller: stl (Table 4.2)")
             if self.direction is not direction:
                 raise ValueError(f"controller.{field} needs direction: {direction.value}")
+        if ctrl.reach_controller == GPS_REACH and ctrl.policy is None:
+            raise ValueError("controller.policy (a directory from `gazebot gps train --out DIR`)"
+                             " is needed by reach_controller: gps")
+        if ctrl.policy is not None and ctrl.reach_controller != GPS_REACH:
+            raise ValueError("controller.policy is the gps controller's: it needs "
+                             "reach_controller: gps")
+        if ctrl.reach_controller == GPS_REACH and self.direction is Direction.ROBOT_TO_HUMAN:
+            raise ValueError("reach_controller: gps was trained to reach a person's hand to take"
+                             " from it: it needs direction: human-to-robot")
         return self
 
     @property

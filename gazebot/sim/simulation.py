@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -27,6 +28,7 @@ from gazebot.sim.receiver import ReceiverState, SimulatedReceiver
 from gazebot.sim.robot import SimRobot, load_sim_robot
 from gazebot.sim.scene import OBSERVER, Scene, build_scene
 from gazebot.sim.scene_config import (
+    GPS_REACH,
     JOINT_REACH,
     ControllerConfig,
     Direction,
@@ -37,8 +39,17 @@ from gazebot.sim.scene_config import (
     TrackingNoiseConfig,
     load_scene,
 )
+from gazebot.sim.torque_arm import (
+    JointImpedance,
+    arm_actuator,
+    impedance_from_model,
+    is_torque_motor,
+)
 from gazebot.sim.tracking import TrackingNoise
 from gazebot.types import Event, EventKind, TrackingFrame
+
+if TYPE_CHECKING:
+    from gazebot.sim.policy_reach import PolicyReach
 
 
 def _feedback_banner(frame: np.ndarray, text: str) -> np.ndarray:
@@ -110,8 +121,9 @@ class HandoverSimulation:
     """One simulated handover.
 
     Args:
-        robot: Robot name (``sawyer``, ``jaco2``), robot YAML path, parsed
-            :class:`~gazebot.kinematics.config.RobotConfig` or a :class:`SimRobot`.
+        robot: Robot name (``sawyer``, ``jaco2``, ``panda``: a torque-motor arm whose position
+            goals go through joint impedance, :mod:`gazebot.sim.torque_arm`), robot YAML path,
+            parsed :class:`~gazebot.kinematics.config.RobotConfig` or a :class:`SimRobot`.
         scene: Scene name (``configs/scenes/<name>.yaml``), YAML path or a :class:`SceneConfig`.
         seed: Seeds the giver's timing and the tracking noise (same seed, same handover).
         tracking_noise: Overrides the scene's tracking noise (``None``: the scene's).
@@ -139,7 +151,12 @@ class HandoverSimulation:
 
         m = self.model
         self._arm_qpos = np.array([m.joint(j).qposadr[0] for j in self.robot.arm_joints])
-        self._arm_act = np.array([self._actuator(j) for j in self.robot.arm_joints])
+        self._arm_act = np.array([self._arm_actuator(j) for j in self.robot.arm_joints])
+        self._arm_qvel = np.array([m.joint(j).dofadr[0] for j in self.robot.arm_joints])
+        # A torque-motor arm (the Panda learner) takes position goals through joint impedance.
+        self._impedance: JointImpedance | None = None
+        if all(is_torque_motor(m, a) for a in self._arm_act):
+            self._impedance = impedance_from_model(m, self._arm_act, self.robot.mjcf)
         self._head_act = {j: self._actuator(j) for j in self.robot.head_joints}
         self._head_qpos = {j: int(m.joint(j).qposadr[0]) for j in self.robot.head_joints}
         self._gripper_act = self._actuator(self.robot.gripper_actuator)
@@ -152,10 +169,15 @@ class HandoverSimulation:
         ]
 
         self._arm_lo, self._arm_hi = np.array([self._ctrl_limits(a) for a in self._arm_act]).T
+        if self._impedance is not None:  # goals are bounded by the joints, not the motors
+            joint_ids = [m.joint(j).id for j in self.robot.arm_joints]
+            self._arm_lo, self._arm_hi = m.jnt_range[joint_ids].T
         arm_ranges = np.array([m.jnt_range[m.joint(j).id] for j in self.robot.arm_joints])
         self.home = nearest_equivalent(self.robot.home, self.robot.handover, arm_ranges)
         self.data.qpos[self._arm_qpos] = self.home
-        self.data.ctrl[self._arm_act] = self.home
+        self._arm_goal = self.home.copy()
+        if self._impedance is None:
+            self.data.ctrl[self._arm_act] = self.home
         for j, a in self._head_act.items():
             self.data.ctrl[a] = self._clip_ctrl(a, self.data.qpos[self._head_qpos[j]])
         self.data.ctrl[self._gripper_act] = 0.0
@@ -214,10 +236,13 @@ class HandoverSimulation:
         mujoco.mj_forward(m, self.data)
 
     # ----------------------------------------------------------------------------- helpers
-    def _cartesian_reach(self, ctrl: ControllerConfig) -> CartesianReach | None:
-        """The seed's reach controller on the arm, or None for the joint-space reach."""
+    def _cartesian_reach(self, ctrl: ControllerConfig) -> CartesianReach | PolicyReach | None:
+        """The seed's reach controller on the arm (the learned ``gps`` policy's torque-level
+        reach on a torque arm), or None for the joint-space reach."""
         if ctrl.reach_controller == JOINT_REACH:
             return None
+        if ctrl.reach_controller == GPS_REACH:
+            return self._policy_reach(ctrl)
         from gazebot.controllers import make_controller
         from gazebot.controllers.arm_ik import ArmIK
         from gazebot.sim.cartesian_reach import scene_controllers_config
@@ -238,6 +263,28 @@ class HandoverSimulation:
         base = self.data.xpos[m.jnt_bodyid[m.joint(self.robot.arm_joints[0]).id]].copy()
         return CartesianReach(make_controller(ctrl.reach_controller, cfg), ik, base)
 
+    def _policy_reach(self, ctrl: ControllerConfig) -> PolicyReach:
+        """The ``gps`` policy of ``ctrl.policy`` on this robot's arm.
+
+        Raises:
+            ValueError: the robot's arm is not a torque-controlled Panda learner, or the policy
+                cannot run here (see :class:`~gazebot.controllers.gps.GPSController`).
+        """
+        from gazebot.controllers import CONTROLLERS
+        from gazebot.controllers.config import load_controllers_config
+        from gazebot.sim.policy_reach import PolicyReach
+
+        if self._impedance is None or len(self.robot.arm_joints) != 7:
+            raise ValueError(
+                f"controller 'gps' drives the Panda learner's seven joint torques: robot "
+                f"{self.robot.name!r} has no torque-controlled 7-joint arm (use --robot panda)"
+            )
+        policy = CONTROLLERS.make(GPS_REACH, load_controllers_config(ctrl.controllers),
+                                  policy=ctrl.policy)
+        mujoco.mj_kinematics(self.model, self.data)
+        return PolicyReach(policy, self.model, self.data, self.robot.arm_joints,
+                           self.robot.gripper_site)
+
     def _whole_task(self, ctrl: ControllerConfig) -> dict:
         """The pick-up / drop-off of Table 4.2's whole task, with the STL gripper (scene
         validation makes sure the reach is ``stl``)."""
@@ -253,6 +300,12 @@ class HandoverSimulation:
             "dropoff": None if ctrl.dropoff_m is None else np.asarray(ctrl.dropoff_m, float),
             "gripper": STLGripper(timing.stl, timing.dt_s),
         }
+
+    def _arm_actuator(self, joint: str) -> int:
+        act = arm_actuator(self.model, joint)
+        if act < 0:
+            raise ValueError(f"robot {self.robot.name!r} has no actuator on arm joint {joint!r}")
+        return act
 
     def _actuator(self, name: str) -> int:
         act = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
@@ -381,15 +434,43 @@ class HandoverSimulation:
         for e in events:
             self._on_robot_event(e)
         self._events.extend(events)
+        torque = None
         if not self._arm_external:
-            self.data.ctrl[self._arm_act] = np.clip(cmd.arm, self._arm_lo, self._arm_hi)
+            self._arm_goal = np.asarray(cmd.arm, float)
+            torque = cmd.torque
         self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, cmd.gripper)
         n = max(1, round((t - self.data.time) / self.model.opt.timestep))
-        mujoco.mj_step(self.model, self.data, nstep=n)
+        if self._impedance is None:
+            if not self._arm_external:
+                self.data.ctrl[self._arm_act] = np.clip(cmd.arm, self._arm_lo, self._arm_hi)
+            mujoco.mj_step(self.model, self.data, nstep=n)
+        else:
+            self._step_torque_arm(n, torque)
         self._t = t
         mujoco.mj_kinematics(self.model, self.data)
         self._place_kinematic()
         mujoco.mj_kinematics(self.model, self.data)
+
+    def _step_torque_arm(self, n: int, torque: np.ndarray | None) -> None:
+        """``n`` physics steps of a torque-motor arm: ``torque`` held (a torque-level reach),
+        else the joint impedance toward the arm goal evaluated every step. Never a non-finite
+        or out-of-bounds torque."""
+        imp = self._impedance
+        assert imp is not None
+        held = None
+        if torque is not None:
+            held = np.clip(np.asarray(torque, float), -imp.tau_max, imp.tau_max)
+            if not np.all(np.isfinite(held)):
+                held = None  # hold the posture instead
+                self._arm_goal = self.data.qpos[self._arm_qpos].copy()
+        for _ in range(n):
+            if held is not None:
+                self.data.ctrl[self._arm_act] = held
+            else:
+                self.data.ctrl[self._arm_act] = imp.torque(
+                    self._arm_goal, self.data.qpos[self._arm_qpos], self.data.qvel[self._arm_qvel]
+                )
+            mujoco.mj_step(self.model, self.data)
 
     def _sense_robot_giver(self, t: float, obj: np.ndarray) -> Sensed:
         """Robot-to-human: the person takes the object once it is within grasp, the robot lets
@@ -528,6 +609,12 @@ class HandoverSimulation:
             if not math.isfinite(value):
                 raise ValueError(f"arm joint {name!r} goal must be finite, got {value}")
         self._arm_external = True
+        if self._impedance is not None:  # goals for the joint impedance, within joint ranges
+            index = {j: i for i, j in enumerate(self.robot.arm_joints)}
+            for name, value in joints.items():
+                jr = self.model.jnt_range[self.model.joint(name).id]
+                self._arm_goal[index[name]] = min(max(float(value), jr[0]), jr[1])
+            return
         for name, value in joints.items():
             self.data.ctrl[arm[name]] = self._clip_ctrl(arm[name], float(value))
 

@@ -9,6 +9,7 @@ import csv
 from datetime import datetime, timezone
 from pathlib import Path
 
+from gazebot.atomic import atomic_path
 from gazebot.study.csvio import check_output_file
 from gazebot.study.folder import load_study
 from gazebot.study.store import QUESTION_KEYS
@@ -59,9 +60,7 @@ def export_responses(
     answers = study.store().answers(include_practice=include_practice)
     by_key = {(s.participant, s.session): s for s in study.plan}
     two_groups = len({a.mode for a in answers}) > 1
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(out.name + ".part")
-    with tmp.open("w", newline="", encoding="utf-8") as fh:
+    with atomic_path(out) as tmp, tmp.open("w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(EXPORT_COLUMNS)
         for a in answers:
@@ -98,5 +97,4 @@ def export_responses(
                     "" if seconds is None else f"{seconds:.3f}",
                 ]
             )
-    tmp.replace(out)
     return out, len(answers)

@@ -37,6 +37,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from gazebot.atomic import atomic_path
 from gazebot.study.cache import RenderFn, VideoSpec, code_version, inputs_digest
 from gazebot.study.pair_video import make_pair_video
 from gazebot.study.plan import Session, write_plan
@@ -135,31 +136,29 @@ def _render_video_job(
     file. ``pass_mode``: give the renderer the spec's ``gaze_mode``. The renderer's times sidecar
     is moved first (a renderer that writes none gets one with unknown times), so a cached video
     always has its times."""
-    tmp = out_path.with_name(out_path.stem + f".part{os.getpid()}.mp4")
-    tmp_times = times_path(tmp)
     extra = {"gaze_mode": spec.gaze_mode} if pass_mode else {}
-    try:
-        render_fn(
-            spec.robot,
-            spec.behavior,
-            spec.scene,
-            tmp,
-            seed=spec.seed,
-            width=spec.width,
-            height=spec.height,
-            fps=spec.fps,
-            progress=False,
-            **extra,
-        )
-        if not tmp.is_file() or tmp.stat().st_size == 0:
-            raise RuntimeError(f"renderer wrote no video for {spec}")
-        if read_video_times(tmp) is None:
-            write_video_times(tmp, VideoTimes())
-        os.replace(tmp_times, times_path(out_path))
-        os.replace(tmp, out_path)
-    finally:
-        tmp.unlink(missing_ok=True)
-        tmp_times.unlink(missing_ok=True)
+    with atomic_path(out_path) as tmp:
+        tmp_times = times_path(tmp)
+        try:
+            render_fn(
+                spec.robot,
+                spec.behavior,
+                spec.scene,
+                tmp,
+                seed=spec.seed,
+                width=spec.width,
+                height=spec.height,
+                fps=spec.fps,
+                progress=False,
+                **extra,
+            )
+            if not tmp.is_file() or tmp.stat().st_size == 0:
+                raise RuntimeError(f"renderer wrote no video for {spec}")
+            if read_video_times(tmp) is None:
+                write_video_times(tmp, VideoTimes())
+            os.replace(tmp_times, times_path(out_path))
+        finally:
+            tmp_times.unlink(missing_ok=True)
     return out_path
 
 

@@ -15,6 +15,8 @@ import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from gazebot.atomic import atomic_path
+
 __all__ = ["TIME_COLUMNS", "VideoTimes", "read_video_times", "times_path", "write_video_times"]
 
 PHASES = ("reach", "transfer", "retreat", "done")
@@ -86,9 +88,8 @@ def times_path(video: str | Path) -> Path:
 def write_video_times(video: str | Path, times: VideoTimes) -> Path:
     """Write ``times`` as ``video``'s sidecar (atomically) and return its path."""
     path = times_path(video)
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(asdict(times), indent=2, sort_keys=True), encoding="utf-8")
-    tmp.replace(path)
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(asdict(times), indent=2, sort_keys=True), encoding="utf-8")
     return path
 
 

@@ -8,6 +8,7 @@ import json
 
 import pytest
 
+from gazebot.behaviors import seed_behaviors
 from gazebot.behaviors.spec import AtEvent, AtNever
 
 cli = importlib.import_module("gazebot.cli.behaviors")
@@ -21,11 +22,8 @@ def run(argv: list[str]) -> int:
     return args.func(args)
 
 
-#: The seed's eight gaze behaviors (chapter 6).
-SEED_BEHAVIORS = (
-    "face", "hand", "face-hand-face", "hand-face", "short-face-hand", "long-face-hand",
-    "face-hand-face-as-studied", "hand-face-as-studied",
-)
+#: The seed's gaze behaviors (chapter 6): the built-ins whose YAML says ``source: seed``.
+SEED_BEHAVIORS = seed_behaviors()
 
 
 def test_list_json_lists_builtins_with_their_variants(capsys):

@@ -10,6 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gazebot.behaviors import BehaviorMachine, list_behaviors, load_behavior
+from gazebot.behaviors.machine import Tick
 from gazebot.types import Event, EventKind, GazeContext, Phase
 
 SPECS = {info.name: load_behavior(info.name) for info in list_behaviors([])}
@@ -102,6 +103,74 @@ def test_shuffled_and_duplicated_handover_events_end_in_a_defined_state(name, or
     m.handle(Event(EventKind.HANDOVER_DONE, 4.0, 4.0))
     assert m.target(_ctx(4.0, Phase.DONE, 3.5, math.nan, None, None)).kind == SPECS[name].after
     assert m.state.startswith("done_")
+
+
+class _TimerEveryTick(BehaviorMachine):
+    """A machine fed the ``timer`` trigger on every tick (no tick skipped)."""
+
+    def advance(self, t: float, tracking_end: float | None = None) -> None:
+        if tracking_end is not None:
+            self._tracking_end = tracking_end
+        self._model.trigger("timer", Tick(t, self._tracking_end))
+
+
+EVERY_TICK = {name: _TimerEveryTick(spec) for name, spec in SPECS.items()}
+_HANDOVER = (
+    EventKind.ROBOT_REACH_STARTED,
+    EventKind.REACH_STARTED,
+    EventKind.ROBOT_REACH_ENDED,
+    EventKind.ROBOT_GRASPED,
+    EventKind.TRANSFER_STARTED,
+    EventKind.ROBOT_RETREAT_STARTED,
+    EventKind.RETREAT_STARTED,
+    EventKind.ROBOT_RELEASED,
+    EventKind.TRACKING_LOST,
+    EventKind.TRACKING_RESTORED,
+    EventKind.HANDOVER_DONE,
+)
+
+
+@st.composite
+def handover_steps(draw) -> list:
+    """A handover-like stream: its events (each maybe missing, at jittered times, a planned
+    duration for the robot's motions) and ticks every 25 ms with revised end estimates."""
+    out: list = []
+    for i, kind in enumerate(_HANDOVER * draw(st.integers(1, 2))):
+        if draw(st.booleans()) or draw(st.booleans()):
+            t = 0.4 * i + draw(st.floats(-0.3, 0.3))
+            planned = draw(st.one_of(st.none(), st.floats(0.1, 2.0)))
+            out.append((t, Event(kind, t, t, {} if planned is None else
+                                 {"planned_duration": planned})))
+    ends = draw(st.lists(st.one_of(st.just(math.nan), st.floats(-0.2, 1.5)), min_size=1))
+    for k in range(int(0.4 * 2 * len(_HANDOVER) / 0.025)):
+        t = 0.025 * k
+        out.append((t, (t, Phase.IDLE, 0.0, t + ends[(k // 8) % len(ends)], None, None)))
+    out.sort(key=lambda item: item[0])
+    return [item for _, item in out]
+
+
+@settings(max_examples=150, deadline=None, derandomize=True)
+@given(
+    name=st.sampled_from(sorted(SPECS)),
+    seed=st.integers(0, 2**16),
+    script=st.one_of(handover_steps(), steps),
+)
+def test_a_skipped_timer_tick_never_changes_a_decision(name, seed, script):
+    # The machine skips the timer trigger while its last schedule says nothing can start; a
+    # machine triggered on every tick must pick the same targets by the same rules.
+    fed, skipping = EVERY_TICK[name], MACHINES[name]
+    fed.reset(seed)
+    skipping.reset(seed)
+    for step in script:
+        if isinstance(step, Event):
+            fed.handle(step)
+            skipping.handle(step)
+            continue
+        c = _ctx(*step)
+        a, b = fed.target(c), skipping.target(c)
+        assert a.kind == b.kind and np.array_equal(a.point, b.point, equal_nan=True)
+        assert (fed.state, fed.origin, fed.ignored) == (skipping.state, skipping.origin,
+                                                        skipping.ignored)
 
 
 def test_a_duplicated_reach_start_keeps_the_first_start_time():

@@ -9,19 +9,12 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
+from gazebot.behaviors import seed_behaviors
 from gazebot.engine import GazeEngine
 from gazebot.types import Event, EventKind, TrackingFrame
 
-SEED_BEHAVIORS = (
-    "face",
-    "hand",
-    "short-face-hand",
-    "long-face-hand",
-    "hand-face",
-    "face-hand-face",
-    "hand-face-as-studied",
-    "face-hand-face-as-studied",
-)
+#: The seed's gaze behaviors (chapter 6): the built-ins whose YAML says ``source: seed``.
+SEED_BEHAVIORS = seed_behaviors()
 RATE = 120.0
 FACE = np.array([1.15, 0.0, 1.62])
 HAND_REST = np.array([1.0, -0.22, 0.92])

@@ -15,6 +15,7 @@ from gazebot.behaviors import (
     behavior_path,
     list_behaviors,
     load_behavior,
+    seed_behaviors,
 )
 from gazebot.config import ConfigError
 from gazebot.types import EventKind
@@ -44,6 +45,13 @@ def test_every_builtin_behavior_is_listed_and_loads():
     for name in BUILTINS:
         spec = load_behavior(name)
         assert spec.name == name and spec.description
+
+
+def test_the_seed_behaviors_are_the_builtins_whose_source_is_the_seed():
+    # Every test that runs "the seed's behaviors" takes them from seed_behaviors(); here they are
+    # pinned: the eight of chapter 6, not the data-driven human-receiver.
+    assert set(seed_behaviors()) == BUILTINS - {"human-receiver"}
+    assert all(load_behavior(n).source.startswith("seed ") for n in seed_behaviors())
 
 
 def test_at_accepts_fraction_mapping_event_offset_never_and_parameters(tmp_path):

@@ -5,37 +5,14 @@ numbers in the documented JSON shape."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pytest
 import yaml
 
 from gazebot.cli import main
-from gazebot.gps.config import default_gps_path
 
 pytest.importorskip("jax", reason="gazebot gps needs the optional extra gazebot[gps]")
 pytest.importorskip("sklearn", reason="gazebot gps needs the optional extra gazebot[gps]")
-
-
-@pytest.fixture(scope="module")
-def tiny_config(tmp_path_factory) -> Path:
-    data = yaml.safe_load(default_gps_path().read_text(encoding="utf-8"))
-    data["scene"]["trial_s"] = 1.0
-    data["shell"]["azimuth_step_deg"] = 45.0  # 3 azimuths
-    data["gps"].update(samples=3, policy_steps=200, batch=64, gmm_clusters=2,
-                       inner_iterations=2)
-    path = tmp_path_factory.mktemp("cfg") / "gps.yaml"
-    path.write_text(yaml.safe_dump(data), encoding="utf-8")
-    return path
-
-
-@pytest.fixture(scope="module")
-def trained(tiny_config, tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("policy")
-    assert main(["gps", "train", "--controllers", "8", "--trainer", "static", "--state",
-                 "reduced", "--iterations", "4", "--config", str(tiny_config), "--out",
-                 str(out), "--quiet"]) == 0
-    return out
 
 
 def test_training_lowers_the_local_controllers_cost_and_saves_the_policy(trained):

@@ -119,3 +119,52 @@ def test_every_rule_is_reachable_from_its_sources():
     for rule in RULES:
         for source in rule.sources:
             assert rule.dest is None or rule.dest is not source, rule
+
+
+def test_the_machine_is_built_from_the_rule_table():
+    s = HandoverState()
+    assert s.definition["states"] == [p.value for p in Phase]
+    rows = [(r, src) for r in RULES for src in r.sources]
+    transitions = s.definition["transitions"]
+    assert len(transitions) == len(rows)
+    for (rule, source), t in zip(rows, transitions, strict=True):
+        assert (t["trigger"], t["source"]) == (rule.trigger.value, source.value)
+        assert t["dest"] == (rule.dest.value if rule.dest is not None else None)  # None: stays
+        assert [c.__name__ for c in t["conditions"]] == [rule.condition]
+
+
+# How to be in each phase of a handover whose last change was at 1.0 s (in a reach: the other
+# party's reach start than the rule's).
+_INTO = {
+    Phase.IDLE: [],
+    Phase.REACH: [("robot_reach_started", 1.0)],
+    (Phase.REACH, EventKind.ROBOT_REACH_STARTED): [("reach_started", 1.0)],
+    Phase.TRANSFER: [("transfer_started", 1.0)],
+    Phase.RETREAT: [("retreat_started", 1.0)],
+    Phase.DONE: [("reach_started", 0.5), ("handover_done", 1.0)],
+}
+
+
+@pytest.mark.parametrize(
+    ("rule", "source"), [(r, src) for r in RULES for src in r.sources],
+    ids=lambda x: x.value if isinstance(x, Phase) else x.trigger.value,
+)
+def test_every_row_of_the_table_does_what_it_says(rule, source):
+    s = HandoverState()
+    for kind, t in _INTO.get((source, rule.trigger), _INTO[source]):
+        s.apply(ev(kind, t))
+    assert s.phase is source
+    start = s.phase_start
+    if rule.dest is None:  # the other party's reach: the phase stays, its start moves earlier
+        assert s.would_move(ev(rule.trigger.value, 0.8)) is None
+        assert s.apply(ev(rule.trigger.value, 0.8)) is None
+        assert (s.phase, s.phase_start, s.ignored) == (source, 0.8, 0)
+        return
+    if source is not Phase.IDLE:
+        stale = ev(rule.trigger.value, 0.9)  # older than the last phase change
+        assert s.would_move(stale) is None and s.apply(stale) is None and s.phase is source
+        assert s.phase_start == start
+    assert s.would_move(ev(rule.trigger.value, 2.0)) == 2.0
+    change = s.apply(ev(rule.trigger.value, 2.0))
+    assert change is not None and change.rule == rule
+    assert (s.phase, s.phase_start, change.previous) == (rule.dest, 2.0, source)

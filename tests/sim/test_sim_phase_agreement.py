@@ -16,22 +16,14 @@ from __future__ import annotations
 
 import pytest
 
-from gazebot.behaviors import GazeOrigin
+from gazebot.behaviors import GazeOrigin, seed_behaviors
 from gazebot.sim.scene_config import Initiator, load_scene, scene_names
 from gazebot.types import Phase
 
 pytest.importorskip("mujoco")
 
-SEED_BEHAVIORS = (
-    "face",
-    "hand",
-    "short-face-hand",
-    "long-face-hand",
-    "hand-face",
-    "face-hand-face",
-    "face-hand-face-as-studied",
-    "hand-face-as-studied",
-)
+#: The seed's gaze behaviors (chapter 6): the built-ins whose YAML says ``source: seed``.
+SEED_BEHAVIORS = seed_behaviors()
 
 
 class _SharedDetector:

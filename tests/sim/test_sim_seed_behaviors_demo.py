@@ -14,20 +14,13 @@ import itertools
 
 import pytest
 
+from gazebot.behaviors import seed_behaviors
 from gazebot.types import EventKind
 
 pytest.importorskip("mujoco")
 
-SEED_BEHAVIORS = (
-    "face",
-    "hand",
-    "short-face-hand",
-    "long-face-hand",
-    "hand-face",
-    "face-hand-face",
-    "face-hand-face-as-studied",
-    "hand-face-as-studied",
-)
+#: The seed's gaze behaviors (chapter 6): the built-ins whose YAML says ``source: seed``.
+SEED_BEHAVIORS = seed_behaviors()
 SHIFT_TOL_S = 0.05  # the "within 50 ms"
 
 

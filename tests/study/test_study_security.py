@@ -269,6 +269,34 @@ def test_csrf_tokens_are_random_per_visitor_and_per_admin_session(study_dir):
     assert c.get("/admin").status_code == 403
 
 
+class _Clock:
+    """A Unix clock moved by hand."""
+
+    def __init__(self, now: float) -> None:
+        self.now = now
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_an_admin_sign_in_expires_and_asks_for_the_token_again(study_dir):
+    clock = _Clock(1_800_000_000.0)
+    _, c = _client(study_dir, remote="192.0.2.7", admin_session_s=3600, clock=clock)
+    _sign_in(c)
+    cookie = c.get_cookie(ADMIN_COOKIE)
+    assert cookie.max_age == 3600
+    clock.now += 3599
+    assert c.get("/admin").status_code == 200
+    clock.now += 2  # one hour and a second after the sign-in
+    assert c.get("/admin").status_code == 403
+    # A cookie whose time was edited by hand is no sign-in either (the MAC covers the time).
+    sid, issued, mac = cookie.value.split(".")
+    c.set_cookie(ADMIN_COOKIE, f"{sid}.{int(clock.now)}.{mac}")
+    assert c.get("/admin").status_code == 403
+    _sign_in(c)  # signing in again opens it
+    assert c.get("/admin").status_code == 200
+
+
 def test_a_body_over_the_cap_is_refused_with_413(study_dir):
     web, c = _client(study_dir)
     link = web.link_path(2)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import ipaddress
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from functools import wraps
@@ -48,6 +49,7 @@ from gazebot.study.questionnaire import (
 )
 from gazebot.study.store import Progress, ResponseStore
 from gazebot.study.web.security import (
+    ADMIN_SESSION_MAX_AGE_S,
     LOOPBACK_HOSTS,
     MAX_BODY_BYTES,
     admin_cookie,
@@ -150,6 +152,8 @@ def create_app(
     admin_token: str | None = None,
     local_admin: bool = False,
     allowed_hosts: tuple[str, ...] = LOOPBACK_HOSTS,
+    admin_session_s: float = ADMIN_SESSION_MAX_AGE_S,
+    clock: Callable[[], float] = time.time,
 ) -> Flask:
     """The Flask app of the rendered study in ``study_dir`` (answers in
     ``study_dir/responses.sqlite``). ``admin_token``: the token that opens ``/admin`` (default:
@@ -157,7 +161,9 @@ def create_app(
     token to requests from the loopback interface (any user or program on this machine, and on
     Debian a browser on it that opens the machine's own name, which resolves to 127.0.1.1);
     ``allowed_hosts``: the names a request's ``Host`` may give (an IP address is always
-    accepted, see :func:`~gazebot.study.web.security.host_allowed`), anything else is 400."""
+    accepted, see :func:`~gazebot.study.web.security.host_allowed`), anything else is 400;
+    ``admin_session_s``: how long a sign-in lasts (then the token is asked again); ``clock``:
+    the Unix time in s."""
     study = load_study(study_dir)
     store = study.store()
     web = StudyWeb(study, store, store.links(study.participants), store.secret("csrf"))
@@ -195,7 +201,7 @@ def create_app(
         its forms' CSRF tokens are bound to a secret cookie all the same."""
         if "admin_session" not in g:
             cookie = request.cookies.get(ADMIN_COOKIE, "")
-            sid = admin_session_of(web.csrf_key, admin_token, cookie)
+            sid = admin_session_of(web.csrf_key, admin_token, cookie, clock(), admin_session_s)
             if sid is None and local_admin and _is_loopback(request.remote_addr):
                 sid = g.new_admin_session = new_token()
             g.admin_session = sid
@@ -256,8 +262,14 @@ def create_app(
         if g.get("new_visitor"):
             resp.set_cookie(VISITOR_COOKIE, g.visitor, httponly=True, samesite="Lax")
         if g.get("new_admin_session"):
-            cookie = admin_cookie(web.csrf_key, admin_token, g.new_admin_session)
-            resp.set_cookie(ADMIN_COOKIE, cookie, httponly=True, samesite="Strict")
+            cookie = admin_cookie(web.csrf_key, admin_token, g.new_admin_session, int(clock()))
+            resp.set_cookie(
+                ADMIN_COOKIE,
+                cookie,
+                max_age=int(admin_session_s),
+                httponly=True,
+                samesite="Strict",
+            )
         return resp
 
     def page(template: str, status: int = 200, **kw: object):

@@ -67,18 +67,36 @@ def csrf_token(secret: bytes, scope: str, session: str) -> str:
     return _mac(secret, f"csrf:{scope}:{session}")
 
 
-def admin_cookie(secret: bytes, admin_token: str, session: str) -> str:
-    """The admin session cookie of the random id ``session``: ``SESSION.MAC``, the MAC keyed by
-    the server's secret over the id and the admin token (a new token ends every session)."""
-    return f"{session}.{_mac(secret, f'admin-session:{admin_token}:{session}')}"
+#: How long an experimenter's sign-in lasts (s): a working day, so a cookie left in a shared
+#: lab browser stops opening ``/admin`` by the next session.
+ADMIN_SESSION_MAX_AGE_S = 12 * 3600
 
 
-def admin_session_of(secret: bytes, admin_token: str, cookie: str) -> str | None:
-    """The session id of a valid admin cookie (see :func:`admin_cookie`), else ``None``."""
-    session, _, _ = cookie.partition(".")
-    if not is_link_token(session):
+def admin_cookie(secret: bytes, admin_token: str, session: str, issued: int) -> str:
+    """The admin session cookie of the random id ``session`` signed in at ``issued`` (Unix
+    time, s): ``SESSION.ISSUED.MAC``, the MAC keyed by the server's secret over the id, the
+    time and the admin token (a new token ends every session)."""
+    return f"{session}.{issued}.{_mac(secret, f'admin-session:{admin_token}:{session}:{issued}')}"
+
+
+def admin_session_of(
+    secret: bytes,
+    admin_token: str,
+    cookie: str,
+    now: float,
+    max_age_s: float = ADMIN_SESSION_MAX_AGE_S,
+) -> str | None:
+    """The session id of a valid admin cookie (see :func:`admin_cookie`) issued at most
+    ``max_age_s`` before ``now`` (and not in the future), else ``None``."""
+    session, _, rest = cookie.partition(".")
+    issued_text, _, _ = rest.partition(".")
+    if not is_link_token(session) or not issued_text.isdigit() or len(issued_text) > 12:
         return None
-    return session if tokens_equal(cookie, admin_cookie(secret, admin_token, session)) else None
+    issued = int(issued_text)
+    if not 0 <= now - issued <= max_age_s:
+        return None
+    expected = admin_cookie(secret, admin_token, session, issued)
+    return session if tokens_equal(cookie, expected) else None
 
 
 def tokens_equal(given: str, expected: str) -> bool:
