@@ -44,7 +44,6 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
-from itertools import islice
 
 import numpy as np
 
@@ -63,11 +62,51 @@ from gazebot.types import Event, EventKind, Phase, TrackingFrame
 
 def _point(p: object) -> np.ndarray:
     """A point as a float 3-vector (NaNs if it is not a numeric 3-vector)."""
+    if type(p) is np.ndarray and p.dtype == np.float64 and p.shape == (3,):
+        return p  # the usual case (the engine's frames): no conversion
     try:
         v = np.asarray(p, dtype=float).reshape(-1)
     except (TypeError, ValueError):
         return np.full(3, np.nan)
     return v if v.shape == (3,) else np.full(3, np.nan)
+
+
+class _Samples:
+    """The samples kept (rows ``[t, giver xyz, receiver xyz]``) in one array that grows and is
+    compacted in place: the analysis reads them as views, with no per-sample conversion."""
+
+    def __init__(self) -> None:
+        self._buf = np.empty((256, 7))
+        self._s0 = self._s1 = 0
+
+    def __len__(self) -> int:
+        return self._s1 - self._s0
+
+    def append(self, row: list[float]) -> None:
+        buf = self._buf
+        if self._s1 == buf.shape[0]:
+            m = self._s1 - self._s0
+            if 2 * m > buf.shape[0]:
+                self._buf = np.empty((2 * buf.shape[0], 7))
+            self._buf[:m] = buf[self._s0 : self._s1]
+            buf, self._s0, self._s1 = self._buf, 0, m
+        buf[self._s1] = row
+        self._s1 += 1
+
+    def drop_before(self, t0: float) -> None:
+        """Forget the samples older than ``t0``."""
+        buf, i, end = self._buf, self._s0, self._s1
+        while i < end and buf[i, 0] < t0:
+            i += 1
+        self._s0 = i
+
+    def time(self, i: int) -> float:
+        """Time of the ``i``-th sample kept."""
+        return float(self._buf[self._s0 + i, 0])
+
+    def rows(self) -> np.ndarray:
+        """The samples kept (a view: valid until the next :meth:`append`)."""
+        return self._buf[self._s0 : self._s1]
 
 
 @dataclass
@@ -107,9 +146,7 @@ class PhaseDetector:
         self.tracking = True
         self.stats = DetectorStats()
         self._queue: deque[Event] = deque()
-        self._t: deque[float] = deque()
-        self._g: deque[np.ndarray] = deque()
-        self._r: deque[np.ndarray] = deque()
+        self._samples = _Samples()
         self._last_t = -math.inf
         self._last_analysis = -math.inf
         self._seen_g = self._seen_r = math.nan  # last valid sample of each hand
@@ -190,7 +227,7 @@ class PhaseDetector:
     # ----------------------------------------------------------------- internals
     def _enter(self, phase: Phase, t0: float) -> None:
         # Joined late: fewer than two samples seen before the phase's start.
-        self._joined_late = len(self._t) < 3 or self._t[1] >= t0
+        self._joined_late = len(self._samples) < 3 or self._samples.time(1) >= t0
         self.phase = phase
         self.phase_start = t0
         self._floor = t0
@@ -228,14 +265,14 @@ class PhaseDetector:
         st.samples += 1
         c = self.config
         g, r = _point(frame.giver_hand), _point(frame.receiver_hand)
-        g_ok, r_ok = bool(np.isfinite(g).all()), bool(np.isfinite(r).all())
-        self._t.append(t)
-        self._g.append(g)
-        self._r.append(r)
-        while self._t and self._t[0] < t - c.online_window:
-            self._t.popleft()
-            self._g.popleft()
-            self._r.popleft()
+        gx, gy, gz = g.tolist()
+        rx, ry, rz = r.tolist()
+        finite = math.isfinite
+        g_ok = finite(gx) and finite(gy) and finite(gz)
+        r_ok = finite(rx) and finite(ry) and finite(rz)
+        samples = self._samples
+        samples.append([t, gx, gy, gz, rx, ry, rz])
+        samples.drop_before(t - c.online_window)
         if g_ok:
             self._seen_g = t
         if r_ok:
@@ -245,7 +282,7 @@ class PhaseDetector:
         if not (g_ok and r_ok):
             st.held += 1
             if self.tracking:
-                first = self._t[0]
+                first = samples.time(0)
                 last_g = self._seen_g if self._seen_g == self._seen_g else first
                 last_r = self._seen_r if self._seen_r == self._seen_r else first
                 last = min(last_g, last_r)
@@ -315,10 +352,11 @@ class PhaseDetector:
         prediction from the signals)."""
         c = self.config
         self.stats.analyses += 1
-        n = len(self._t)
+        n = len(self._samples)
         if n < 3:
             return
-        t = np.fromiter(self._t, float, n)
+        rows = self._samples.rows()
+        t = rows[:, 0]
         i0 = 0
         if self.phase is not Phase.IDLE and math.isfinite(self.phase_start):
             # After contact the rules need the hold and what follows, a reach (or, once done,
@@ -329,11 +367,8 @@ class PhaseDetector:
             i0 = int(np.searchsorted(t, self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
-        traj = Trajectory(
-            t[i0:],
-            np.array(list(islice(self._g, i0, None))),
-            np.array(list(islice(self._r, i0, None))),
-        )
+        window = rows[i0:]
+        traj = Trajectory(window[:, 0].copy(), window[:, 1:4].copy(), window[:, 4:].copy())
         s = self.segmenter.online_signals(traj)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
@@ -456,7 +491,8 @@ class PhaseDetector:
             return None
         # the last sample of the last rest at least reach_stall long
         edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
-        runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+        bounds = edges.tolist()  # (plain ints: iterating the array would box each element)
+        runs = [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
         runs = [(a, b) for a, b in runs if b - a + 1 >= need and b < rest.size - 1]
         if not runs:
             return None

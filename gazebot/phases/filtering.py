@@ -8,14 +8,21 @@
 3. Zero-lag Gaussian smoothing (``smoothing``, never narrower than two input samples) and
    velocities by central differences, unknown next to a tracking gap (where the window is
    one-sided and would flatten the motion into a false rest).
+
+Both hands go through each step together (one array of six columns): the online detector runs
+this every few ticks on a few hundred samples, where numpy's per-call overhead, not the
+arithmetic, sets the cost. The result is, bit for bit, what the steps give one hand at a time
+(``tests/phases/signals_reference.py`` keeps that form and the tests compare the two).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d
+from scipy.ndimage import correlate1d, gaussian_filter1d
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.trajectory import Trajectory
@@ -71,106 +78,223 @@ class Signals:
         return float(self.t[1] - self.t[0]) if self.t.shape[0] > 1 else 0.0
 
 
-def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float) -> np.ndarray:
-    """``p`` with stale repeats set to NaN: a sample exactly equal to the previous valid one,
-    while the hand moved faster than ``moving_speed`` between the two valid samples before."""
-    out = p.copy()
-    ok = np.flatnonzero(np.isfinite(p).all(axis=1))
-    if ok.size < 3:
-        return out
-    same = np.all(p[ok[1:]] == p[ok[:-1]], axis=1)
+def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarray) -> np.ndarray:
+    """Which rows of ``p`` are stale repeats (a bool mask): a sample exactly equal to the
+    previous valid one (``ok``: the valid rows), while the hand moved faster than
+    ``moving_speed`` between the two valid samples before."""
+    stale = np.zeros(p.shape[0], dtype=bool)
+    idx = np.flatnonzero(ok)
+    if idx.size < 3:
+        return stale
+    pv = p[idx]
+    same = (pv[1:] == pv[:-1]).all(axis=1)
     if not same.any():
-        return out
-    last_fresh = -1  # index into ok of the last sample that was not a repeat
+        return stale
+    last_fresh = -1  # index into idx of the last sample that was not a repeat
     prev_fresh = -1
-    for k in range(1, ok.size):
-        if not same[k - 1]:
+    for k, rep in enumerate(same.tolist(), start=1):
+        if not rep:
             prev_fresh, last_fresh = last_fresh, k
             continue
         if last_fresh < 0 or prev_fresh < 0:
             continue
-        i0, i1 = ok[prev_fresh], ok[last_fresh]
+        i0, i1 = idx[prev_fresh], idx[last_fresh]
         dt = t[i1] - t[i0]
         v = float(np.linalg.norm(p[i1] - p[i0]) / dt) if dt > 0 else 0.0
         if v > moving_speed:
-            out[ok[k]] = np.nan
-    return out
+            stale[idx[k]] = True
+    return stale
 
 
-def resample(t: np.ndarray, p: np.ndarray, grid: np.ndarray, max_gap: float) -> np.ndarray:
-    """Linear interpolation of the valid rows of ``p`` onto ``grid``; NaN inside long gaps."""
-    ok = np.isfinite(p).all(axis=1)
-    out = np.full((grid.shape[0], 3), np.nan)
-    if np.count_nonzero(ok) < 2:
-        return out
-    tv, pv = t[ok], p[ok]
-    for k in range(3):
-        out[:, k] = np.interp(grid, tv, pv[:, k])
+def _far_from_samples(tv: np.ndarray, grid: np.ndarray, bar: float) -> np.ndarray:
+    """Grid points inside a gap longer than ``bar`` between the valid sample times ``tv`` (or
+    outside them), unless the point is a sample itself."""
     j = np.searchsorted(tv, grid, side="right")
-    inside = (j > 0) & (j < tv.shape[0])
     gap = np.full(grid.shape[0], np.inf)
-    gap[inside] = tv[j[inside]] - tv[j[inside] - 1]
+    inside = (j > 0) & (j < tv.shape[0])
+    ji = j[inside]
+    gap[inside] = tv[ji] - tv[ji - 1]
     # grid points that are samples (both sorted: a searchsorted, not np.isin's sort)
     k = np.minimum(np.searchsorted(tv, grid), tv.shape[0] - 1)
-    exact = tv[k] == grid
-    out[(gap > max_gap + 1e-9) & ~exact] = np.nan
+    return (gap > bar) & (tv[k] != grid)
+
+
+def resample(
+    t: np.ndarray, p: np.ndarray, ok: np.ndarray | None, grid: np.ndarray, max_gap: float
+) -> np.ndarray:
+    """Linear interpolation of the valid rows (``ok``; ``None``: all) of ``p`` (N, 3 or 6: two
+    hands that share ``ok``) onto ``grid``; NaN inside gaps longer than ``max_gap``."""
+    out = np.full((grid.shape[0], p.shape[1]), np.nan)
+    tv, pv = (t, p) if ok is None else (t[ok], p[ok])
+    if tv.shape[0] < 2:
+        return out
+    for k in range(p.shape[1]):
+        out[:, k] = np.interp(grid, tv, pv[:, k])
+    bar = max_gap + 1e-9
+    if float(np.max(np.diff(tv))) <= bar:
+        # No gap between the samples is that long (the usual case): only the grid points
+        # before the first sample or after the last one are far from them.
+        out[: int(np.searchsorted(grid, tv[0], side="left"))] = np.nan
+        out[int(np.searchsorted(grid, tv[-1], side="right")) :] = np.nan
+    else:
+        out[_far_from_samples(tv, grid, bar)] = np.nan
     return out
 
 
-def _gauss(x: np.ndarray, sigma: float) -> np.ndarray:
-    """Gaussian smoothing along axis 0, edges padded with the end values (scipy.ndimage)."""
-    return gaussian_filter1d(x, sigma, axis=0, mode="nearest", truncate=3.0)
+@lru_cache(maxsize=16)
+def _seen_share(sigma: float) -> float:
+    """The smoothed "seen" mask of a hand seen at every row: the same value everywhere (the
+    filter sums the same products at each row), computed once per ``sigma``."""
+    return float(correlate1d(np.ones(1), gaussian_weights(sigma), mode="nearest")[0])
 
 
-def smooth(x: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
-    """NaN-aware Gaussian smoothing along axis 0 (normalised convolution), zero lag.
+@lru_cache(maxsize=16)
+def gaussian_weights(sigma: float) -> np.ndarray:
+    """The weights ``scipy.ndimage.gaussian_filter1d(x, sigma, truncate=3.0)`` correlates with
+    (its response to a unit impulse: a sum of one product and zeros, so exactly its weights),
+    computed once per ``sigma``."""
+    radius = int(3.0 * float(sigma) + 0.5)
+    impulse = np.zeros(2 * radius + 1)
+    impulse[radius] = 1.0
+    w = gaussian_filter1d(impulse, sigma, mode="nearest", truncate=3.0)
+    w.setflags(write=False)
+    return w
 
-    Returns the smoothed rows and, per row, the share of the smoothing window that held data
-    (1 away from tracking gaps)."""
-    m = np.isfinite(x).all(axis=1)
+
+def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """NaN-aware Gaussian smoothing along axis 0 (normalised convolution), zero lag, edges
+    padded with the end values. ``x`` holds one hand per three columns, ``m`` (N, hands) which
+    rows of each hand hold data.
+
+    Returns the smoothed rows and, per row and hand, the share of the smoothing window that
+    held data (1 away from tracking gaps)."""
+    hands = m.shape[1]
     if sigma <= 0 or x.shape[0] < 2:
         return x, m.astype(float)
-    num = _gauss(np.where(m[:, None], x, 0.0), sigma)
-    den = _gauss(m.astype(float), sigma)
-    out = num / np.maximum(den, 1e-12)[:, None]
+    rows = x.shape[0]
+    w = gaussian_weights(sigma)
+    if m.all():
+        # Every row seen (the usual case): only the positions need smoothing; the seen share
+        # is the same at every row.
+        share = _seen_share(sigma)
+        den = np.full((rows, hands), share)
+        out = correlate1d(x, w, axis=0, mode="nearest") / max(share, 1e-12)
+        if share < 0.5:
+            out[:] = np.nan
+        return out, den
+    # per row and hand: x, y, z (0 where unseen) and whether seen; smoothed in one call
+    stack = np.empty((rows, hands, 4))
+    stack[:, :, :3] = x.reshape(rows, hands, 3)
+    np.copyto(stack[:, :, :3], 0.0, where=~m[:, :, None])
+    stack[:, :, 3] = m
+    both = correlate1d(stack, w, axis=0, mode="nearest")
+    den = both[:, :, 3]
+    out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
     out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
-    return out, den
+    return out.reshape(rows, 3 * hands), den
+
+
+def _median(x: np.ndarray) -> float:
+    """``np.median`` of a non-empty 1-D float array (the middle value, or the mean of the two
+    middle ones; NaN if any is NaN), without its generic machinery."""
+    n = x.shape[0]
+    h = n // 2
+    kth = [h, n - 1] if n % 2 else [h - 1, h, n - 1]
+    part = np.partition(x, kth)
+    if math.isnan(part[-1]):
+        return math.nan
+    return float(part[h]) if n % 2 else (float(part[h - 1]) + float(part[h])) / 2.0
+
+
+def quantile(x: np.ndarray, q: float) -> float:
+    """``np.quantile(x, q)`` (its default ``linear`` method) of a non-empty 1-D float array
+    without NaN: the two order statistics around ``(n - 1) q`` and numpy's interpolation
+    between them, without its generic machinery (the transfer rule reads one per analysis)."""
+    n = x.shape[0]
+    vi = (n - 1) * q
+    if vi >= n - 1:
+        lo = hi = n - 1
+    elif vi < 0:
+        lo = hi = 0
+    else:
+        lo = math.floor(vi)
+        hi = lo + 1
+    part = np.partition(x, [lo, hi] if hi != lo else [lo])
+    a, b = float(part[lo]), float(part[hi])
+    gamma = vi - lo
+    # numpy's _lerp: from the nearer end
+    diff = b - a
+    return b - diff * (1.0 - gamma) if gamma >= 0.5 else a + diff * gamma
+
+
+def _norms(x: np.ndarray) -> np.ndarray:
+    """Row norms of real (N, 3) ``x``: what ``np.linalg.norm(x, axis=1)`` computes (the squares
+    summed in its order, pinned by the tests against it), column by column: numpy's reduction
+    over a length-3 axis costs more than the three columns."""
+    return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])
 
 
 def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     """Frozen samples out, resample, smooth and differentiate the hands of ``trajectory``
     (sorted by time, see :meth:`Trajectory.cleaned`)."""
     t = trajectory.t
+    n = t.shape[0]
     dt = 1.0 / config.analysis_rate
-    grid = t.copy() if t.shape[0] < 2 else np.arange(t[0], t[-1] + 0.5 * dt, dt)
-    g = drop_frozen(t, trajectory.giver_hand, config.frozen_speed)
-    r = drop_frozen(t, trajectory.receiver_hand, config.frozen_speed)
-    g = resample(t, g, grid, config.max_gap_hold)
-    r = resample(t, r, grid, config.max_gap_hold)
+    grid = t.copy() if n < 2 else np.arange(t[0], t[-1] + 0.5 * dt, dt)
+    p = np.concatenate((trajectory.giver_hand, trajectory.receiver_hand), axis=1)
+    fin = np.isfinite(p)
+    ok = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands): every coordinate seen
+    ok_g, ok_r = ok[:, 0], ok[:, 1]
+    all_seen = bool(ok_g.all()) and bool(ok_r.all())
+    # A stale repeat equals the sample before; with every sample seen and no coordinate equal
+    # to the one before, there is none (the usual case: no per-hand search).
+    if not (all_seen and not (p[1:] == p[:-1]).any()):
+        ok_g &= ~drop_frozen(t, p[:, :3], config.frozen_speed, ok_g)
+        ok_r &= ~drop_frozen(t, p[:, 3:], config.frozen_speed, ok_r)
+        all_seen = False
+    if all_seen:
+        x = resample(t, p, None, grid, config.max_gap_hold)
+    elif np.array_equal(ok_g, ok_r):  # both hands seen at the same samples
+        x = resample(t, p, ok_g, grid, config.max_gap_hold)
+    else:
+        x = np.concatenate(
+            (
+                resample(t, p[:, :3], ok_g, grid, config.max_gap_hold),
+                resample(t, p[:, 3:], ok_r, grid, config.max_gap_hold),
+            ),
+            axis=1,
+        )
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
     # corners at every sample that would otherwise show up as speed spikes.
-    med_dt = float(np.median(np.diff(t))) if t.shape[0] > 1 else dt
+    med_dt = _median(np.diff(t)) if n > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
-    g, g_full = smooth(g, sigma_s / dt)
-    r, r_full = smooth(r, sigma_s / dt)
+    fin = np.isfinite(x)
+    m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands)
+    x, full = smooth(x, m, sigma_s / dt)
     if grid.shape[0] >= 2:
-        gv = np.gradient(g, dt, axis=0)
-        rv = np.gradient(r, dt, axis=0)
+        # np.gradient's central differences inside, one-sided at the ends (its arithmetic,
+        # without its generic set-up)
+        v = np.empty_like(x)
+        v[1:-1] = (x[2:] - x[:-2]) / (2.0 * dt)
+        v[0] = (x[1] - x[0]) / dt
+        v[-1] = (x[-1] - x[-2]) / dt
         # Next to a tracking gap the window is one-sided and flattens the motion: velocities
         # there are unknown, not slow.
-        gv[g_full < FULL_WINDOW] = np.nan
-        rv[r_full < FULL_WINDOW] = np.nan
+        v = v.reshape(v.shape[0], 2, 3)
+        v[full < FULL_WINDOW] = np.nan
+        v = v.reshape(v.shape[0], 6)
     else:
-        gv = np.full_like(g, np.nan)
-        rv = np.full_like(r, np.nan)
+        v = np.full_like(x, np.nan)
+    g, r = x[:, :3], x[:, 3:]
+    gv, rv = v[:, :3], v[:, 3:]
     rel = r - g
     rel_v = rv - gv
-    distance = np.linalg.norm(rel, axis=1)
-    rel_speed = np.linalg.norm(rel_v, axis=1)
+    distance = _norms(rel)
+    rel_speed = _norms(rel_v)
     closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
-    common = 0.5 * np.linalg.norm(gv + rv, axis=1)
-    g_speed = np.linalg.norm(gv, axis=1)
-    r_speed = np.linalg.norm(rv, axis=1)
+    common = 0.5 * _norms(gv + rv)
+    g_speed = _norms(gv)
+    r_speed = _norms(rv)
     return Signals(
         t=grid,
         giver=g,

@@ -118,6 +118,9 @@ class GazeLoop:
                         for n, lo, hi in zip(robot.head_joints, robot.lower, robot.upper,
                                              strict=True)]
         self._rest = [float(r) for r in robot.rest]
+        # (per tick: the command pose's joints with their rest values, and the eyes' range)
+        self._rest_of = [(n, r) for (n, _, _), r in zip(self._limits, self._rest, strict=True)]
+        self._eyes = robot.eyes
 
     @classmethod
     def from_config(
@@ -205,7 +208,7 @@ class GazeLoop:
             and isfinite(cmd.blink)
             and isfinite(cmd.gaze_shift)
             and self._within_limits(head)
-            and not self.robot.eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]
+            and not self._eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]
         ):
             self.unsafe += 1
             return None
@@ -245,7 +248,7 @@ class GazeLoop:
             if all(isinstance(v, (int, float)) and math.isfinite(v) for v in measured):
                 return [min(max(v, lo), hi)
                         for v, (_, lo, hi) in zip(measured, self._limits, strict=True)]
-        return [head.get(n, r) for (n, _, _), r in zip(self._limits, self._rest, strict=True)]
+        return [head.get(n, r) for n, r in self._rest_of]
 
     def _within_limits(self, head: Mapping[str, float]) -> bool:
         """Every head goal is for a joint of the robot and within its limits (a check, not a

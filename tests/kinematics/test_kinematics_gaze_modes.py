@@ -141,10 +141,13 @@ def test_eyes_only_through_the_engine_on_a_handover():
 )
 def test_every_consumer_command_takes_a_gaze_mode(argv):
     from gazebot.cli import build_parser
+    from gazebot.cli.demo import default_robot
 
     args = build_parser().parse_args([*argv, "--gaze-mode", "eyes-only"])
     assert args.gaze_mode == "eyes-only"
-    robot = with_gaze_mode(args.robot, args.gaze_mode)
+    # the demo's robot follows its controller (the learned gps reach runs on the panda)
+    name = default_robot(args) if argv[0] == "demo" else args.robot
+    robot = with_gaze_mode(name, args.gaze_mode)
     assert RobotModel.load(robot).gaze_mode == "eyes-only"
     assert build_parser().parse_args(argv).gaze_mode is None  # default: the robot YAML's
 

@@ -42,10 +42,12 @@ class GazebotSegmenter(Segmenter):
             return None
         s = compute_signals(trajectory, self.config)
         if partial and self.config.edge_guard > 0:
-            keep = s.t <= float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
-            if np.count_nonzero(keep) < 3:
+            # (the grid is sorted: the samples kept are a prefix, taken as views)
+            cut = float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
+            keep = int(np.searchsorted(s.t, cut, side="right"))
+            if keep < 3:
                 return None
-            s = Signals(*(getattr(s, f)[keep] for f in s.__dataclass_fields__))
+            s = Signals(*(getattr(s, f)[:keep] for f in s.__dataclass_fields__))
         return s
 
     # ---- online hooks

@@ -19,6 +19,23 @@ from gazebot.phases.config import PhaseConfig
 from gazebot.phases.methods.base import OnlineState, TriggerMode
 from gazebot.types import Phase
 
+_COLUMNS = 11  # t, giver xyz, receiver xyz, relative xyz, distance
+# What np.nanmax computes for a float array (the largest value that is not NaN; NaN if all
+# are), without its argument handling and all-NaN warning: it runs every period.
+_nanmax = np.fmax.reduce
+
+
+def _nanmean2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.nanmean([a, b], axis=0)`` of two 3-vectors: per coordinate the sum of the values
+    that are not NaN (NaN counted as 0) over their count, NaN if none (numpy's arithmetic,
+    without its generic machinery and warning)."""
+    out = []
+    for u, w in zip(a.tolist(), b.tolist(), strict=True):
+        u_ok, w_ok = u == u, w == w
+        n = u_ok + w_ok
+        out.append(((u if u_ok else 0.0) + (w if w_ok else 0.0)) / n if n else math.nan)
+    return np.array(out)
+
 
 class GazebotTrigger:
     """Per-period mean positions of both hands, and the loosened rule of the current phase.
@@ -29,19 +46,29 @@ class GazebotTrigger:
 
     def __init__(self, config: PhaseConfig) -> None:
         self.config = config
-        self._acc = np.zeros(6)
-        self._acc_n = np.zeros(2)
-        # rows [t, giver xyz, receiver xyz] in _sum[_s0:_s1] (grown and compacted in place)
-        self._sum = np.empty((64, 7))
+        # Sums of the positions seen this period (giver xyz, receiver xyz) and their counts, in
+        # plain floats: a sample costs a few additions, not numpy calls.
+        self._acc = [0.0] * 6
+        self._acc_n = [0, 0]
+        # rows [t, giver xyz, receiver xyz, relative xyz, distance] in _sum[_s0:_s1] (grown and
+        # compacted in place); the relative position and distance are computed once per row.
+        self._sum = np.empty((64, _COLUMNS))
         self._s0 = self._s1 = 0
 
     def add(self, g: np.ndarray, g_ok: bool, r: np.ndarray, r_ok: bool) -> None:
         """Accumulate one sample's hand positions (``*_ok``: that hand was seen)."""
+        acc = self._acc
         if g_ok:
-            self._acc[:3] += g
+            x, y, z = g.tolist()
+            acc[0] += x
+            acc[1] += y
+            acc[2] += z
             self._acc_n[0] += 1
         if r_ok:
-            self._acc[3:] += r
+            x, y, z = r.tolist()
+            acc[3] += x
+            acc[4] += y
+            acc[5] += z
             self._acc_n[1] += 1
 
     def decide(self, now: float, state: OnlineState) -> TriggerMode:
@@ -56,26 +83,35 @@ class GazebotTrigger:
         return {Phase.REACH: "refresh", Phase.RETREAT: "full"}.get(state.phase, "skip")  # type: ignore[return-value]
 
     def _summarise(self, now: float) -> None:
-        """Append the mean hand positions since the last period (NaN: none seen) and drop
-        rows older than ``online_window``."""
+        """Append the mean hand positions since the last period (NaN: none seen), their
+        relative position and distance, and drop rows older than ``online_window``."""
         c = self.config
-        n = self._acc_n
         buf = self._sum
         while self._s0 < self._s1 and buf[self._s0, 0] < now - c.online_window:
             self._s0 += 1
         if self._s1 == buf.shape[0]:
             m = self._s1 - self._s0
             if 2 * m > buf.shape[0]:
-                self._sum = np.empty((2 * buf.shape[0], 7))
+                self._sum = np.empty((2 * buf.shape[0], _COLUMNS))
             self._sum[:m] = buf[self._s0 : self._s1]
             buf, self._s0, self._s1 = self._sum, 0, m
-        row = buf[self._s1]
-        row[0] = now
-        row[1:4] = self._acc[:3] / n[0] if n[0] else np.nan
-        row[4:] = self._acc[3:] / n[1] if n[1] else np.nan
+        a = self._acc
+        ng, nr = self._acc_n
+        nan = math.nan
+        gx, gy, gz = (a[0] / ng, a[1] / ng, a[2] / ng) if ng else (nan, nan, nan)
+        rx, ry, rz = (a[3] / nr, a[4] / nr, a[5] / nr) if nr else (nan, nan, nan)
+        dx, dy, dz = rx - gx, ry - gy, rz - gz
+        # (the sum in this order is what np.linalg.norm(rel, axis=1) computes; a test pins it)
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        buf[self._s1] = (now, gx, gy, gz, rx, ry, rz, dx, dy, dz, d)
         self._s1 += 1
-        self._acc[:] = 0.0
-        n[:] = 0.0
+        self._acc = [0.0] * 6
+        self._acc_n = [0, 0]
+
+    def rows(self) -> np.ndarray:
+        """The per-period rows kept: ``[t, giver xyz, receiver xyz, relative xyz, distance]``
+        (a view, valid until the next :meth:`decide`)."""
+        return self._sum[self._s0 : self._s1]
 
     def _boundary_possible(self, state: OnlineState) -> bool:
         """A necessary condition of the rule that ends the current phase, on the per-period
@@ -88,8 +124,8 @@ class GazebotTrigger:
         rows = self._sum[self._s0 : self._s1]
         ts = rows[:, 0]
         g = rows[:, 1:4]
-        rel = rows[:, 4:] - g
-        d = np.linalg.norm(rel, axis=1)
+        rel = rows[:, 7:10]
+        d = rows[:, 10]
         if not math.isfinite(d[-1]):
             return True
         loose = c.trigger_distance_factor
@@ -99,9 +135,10 @@ class GazebotTrigger:
         if ph is Phase.REACH:
             # A transfer needs the approach to have stopped, an aborted reach the hands apart:
             # either way the hands are no longer closing fast.
-            recent = d[ts >= ts[-1] - (c.min_transfer + c.edge_guard + c.online_period)]
-            return float(np.nanmax(recent)) - d[-1] <= c.trigger_still_factor * c.still_closing
-        since = ts >= state.phase_start
+            since = ts[-1] - (c.min_transfer + c.edge_guard + c.online_period)
+            recent = d[int(np.searchsorted(ts, since)) :]  # (ts increases)
+            return float(_nanmax(recent)) - d[-1] <= c.trigger_still_factor * c.still_closing
+        since = slice(int(np.searchsorted(ts, state.phase_start)), None)  # (ts increases)
         if ph is Phase.TRANSFER:
             # A release moves the hands' relative position off the held pose.
             held = rel[since]
@@ -109,7 +146,7 @@ class GazebotTrigger:
             if held.shape[0] < 2:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
-            off = float(np.linalg.norm(np.nanmean(rel[-2:], axis=0) - held.mean(axis=0)))
+            off = float(np.linalg.norm(_nanmean2(rel[-2], rel[-1]) - held.mean(axis=0)))
             return off >= loose * c.release_distance
         if ph is Phase.RETREAT:
             if state.joined_late:
@@ -124,7 +161,7 @@ class GazebotTrigger:
                 return True
             if not math.isfinite(float(step[-1])):
                 return True
-            return bool(step[-1] <= c.trigger_landing_fraction * np.nanmax(step))
+            return bool(step[-1] <= c.trigger_landing_fraction * _nanmax(step))
         return True
 
     def _reach_possible(
@@ -134,15 +171,16 @@ class GazebotTrigger:
         began and the giver's hand moving since they were farthest."""
         c = self.config
         loose = c.trigger_distance_factor
-        after = np.flatnonzero(ts >= floor - c.online_period)
-        if after.size <= k:
+        first = int(np.searchsorted(ts, floor - c.online_period))  # (ts increases)
+        if ts.shape[0] - first <= k:
             return False
-        da = d[after[0] :]
-        closed = float(np.nanmax(da)) - d[-1]
+        da = d[first:]
+        d_max = _nanmax(da)
+        closed = float(d_max) - d[-1]
         # (the predictive rule confirms a reach from predict_distance of the giver's own travel)
         if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
             return False
-        i_max = after[0] + int(np.nanargmax(da))
+        i_max = first + int(np.argmax(da == d_max))  # np.nanargmax: the first largest
         own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(float(d[-1]), 1e-9)
         deep = closed >= c.trigger_deep_fraction * c.min_approach
         if not deep and not own >= c.trigger_own_fraction * c.reach_confirm_distance:
@@ -155,4 +193,4 @@ class GazebotTrigger:
         if gm.shape[0] <= k:
             return True
         v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * c.online_period)
-        return bool(np.nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)
+        return bool(_nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)

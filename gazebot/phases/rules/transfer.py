@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals
+from gazebot.phases.filtering import Signals, quantile
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -190,7 +190,7 @@ def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
     carrying the object, the ``hold_floor_quantile`` of its relative speed."""
     hold = s.rel_speed[a : b + 1]
     hold = hold[np.isfinite(hold)]
-    return float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
+    return quantile(hold, c.hold_floor_quantile) if hold.size else 0.0  # (np.quantile's)
 
 
 def v_settle_fraction(s: Signals, c: PhaseConfig, lo: int, a: int) -> float:

@@ -1,0 +1,83 @@
+"""The online detector's fast path (fused signals, the trigger's per-period rows in plain
+floats, samples kept in one array) emits exactly the events and counts of the straightforward
+path it replaced (tests/phases/signals_reference.py, tests/phases/trigger_reference.py) on the
+synthetic set, the issue-20 cases, and on noisy input with NaN, frozen, duplicate, out-of-order
+and timeless samples."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import gazebot.phases.methods.gazebot as gazebot_method
+from gazebot.phases.config import PhaseConfig
+from gazebot.phases.detector import run_online
+from gazebot.phases.synthetic import (
+    SyntheticOptions,
+    case_set,
+    early_lift_set,
+    generate,
+    synthetic_set,
+)
+from gazebot.phases.trajectory import Trajectory
+from tests.phases.signals_reference import reference_signals
+from tests.phases.trigger_reference import ReferenceTrigger
+
+
+def _damaged(traj: Trajectory, seed: int) -> Trajectory:
+    """NaN rows and coordinates, frozen repeats, a long gap, swapped (out-of-order) and
+    duplicated times, NaN times."""
+    rng = np.random.default_rng(seed)
+    t, g, r = traj.t.copy(), traj.giver_hand.copy(), traj.receiver_hand.copy()
+    n = t.shape[0]
+    g[rng.choice(n, n // 20, replace=False)] = np.nan
+    r[rng.choice(n, n // 40, replace=False), 1] = np.nan
+    for k in rng.choice(n - 5, 8, replace=False):
+        g[k + 1 : k + 4] = g[k]
+    for k in rng.choice(n - 2, 6, replace=False):
+        t[[k, k + 1]] = t[[k + 1, k]]
+    for k in rng.choice(n - 2, 4, replace=False):
+        t[k + 1] = t[k]
+    t[rng.choice(n, 3, replace=False)] = np.nan
+    k = n // 2
+    g[k : k + n // 10] = np.nan
+    return Trajectory(t, g, r, traj.giver_face, traj.gripper_closed, traj.load_share)
+
+
+def _recordings() -> list[Trajectory]:
+    out = []
+    for i, h in enumerate(synthetic_set(10, seed=7)):
+        out += [h.trajectory, _damaged(h.trajectory, i)]
+    for kind in ("carry", "still", "quick30", "quick_noisy"):
+        out += [h.trajectory for h in case_set(kind, 2, seed=1)]  # type: ignore[arg-type]
+    out += [h.trajectory for h in early_lift_set(2, seed=1)]
+    noisy = SyntheticOptions(
+        rate=30.0, irregular=0.3, noise=0.004, dropouts_per_s=1.0, frozen_per_s=1.0, handovers=3
+    )
+    out.append(generate(seed=2, options=noisy).trajectory)
+    return out
+
+
+def _events(traj: Trajectory, config: PhaseConfig) -> tuple[list[tuple], str]:
+    res = run_online(traj, config)
+    return [(e.kind, e.t, e.detected_at, sorted(e.info.items())) for e in res.events], repr(
+        res.stats
+    )
+
+
+@pytest.fixture(scope="module")
+def recordings() -> list[Trajectory]:
+    return _recordings()
+
+
+def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monkeypatch):
+    config = PhaseConfig()
+    fast = [_events(tr, config) for tr in recordings]
+    monkeypatch.setattr(gazebot_method, "compute_signals", reference_signals)
+    monkeypatch.setattr(
+        gazebot_method.GazebotSegmenter, "trigger", lambda self: ReferenceTrigger(self.config)
+    )
+    slow = [_events(tr, config) for tr in recordings]
+    assert sum(len(ev) for ev, _ in fast) > 4 * len(recordings)  # the recordings do show phases
+    for i, (a, b) in enumerate(zip(fast, slow, strict=True)):
+        assert a == b, f"recording {i}"

@@ -1,0 +1,152 @@
+"""The fused signal pipeline (both hands at once, cached smoothing weights) equals, bit for bit,
+the straightforward one hand at a time (tests/phases/signals_reference.py), on clean, noisy,
+NaN, frozen, irregular and sparse input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import compute_signals, gaussian_weights
+from gazebot.phases.synthetic import SyntheticOptions, generate, synthetic_set
+from gazebot.phases.trajectory import Trajectory
+from tests.phases.signals_reference import reference_signals
+
+
+def _assert_same(traj: Trajectory, config: PhaseConfig) -> None:
+    ours = compute_signals(traj, config)
+    ref = reference_signals(traj, config)
+    for name in ref.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(ours, name), getattr(ref, name), err_msg=name)
+
+
+def _damaged(traj: Trajectory, seed: int) -> Trajectory:
+    """NaN rows and single NaN coordinates, frozen repeats while moving, a long gap, and one
+    hand missing where the other is seen."""
+    rng = np.random.default_rng(seed)
+    g, r = traj.giver_hand.copy(), traj.receiver_hand.copy()
+    n = g.shape[0]
+    g[rng.choice(n, n // 15, replace=False)] = np.nan
+    r[rng.choice(n, n // 25, replace=False), 2] = np.nan
+    for k in rng.choice(n - 6, 6, replace=False):
+        g[k + 1 : k + 5] = g[k]
+        r[k + 2 : k + 4] = r[k + 1]
+    g[n // 2 : n // 2 + n // 8] = np.nan
+    return Trajectory(traj.t, g, r)
+
+
+CASES = [
+    SyntheticOptions(rate=120.0, posture="standing"),
+    SyntheticOptions(rate=30.0, irregular=0.3, noise=0.004, dropouts_per_s=1.0, frozen_per_s=1.0),
+    SyntheticOptions(rate=8.0, noise=0.004),
+    SyntheticOptions(rate=240.0, handovers=2),
+]
+
+
+@pytest.mark.parametrize("options", CASES, ids=["120Hz", "30Hz-noisy", "8Hz", "240Hz"])
+def test_fused_signals_equal_the_one_hand_pipeline(options: SyntheticOptions) -> None:
+    traj = generate(seed=5, options=options).trajectory
+    config = PhaseConfig()
+    _assert_same(traj, config)
+    _assert_same(_damaged(traj, 1), config)
+    for n in (1, 2, 3, 7, 40):  # the first samples an online detector sees
+        _assert_same(Trajectory(traj.t[:n], traj.giver_hand[:n], traj.receiver_hand[:n]), config)
+
+
+def test_fused_signals_equal_on_the_synthetic_set() -> None:
+    config = PhaseConfig()
+    for i, h in enumerate(synthetic_set(8, seed=2)):
+        traj, _, _ = h.trajectory.cleaned()
+        _assert_same(traj, config)
+        _assert_same(_damaged(traj, i), config)
+
+
+def test_fused_signals_equal_with_narrow_smoothing_and_a_hand_never_seen() -> None:
+    traj = generate(seed=1, options=CASES[1]).trajectory
+    _assert_same(traj, PhaseConfig(smoothing=0.01, analysis_rate=240.0))
+    blind = Trajectory(traj.t, traj.giver_hand, np.full_like(traj.receiver_hand, np.nan))
+    _assert_same(blind, PhaseConfig())
+
+
+def test_cached_weights_are_the_gaussian_filters_own() -> None:
+    from scipy.ndimage import correlate1d, gaussian_filter1d
+
+    x = np.random.default_rng(0).normal(size=(50, 2))
+    w = gaussian_weights(4.7)
+    assert not w.flags.writeable
+    np.testing.assert_array_equal(
+        correlate1d(x, w, axis=0, mode="nearest"),
+        gaussian_filter1d(x, 4.7, axis=0, mode="nearest", truncate=3.0),
+    )
+
+
+def test_trigger_rows_hold_the_period_means_and_numpys_distances() -> None:
+    """The gazebot trigger keeps per-period means, relative positions and distances in plain
+    floats; they equal numpy's mean and ``np.linalg.norm`` of the same samples bit for bit (the
+    summation order is the one numpy uses for 3-vectors)."""
+    from gazebot.phases.methods.base import OnlineState
+    from gazebot.phases.methods.gazebot_trigger import GazebotTrigger
+    from gazebot.types import Phase
+
+    traj = _damaged(generate(seed=4, options=CASES[1]).trajectory, 3)
+    config = PhaseConfig()
+    trig = GazebotTrigger(config)
+    state = OnlineState(Phase.IDLE, float("nan"), -np.inf, True, False, -np.inf)
+    period: list[tuple[np.ndarray, np.ndarray]] = []
+    expected = []
+    for t, g, r in zip(traj.t, traj.giver_hand, traj.receiver_hand, strict=True):
+        g_ok, r_ok = bool(np.isfinite(g).all()), bool(np.isfinite(r).all())
+        trig.add(g, g_ok, r, r_ok)
+        period.append((g, r))
+        if len(period) == 3:
+            gs = [a for a, _ in period if np.isfinite(a).all()]
+            rs = [b for _, b in period if np.isfinite(b).all()]
+            gm = np.sum(gs, axis=0) / len(gs) if gs else np.full(3, np.nan)
+            rm = np.sum(rs, axis=0) / len(rs) if rs else np.full(3, np.nan)
+            expected.append(np.concatenate([[t], gm, rm, rm - gm, [0.0]]))
+            trig.decide(float(t), state)
+            period.clear()
+    rows = trig.rows()
+    want = np.array(expected)[-rows.shape[0] :]
+    want[:, 10] = np.linalg.norm(want[:, 7:10], axis=1)  # as the trigger computed it before
+    np.testing.assert_array_equal(rows, want)
+    assert np.isnan(rows[:, 10]).any() and np.isfinite(rows[:, 10]).any()
+
+
+def test_median_of_the_sample_steps_is_numpys() -> None:
+    from gazebot.phases.filtering import _median
+
+    rng = np.random.default_rng(1)
+    for n in (1, 2, 3, 4, 7, 10, 101):
+        x = rng.uniform(0.004, 0.03, size=n)
+        assert _median(x) == float(np.median(x))
+        x[n // 2] = np.nan
+        assert np.isnan(_median(x))
+
+
+def test_quantile_is_numpys_linear_quantile() -> None:
+    from gazebot.phases.filtering import quantile
+
+    rng = np.random.default_rng(2)
+    for n in (1, 2, 3, 5, 8, 33, 200):
+        x = rng.gamma(2.0, 0.02, size=n)
+        x[rng.random(n) < 0.1] = 0.05  # ties
+        for q in (0.0, 0.1, 0.25, 0.3333, 0.5, 0.75, 0.9, 1.0, float(rng.random())):
+            assert quantile(x, q) == float(np.quantile(x, q)), (n, q)
+
+
+def test_two_row_nanmean_is_numpys() -> None:
+    import warnings
+
+    from gazebot.phases.methods.gazebot_trigger import _nanmean2
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        ab = rng.normal(size=(2, 3))
+        ab[rng.random((2, 3)) < 0.3] = np.nan
+        ab[rng.random((2, 3)) < 0.05] = -0.0
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # numpy warns on an all-NaN column
+            want = np.nanmean(ab, axis=0)
+        np.testing.assert_array_equal(_nanmean2(ab[0], ab[1]), want)
