@@ -90,22 +90,32 @@ def _kth_results() -> list[Result]:
     return out
 
 
-def _reach_onset(cfg: PhaseConfig) -> tuple[float, float, int, int]:
-    """(median, p90 latency in ms, false reaches, recordings without a handover)."""
-    lat = []
-    for case in synthetic_set(40, seed=7):
+def _latencies(cfg: PhaseConfig, cases) -> dict[float, list[float]]:
+    """Reach confirmation latency (ms after the true onset: the event's ``detected_at``, not
+    its back-dated ``t``) per recording rate."""
+    out: dict[float, list[float]] = {}
+    for case in cases:
         ev = [
             e for e in run_online(case.trajectory, cfg).events if e.kind is EventKind.REACH_STARTED
         ]
         for e, h in zip(ev, case.truth, strict=False):
-            lat.append((e.detected_at - h.reach_start) * 1e3)
+            out.setdefault(case.options.rate, []).append((e.detected_at - h.reach_start) * 1e3)
+    return out
+
+
+def _reach_onset(cfg: PhaseConfig) -> tuple[float, float, int, int, dict[float, list[float]]]:
+    """(median, p90 latency in ms, false reaches, recordings without a handover, latencies per
+    rate)."""
+    per_rate = _latencies(cfg, synthetic_set(40, seed=7))
+    lat = [x for v in per_rate.values() for x in v]
     rests = [
         rest_recording(rate, noise, 20.0, seed=k, fidget=fidget)
         for k, rate in enumerate((8.0, 30.0, 120.0, 240.0))
         for noise in (0.002, 0.005)
         for fidget in (False, True)
     ]
-    return float(np.median(lat)), float(np.percentile(lat, 90)), _false(cfg, rests), len(rests)
+    med, p90 = float(np.median(lat)), float(np.percentile(lat, 90))
+    return med, p90, _false(cfg, rests), len(rests), per_rate
 
 
 def _false(cfg: PhaseConfig, recordings: list[Trajectory]) -> int:
@@ -115,13 +125,21 @@ def _false(cfg: PhaseConfig, recordings: list[Trajectory]) -> int:
     )
 
 
+def _by_rate(per_rate: dict[float, list[float]]) -> str:
+    return ", ".join(
+        f"{rate:g} Hz {np.median(v):.0f}/{np.percentile(v, 90):.0f}"
+        for rate, v in sorted(per_rate.items())
+    )
+
+
 def _reach_results() -> list[Result]:
-    med, p90, false, n = _reach_onset(PhaseConfig())
-    # The same method without its predictive rule (predict_distance out of reach): the
-    # smoothed signals alone (2 cm of closing past the edge guard), as before issue 20's rule.
-    smoothed = PhaseConfig(predict_distance=1e3)
-    smed, sp90, sfalse, _ = _reach_onset(smoothed)
-    pmed, pp90, pfalse, _ = _reach_onset(PhaseConfig(method=SEED))
+    med, p90, false, n, per_rate = _reach_onset(PhaseConfig())
+    # The same method without its predictive rules (predict_distance and sequential_evidence
+    # out of reach): the smoothed signals alone (2 cm of closing past the edge guard), as
+    # before issue 20's rules.
+    smoothed = PhaseConfig(predict_distance=1e3, sequential_evidence=1e9)
+    smed, sp90, sfalse, _, _ = _reach_onset(smoothed)
+    pmed, pp90, pfalse, _, _ = _reach_onset(PhaseConfig(method=SEED))
     # More fidgeting givers (10 seeds the rules were not tuned on, 6 rates, 2 and 5 mm noise).
     fidgets = [
         rest_recording(rate, noise, 20.0, seed=seed, fidget=True)
@@ -130,7 +148,7 @@ def _reach_results() -> list[Result]:
         for noise in (0.002, 0.005)
     ]
     wide, swide = _false(PhaseConfig(), fidgets), _false(smoothed, fidgets)
-    return [
+    out = [
         Result(
             "online reach onset, median after the true onset",
             med,
@@ -140,11 +158,33 @@ def _reach_results() -> list[Result]:
             note=(
                 f"p90 {p90:.0f} ms (peer {pp90:.0f}); false reaches {false} in {n} recordings "
                 f"without a handover (peer {pfalse}); 40 synthetic recordings, 8-240 Hz. "
-                f"Without the predictive rule: {smed:.0f} / {sp90:.0f} ms, {sfalse} false. "
-                f"{len(fidgets)} more fidgeting recordings: {wide} false ({swide} without it)"
+                f"Without the predictive rules: {smed:.0f} / {sp90:.0f} ms, {sfalse} false. "
+                f"{len(fidgets)} more fidgeting recordings: {wide} false ({swide} without them). "
+                f"Median/p90 ms per rate: {_by_rate(per_rate)}"
             ),
         )
     ]
+    # Per noise level: the same generator with the marker noise fixed (21 recordings, 3 per rate).
+    for noise in (0.0, 0.002, 0.005):
+        cases = synthetic_set(21, seed=8, noise=noise)
+        ours = _latencies(PhaseConfig(), cases)
+        peer = _latencies(PhaseConfig(method=SEED), cases)
+        lat = [x for v in ours.values() for x in v]
+        plat = [x for v in peer.values() for x in v]
+        out.append(
+            Result(
+                f"online reach onset at {noise * 1e3:g} mm noise, median",
+                float(np.median(lat)),
+                float(np.median(plat)),
+                "ms",
+                f"{SEED} run online",
+                note=(
+                    f"p90 {np.percentile(lat, 90):.0f} ms (peer {np.percentile(plat, 90):.0f}); "
+                    f"21 synthetic recordings, 8-240 Hz; per rate: {_by_rate(ours)}"
+                ),
+            )
+        )
+    return out
 
 
 def _hold_kind_results() -> list[Result]:

@@ -36,7 +36,7 @@ class IterationLog:
     local_cost: float  # mean over conditions and samples, local controllers' samples
     local_error_m: float  # mean final error of those samples
     policy_error_m: float  # mean final error of the global policy on the training targets
-    policy_kl: float  # mean E_p KL(p || pi) per step after the update
+    policy_kl: float  # mean E_p KL per step after the update (the direction eq. 5.6 penalises)
     nu_mean: float
     eta_mean: float
 
@@ -93,14 +93,20 @@ def _sample_moments(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def policy_targets(ctrl: LinearGaussian, X: np.ndarray, lam: np.ndarray,
-                   nu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                   nu: np.ndarray, policy_cov: np.ndarray | None = None,
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """Eq. 5.5's regression for one condition at its sample states X (M, T, dX): the targets
     mu_p(x) - C_t lambda_t / nu_t (M, T, dU) and the weights nu_t C_t^-1 (T, dU, dU).
 
     They make the loss nu_t/2 (mu - target)' C_t^-1 (mu - target) equal, up to a constant, to
     mu' lambda_t plus the mean part of nu_t KL(pi || p) (the seed writes KL(p || pi); see the
-    README's "where we differ")."""
-    prec = ctrl.precision  # (T, dU, dU)
+    README's "where we differ"). Given ``policy_cov`` Sigma_pi (dU, dU), the seed's eq. 5.5 as
+    printed: the mean part of nu_t KL(p || pi), weights nu_t Sigma_pi^-1, targets
+    mu_p - Sigma_pi lambda_t / nu_t."""
+    if policy_cov is None:
+        prec = ctrl.precision  # (T, dU, dU)
+    else:
+        prec = np.broadcast_to(np.linalg.inv(policy_cov), ctrl.cov.shape)
     mu_p = np.einsum("tux,mtx->mtu", ctrl.K, X) + ctrl.k
     # nu/2 (mu - mu_p)' P (mu - mu_p) + mu' lam
     #   = nu/2 (mu - (mu_p - P^-1 lam / nu))' P (...) + const
@@ -114,9 +120,11 @@ def _update_policy(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, seed: int) 
     g = cfg.gps
     c, m, horizon, dx = Xs.shape
     du = st.lam.shape[-1]
+    seed_kl = g.kl_directions == "seed"
     xs, tgts, wts, precs = [], [], [], []
     for i, ctrl in enumerate(st.controllers):
-        target, w = policy_targets(ctrl, Xs[i], st.lam[i], st.nu[i])
+        target, w = policy_targets(ctrl, Xs[i], st.lam[i], st.nu[i],
+                                   st.policy.cov if seed_kl else None)
         xs.append(Xs[i].reshape(-1, dx))
         tgts.append(target.reshape(-1, du))
         wts.append(np.broadcast_to(w, (m,) + w.shape).reshape(-1, du, du))
@@ -125,9 +133,24 @@ def _update_policy(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, seed: int) 
     W = W / np.mean(np.trace(W, axis1=1, axis2=2)) * du  # normalised as Levine et al. do
     policy = train_policy(st.policy, np.concatenate(xs), np.concatenate(tgts), W,
                           g.policy_steps, g.batch, g.learning_rate, seed)
-    mean_prec = np.mean(np.concatenate(precs), axis=0)
-    cov = np.linalg.inv(mean_prec)
+    if seed_kl:
+        cov = seed_policy_cov(st.controllers, Xs, policy)
+    else:
+        mean_prec = np.mean(np.concatenate(precs), axis=0)
+        cov = np.linalg.inv(mean_prec)
     st.policy = PolicyParams(**{**policy.__dict__, "cov": 0.5 * (cov + cov.T)})
+
+
+def seed_policy_cov(controllers: list[LinearGaussian], Xs: np.ndarray,
+                    policy: PolicyParams) -> np.ndarray:
+    """The state-independent Sigma_pi minimising sum_t E_p(x) KL(p || pi) (eq. 5.5 as printed):
+    the mean over conditions, steps and samples of C_t + (mu_p - mu_pi)(mu_p - mu_pi)'."""
+    covs = []
+    for ctrl, X in zip(controllers, Xs, strict=True):
+        d = np.einsum("tux,mtx->mtu", ctrl.K, X) + ctrl.k - policy.mean(X)
+        m, horizon = d.shape[:2]
+        covs.append(ctrl.cov.mean(axis=0) + np.einsum("mti,mtj->ij", d, d) / (m * horizon))
+    return np.mean(covs, axis=0)
 
 
 def dual_step(lam: np.ndarray, nu: np.ndarray, mu_pi: np.ndarray, mu_p: np.ndarray,
@@ -159,6 +182,7 @@ def inner_loop(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, dyns: list[Line
     controllers that produced the samples. Updates ``st``; returns the last pass's eta and mean
     KL(p || pi) per condition."""
     g = cfg.gps
+    seed_kl = g.kl_directions == "seed"
     sampled = list(st.controllers)
     etas: list[float] = []
     kls: list[float] = []
@@ -174,11 +198,14 @@ def inner_loop(cfg: GPSFileConfig, st: GPSState, Xs: np.ndarray, dyns: list[Line
             mu_pi = st.policy.mean(X)
             mu_p = np.einsum("tux,mtx->mtu", ctrl.K, X) + ctrl.k
             st.lam[i] = dual_step(st.lam[i], st.nu[i], mu_pi, mu_p, st.policy.cov, g.dual_rate)
-            # nu_t grows where the local controller and the policy disagree, shrinks where not.
+            # nu_t grows where the local controller and the policy disagree, shrinks where not,
+            # measured by the KL the trajectory step penalises.
             mu_x, sig_x = _sample_moments(X)
-            kl_t = kl_per_step(mu_x, sig_x, ctrl, lin)
+            kl_t = (kl_per_step(mu_x, sig_x, lin, ctrl) if seed_kl
+                    else kl_per_step(mu_x, sig_x, ctrl, lin))
             st.nu[i] = adapt_nu(st.nu[i], kl_t, g.kl_policy_target, g.nu_init, g.nu_max)
-            new, eta, _ = lqg_update(dyn, Cm, cv, sampled[i], lin, st.nu[i], st.lam[i], g.kl_step)
+            new, eta, _ = lqg_update(dyn, Cm, cv, sampled[i], lin, st.nu[i], st.lam[i], g.kl_step,
+                                     seed_directions=seed_kl)
             new_ctrls.append(new)
             etas.append(eta)
             kls.append(float(kl_t.mean()))

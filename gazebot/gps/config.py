@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -112,6 +113,10 @@ class GPSConfig(_Strict):
     policy_steps: int = Field(ge=1)
     batch: int = Field(ge=1)
     seed: int = 0
+    # Which KL each BADMM step penalises: "levine" (default) fits the policy to KL(pi || p) and
+    # bounds the trajectory step by KL(p || pi), as Levine et al.'s released code; "seed" uses
+    # eqs. 5.5/5.6 as printed: KL(p || pi) in the policy step, KL(pi || p) in the trajectory step.
+    kl_directions: Literal["levine", "seed"] = "levine"
 
 
 class GPSFileConfig(_Strict):

@@ -13,6 +13,12 @@ Two departures from the seed's eq. 5.6, as in Levine et al.'s BADMM GPS (the see
 policy term is nu_t KL(p || pi_lin), where eq. 5.6 writes nu_t KL(pi_theta || p); and the step
 bound KL(p || p_prev) <= kl_step is added (eq. 5.6 has none). The README's "where we differ"
 says why.
+
+With ``seed_directions`` the policy term is eq. 5.6's as printed, nu_t E_p(x)[KL(pi_lin || p)]
+= nu_t/2 E[tr(C_t^-1 S_t) + (mu_p - mu_pi)' C_t^-1 (mu_p - mu_pi) + log det C_t] + const. Its mean
+part is weighted by the new controller's own precision C_t^-1, which no LQR can hold; we weight
+it by the sampled controller's precision (exact when the step leaves C_t unchanged) and solve
+the covariance exactly (:func:`seed_covariance`).
 """
 
 from __future__ import annotations
@@ -46,10 +52,40 @@ def _kl_quadratic(K: np.ndarray, k: np.ndarray, prec: np.ndarray) -> tuple[np.nd
     return M, v
 
 
+def seed_covariance(quu: np.ndarray, w: np.ndarray, s: np.ndarray, eta: float,
+                    nu: float) -> np.ndarray:
+    """The controller covariance C minimising, per step (in the units of Q / (eta + nu)),
+
+        1/2 tr((Q_uu - nu W) C) - eta/2 log det C + nu/2 (tr(C^-1 S) + log det C),
+
+    i.e. the expected cost, eta KL(p || p_prev)'s entropy part and eq. 5.6's nu KL(pi || p)'s
+    covariance part (S the policy's covariance; nu W is the mean-term weight that Q_uu holds,
+    whose tr(W C) the literal KL does not have). Stationarity, with P = C^-1 and
+    B = Q_uu - nu W, is nu P S P + (eta - nu) P - B = 0; with Y = S^1/2 P S^1/2 it is a scalar
+    quadratic per eigenvalue g of S^1/2 B S^1/2, whose positive root is
+    y = 2 g / ((eta - nu) + sqrt((eta - nu)^2 + 4 nu g)). Raises :class:`NotPositiveDefinite`
+    where B is not positive definite (eta must grow)."""
+    b = quu - nu * w
+    ev, vec = np.linalg.eigh(0.5 * (s + s.T))
+    if ev.min() <= 0:
+        raise NotPositiveDefinite("policy covariance not positive definite")
+    s_half = (vec * np.sqrt(ev)) @ vec.T
+    g, gv = np.linalg.eigh(s_half @ (0.5 * (b + b.T)) @ s_half)
+    if g.min() <= 0:
+        raise NotPositiveDefinite("Q_uu - nu W not positive definite")
+    d = eta - nu
+    y = 2.0 * g / (d + np.sqrt(d * d + 4.0 * nu * g))
+    cov = s_half @ (gv / y) @ gv.T @ s_half  # C = S^1/2 Y^-1 S^1/2
+    return 0.5 * (cov + cov.T)
+
+
 def backward(dyn: LinearDynamics, Cm: np.ndarray, cv: np.ndarray, prev: LinearGaussian,
              pol: PolicyLinearization | None, nu: np.ndarray, lam: np.ndarray,
-             eta: float) -> LinearGaussian:
-    """One LQR backward pass for the combined cost; raises :class:`NotPositiveDefinite`."""
+             eta: float, seed_directions: bool = False) -> LinearGaussian:
+    """One LQR backward pass for the combined cost; raises :class:`NotPositiveDefinite`.
+
+    ``seed_directions``: the policy term is nu KL(pi_lin || p) (eq. 5.6 as printed), its mean
+    part weighted by ``prev``'s precision, the covariance from :func:`seed_covariance`."""
     horizon, du, dx = prev.K.shape
     K = np.zeros_like(prev.K)
     k = np.zeros_like(prev.k)
@@ -58,6 +94,8 @@ def backward(dyn: LinearDynamics, Cm: np.ndarray, cv: np.ndarray, prev: LinearGa
     Vx = np.zeros(dx)
     prev_prec = np.linalg.inv(prev.cov)
     pol_prec = np.linalg.inv(pol.cov) if pol is not None else None
+    if seed_directions and pol_prec is not None:
+        pol_prec = prev_prec  # the mean part of KL(pi || p) is weighted by p's precision
     for t in range(horizon - 1, -1, -1):
         M, v = _kl_quadratic(prev.K[t], prev.k[t], prev_prec[t])
         w = nu[t] if pol is not None else 0.0
@@ -84,7 +122,11 @@ def backward(dyn: LinearDynamics, Cm: np.ndarray, cv: np.ndarray, prev: LinearGa
         inv_quu = np.linalg.solve(L.T, np.linalg.solve(L, np.eye(du)))
         K[t] = -inv_quu @ Qux
         k[t] = -inv_quu @ qu
-        cov[t] = 0.5 * (inv_quu + inv_quu.T)
+        if seed_directions and pol is not None:
+            total = eta + w
+            cov[t] = seed_covariance(Quu, prev_prec[t], pol.cov[t], eta / total, w / total)
+        else:
+            cov[t] = 0.5 * (inv_quu + inv_quu.T)
         Vxx = Q[:dx, :dx] + Q[:dx, dx:] @ K[t]
         Vxx = 0.5 * (Vxx + Vxx.T)
         Vx = q[:dx] + Q[:dx, dx:] @ k[t]
@@ -127,14 +169,17 @@ def kl_per_step(mu: np.ndarray, sig: np.ndarray, new: LinearGaussian | PolicyLin
 def lqg_update(dyn: LinearDynamics, Cm: np.ndarray, cv: np.ndarray, prev: LinearGaussian,
                pol: PolicyLinearization | None, nu: np.ndarray, lam: np.ndarray,
                kl_step: float, eta_bounds: tuple[float, float] = (1e-6, 1e16),
-               iterations: int = 30) -> tuple[LinearGaussian, float, float]:
+               iterations: int = 30,
+               seed_directions: bool = False) -> tuple[LinearGaussian, float, float]:
     """The new local controller with mean KL(new || prev) <= ``kl_step`` (eq. 5.6), by bisection
-    on log(eta). Returns (controller, eta, achieved mean KL)."""
+    on log(eta). Returns (controller, eta, achieved mean KL). ``seed_directions``: see
+    :func:`backward`."""
     lo, hi = np.log(eta_bounds[0]), np.log(eta_bounds[1])
 
     def solve(log_eta: float) -> tuple[LinearGaussian, float] | None:
         try:
-            ctrl = backward(dyn, Cm, cv, prev, pol, nu, lam, float(np.exp(log_eta)))
+            ctrl = backward(dyn, Cm, cv, prev, pol, nu, lam, float(np.exp(log_eta)),
+                            seed_directions)
         except NotPositiveDefinite:
             return None
         mu, sig = forward(dyn, ctrl)

@@ -8,7 +8,9 @@ controller's action precision: the Lagrange term of eq. 5.5 plus the mean part o
 nu_t KL(pi || p_i), NOT of the seed's KL(p_i || pi) (whose mean part would be weighted by the
 policy's precision). Its covariance is the inverse of the local controllers' mean precision, the
 minimiser of the covariance part of that same KL(pi || p_i). This is the direction of Levine et
-al.'s BADMM (the seed's reference [92]); the README's "where we differ" says why.
+al.'s BADMM (the seed's reference [92]); the README's "where we differ" says why. With
+``kl_directions: seed`` the weights are the policy's own precision and the covariance
+``badmm.seed_policy_cov`` (eq. 5.5 as printed).
 """
 
 from __future__ import annotations

@@ -3,9 +3,10 @@ for the human (seed 5.4), and its human-like joint trajectory (eq. 5.12).
 
 The arm moves in the vertical plane through the learner's base axis at the tester's azimuth: its
 shoulder stands ``shoulder_distance_m`` from that axis at ``shoulder_height_m``; at zero joint
-angles the arm hangs straight down, positive angles swing it towards the learner. The seed's
-theta_0 = 0 of eq. 5.12 is the tester's rest posture ``rest_deg`` (ours: upper arm down, forearm
-level, as a person holding an object in front of them); the seed does not give its arm's zero.
+angles the arm hangs straight down, positive angles swing it towards the learner. Eq. 5.12's
+theta_0 is the configured ``rest_deg``: the seed's "theta_0,1 = theta_0,2 = 0" (configs/gps.yaml),
+i.e. with our zero the arm hanging straight down, elbow extended. The seed does not say where its
+arm's zero points; straight down is a person's relaxed arm.
 """
 
 from __future__ import annotations

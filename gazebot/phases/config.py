@@ -106,6 +106,18 @@ class PhaseConfig(BaseModel):
             standard errors of the fit (the measured noise floor) ...
         predict_horizon: ... and the model, extrapolated this far ahead (s), closes ...
         predict_gap_share: ... this share of the gap the hands started from.
+        sequential_window: Online, ``gazebot``'s sequential reach rule
+            (:mod:`~gazebot.phases.rules.sequential`, a likelihood-ratio test of a reach against
+            a fidget, beside the predictive rule) reads the giver's hand over this long (s) ...
+        sequential_onset_span: ... trying onsets up to this long (s) before the newest sample ...
+        sequential_onset_step: ... this far apart (s) ...
+        sequential_durations: ... and minimum-jerk durations (s) from the first to the second ...
+        sequential_duration_steps: ... in this many geometric steps ...
+        fidget_amplitude: ... a fidget moves the hand at most this far (m), a reach at least
+            ``min_approach`` ...
+        sequential_evidence: ... and a reach is confirmed once it explains the window better
+            than any fidget by this many noise variances (``2 ln`` of the likelihood ratio); it
+            heads and closes the gap as the predictive rule's ``predict_cos`` ... ask.
         trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
             the distances its rules need (loose: it fires before the rule can).
         trigger_speed_baseline: ... speeds from mean positions this far apart (s).
@@ -176,6 +188,13 @@ class PhaseConfig(BaseModel):
     predict_sigmas: float = Field(3.0, ge=0)
     predict_horizon: float = Field(0.3, ge=0)
     predict_gap_share: float = Field(0.15, ge=0, lt=1)
+    sequential_window: float = Field(0.8, gt=0)
+    sequential_onset_span: float = Field(0.5, gt=0)
+    sequential_onset_step: float = Field(0.02, gt=0)
+    sequential_durations: tuple[float, float] = (0.15, 2.5)
+    sequential_duration_steps: int = Field(9, ge=2)
+    fidget_amplitude: float = Field(0.02, gt=0)
+    sequential_evidence: float = Field(25.0, gt=0)
     trigger_distance_factor: float = Field(0.5, gt=0, le=1)
     trigger_speed_baseline: float = Field(0.1, gt=0)
     trigger_deep_fraction: float = Field(0.8, gt=0, le=1)
@@ -202,6 +221,13 @@ class PhaseConfig(BaseModel):
             raise ValueError("load_share_robot >= load_share_shared")
         if self.rest_speed > self.reach_onset_speed:
             raise ValueError("rest_speed <= reach_onset_speed")
+        lo, hi = self.sequential_durations
+        if not 0 < lo < hi:
+            raise ValueError("sequential_durations: (shortest, longest), 0 < shortest < longest")
+        if self.fidget_amplitude >= self.min_approach:
+            raise ValueError("fidget_amplitude < min_approach (a fidget is smaller than a reach)")
+        if self.sequential_window <= self.sequential_onset_span:
+            raise ValueError("sequential_window > sequential_onset_span (rest before each onset)")
         return self
 
 

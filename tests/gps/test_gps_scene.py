@@ -172,3 +172,16 @@ def test_trial_error_is_the_mean_gap_over_the_last_half_second():
     trial = Trial(np.zeros((40, 1)), np.zeros((40, 1)), p_r, p_h, np.zeros(n), 0.05)
     # t = 1.5 .. 2.0 s: gaps 0.25, 0.225, ..., 0 (11 samples), mean 0.125 m.
     assert trial.final_error() == pytest.approx(0.125)
+
+
+def test_the_moving_tester_starts_at_the_seeds_theta_0_with_the_arm_hanging_straight_down(scene):
+    """Seed 5.4: "We set theta_0,1 = theta_0,2 = 0" in eq. 5.12; our zero hangs the arm down."""
+    tc = CFG.scene.tester
+    assert tc.rest_deg == (0.0, 0.0)
+    p = training_targets(CFG.shell, 8)[0]
+    m = motion_to(p, True, tc)
+    assert m.theta0 == (0.0, 0.0)
+    obs = scene.reset(m)
+    below_shoulder = hand_position(m.azimuth, 0.0, 0.0, tc)
+    assert below_shoulder[2] == pytest.approx(tc.shoulder_height_m - tc.upper_arm_m - tc.forearm_m)
+    np.testing.assert_allclose(obs.p_h, below_shoulder, atol=0.002)

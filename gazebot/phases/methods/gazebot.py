@@ -24,6 +24,7 @@ from gazebot.phases.rules.directed import directed_reach
 from gazebot.phases.rules.reach import reach_start, trailing_reach
 from gazebot.phases.rules.release import transfer_end
 from gazebot.phases.rules.retreat import far_after, rest_after, retreat_done
+from gazebot.phases.rules.sequential import sequential_reach
 from gazebot.phases.rules.transfer import TransferCore, find_cores
 from gazebot.phases.segment import Segment
 from gazebot.phases.trajectory import Trajectory
@@ -62,13 +63,16 @@ class GazebotSegmenter(Segmenter):
 
     def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
         """The segments the signals show so far; with no phase under way at their end, a reach
-        the raw samples predict (:mod:`~gazebot.phases.rules.directed`: the giver's hand
-        accelerating toward the receiver) before the signals can show it."""
+        the raw samples predict before the signals can show it: the giver's hand accelerating
+        toward the receiver (:mod:`~gazebot.phases.rules.directed`), or, if not, moving in a
+        way no fidget does (:mod:`~gazebot.phases.rules.sequential`)."""
         segs = self.segment_signals(s, now, True)
         if segs and (segs[-1].open or segs[-1].phase is not Phase.RETREAT):
             return segs
         after = segs[-1].end if segs else -math.inf
         onset = directed_reach(trajectory, self.config, after)
+        if onset is None:
+            onset = sequential_reach(trajectory, self.config, after)
         if onset is not None:
             k = segs[-1].handover + 1 if segs else 0
             segs.append(Segment(Phase.REACH, min(onset, now), now, k, open=True))

@@ -177,7 +177,9 @@ class GazebotTrigger:
         da = d[first:]
         d_max = _nanmax(da)
         closed = float(d_max) - d[-1]
-        # (the predictive rule confirms a reach from predict_distance of the giver's own travel)
+        # (the predictive rule confirms a reach from predict_distance of the giver's own travel;
+        # the sequential one, in practice, past 1.2 cm: every fidget fits a cubic start up to
+        # its midpoint, so it waits for more than half the largest fidget)
         if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
             return False
         i_max = first + int(np.argmax(da == d_max))  # np.nanargmax: the first largest

@@ -1,0 +1,212 @@
+"""Idle -> reach, predictive (online): a sequential likelihood-ratio test on the giver's hand.
+
+A reach and a fidget start alike: near its start every minimum-jerk motion covers ``k (t -
+t0)^3``, whatever its size, so the first few centimetres cannot tell a 2 cm adjustment from a
+40 cm reach. What does tell them apart is how long the cubic growth goes on: a fidget's
+profile bends over at its midpoint, a reach's keeps growing. The rule therefore compares two
+classes of motion, each a minimum-jerk motion from rest (the seed's local linear model of the
+hand, eq. 4.5, in its minimum-jerk form) with onset ``t0`` within the last
+``sequential_onset_span`` and duration ``T`` within ``sequential_durations``:
+
+- a *fidget* (or rest, or sway): amplitude at most ``fidget_amplitude`` (1-2 cm adjustments);
+- a *reach*: amplitude at least ``min_approach`` (any reach closes 10 cm).
+
+For each ``(t0, T)`` on a grid, the best amplitude vector (3-D, with a free rest position) is a
+least-squares fit in closed form, clipped to the class's bound. The statistic is the
+generalised likelihood ratio ``(RSS_fidget - RSS_reach) / sigma^2``: the sum of squared
+residuals the best fidget leaves beyond the best reach, in units of the noise variance
+``sigma^2`` (the larger of the marker noise measured before the window, :func:`noise_floor`,
+and the reach fit's own residual, and at least the grids' resolution: the onset grid misplaces
+a moving hand by up to half a step times its speed). A reach is confirmed when it reaches
+``sequential_evidence``.
+Because the statistic sums over the samples in units of the measured noise, its bar scales
+with the sample rate and the noise floor by construction: more samples or less noise confirm
+sooner, sparse or noisy samples later; no travel distance or speed is fixed. The only
+distances are the two classes' bounds, which are properties of human motion, not of the
+tracker.
+
+Further, the fitted reach must head toward the receiver (within ``acos(predict_cos)`` of the
+line from its rest position to the receiver's hand) and the hands' gap must be closing at a
+reach's pace: a constant-acceleration fit of the gap over the last ``predict_window``
+closes ``predict_gap_share`` of the starting gap within ``predict_horizon`` (a hand adjusted
+sideways at arm's length, or a receiver moving away, does not). The onset is the fitted
+reach's ``t0``.
+
+It runs beside the constant-acceleration rule (:mod:`~gazebot.phases.rules.directed`), whose
+bars are fixed at their floors (1.6 cm of travel, 15 cm/s); the method takes whichever
+confirms first.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gazebot.phases.config import PhaseConfig
+from gazebot.phases.rules.directed import _fit, noise_floor
+from gazebot.phases.trajectory import Trajectory
+
+
+@dataclass(frozen=True)
+class ReachEvidence:
+    """The test's outcome at one sample.
+
+    Attributes:
+        statistic: ``(RSS_fidget - RSS_reach) / sigma^2`` (1): how much better a reach
+            explains the window than any fidget.
+        onset: The best reach's start ``t0`` (s).
+        duration: ... its duration ``T`` (s).
+        amplitude: ... its amplitude vector (m, 3).
+        rest: ... the hand's rest position before it (m, 3).
+        sigma: The noise used (m, per axis).
+    """
+
+    statistic: float
+    onset: float
+    duration: float
+    amplitude: np.ndarray
+    rest: np.ndarray
+    sigma: float
+
+
+def min_jerk_profile(s: np.ndarray) -> np.ndarray:
+    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (clipped to 0..1)."""
+    s = np.clip(s, 0.0, 1.0)
+    return s * s * s * (10.0 + s * (6.0 * s - 15.0))
+
+
+def _best_reduction(
+    s: np.ndarray, b: np.ndarray, lo: float, hi: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The largest drop of the residual sum of squares ``2 m |S| - m^2 B`` over amplitudes
+    ``m`` in ``[lo, hi]`` (``S`` (..., 3): template-data products, ``B``: template energy), and
+    that ``m``."""
+    norm = np.linalg.norm(s, axis=-1)
+    m = np.clip(norm / np.maximum(b, 1e-12), lo, hi)
+    return 2.0 * m * norm - m * m * b, m
+
+
+def _binned(t: np.ndarray, x: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Samples averaged per ``step`` (s) bin: (mean times, mean positions, counts). The
+    templates are smooth on that scale, so the test loses nothing; at 240 Hz it reads a
+    third as many rows."""
+    key = np.floor((t - t[0]) / step).astype(np.int64)
+    cuts = np.flatnonzero(np.diff(key)) + 1
+    counts = np.diff(np.concatenate([[0], cuts, [t.shape[0]]])).astype(float)
+    starts = np.concatenate([[0], cuts])
+    tb = np.add.reduceat(t, starts) / counts
+    xb = np.add.reduceat(x, starts, axis=0) / counts[:, None]
+    return tb, xb, counts
+
+
+def reach_evidence(
+    t: np.ndarray, x: np.ndarray, now: float, noise: float, c: PhaseConfig
+) -> ReachEvidence | None:
+    """The likelihood-ratio test of the module docstring on samples ``x`` (N, 3) at times
+    ``t`` (s, all finite, ending at ``now``), marker noise ``noise`` (m); ``None`` if the
+    samples cannot carry it (fewer than ``predict_min_samples``)."""
+    n = t.shape[0]
+    if n < c.predict_min_samples:
+        return None
+    lo_t, hi_t = c.sequential_durations
+    durations = np.geomspace(lo_t, hi_t, c.sequential_duration_steps)
+    onsets = now - np.arange(0.0, c.sequential_onset_span, c.sequential_onset_step)
+    tb, xb, w = _binned(t, x, 0.5 * c.sequential_onset_step)
+    mean_x = w @ xb / n
+    xc = xb - mean_x
+    # templates (onset, duration, bin), centred (weighted): the rest position is free
+    tmpl = min_jerk_profile((tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None])
+    mean_b = tmpl @ w / n
+    tmpl -= mean_b[..., None]
+    wt = tmpl * w
+    energy = np.einsum("abn,abn->ab", wt, tmpl)
+    prod = wt @ xc  # (onset, duration, 3)
+    reach, m_reach = _best_reduction(prod, energy, c.min_approach, math.inf)
+    fidget, _ = _best_reduction(prod, energy, 0.0, c.fidget_amplitude)
+    k = np.unravel_index(int(np.argmax(reach)), reach.shape)
+    best_fidget = float(fidget.max())
+    rss0 = float(np.einsum("ij,ij->", x - mean_x, x - mean_x))
+    dof = max(3 * n - 7, 1)
+    norm = float(np.linalg.norm(prod[k]))
+    amp = m_reach[k] * prod[k] / norm if norm > 0 else np.zeros(3)
+    # The grids' own resolution: an onset off by half a step misplaces a motion moving at
+    # speed v by up to v step / 2 (uniform: / sqrt 3), noise or not (with none, the fits'
+    # tiny misfits alone would otherwise decide).
+    s_now = min((now - float(onsets[k[0]])) / float(durations[k[1]]), 1.0)
+    speed = float(np.linalg.norm(amp)) * 30.0 * s_now**2 * (1.0 - s_now) ** 2 / durations[k[1]]
+    grid = speed * 0.5 * c.sequential_onset_step
+    sigma2 = max(noise * noise, (rss0 - float(reach[k])) / dof, grid * grid / 3.0, 1e-12)
+    rest = mean_x - amp * mean_b[k]
+    return ReachEvidence(
+        (float(reach[k]) - best_fidget) / sigma2,
+        float(onsets[k[0]]),
+        float(durations[k[1]]),
+        amp,
+        rest,
+        math.sqrt(sigma2),
+    )
+
+
+def sequential_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | None:
+    """The onset of a reach the giver's hand shows toward the receiver at the newest sample of
+    ``traj`` (see the module docstring), ``None`` if it shows none. Only samples after
+    ``after`` (s) are read (the previous handover's end)."""
+    t_all = traj.t
+    if t_all.shape[0] < c.predict_min_samples + 2:
+        return None
+    g, r = traj.giver_hand, traj.receiver_hand
+    now = float(t_all[-1])
+    lo = int(np.searchsorted(t_all, max(now - c.sequential_window - c.predict_noise_window, after)))
+    ok = np.isfinite(g[lo:]).all(axis=1) & np.isfinite(r[lo:]).all(axis=1) & (t_all[lo:] > after)
+    if not ok[-1]:
+        return None  # both hands seen now: the model is not extrapolated across a dropout
+    idx = lo + np.flatnonzero(ok)
+    tv = t_all[idx]
+    win = idx[tv > now - c.sequential_window]
+    if win.size < c.predict_min_samples:
+        return None
+    steps = np.diff(t_all[win])
+    if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
+        return None  # a dropout inside the window leaves the model unconstrained there
+    # A fidget fits any cubic start up to its midpoint: a hand not yet half the largest fidget
+    # from its rest (the window before every onset tried), or not toward the receiver, cannot
+    # be told from one (cheap skips before the test).
+    tw = t_all[win]
+    rest = win[tw <= now - c.sequential_onset_span]
+    last = win[tw >= now - 0.5 * c.sequential_onset_step]
+    if rest.size:
+        moved = g[last].mean(axis=0) - g[rest].mean(axis=0)
+        toward = float(moved @ (r[-1] - g[rest].mean(axis=0)))
+        if np.linalg.norm(moved) < 0.5 * c.fidget_amplitude or toward <= 0.0:
+            return None
+    noise = noise_floor(g[idx[tv <= now - c.sequential_window]])
+    # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted
+    # sideways at arm's length, closes it slower than the hand moves): a constant-acceleration
+    # model of the gap closes faster than predict_sigmas of its standard error ...
+    w0 = min(now - c.predict_window, float(t_all[win[-c.predict_min_samples]]))
+    fit = win[t_all[win] >= w0]
+    gap_fit = _fit(t_all[fit] - now, -np.linalg.norm(r[fit] - g[fit], axis=1), noise)
+    if gap_fit is None:
+        return None
+    (_, v_c, a_c, _), (_, s_v, _, _) = gap_fit
+    if not v_c >= c.predict_sigmas * s_v:
+        return None
+    ev = reach_evidence(t_all[win], g[win], now, noise, c)
+    if ev is None or not ev.statistic >= c.sequential_evidence:
+        return None
+    # Toward the receiver: the fitted reach within acos(predict_cos) of the line to its hand.
+    line = r[-1] - ev.rest
+    gap = float(np.linalg.norm(line))
+    amp = float(np.linalg.norm(ev.amplitude))
+    if gap <= 1e-6 or amp <= 0 or float(ev.amplitude @ line) < c.predict_cos * amp * gap:
+        return None
+    # ... and, extrapolated predict_horizon ahead, closes a share of the gap the hands started
+    # from.
+    h = c.predict_horizon
+    closed = float(np.linalg.norm(r[-1] - ev.rest)) - float(np.linalg.norm(r[-1] - g[-1]))
+    ahead = closed + v_c * h + 0.5 * max(a_c, 0.0) * h * h
+    if not ahead >= c.predict_gap_share * gap:
+        return None
+    return max(ev.onset, float(t_all[win[0]]), after)
