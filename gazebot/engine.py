@@ -203,7 +203,9 @@ class GazeEngine:
         tracking_end = (
             detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
-        ctx = GazeContext(t=t, points=self._points(frame), tracking_end=tracking_end)
+        # Every field given, so the frozen dataclass is filled directly (see _command).
+        ctx = object.__new__(GazeContext)
+        ctx.__dict__.update(t=t, points=self._points(frame), tracking_end=tracking_end)
         try:
             target = self.behavior.target(ctx)
             kind, point = target.kind, target.point

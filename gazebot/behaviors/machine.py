@@ -746,16 +746,13 @@ class BehaviorMachine:
         if p is None:
             return None
         arr = p if type(p) is np.ndarray and p.dtype == np.float64 else _as3(p)
-        # Scalar checks: much cheaper than np.isfinite(...).all() on a 3-vector.
-        if (
-            arr is not None
-            and arr.shape == (3,)
-            and math.isfinite(arr[0])
-            and math.isfinite(arr[1])
-            and math.isfinite(arr[2])
-        ):
-            return arr
-        return None
+        if arr is None or arr.shape != (3,):
+            return None
+        # Scalar checks on one list: much cheaper than np.isfinite(...).all() on a 3-vector,
+        # or than three NumPy scalars.
+        x, y, z = arr.tolist()
+        isfinite = math.isfinite
+        return arr if isfinite(x) and isfinite(y) and isfinite(z) else None
 
 
 def _as3(p: object) -> np.ndarray | None:

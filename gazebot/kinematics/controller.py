@@ -208,8 +208,17 @@ class GazeController:
                         self._saccade = None
                 limit = self.robot.eye_velocity_limit * dt
                 e0, e1 = self._eyes
-                yaw = min(max(yaw, e0 - limit), e0 + limit)
-                pitch = min(max(pitch, e1 - limit), e1 + limit)
+                # min(max(v, lo), hi) as comparisons (the same result, NaN included)
+                lo, hi = e0 - limit, e0 + limit
+                if yaw < lo:
+                    yaw = lo
+                if yaw > hi:
+                    yaw = hi
+                lo, hi = e1 - limit, e1 + limit
+                if pitch < lo:
+                    pitch = lo
+                if pitch > hi:
+                    pitch = hi
                 yaw, pitch, _ = eyes.clip(yaw, pitch)
                 self._eyes = (yaw, pitch)
                 self._residual = eyes.residual(yaw, pitch, v)
@@ -357,7 +366,7 @@ class GazeController:
             duration = max(remaining, cfg.tracking_duration_s, need)
         if new_shift or goal_change > _REPLAN_EPS or traj is None:
             if move > _REPLAN_EPS or speed > 0.0:
-                self._traj = MinJerkTrajectory(t_start, duration, q, goal, vel, acc)
+                self._traj = MinJerkTrajectory.of_floats(t_start, duration, q, goal, vel, acc)
         self._goal = goal
 
         # Eyes: a saccade from where they are now toward the target (re-aimed every tick).

@@ -44,8 +44,16 @@ class DisplayEyes:
 
     def clip(self, yaw: float, pitch: float) -> tuple[float, float, bool]:
         """Clip to the eye range; the flag says whether anything was clipped."""
-        y = min(max(yaw, self.yaw_range[0]), self.yaw_range[1])
-        p = min(max(pitch, self.pitch_range[0]), self.pitch_range[1])
+        # min(max(v, lo), hi) as comparisons (the same result, NaN included): this runs twice
+        # per controller tick and once per loop tick.
+        lo, hi = self.yaw_range
+        y = lo if yaw < lo else yaw
+        if y > hi:
+            y = hi
+        lo, hi = self.pitch_range
+        p = lo if pitch < lo else pitch
+        if p > hi:
+            p = hi
         return y, p, (y != yaw or p != pitch)
 
     def look(self, v: np.ndarray | Sequence[float]) -> tuple[float, float, bool]:

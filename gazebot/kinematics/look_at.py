@@ -17,7 +17,6 @@ from typing import NamedTuple
 import numpy as np
 
 from gazebot.kinematics.config import IKSettings
-from gazebot.kinematics.eyes import angle_between
 from gazebot.kinematics.robot import GazePose, RobotModel
 
 _LIMIT_EPS = 1e-9
@@ -165,7 +164,9 @@ def _pointing_error(
     a = ux * xx + uy * xy + uz * xz
     b = ux * b1x + uy * b1y + uz * b1z
     c = ux * b2x + uy * b2y + uz * b2z
-    rho2 = max(a * a + b * b, 1e-18)
+    rho2 = a * a + b * b
+    if rho2 < 1e-18:  # max(rho2, 1e-18) without the call
+        rho2 = 1e-18
     rho = math.sqrt(rho2)
     n2 = rho2 + c * c
     d_az: list[float] = []
@@ -262,8 +263,6 @@ def solve_ik_raw(
             move of the target, as with a full solve.)
     """
     lower, upper, rest = robot.head_bounds
-    lower_eps = [v + _LIMIT_EPS for v in lower]
-    upper_eps = [v - _LIMIT_EPS for v in upper]
     n = len(qs)
     lam = cfg.damping
     tol = cfg.tolerance
@@ -321,8 +320,8 @@ def solve_ik_raw(
                     continue
         # The active set below only matters when some joint is at a limit.
         at_limit = False
-        for q, lo, hi in zip(qs, lower_eps, upper_eps, strict=True):
-            if q <= lo or q >= hi:
+        for q, lo, hi in zip(qs, lower, upper, strict=True):
+            if q <= lo + _LIMIT_EPS or q >= hi - _LIMIT_EPS:
                 at_limit = True
                 break
         free = range(n)
@@ -418,7 +417,8 @@ def solve_ik_raw(
         r01 * dx + r11 * dy + r21 * dz,
         r02 * dx + r12 * dy + r22 * dz,
     )
-    residual = angle_between((1.0, 0.0, 0.0), local)
+    # angle_between((1, 0, 0), local) with its zero terms dropped (the same floats).
+    residual = math.atan2(math.sqrt(local[2] * local[2] + local[1] * local[1]), local[0])
     reached = residual <= tol
     if jacobian and rows is None:
         rows = robot.gaze_jacobian_rows(qs)

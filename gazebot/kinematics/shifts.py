@@ -125,15 +125,49 @@ class MinJerkTrajectory(Trajectory):
         # Plain floats on purpose: the gaze controller re-plans every tick for 1-4 joints, where
         # numpy's per-call overhead would cost more than the arithmetic.
         start = _floats(p0)
-        goal = _floats(p1)
         n = len(start)
-        vel = [0.0] * n if v0 is None else _floats(v0)
-        acc = [0.0] * n if a0 is None else _floats(a0)
+        self._plan(
+            float(t0),
+            float(duration),
+            start,
+            _floats(p1),
+            [0.0] * n if v0 is None else _floats(v0),
+            [0.0] * n if a0 is None else _floats(a0),
+        )
+
+    @classmethod
+    def of_floats(
+        cls,
+        t0: float,
+        duration: float,
+        p0: Sequence[float],
+        p1: Sequence[float],
+        v0: Sequence[float],
+        a0: Sequence[float],
+    ) -> MinJerkTrajectory:
+        """The trajectory ``MinJerkTrajectory(t0, duration, p0, p1, v0, a0)`` gives, from values
+        that already are Python floats (``duration > 0``, sequences of equal length): the gaze
+        controller re-plans every tick and skips the conversions (a duration from the config
+        may be an int)."""
+        traj = cls.__new__(cls)
+        traj._plan(t0, float(duration), p0, p1, v0, a0)
+        return traj
+
+    def _plan(
+        self,
+        t0: float,
+        T: float,
+        start: Sequence[float],
+        goal: Sequence[float],
+        vel: Sequence[float],
+        acc: Sequence[float],
+    ) -> None:
+        """The quintic's coefficients per joint from floats."""
+        n = len(start)
         if not len(goal) == len(vel) == len(acc) == n:
             raise ValueError("p0, p1, v0 and a0 must have the same length")
-        T = float(duration)
         k3, k4, k5 = 0.5 / T**3, 0.5 / T**4, 0.5 / T**5
-        self.t0 = float(t0)
+        self.t0 = t0
         self.duration = T
         self._goal = tuple(goal)
         coeffs = []

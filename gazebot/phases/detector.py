@@ -327,6 +327,10 @@ class PhaseDetector:
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
         """Gripper / load-share evidence; True if it started a phase on this frame."""
+        if frame.gripper_closed is None and frame.load_share is None:
+            # No evidence (tracking alone, the usual frame): what the checks below conclude.
+            self._prev_evidence = False
+            return False
         c = self.config
         grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
         load = frame.load_share
@@ -368,7 +372,9 @@ class PhaseDetector:
             if n - i0 < 3:
                 i0 = 0
         window = rows[i0:]
-        traj = Trajectory(window[:, 0].copy(), window[:, 1:4].copy(), window[:, 4:].copy())
+        # (the rows are float64 of known shapes: no conversion or check needed)
+        traj = Trajectory.of_hands(window[:, 0].copy(), window[:, 1:4].copy(),
+                                   window[:, 4:].copy())
         s = self.segmenter.online_signals(traj)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:

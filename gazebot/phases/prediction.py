@@ -26,7 +26,9 @@ def _mirrored(t: np.ndarray, v: np.ndarray, onset: float, nominal: float, c: Pha
     ok = np.isfinite(v)
     if not ok.any():
         return onset + nominal
-    i = int(np.nanargmax(v))
+    # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its copies
+    # and checks)
+    i = int(np.argmax(np.where(np.isnan(v), -np.inf, v)))
     peak = float(v[i])
     last = float(v[np.flatnonzero(ok)[-1]])
     if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:

@@ -66,6 +66,23 @@ class Trajectory:
                 raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
             setattr(self, name, arr)
 
+    @classmethod
+    def of_hands(cls, t: np.ndarray, giver_hand: np.ndarray, receiver_hand: np.ndarray
+                 ) -> Trajectory:
+        """``Trajectory(t, giver_hand, receiver_hand)`` from float64 arrays already shaped
+        ``(N,)``, ``(N, 3)``, ``(N, 3)`` (the samples the online detector keeps), without the
+        constructor's conversions and checks: it builds one per analysis. Face, gripper and
+        load share are unknown (NaN), as the constructor makes them."""
+        traj = cls.__new__(cls)
+        n = t.shape[0]
+        traj.t = t
+        traj.giver_hand = giver_hand
+        traj.receiver_hand = receiver_hand
+        traj.giver_face = _nan_points(n)
+        traj.gripper_closed = np.full(n, np.nan)
+        traj.load_share = np.full(n, np.nan)
+        return traj
+
     def __len__(self) -> int:
         return int(self.t.shape[0])
 

@@ -35,6 +35,8 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Protocol
 
+import numpy as np
+
 from gazebot.render.blink import BlinkModel
 from gazebot.types import (
     Event,
@@ -47,8 +49,6 @@ from gazebot.types import (
 
 if TYPE_CHECKING:
     from pathlib import Path
-
-    import numpy as np
 
     from gazebot.kinematics import RobotConfig
     from gazebot.phases import PhaseConfig
@@ -213,9 +213,18 @@ class GazeLoop:
             self.unsafe += 1
             return None
         distance = None
-        if is_valid_point(cmd.target_point):
+        point = cmd.target_point
+        if type(point) is np.ndarray and point.shape == (3,) and point.dtype.kind == "f":
+            # is_valid_point on the floats read once (the engine's points are such arrays)
+            x, y, z = point.tolist()
+            valid = isfinite(x) and isfinite(y) and isfinite(z)
+        elif is_valid_point(point):
+            x, y, z = np.asarray(point, dtype=float).tolist()
+            valid = True
+        else:
+            valid = False
+        if valid:
             rows = self._gaze_frame(self._display_pose(head, joints))
-            x, y, z = cmd.target_point.tolist()
             dx, dy, dz = x - rows[0][3], y - rows[1][3], z - rows[2][3]
             d = math.sqrt(dx * dx + dy * dy + dz * dz)
             # A target at the display itself (or beyond any float) has no defined vergence.

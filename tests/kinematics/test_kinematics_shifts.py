@@ -264,3 +264,11 @@ def test_non_numeric_time_is_a_clear_error(jaco2):
     c = GazeController(jaco2)
     with pytest.raises(ValueError, match="time must be a number"):
         c.update(None, jaco2.points["face"])
+
+
+def test_of_floats_plans_the_same_trajectory_as_the_constructor():
+    args = (0.25, 1, [0.1, -0.4], [0.6, 0.2], [0.05, -0.3], (1.5, 0.0))
+    ref, fast = MinJerkTrajectory(*args), MinJerkTrajectory.of_floats(*args)
+    assert fast.end_time == ref.end_time and fast.duration == ref.duration == 1.0
+    for t in (0.0, 0.25, 0.5, 0.9, 1.25, 2.0):
+        assert fast.sample(t) == ref.sample(t)

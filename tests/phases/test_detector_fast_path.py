@@ -81,3 +81,42 @@ def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monk
     assert sum(len(ev) for ev, _ in fast) > 4 * len(recordings)  # the recordings do show phases
     for i, (a, b) in enumerate(zip(fast, slow, strict=True)):
         assert a == b, f"recording {i}"
+
+
+def test_of_hands_builds_the_trajectory_the_constructor_builds():
+    rng = np.random.default_rng(2)
+    t, g, r = np.sort(rng.random(40)), rng.random((40, 3)), rng.random((40, 3))
+    g[5] = np.nan
+    ref, fast = Trajectory(t, g, r), Trajectory.of_hands(t, g, r)
+    for name in ("t", "giver_hand", "receiver_hand", "giver_face", "gripper_closed",
+                 "load_share"):
+        a, b = getattr(ref, name), getattr(fast, name)
+        assert a.shape == b.shape and a.dtype == b.dtype
+        np.testing.assert_array_equal(a, b)
+
+
+
+def test_the_predicted_end_reads_the_peak_np_nanargmax_finds():
+    from gazebot.phases.prediction import _mirrored
+
+    def reference(t, v, onset, nominal, c):  # the code before, with np.nanargmax
+        ok = np.isfinite(v)
+        if not ok.any():
+            return onset + nominal
+        i = int(np.nanargmax(v))
+        peak, last = float(v[i]), float(v[np.flatnonzero(ok)[-1]])
+        if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
+            return onset + 2.0 * max(float(t[i]) - onset, 0.0)
+        return onset + nominal
+
+    c = PhaseConfig()
+    rng = np.random.default_rng(4)
+    for _ in range(2000):
+        n = int(rng.integers(1, 30))
+        t = np.arange(n) / 100.0
+        v = np.round(rng.random(n), 1)  # ties: the first largest wins
+        v[rng.random(n) < 0.3] = np.nan
+        v[rng.random(n) < 0.05] = np.inf
+        if np.isnan(v).all():
+            continue
+        assert _mirrored(t, v, 0.05, 0.8, c) == reference(t, v, 0.05, 0.8, c)
