@@ -149,7 +149,12 @@ def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset
     [report] = events.where(kind="competing_tracking")
     assert report.info["source"].startswith("tracker_b ")
     assert report.info["owner"].startswith("tracker_a ")
-    assert report.info["group"] == "giver_face, giver_hand"  # both refused parts, one report
+    # One report per rival, naming the parts refused by the time it was made (the face's first
+    # sample may still be in flight on a busy machine); the rival then holds both parts.
+    assert report.info["group"] in ("giver_hand", "giver_face", "giver_face, giver_hand")
+    assert wait_until(
+        lambda: [r.group for r in drv.tracking_rivals()] == ["giver_face, giver_hand"]
+    )
     assert "second tracking source tracker_b" in drv.drops.reasons()[hand]
     # tracker a goes silent: tracker b takes over, with one clock reset for its clock
     state = {"t": 6.0}
