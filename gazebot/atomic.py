@@ -1,5 +1,5 @@
-"""Atomic output files: everything gazebot writes (videos, MCAP recordings, study exports,
-sidecars) goes to a hidden temporary file beside the target and is renamed over it only when
+"""Atomic output files: the videos, MCAP recordings, study exports, cached study videos and
+their sidecars go to a hidden temporary file beside the target and are renamed over it only when
 writing finished without an error, so an interrupted or failing run never leaves a truncated
 file where a reader expects a whole one (and an older whole file stays until it is replaced).
 """

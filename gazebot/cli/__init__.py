@@ -67,11 +67,6 @@ def _plain(text: str | None) -> str | None:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    from gazebot.sim.gl_check import ensure_gl_backend
-
-    # Before any command imports MuJoCo (some do before they simulate): off-screen EGL unless
-    # MUJOCO_GL says otherwise; a no-op once MuJoCo is loaded.
-    ensure_gl_backend(probe_first=False)
     try:
         result = args.func(args)
         sys.stdout.flush()

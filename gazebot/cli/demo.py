@@ -144,7 +144,7 @@ def scene_with_overrides(args: argparse.Namespace):
     if not overrides:
         ctrl = load_scene(base).controller  # a scene YAML may ask for the learned reach itself
         if ctrl.reach_controller == GPS_REACH:
-            check_policy(ctrl.policy, args)
+            check_policy(ctrl.policy, default_robot(args))
         return base
     from gazebot.sim.cartesian_reach import scene_controllers_config
     from gazebot.sim.scene_config import (
@@ -177,12 +177,12 @@ def scene_with_overrides(args: argparse.Namespace):
     except ValueError as exc:  # pydantic's ValidationError is one; it names the field
         raise option_error(exc, _OPTIONS, "invalid controller options") from exc
     if scene.controller.reach_controller == GPS_REACH:
-        check_policy(scene.controller.policy, args)
+        check_policy(scene.controller.policy, default_robot(args))
     return scene
 
 
-def check_policy(policy: str | None, args: argparse.Namespace) -> None:
-    """Before any simulation: the ``gps`` policy loads and fits ``--robot`` (one-line errors)."""
+def check_policy(policy: str | None, robot: str) -> None:
+    """Before any simulation: the ``gps`` policy loads and fits ``robot`` (one-line errors)."""
     import mujoco
 
     from gazebot.config import ConfigError
@@ -196,7 +196,6 @@ def check_policy(policy: str | None, args: argparse.Namespace) -> None:
         controller = CONTROLLERS.make(GPS_REACH, None, policy=policy)
     except (ConfigError, ValueError) as exc:
         raise UsageError(f"--policy {policy}: {exc}") from None
-    robot = getattr(args, "robot", "panda")
     try:
         sim_robot = load_sim_robot(robot)
     except (FileNotFoundError, ConfigError):
@@ -214,11 +213,17 @@ def check_policy(policy: str | None, args: argparse.Namespace) -> None:
 
 
 def default_robot(args: argparse.Namespace) -> str:
-    """``--robot``, else the robot the controller runs on: the learned ``gps`` policy drives
-    the Panda it was trained on; every other controller defaults to the Sawyer."""
+    """``--robot``, else the robot the reach controller (``--controller``, else the scene's)
+    runs on: the learned ``gps`` policy drives the Panda it was trained on; every other
+    controller defaults to the Sawyer."""
     if args.robot is not None:
         return str(args.robot)
-    return "panda" if getattr(args, "controller", None) == "gps" else "sawyer"
+    from gazebot.sim.scene_config import GPS_REACH, load_scene
+
+    controller = getattr(args, "controller", None)
+    if controller is None:
+        controller = load_scene(args.scene).controller.reach_controller
+    return "panda" if controller == GPS_REACH else "sawyer"
 
 
 def run_demo(args: argparse.Namespace) -> int:
@@ -243,6 +248,15 @@ def run_demo(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    from gazebot.sim.gl_check import ensure_gl_backend
+
+    try:
+        # Before anything loads MuJoCo (the gps policy check loads a model): the first working
+        # of EGL and OSMesa, unless MUJOCO_GL says.
+        ensure_gl_backend()
+    except OffscreenRenderingError as exc:
+        print(f"gazebot: error: {exc}", file=sys.stderr)
+        return 2
     from gazebot.sim.policy_reach import PolicyReachLog
     from gazebot.sim.stl_monitor import HandoverMonitor
 

@@ -41,15 +41,17 @@ CONTROLLERS.register(
     "stl", "gazebot.controllers.stl:STLController",
     "STL specification as a MILP in receding horizon (eqs. 4.1-4.5)",
 )
+#: The learned reach's registry name (the simulator's scenes and the demo use this one).
+GPS = "gps"
 CONTROLLERS.register(
-    "gps", "gazebot.controllers.gps:GPSController",
+    GPS, "gazebot.controllers.gps:GPSController",
     "learned GPS policy (chapter 5): Panda joint torques; needs `--policy DIR`, runs on `panda`",
 )
 
 
 #: Registered controllers that command joint torques and plan no Cartesian velocities: they run
 #: only in the simulator, on a robot with their arm, and ``gazebot reach-plan`` does not offer them.
-TORQUE_CONTROLLERS: tuple[str, ...] = ("gps",)  # gazebot.sim.scene_config.GPS_REACH
+TORQUE_CONTROLLERS: tuple[str, ...] = (GPS,)
 
 
 def planner_names() -> tuple[str, ...]:

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gazebot.controllers import GPS
 from gazebot.controllers.config import ControllersConfig, load_controllers_config
 
 #: The state fields the handover scene cannot give (FULL, eq. 5.8).
@@ -55,7 +56,7 @@ class GPSController:
             missing; ``ConfigError`` for a directory that holds no policy.
     """
 
-    name = "gps"
+    name = GPS
 
     def __init__(self, config: ControllersConfig | None = None,
                  policy: str | Path | None = None) -> None:

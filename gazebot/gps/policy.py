@@ -61,6 +61,23 @@ class PolicyParams:
         with np.load(path) as z:
             return cls(**{k: z[k] for k in cls.__dataclass_fields__})
 
+    def shape_error(self, dx: int, du: int) -> tuple[str, str, str] | None:
+        """(array, what was expected, what it is) for the first array that does not fit states
+        of size ``dx`` and actions of size ``du``, else ``None``: a network saved for another
+        state representation would otherwise fail deep inside a rollout."""
+        hidden = self.b1.shape[0] if self.b1.ndim == 1 and self.b1.shape[0] > 0 else None
+        expected = {
+            "b1": (hidden or "H",), "w1": (dx, hidden), "w2": (hidden, du), "b2": (du,),
+            "x_mean": (dx,), "x_scale": (dx,), "u_scale": (du,), "cov": (du, du),
+        }
+        for name, shape in expected.items():
+            value = getattr(self, name)
+            if hidden is None or value.shape != shape:
+                return name, f"shape {shape}", str(value.shape)
+            if not np.issubdtype(value.dtype, np.floating) or not np.all(np.isfinite(value)):
+                return name, "finite floats", f"{value.dtype} with non-finite values"
+        return None
+
 
 def init_policy(dx: int, du: int, hidden: int, u_scale: np.ndarray, seed: int) -> PolicyParams:
     """He-initialised weights, zero biases, identity normalisation."""

@@ -4,6 +4,7 @@ trained: state kind, trainer, targets, the configuration, the iteration log)."""
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -13,7 +14,8 @@ from gazebot.config import ConfigError, validate
 from gazebot.gps.badmm import TrainResult
 from gazebot.gps.config import GPSFileConfig
 from gazebot.gps.policy import PolicyParams
-from gazebot.gps.state import StateKind
+from gazebot.gps.scene import DU
+from gazebot.gps.state import DIMS, StateKind
 
 
 @dataclass(frozen=True)
@@ -66,9 +68,15 @@ def load(directory: str | Path) -> TrainedPolicy:
     cfg = validate(GPSFileConfig, meta["config"], f"{meta_path}:config")
     try:
         policy = PolicyParams.load(d / "policy.npz")
-    except (OSError, KeyError, ValueError) as exc:
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
         raise ConfigError(d / "policy.npz", "<file>", "the policy network's arrays",
                           str(exc)) from exc
+    problem = policy.shape_error(DIMS[kind], DU)
+    if problem is not None:
+        name, expected, got = problem
+        raise ConfigError(d / "policy.npz", name,
+                          f"{expected} for the {kind.value} state in meta.json "
+                          f"({DIMS[kind]} values) and {DU} actions", got)
     return TrainedPolicy(policy, cfg, kind, meta["trainer"] == "moving",
                          np.asarray(meta["targets_m"], dtype=float), int(meta["controllers"]),
                          list(meta.get("log", [])))

@@ -165,16 +165,17 @@ class PolicyReachLog:
         if not isinstance(reach, PolicyReach):
             return
         self._reach = reach
-        self.max_torque_nm = max(self.max_torque_nm,
-                                 float(np.abs(sim.data.ctrl[sim._arm_act]).max()))
         if sim.controller.state not in (ControllerState.REACHING, ControllerState.AT_HANDOVER):
             return
+        # the policy's own torques (home, retreat and holding run the impedance law)
+        self.max_torque_nm = max(self.max_torque_nm,
+                                 float(np.abs(sim.data.ctrl[sim._arm_act]).max()))
         gripper = sim.data.site_xpos[sim._gripper_site]
         gaps = (float(np.linalg.norm(gripper - sim.data.mocap_pos[sim.scene.object_mocap])),
                 float(np.linalg.norm(gripper - sim.giver.hand)))
         if self._start is None:
             self._start, self._t0 = gaps, sim.t
-        self._end, self._reach_s = gaps, sim.t - (self._t0 or sim.t)
+        self._end, self._reach_s = gaps, sim.t - self._t0
 
     def summary(self) -> dict | None:
         """The JSON summary (m, s, N m), None when no learned reach ran."""

@@ -11,6 +11,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from gazebot.config import configs_dir, load_model
+from gazebot.controllers import GPS
 
 
 class _Strict(BaseModel):
@@ -84,7 +85,7 @@ class GiverConfig(_Strict):
 #: The reach without a controller: a joint-space minimum-jerk move to the predefined handover
 #: pose (the gaze studies' robot).
 JOINT_REACH = "joint"
-GPS_REACH = "gps"  # the learned reach: needs controller.policy
+GPS_REACH = GPS  # the learned reach: needs controller.policy
 
 
 def reach_controller_names() -> tuple[str, ...]:

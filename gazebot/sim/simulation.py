@@ -436,7 +436,9 @@ class HandoverSimulation:
         self._events.extend(events)
         torque = None
         if not self._arm_external:
-            self._arm_goal = np.asarray(cmd.arm, float)
+            # Joint goals inside the arm's ranges, as the position servos get them (NaN stays:
+            # it means "hold").
+            self._arm_goal = np.clip(np.asarray(cmd.arm, float), self._arm_lo, self._arm_hi)
             torque = cmd.torque
         self.data.ctrl[self._gripper_act] = self._clip_ctrl(self._gripper_act, cmd.gripper)
         n = max(1, round((t - self.data.time) / self.model.opt.timestep))

@@ -73,3 +73,12 @@ def test_the_impedance_holds_the_measured_posture_for_a_non_finite_goal():
     assert np.all(np.isfinite(tau)) and tau[2] == 0.0
     assert np.all(np.abs(tau) <= np.array(panda.TAU_MAX_NM))  # 50 N m asked, 12 on the wrist
     assert tau[6] == panda.TAU_MAX_NM[6]
+
+
+def test_the_handover_robots_home_is_the_pose_the_policy_was_trained_from():
+    """``configs/robots/panda.yaml``'s ``arm_home_deg`` and ``configs/gps.yaml``'s
+    ``scene.home_deg`` are one posture: the learned reach starts where it was trained to."""
+    from gazebot.sim.robot import load_sim_robot
+
+    home = load_sim_robot("panda").home
+    np.testing.assert_allclose(home, np.deg2rad(load_gps_config().scene.home_deg), atol=1e-12)

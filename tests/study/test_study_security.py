@@ -295,6 +295,9 @@ def test_an_admin_sign_in_expires_and_asks_for_the_token_again(study_dir):
     assert c.get("/admin").status_code == 403
     _sign_in(c)  # signing in again opens it
     assert c.get("/admin").status_code == 200
+    # A time that is not ASCII digits (a raw 0xB2 byte arrives as '²') is no sign-in, not a 500.
+    c.set_cookie(ADMIN_COOKIE, f"{sid}.\u00b2.{mac}")
+    assert c.get("/admin").status_code == 403
 
 
 def test_a_body_over_the_cap_is_refused_with_413(study_dir):

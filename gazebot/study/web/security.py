@@ -90,7 +90,8 @@ def admin_session_of(
     ``max_age_s`` before ``now`` (and not in the future), else ``None``."""
     session, _, rest = cookie.partition(".")
     issued_text, _, _ = rest.partition(".")
-    if not is_link_token(session) or not issued_text.isdigit() or len(issued_text) > 12:
+    # ASCII digits only: str.isdigit() also accepts e.g. '²', which int() refuses.
+    if not is_link_token(session) or re.fullmatch(r"[0-9]{1,12}", issued_text) is None:
         return None
     issued = int(issued_text)
     if not 0 <= now - issued <= max_age_s:
