@@ -88,6 +88,11 @@ class PolicyReach:
         m, d = self.model, self.data
         rot = d.xmat[self._base].reshape(3, 3)
         origin = d.xpos[self._base]
+        # The simulation steps and then updates positions only (mj_kinematics), so the body
+        # velocities are one physics step old: bring them to the current state, as the
+        # training scene's mj_forward does before it reads them.
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_comVel(m, d)
         mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_SITE, self._site, self._vel, 0)
         return LearnerState(
             theta_r=d.qpos[self._qadr].copy(),

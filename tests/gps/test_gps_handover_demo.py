@@ -122,6 +122,17 @@ def test_a_full_state_policy_names_the_fields_the_scene_lacks(trained, tmp_path,
     meta = json.loads((full / "meta.json").read_text())
     meta["state"] = "full"
     (full / "meta.json").write_text(json.dumps(meta))
+    # a network of the FULL state's size (49 inputs: the tester's joint angles and velocities
+    # added), so the load succeeds and the scene's refusal is what is tested
+    from gazebot.gps.state import DIMS, StateKind
+
+    with np.load(full / "policy.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    extra = DIMS[StateKind.FULL] - arrays["w1"].shape[0]
+    arrays["w1"] = np.vstack([arrays["w1"], np.zeros((extra, arrays["w1"].shape[1]))])
+    arrays["x_mean"] = np.concatenate([arrays["x_mean"], np.zeros(extra)])
+    arrays["x_scale"] = np.concatenate([arrays["x_scale"], np.ones(extra)])
+    np.savez(full / "policy.npz", **arrays)
     assert main(["demo", "--robot", "panda", "--controller", "gps", "--policy", str(full),
                  "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err

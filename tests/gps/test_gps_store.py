@@ -9,8 +9,11 @@ import shutil
 import numpy as np
 import pytest
 
-from gazebot.config import ConfigError
-from gazebot.gps.store import load
+pytest.importorskip("jax", reason="gazebot gps needs the optional extra gazebot[gps]")
+pytest.importorskip("sklearn", reason="gazebot gps needs the optional extra gazebot[gps]")
+
+from gazebot.config import ConfigError  # noqa: E402
+from gazebot.gps.store import load  # noqa: E402
 
 
 def _copy(trained, tmp_path):
