@@ -95,7 +95,9 @@ class PartTracker:
             pub.publish(convert.point_stamped(t, xyz, "world"))
 
 
-def test_a_hand_tracker_and_a_separate_face_tracker_both_reach_the_engine(bus):
+def _engine_node(bus):
+    """An engine node (not started) whose sources go silent after 0.3 s: (driver, fake engine,
+    node, its thread, its event recorder); closed with the bus."""
     drv = ZenohRobotDriver(bus.listener(), bus.names, "engine", source_timeout=0.3)
     engine = FakeEngine()
     node = EngineNode(GazeLoop(engine), drv, FAST)
@@ -103,7 +105,11 @@ def test_a_hand_tracker_and_a_separate_face_tracker_both_reach_the_engine(bus):
     th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
     bus.closers.append(drv.close)
     bus.closers.append(lambda: (stop.set(), th.is_alive() and th.join(timeout=5)))
-    events = events_of(drv)
+    return drv, engine, node, th, events_of(drv)
+
+
+def test_a_hand_tracker_and_a_separate_face_tracker_both_reach_the_engine(bus):
+    drv, engine, node, th, events = _engine_node(bus)
     hands = PartTracker(bus, "mocap", {"giver_hand": (topics.GIVER_HAND, [1.0, 0.0, 1.0])})
     face = PartTracker(bus, "face_tracker", {"giver_face": (topics.GIVER_FACE, [1.0, 0.3, 1.5])})
     assert wait_until(lambda: drv._expected_parts() == {"giver_hand", "giver_face"})
@@ -122,14 +128,7 @@ def test_a_hand_tracker_and_a_separate_face_tracker_both_reach_the_engine(bus):
 
 
 def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset_per_sample(bus):
-    drv = ZenohRobotDriver(bus.listener(), bus.names, "engine", source_timeout=0.3)
-    engine = FakeEngine()
-    node = EngineNode(GazeLoop(engine), drv, FAST)
-    stop = threading.Event()
-    th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
-    bus.closers.append(drv.close)
-    bus.closers.append(lambda: (stop.set(), th.is_alive() and th.join(timeout=5)))
-    events = events_of(drv)
+    drv, engine, node, th, events = _engine_node(bus)
     a, b = Tracker(bus, "tracker_a"), Tracker(bus, "tracker_b")
     hand = bus.names.resolve(topics.GIVER_HAND.name)
     assert wait_until(lambda: drv._expected_parts() == {"giver_hand", "giver_face"}
