@@ -188,7 +188,9 @@ def _check_graph(topics: dict) -> None:
 def test_a_ros2_node_sees_gazebots_topics_and_decodes_a_handovers_gaze(router, msgdir):
     peer = Peer("listen", router, msgdir, "--duration", "90")
     peer.wait_line("ready", 120)  # subscribed first: it sees the handover from its start
-    sim = _gazebot("sim", "--with-engine", "--headless", "--duration", "16", "--speed", "2",
+    # 24 s simulated: the handover ends near 8 s, and on a machine whose cores are busy the
+    # engine's `done` (re-sent with every heartbeat) must still reach the peer before the end.
+    sim = _gazebot("sim", "--with-engine", "--headless", "--duration", "24", "--speed", "2",
                    "--listen", "tcp/127.0.0.1:0", "--connect", f"tcp/127.0.0.1:{router}",
                    "--json")
     sim_out, _ = _finish(sim, 180)
