@@ -264,9 +264,12 @@ def test_whole_participant_in_chromium_survives_a_server_sigkill_mid_session(dri
         status, _, _ = http("POST", f"{link}/session/{last}", resent, {"Origin": server.base})
         assert status == 403
         d.get(link)
+        # the page may still be building on a busy machine: wait for its text, not a snapshot
+        _wait(lambda: "completed all" in d.page_source,
+              what="the completed message")
         assert "completed all" in d.find_element(By.ID, "message").text
         d.get(f"{server.base}/p/1")  # a participant number is no link
-        assert "No such participant link" in d.page_source
+        _wait(lambda: "No such participant link" in d.page_source, what="the not-found page")
     finally:
         server.stop()
 
