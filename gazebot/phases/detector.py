@@ -302,8 +302,16 @@ class PhaseDetector:
 
         if self._robot_evidence(frame, t):
             return
-        if t - self._last_analysis >= c.online_period:
-            self._last_analysis = t
+        if t - self._last_analysis >= c.online_period - 1e-9:
+            # On a fixed grid of online_period (the first sample at or after each tick), not
+            # online_period after the last analysed sample: that waits up to twice the period
+            # when samples come just faster than it (60 Hz: 33 ms, 100 Hz: 30 ms by rounding),
+            # so more samples would confirm later.
+            since = t - self._last_analysis
+            if c.online_period > 0 and since < 4.0 * c.online_period:
+                self._last_analysis += c.online_period * math.floor(since / c.online_period + 1e-6)
+            else:
+                self._last_analysis = t  # the first sample, or after a pause: a new grid
             mode = "full"
             if self._trigger is not None:
                 state = OnlineState(

@@ -22,13 +22,19 @@ from gazebot.phases.filtering import Signals
 from gazebot.types import Phase
 
 
-def _mirrored(t: np.ndarray, v: np.ndarray, onset: float, nominal: float, c: PhaseConfig) -> float:
-    ok = np.isfinite(v)
+def _mirrored(
+    t: np.ndarray, v: np.ndarray, onset: float, nominal: float, now: float, c: PhaseConfig
+) -> float:
+    # The speed is read no nearer the newest sample than the smoothing window: the last
+    # stretch of a one-sided Gaussian window sags, and a sag read as "past its peak" would
+    # mirror the onset about a peak not yet reached (how early depends on when the analysis
+    # happened to run).
+    read = t <= now - c.smoothing
+    ok = np.isfinite(v) & read
     if not ok.any():
         return onset + nominal
-    # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its copies
-    # and checks)
-    i = int(np.argmax(np.where(np.isnan(v), -np.inf, v)))
+    # (np.nanargmax over the samples read, without its copies and checks)
+    i = int(np.argmax(np.where(read & ~np.isnan(v), v, -np.inf)))
     peak = float(v[i])
     last = float(v[np.flatnonzero(ok)[-1]])
     if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
@@ -46,7 +52,7 @@ def predict_end(phase: Phase, start: float, s: Signals | None, now: float, c: Ph
     if s is None or s.t.shape[0] == 0:
         return max(start + nominal, now)
     i0 = int(np.searchsorted(s.t, start))
-    pred = _mirrored(s.t[i0:], s.giver_speed[i0:], start, nominal, c)
+    pred = _mirrored(s.t[i0:], s.giver_speed[i0:], start, nominal, now, c)
     if phase is Phase.REACH:
         j0 = int(np.searchsorted(s.t, start - nominal))
         rv = s.receiver_speed[j0:]
@@ -54,5 +60,5 @@ def predict_end(phase: Phase, start: float, s: Signals | None, now: float, c: Ph
         if moving.size:
             r_on = float(s.t[j0 + int(moving[0])])
             k0 = j0 + int(moving[0])
-            pred = max(pred, _mirrored(s.t[k0:], s.receiver_speed[k0:], r_on, nominal, c))
+            pred = max(pred, _mirrored(s.t[k0:], s.receiver_speed[k0:], r_on, nominal, now, c))
     return max(pred, now)
