@@ -3,7 +3,8 @@ the sample rate): it decides on a fixed grid of ``online_period`` whatever the r
 ``online_period`` after the last sample it analysed, which waited up to twice the period at
 60-100 Hz), and on the same motions sampled at 8, 30, 120 and 240 Hz a reach is confirmed no
 later at a higher rate. And a reach the hands then move apart from (past where they were when it
-began) ends at once, so the approach that follows is the reach."""
+began) ends at once, so the approach that follows is the reach; and a fidget that the
+predictive rule's window-averaged acceleration reads as still accelerating is no reach."""
 
 from __future__ import annotations
 
@@ -91,3 +92,19 @@ def test_a_reach_the_receiver_steps_back_from_ends_and_the_next_approach_is_the_
     assert events[1].info["source"] == "aborted"
     assert 1.0 <= events[1].detected_at <= 1.3  # the hands passed their start distance ~1.1 s
     assert events[2].t >= 1.1  # the approach, dated from its own onset
+
+
+@pytest.mark.parametrize(
+    ("seed", "rate", "noise"),
+    [(412, 120.0, 0.002), (421, 60.0, 0.002), (421, 60.0, 0.005), (422, 60.0, 0.005)],
+)
+def test_a_fidget_the_constant_acceleration_fit_reads_as_accelerating_is_no_reach(
+    seed, rate, noise
+):
+    # Fidgets of ~2 cm toward the receiver in 0.25-0.3 s: past their midpoint the predictive
+    # rule's 0.2 s fit still reads a positive (window-averaged) acceleration at 1.6-2 cm of
+    # travel; the sequential statistic (a reach explains the window no better than a fidget)
+    # keeps them fidgets (directed_support).
+    traj = rest_recording(rate, noise, 20.0, seed=seed, fidget=True)
+    reaches = [e for e in run_online(traj).events if e.kind is EventKind.REACH_STARTED]
+    assert reaches == []
