@@ -10,7 +10,10 @@ goal is refined to the full tolerance. Then:
   re-plans a minimum-jerk move to the new goal with ``neck_duration_s`` and the eyes saccade
   with ``eye_duration_s`` (both stretched to respect velocity limits);
 * smaller changes are **tracked**: the neck re-plans from its current position, velocity and
-  acceleration (no jumps), the eyes follow the target directly (smooth pursuit);
+  acceleration (no jumps), the eyes follow the target directly (smooth pursuit); while the
+  target stays within ``IKConfig.goal_deadband`` (seen from the goal's gaze origin) of the one
+  the head goal was solved for, the goal is kept (no solve, no re-plan) and the eyes take the
+  difference (until the target stops: then the goal is refined as above);
 * the eyes always aim from the neck's *current* pose, so once the saccade lands they
   counter-rotate while the neck catches up and the gaze stays on the target (the iCub gaze
   controller's behaviour), and they take whatever the head cannot do (Sawyer has only pan).
@@ -124,6 +127,9 @@ class GazeController:
         # The last IK solution (its q is ``_goal``) and the arm revision it was solved for: its
         # gaze frame and Jacobian seed the next warm start.
         self._solution: tuple[RawSolution, int] | None = None
+        # The goal's gaze origin and the unit direction from it to the target the goal was
+        # solved for (the deadband's reference), or None.
+        self._solved_for: tuple[float, float, float, float, float, float] | None = None
 
     @property
     def head(self) -> dict[str, float]:
@@ -292,6 +298,22 @@ class GazeController:
             r02 * dx + r12 * dy + r22 * dz,
         )
 
+    def _in_deadband(self, target: tuple[float, float, float]) -> bool:
+        """Whether ``target`` is within ``ik.goal_deadband`` of the target the head goal was
+        solved for, seen from the goal's gaze origin, while the eyes keep the gaze on target
+        (the last tick's residual within ``ik.tolerance``: not during a saccade, not with eyes
+        at their range or fixed, as in ``head-only`` mode)."""
+        ref = self._solved_for
+        deadband = self.ik.goal_deadband
+        if ref is None or deadband <= 0.0 or not self._residual <= self.ik.tolerance:
+            return False
+        ox, oy, oz, ux, uy, uz = ref
+        dx, dy, dz = target[0] - ox, target[1] - oy, target[2] - oz
+        # angle_between on a unit reference: atan2(|u x d|, u . d) <= deadband
+        cx, cy, cz = uy * dz - uz * dy, uz * dx - ux * dz, ux * dy - uy * dx
+        angle = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ux * dx + uy * dy + uz * dz)
+        return angle <= deadband
+
     def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
@@ -315,6 +337,12 @@ class GazeController:
         tracking = not new_shift and target != self._target
         last = self._solution
         if last is not None and last[1] == revision and last[0].q is self._goal:
+            if tracking and self._in_deadband(target):
+                # The head goal stays; the eyes, aimed from the head's pose, take the rest. It
+                # is solved in full once the target stands still.
+                self._target = target
+                self._goal_final = False
+                return 0.0
             warm_frame, warm_rows = last[0].frame, last[0].rows  # the warm start's kinematics
         else:
             warm_frame = warm_rows = None
@@ -332,6 +360,11 @@ class GazeController:
             return 0.0  # at the gaze origin: no direction to look
         self._solution = (sol, revision)
         self._target = target
+        if self.ik.goal_deadband > 0.0:
+            (_, _, _, ox), (_, _, _, oy), (_, _, _, oz) = sol.frame
+            dx, dy, dz = target[0] - ox, target[1] - oy, target[2] - oz
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)  # > 0: the solve was valid
+            self._solved_for = (ox, oy, oz, dx / d, dy / d, dz / d)
         goal = sol.q
         # A solve stopped by the iteration cap or at the tracking tolerance is refined on the
         # next tick even if nothing moved.
