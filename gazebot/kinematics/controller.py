@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gazebot.kinematics.eyes import angle_between
+from gazebot.kinematics.eyes import angle_of
 from gazebot.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.kinematics.robot import RobotModel
 from gazebot.kinematics.shifts import (
@@ -175,28 +175,32 @@ class GazeController:
         if self._traj is not None and dt > 0.0:
             pos = self._traj.sample(self._clock)[0]
             q_prev = self._q
-            q = []
-            vel = []
-            finite = True
-            for p, a, (v, lo, hi) in zip(pos, q_prev, self._limits, strict=True):
-                # Rate limit, then joint limits (comparisons, not min/max calls: this is the hot
-                # path; a NaN stays NaN and is caught below).
-                step = v * dt
-                x = p
-                if x < a - step:
-                    x = a - step
-                if x > a + step:
-                    x = a + step
-                if x < lo:
-                    x = lo
-                if x > hi:
-                    x = hi
-                finite = finite and math.isfinite(x)
-                q.append(x)
-                vel.append((x - a) / dt)
-            if finite:
-                self._vel = vel
-                self._q = q
+            if pos == tuple(q_prev):
+                # At rest on the plan's goal (within the limits): what the loop below gives.
+                self._vel = [0.0] * len(q_prev)
+            else:
+                q = []
+                vel = []
+                finite = True
+                for p, a, (v, lo, hi) in zip(pos, q_prev, self._limits, strict=True):
+                    # Rate limit, then joint limits (comparisons, not min/max calls: this is the
+                    # hot path; a NaN stays NaN and is caught below).
+                    step = v * dt
+                    x = p
+                    if x < a - step:
+                        x = a - step
+                    if x > a + step:
+                        x = a + step
+                    if x < lo:
+                        x = lo
+                    if x > hi:
+                        x = hi
+                    finite = finite and math.isfinite(x)
+                    q.append(x)
+                    vel.append((x - a) / dt)
+                if finite:
+                    self._vel = vel
+                    self._q = q
         elif dt > 0.0:
             self._vel = [0.0] * len(self._q)
 
@@ -272,10 +276,10 @@ class GazeController:
             if p.shape != (3,):
                 raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
         x, y, z = p.tolist()
-        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
-            return None
-        # A corrupted, absurdly far sample is held like a missing one.
-        return (x, y, z) if max(abs(x), abs(y), abs(z)) <= self.ik.max_distance else None
+        # Finite and not absurdly far (a corrupted sample is held like a missing one); a NaN
+        # fails every comparison.
+        m = self.ik.max_distance
+        return (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
 
     def _gaze_frame(self) -> list[list[float]]:
         """Gaze frame rows at the head command (cached: the eyes of one tick and the re-plan of
@@ -308,11 +312,7 @@ class GazeController:
         if ref is None or deadband <= 0.0 or not self._residual <= self.ik.tolerance:
             return False
         ox, oy, oz, ux, uy, uz = ref
-        dx, dy, dz = target[0] - ox, target[1] - oy, target[2] - oz
-        # angle_between on a unit reference: atan2(|u x d|, u . d) <= deadband
-        cx, cy, cz = uy * dz - uz * dy, uz * dx - ux * dz, ux * dy - uy * dx
-        angle = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ux * dx + uy * dy + uz * dz)
-        return angle <= deadband
+        return angle_of(ux, uy, uz, target[0] - ox, target[1] - oy, target[2] - oz) <= deadband
 
     def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
@@ -322,12 +322,12 @@ class GazeController:
         origin = (frame[0][3], frame[1][3], frame[2][3])
         to_new = (target[0] - origin[0], target[1] - origin[1], target[2] - origin[2])
         if self._target is None:
-            amplitude = angle_between(to_new, (frame[0][0], frame[1][0], frame[2][0]))
+            amplitude = angle_of(*to_new, frame[0][0], frame[1][0], frame[2][0])
             new_shift = True
         else:
             old = self._target
             to_old = (old[0] - origin[0], old[1] - origin[1], old[2] - origin[2])
-            amplitude = angle_between(to_new, to_old)
+            amplitude = angle_of(*to_new, *to_old)
             new_shift = amplitude > cfg.saccade_threshold
 
         robot = self.robot
