@@ -99,6 +99,10 @@ class GazeController:
         self._upper = robot.upper.tolist()
         self._vlim = robot.velocity_limits.tolist()
         self._limits = tuple(zip(self._vlim, self._lower, self._upper, strict=True))
+        # The head goal deadband needs eyes that can take the difference (not head-only).
+        eyes = robot.eyes
+        movable = eyes.yaw_range[0] < eyes.yaw_range[1] or eyes.pitch_range[0] < eyes.pitch_range[1]
+        self._deadband = self.ik.goal_deadband if movable else 0.0
         self.reset()
 
     # --- state --------------------------------------------------------------------------------
@@ -306,9 +310,9 @@ class GazeController:
         """Whether ``target`` is within ``ik.goal_deadband`` of the target the head goal was
         solved for, seen from the goal's gaze origin, while the eyes keep the gaze on target
         (the last tick's residual within ``ik.tolerance``: not during a saccade, not with eyes
-        at their range or fixed, as in ``head-only`` mode)."""
+        at their range). Never with fixed eyes (``head-only`` mode)."""
         ref = self._solved_for
-        deadband = self.ik.goal_deadband
+        deadband = self._deadband
         if ref is None or deadband <= 0.0 or not self._residual <= self.ik.tolerance:
             return False
         ox, oy, oz, ux, uy, uz = ref
@@ -360,7 +364,7 @@ class GazeController:
             return 0.0  # at the gaze origin: no direction to look
         self._solution = (sol, revision)
         self._target = target
-        if self.ik.goal_deadband > 0.0:
+        if self._deadband > 0.0:
             (_, _, _, ox), (_, _, _, oy), (_, _, _, oz) = sol.frame
             dx, dy, dz = target[0] - ox, target[1] - oy, target[2] - oz
             d = math.sqrt(dx * dx + dy * dy + dz * dz)  # > 0: the solve was valid
