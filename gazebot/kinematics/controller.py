@@ -177,9 +177,9 @@ class GazeController:
             shift = self._retarget(target, self._clock - dt)
 
         if self._traj is not None and dt > 0.0:
-            pos = self._traj.sample(self._clock)[0]
+            pos = self._traj.sample_position(self._clock)
             q_prev = self._q
-            if pos == tuple(q_prev):
+            if pos == q_prev:
                 # At rest on the plan's goal (within the limits): what the loop below gives.
                 self._vel = [0.0] * len(q_prev)
             else:
