@@ -41,6 +41,15 @@ class IKConfig:
         tracking_tolerance: Looser stop (rad) for a target that moved slightly since the last
             solve (see :func:`solve_ik_raw`): the gaze controller uses it while following a
             moving target, where one Gauss-Newton step from the last solution usually meets it.
+        goal_deadband: The gaze controller keeps its head goal while a tracked target (one
+            that moved without a gaze shift) stays within this angle (rad), seen from the
+            goal's gaze origin, of the target the goal was solved for, and the eyes keep the
+            gaze within ``tolerance`` of it (no saccade under way, eyes not at their range or
+            fixed): the eyes, which always aim from the head's current pose, take the
+            difference, so the gaze stays exact.
+            A quarter degree keeps the tracker's millimetre noise out of the neck and is below
+            a pixel of the drawn eyes; it skips most per-tick solves. 0 re-solves every move.
+            (:func:`solve_ik` itself does not use it.)
     """
 
     damping: float = 1e-4
@@ -53,6 +62,7 @@ class IKConfig:
     min_step: float = 1e-9
     posture_off: float = 1e-3
     tracking_tolerance: float = 1e-4
+    goal_deadband: float = math.radians(0.25)
 
     @classmethod
     def from_settings(cls, settings: IKSettings) -> IKConfig:
