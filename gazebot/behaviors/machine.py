@@ -349,7 +349,19 @@ def diagram(spec: BehaviorSpec) -> str:
         show_conditions=True,
         title=f"gaze behavior {spec.name}",
     )
-    return str(model.get_graph().draw(None))  # type: ignore[attr-defined]
+    text = str(model.get_graph().draw(None))  # type: ignore[attr-defined]
+    return "\n".join(_without_empty_labels(line) for line in text.split("\n"))
+
+
+def _without_empty_labels(line: str) -> str:
+    """``line`` without the empty alternatives in its edge label: ``transitions`` draws a
+    region's initial state as an unlabelled edge from the region, and when a labelled edge joins
+    the same two states it adds ``" | "`` plus nothing (the initial state is drawn as ``[*]``
+    inside the region anyway)."""
+    head, sep, label = line.partition(": ")
+    if not sep or "-->" not in head:
+        return line
+    return head + sep + " | ".join(part for part in label.split(" | ") if part.strip())
 
 
 class _Model:
