@@ -49,7 +49,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.durations import REACH_S
-from gazebot.phases.filtering import Signals
+from gazebot.phases.filtering import SignalCache, Signals
 from gazebot.phases.methods import make_segmenter
 from gazebot.phases.methods.base import OnlineState
 from gazebot.phases.prediction import predict_end
@@ -155,6 +155,9 @@ class PhaseDetector:
         self._prev_evidence: bool | None = False
         self._robot_reports = False
         self._signals: Signals | None = None
+        # The last analysis's signals, so the next one (on the same window, a few samples
+        # longer) computes only the rows the new samples change.
+        self._signal_cache = SignalCache()
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()
@@ -375,7 +378,7 @@ class PhaseDetector:
         # (the rows are float64 of known shapes: no conversion or check needed)
         traj = Trajectory.of_hands(window[:, 0].copy(), window[:, 1:4].copy(),
                                    window[:, 4:].copy())
-        s = self.segmenter.online_signals(traj)
+        s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
             restart = self._reach_restart()

@@ -234,9 +234,61 @@ def _norms(x: np.ndarray) -> np.ndarray:
     return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])
 
 
-def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
+def _derived(
+    x: np.ndarray, v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray]:
+    """From smoothed positions ``x`` and velocities ``v`` (rows, both hands): ``rel, rel_v,
+    distance, rel_speed, giver_speed, receiver_speed, closing, common_speed, hold_speed``, row
+    by row (a row's values depend on that row alone)."""
+    gv, rv = v[:, :3], v[:, 3:]
+    # The five vectors whose norms are needed, in one block: what _norms computes for each,
+    # in a few numpy calls instead of six per vector.
+    q = np.empty((5, x.shape[0], 3))
+    rel, rel_v = q[0], q[1]
+    np.subtract(x[:, 3:], x[:, :3], out=rel)
+    np.subtract(rv, gv, out=rel_v)
+    q[2] = gv
+    q[3] = rv
+    np.add(gv, rv, out=q[4])
+    sq = q * q
+    norms = np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2])
+    distance, rel_speed, g_speed, r_speed = norms[0], norms[1], norms[2], norms[3]
+    common = 0.5 * norms[4]
+    closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
+    hold = np.maximum(np.abs(closing), rel_speed - np.minimum(g_speed, r_speed))
+    return rel, rel_v, distance, rel_speed, g_speed, r_speed, closing, common, hold
+
+
+def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
+    """Velocities of the smoothed rows ``x`` (at least two): np.gradient's central differences
+    inside, one-sided at the ends (its arithmetic, without its generic set-up), NaN where the
+    smoothing window held less than ``FULL_WINDOW`` data (``full``, per row and hand)."""
+    v = np.empty_like(x)
+    v[1:-1] = (x[2:] - x[:-2]) / (2.0 * dt)
+    v[0] = (x[1] - x[0]) / dt
+    v[-1] = (x[-1] - x[-2]) / dt
+    # Next to a tracking gap the window is one-sided and flattens the motion: velocities
+    # there are unknown, not slow.
+    v = v.reshape(v.shape[0], 2, 3)
+    v[full < FULL_WINDOW] = np.nan
+    return v.reshape(v.shape[0], 6)
+
+
+def compute_signals(
+    trajectory: Trajectory, config: PhaseConfig, cache: SignalCache | None = None
+) -> Signals:
     """Frozen samples out, resample, smooth and differentiate the hands of ``trajectory``
-    (sorted by time, see :meth:`Trajectory.cleaned`)."""
+    (sorted by time, see :meth:`Trajectory.cleaned`).
+
+    ``cache``: an online caller's :class:`SignalCache`: when ``trajectory`` extends the one of
+    the previous call (the same samples, more at the end), only the rows the new samples can
+    change are computed; the result is the same, bit for bit. Its arrays are then read-only
+    views, valid until the cache's next call."""
+    if cache is not None:
+        s = cache.extend(trajectory, config)
+        if s is not None:
+            return s
     t = trajectory.t
     n = t.shape[0]
     dt = 1.0 / config.analysis_rate
@@ -271,36 +323,14 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     fin = np.isfinite(x)
     m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands)
     x, full = smooth(x, m, sigma_s / dt)
-    if grid.shape[0] >= 2:
-        # np.gradient's central differences inside, one-sided at the ends (its arithmetic,
-        # without its generic set-up)
-        v = np.empty_like(x)
-        v[1:-1] = (x[2:] - x[:-2]) / (2.0 * dt)
-        v[0] = (x[1] - x[0]) / dt
-        v[-1] = (x[-1] - x[-2]) / dt
-        # Next to a tracking gap the window is one-sided and flattens the motion: velocities
-        # there are unknown, not slow.
-        v = v.reshape(v.shape[0], 2, 3)
-        v[full < FULL_WINDOW] = np.nan
-        v = v.reshape(v.shape[0], 6)
-    else:
-        v = np.full_like(x, np.nan)
-    g, r = x[:, :3], x[:, 3:]
-    gv, rv = v[:, :3], v[:, 3:]
-    rel = r - g
-    rel_v = rv - gv
-    distance = _norms(rel)
-    rel_speed = _norms(rel_v)
-    closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
-    common = 0.5 * _norms(gv + rv)
-    g_speed = _norms(gv)
-    r_speed = _norms(rv)
-    return Signals(
+    v = _velocities(x, full, dt) if grid.shape[0] >= 2 else np.full_like(x, np.nan)
+    rel, rel_v, distance, rel_speed, g_speed, r_speed, closing, common, hold = _derived(x, v)
+    s = Signals(
         t=grid,
-        giver=g,
-        receiver=r,
-        giver_v=gv,
-        receiver_v=rv,
+        giver=x[:, :3],
+        receiver=x[:, 3:],
+        giver_v=v[:, :3],
+        receiver_v=v[:, 3:],
         rel=rel,
         rel_v=rel_v,
         distance=distance,
@@ -309,5 +339,173 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
         receiver_speed=r_speed,
         closing=closing,
         common_speed=common,
-        hold_speed=np.maximum(np.abs(closing), rel_speed - np.minimum(g_speed, r_speed)),
+        hold_speed=hold,
     )
+    if cache is not None:
+        clean = all_seen and n > 1 and float(np.max(np.diff(t))) <= config.max_gap_hold + 1e-9
+        cache.keep(trajectory, config, s if clean else None, x, v, full, sigma_s / dt)
+    return s
+
+
+# The columns a SignalCache keeps per grid row, beside the grid: name -> columns (1: a vector).
+_KEPT = {
+    "x": 6, "v": 6, "full": 2, "rel": 3, "rel_v": 3, "distance": 1, "rel_speed": 1,
+    "giver_speed": 1, "receiver_speed": 1, "closing": 1, "common_speed": 1, "hold_speed": 1,
+}
+# The order _derived returns its arrays in.
+_DERIVED = ("rel", "rel_v", "distance", "rel_speed", "giver_speed", "receiver_speed", "closing",
+            "common_speed", "hold_speed")
+
+
+class SignalCache:
+    """The last signals :func:`compute_signals` computed for one online caller, so that the
+    next call, on the same samples and a few more, computes only the rows the new samples can
+    change: every grid row from half a smoothing kernel before the first grid point past the
+    previous last sample (the interpolation there and the smoothing's end padding change), and
+    one more row for the central differences. Older rows keep their values, bit for bit: each
+    step (interpolation between neighbouring samples, a correlation over the kernel, row-wise
+    arithmetic) reads only that neighbourhood.
+
+    It is used only on the common path: every sample seen, no repeated coordinates (so no
+    stale samples), no gap longer than ``max_gap_hold``, the same smoothing width and the same
+    first sample; anything else is a full computation that starts the cache afresh."""
+
+    def __init__(self) -> None:
+        self._config: PhaseConfig | None = None  # None: nothing kept
+        self._t = np.empty(0)  # the samples the kept signals came from
+        self._g = np.empty((0, 3))
+        self._r = np.empty((0, 3))
+        self._max_dt = 0.0
+        self._sigma = 0.0
+        self._grid = np.empty(0)
+        self._rows = 0  # grid rows kept
+        self._buf: dict[str, np.ndarray] = {}
+        self._owned = False  # the buffers are this cache's (else: a returned result's arrays)
+
+    def keep(
+        self,
+        trajectory: Trajectory,
+        config: PhaseConfig,
+        s: Signals | None,
+        x: np.ndarray,
+        v: np.ndarray,
+        full: np.ndarray,
+        sigma: float,
+    ) -> None:
+        """Remember a full computation's result (``s``; ``None``: not on the common path, keep
+        nothing) with its smoothed rows ``x``, velocities ``v``, window shares ``full`` and
+        smoothing width ``sigma`` (grid steps). The arrays are adopted, not copied: the first
+        extension copies what it keeps."""
+        if s is None or s.t.shape[0] < 3:
+            self._config = None
+            return
+        self._config = config
+        t = trajectory.t
+        self._t = t.copy()
+        self._g = trajectory.giver_hand.copy()
+        self._r = trajectory.receiver_hand.copy()
+        self._max_dt = float(np.max(np.diff(t)))
+        self._sigma = sigma
+        self._grid = s.t
+        self._rows = s.t.shape[0]
+        self._buf = {"x": x, "v": v, "full": full}
+        for name in _DERIVED:
+            self._buf[name] = getattr(s, name)
+        self._owned = False
+
+    def extend(self, trajectory: Trajectory, config: PhaseConfig) -> Signals | None:
+        """The signals of ``trajectory`` if it extends the samples kept on the common path
+        (see the class docstring), else ``None`` (the caller computes them in full)."""
+        if self._config is None or (config is not self._config and config != self._config):
+            return None
+        t = trajectory.t
+        g_in, r_in = trajectory.giver_hand, trajectory.receiver_hand
+        n, n0 = t.shape[0], self._t.shape[0]
+        if n <= n0 or not (
+            (t[:n0] == self._t).all()
+            and (g_in[:n0] == self._g).all()
+            and (r_in[:n0] == self._r).all()
+        ):
+            return None
+        # The new samples (with the last kept one): all seen, none repeating a coordinate of
+        # the one before, no gap longer than max_gap_hold.
+        tail = np.concatenate((g_in[n0 - 1 :], r_in[n0 - 1 :]), axis=1)
+        if not np.isfinite(tail).all() or (tail[1:] == tail[:-1]).any():
+            return None
+        max_dt = max(self._max_dt, float(np.max(np.diff(t[n0 - 1 :]))))
+        if max_dt > config.max_gap_hold + 1e-9:
+            return None
+        dt = 1.0 / config.analysis_rate
+        # The smoothing width: half the median sample interval only counts when it exceeds
+        # half the smoothing, which needs an interval that long.
+        sigma_s = 0.5 * config.smoothing
+        if max_dt > config.smoothing:
+            sigma_s = max(sigma_s, 0.5 * _median(np.diff(t)))
+        if sigma_s / dt != self._sigma:
+            return None
+        grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
+        rows, rows0 = grid.shape[0], self._rows
+        w = gaussian_weights(self._sigma)
+        radius = w.shape[0] // 2
+        # first grid row past the last kept sample (NaN before, or beyond the kept grid)
+        j_c = int(np.searchsorted(self._grid, self._t[-1], side="right"))
+        a = j_c - radius  # first smoothed row that changes
+        # (scipy's correlation of a line that starts at row i0 equals the whole line's only
+        # from row i0 + radius + 1 on: the slice starts one row earlier than the kernel needs)
+        lead = radius + 1
+        if a - lead < 0 or a < 2 or rows < rows0 or grid[rows0 - 1] != self._grid[-1]:
+            return None
+        self._reserve(rows, a)
+        b = self._buf
+        # interpolate the rows the smoothing of rows a.. reads (from the sample before them)
+        gs = grid[a - lead :]
+        i_s = max(int(np.searchsorted(t, gs[0], side="right")) - 1, 0)
+        ts = t[i_s:]
+        xr = np.empty((gs.shape[0], 6))
+        for k in range(3):
+            xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
+            xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
+        xr[int(np.searchsorted(gs, t[-1], side="right")) :] = np.nan
+        fin = np.isfinite(xr)
+        m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]
+        xs, full = smooth(xr, m, self._sigma)
+        b["x"][a:rows] = xs[lead:]
+        b["full"][a:rows] = full[lead:]
+        # velocities from row a - 1 (its central difference reads row a)
+        x = b["x"]
+        b["v"][a - 1 : rows] = _velocities(x[a - 2 : rows], b["full"][a - 2 : rows], dt)[1:]
+        for name, arr in zip(_DERIVED, _derived(x[a - 1 : rows], b["v"][a - 1 : rows]),
+                             strict=True):
+            b[name][a - 1 : rows] = arr
+        self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
+        self._max_dt = max_dt
+        self._grid, self._rows = grid, rows
+
+        def view(name: str) -> np.ndarray:
+            out = b[name][:rows]
+            out.flags.writeable = False
+            return out
+
+        xv, vv = view("x"), view("v")
+        return Signals(
+            t=grid,
+            giver=xv[:, :3],
+            receiver=xv[:, 3:],
+            giver_v=vv[:, :3],
+            receiver_v=vv[:, 3:],
+            **{name: view(name) for name in _DERIVED},
+        )
+
+    def _reserve(self, rows: int, keep: int) -> None:
+        """Buffers of at least ``rows`` rows, owned by the cache, holding the first ``keep``
+        rows kept."""
+        b = self._buf
+        if self._owned and b["x"].shape[0] >= rows:
+            return
+        cap = max(2 * rows, 256)
+        new = {}
+        for name, cols in _KEPT.items():
+            arr = np.empty((cap, cols) if cols > 1 else cap)
+            arr[:keep] = b[name][:keep]
+            new[name] = arr
+        self._buf, self._owned = new, True

@@ -73,7 +73,12 @@ def recordings() -> list[Trajectory]:
 def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monkeypatch):
     config = PhaseConfig()
     fast = [_events(tr, config) for tr in recordings]
-    monkeypatch.setattr(gazebot_method, "compute_signals", reference_signals)
+    # (the reference computes every analysis in full: the detector's signal cache is unused)
+    monkeypatch.setattr(
+        gazebot_method,
+        "compute_signals",
+        lambda traj, config, cache=None: reference_signals(traj, config),
+    )
     monkeypatch.setattr(
         gazebot_method.GazebotSegmenter, "trigger", lambda self: ReferenceTrigger(self.config)
     )

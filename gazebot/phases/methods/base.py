@@ -9,7 +9,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, compute_signals
+from gazebot.phases.filtering import SignalCache, Signals, compute_signals
 from gazebot.phases.segment import Segment
 from gazebot.phases.trajectory import Trajectory
 from gazebot.types import Phase
@@ -80,9 +80,13 @@ class Segmenter(ABC):
         """A fresh cheap trigger for one online detector, or ``None``: analyse every period."""
         return None
 
-    def online_signals(self, trajectory: Trajectory) -> Signals | None:
-        """The signals of the samples seen so far (for the end-of-phase prediction)."""
-        return compute_signals(trajectory, self.config) if len(trajectory) else None
+    def online_signals(
+        self, trajectory: Trajectory, cache: SignalCache | None = None
+    ) -> Signals | None:
+        """The signals of the samples seen so far (for the end-of-phase prediction);
+        ``cache``: the detector's, so a window that only grew is computed only where it
+        changed (see :func:`~gazebot.phases.filtering.compute_signals`)."""
+        return compute_signals(trajectory, self.config, cache) if len(trajectory) else None
 
     def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
         """Segments of the samples seen so far (``s``: :meth:`online_signals` of them)."""

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from gazebot.phases.filtering import Signals, compute_signals
+from gazebot.phases.filtering import SignalCache, Signals, compute_signals
 from gazebot.phases.methods.base import OnlineTrigger, Segmenter
 from gazebot.phases.methods.gazebot_trigger import GazebotTrigger
 from gazebot.phases.rules.directed import directed_reach
@@ -37,11 +37,14 @@ class GazebotSegmenter(Segmenter):
     name = "gazebot"
     rules_after_contact = True
 
-    def signals(self, trajectory: Trajectory, partial: bool = False) -> Signals | None:
-        """The smoothed signals (cut ``edge_guard`` before the last sample when ``partial``)."""
+    def signals(
+        self, trajectory: Trajectory, partial: bool = False, cache: SignalCache | None = None
+    ) -> Signals | None:
+        """The smoothed signals (cut ``edge_guard`` before the last sample when ``partial``;
+        ``cache``: see :func:`~gazebot.phases.filtering.compute_signals`)."""
         if len(trajectory) < 3:
             return None
-        s = compute_signals(trajectory, self.config)
+        s = compute_signals(trajectory, self.config, cache)
         if partial and self.config.edge_guard > 0:
             # (the grid is sorted: the samples kept are a prefix, taken as views)
             cut = float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
@@ -56,10 +59,12 @@ class GazebotSegmenter(Segmenter):
         """The cheap per-period trigger (:mod:`~gazebot.phases.methods.gazebot_trigger`)."""
         return GazebotTrigger(self.config)
 
-    def online_signals(self, trajectory: Trajectory) -> Signals | None:
+    def online_signals(
+        self, trajectory: Trajectory, cache: SignalCache | None = None
+    ) -> Signals | None:
         """The signals cut ``edge_guard`` before the newest sample: the last stretch of the
         smoothed speed sags (one-sided window), so predictions read what the rules read."""
-        return self.signals(trajectory, partial=True)
+        return self.signals(trajectory, partial=True, cache=cache)
 
     def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
         """The segments the signals show so far; with no phase under way at their end, a reach
