@@ -78,6 +78,7 @@ class _Samples:
     def __init__(self) -> None:
         self._buf = np.empty((256, 7))
         self._s0 = self._s1 = 0
+        self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
 
     def __len__(self) -> int:
         return self._s1 - self._s0
@@ -91,14 +92,19 @@ class _Samples:
             self._buf[:m] = buf[self._s0 : self._s1]
             buf, self._s0, self._s1 = self._buf, 0, m
         buf[self._s1] = row
+        if self._s1 == self._s0:
+            self._first_t = row[0]
         self._s1 += 1
 
     def drop_before(self, t0: float) -> None:
         """Forget the samples older than ``t0``."""
+        if self._first_t >= t0:
+            return
         buf, i, end = self._buf, self._s0, self._s1
         while i < end and buf[i, 0] < t0:
             i += 1
         self._s0 = i
+        self._first_t = float(buf[i, 0]) if i < end else math.inf
 
     def time(self, i: int) -> float:
         """Time of the ``i``-th sample kept."""
@@ -181,6 +187,8 @@ class PhaseDetector:
     def update_all(self, frame: TrackingFrame) -> list[Event]:
         """Feed one frame; return every new and queued event, oldest first."""
         self._step(frame)
+        if not self._queue:
+            return []
         out = list(self._queue)
         self._queue.clear()
         return out
@@ -281,7 +289,7 @@ class PhaseDetector:
         if r_ok:
             self._seen_r = t
         if self._trigger is not None:
-            self._trigger.add(g, g_ok, r, r_ok)
+            self._trigger.add((gx, gy, gz), g_ok, (rx, ry, rz), r_ok)
         if not (g_ok and r_ok):
             st.held += 1
             if self.tracking:
@@ -303,19 +311,25 @@ class PhaseDetector:
             info = {"handover": max(self.handover, 0)}
             self._queue.append(Event(EventKind.TRACKING_RESTORED, t, t, info))
 
-        if self._robot_evidence(frame, t):
+        if frame.gripper_closed is None and frame.load_share is None:
+            # No evidence (tracking alone, the usual frame): what _robot_evidence concludes.
+            self._prev_evidence = False
+        elif self._robot_evidence(frame, t):
             return
         if t - self._last_analysis >= c.online_period:
             self._last_analysis = t
             mode = "full"
             if self._trigger is not None:
-                state = OnlineState(
-                    self.phase,
-                    self.phase_start,
-                    self._floor,
-                    self.tracking,
-                    self._joined_late,
-                    self._last_full,
+                # Every field given, so the frozen dataclass is filled directly (its generated
+                # __init__ sets each field through object.__setattr__: a cost every period).
+                state = object.__new__(OnlineState)
+                state.__dict__.update(
+                    phase=self.phase,
+                    phase_start=self.phase_start,
+                    floor=self._floor,
+                    tracking=self.tracking,
+                    joined_late=self._joined_late,
+                    last_full=self._last_full,
                 )
                 mode = self._trigger.decide(t, state)
             if mode != "skip":

@@ -430,9 +430,10 @@ class SignalCache:
         # The new samples (with the last kept one): all seen, none repeating a coordinate of
         # the one before, no gap longer than max_gap_hold.
         tail = np.concatenate((g_in[n0 - 1 :], r_in[n0 - 1 :]), axis=1)
-        if not np.isfinite(tail).all() or (tail[1:] == tail[:-1]).any():
+        # (a sum is finite only if every term is; one that overflows only costs the reuse)
+        if not math.isfinite(float(tail.sum())) or (tail[1:] == tail[:-1]).any():
             return None
-        max_dt = max(self._max_dt, float(np.max(np.diff(t[n0 - 1 :]))))
+        max_dt = max(self._max_dt, float((t[n0:] - t[n0 - 1 : -1]).max()))
         if max_dt > config.max_gap_hold + 1e-9:
             return None
         dt = 1.0 / config.analysis_rate

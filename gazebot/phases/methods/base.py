@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
@@ -42,7 +43,7 @@ class OnlineState:
 class OnlineTrigger(Protocol):
     """A method's cheap per-period check of whether its analysis needs to run."""
 
-    def add(self, g: np.ndarray, g_ok: bool, r: np.ndarray, r_ok: bool) -> None: ...
+    def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None: ...
 
     def decide(self, now: float, state: OnlineState) -> TriggerMode: ...
 

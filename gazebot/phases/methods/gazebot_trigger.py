@@ -12,6 +12,7 @@ field of :class:`~gazebot.phases.config.PhaseConfig` (``trigger_*``, ``configs/p
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -65,22 +66,23 @@ class GazebotTrigger:
         self._sum = np.empty((64, _COLUMNS))
         self._s0 = self._s1 = 0
         self._base = 0
+        self._d_last = math.nan  # the distance of the last row
         # Running values: (first row, rows seen) they cover, and the value.
         self._dmax: tuple[int, int, float] = (-1, -1, math.nan)  # largest distance
         self._held: tuple[int, int, list[float], int] = (-1, -1, [], 0)  # relative sums, count
         self._smax: tuple[int, int, float] = (-1, -1, math.nan)  # largest giver step
 
-    def add(self, g: np.ndarray, g_ok: bool, r: np.ndarray, r_ok: bool) -> None:
+    def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
         """Accumulate one sample's hand positions (``*_ok``: that hand was seen)."""
         acc = self._acc
         if g_ok:
-            x, y, z = g.tolist()
+            x, y, z = g
             acc[0] += x
             acc[1] += y
             acc[2] += z
             self._acc_n[0] += 1
         if r_ok:
-            x, y, z = r.tolist()
+            x, y, z = r
             acc[3] += x
             acc[4] += y
             acc[5] += z
@@ -102,9 +104,9 @@ class GazebotTrigger:
         """Append the mean hand positions since the last period (NaN: none seen), their
         relative position, distance and the giver's step, and drop rows older than
         ``online_window``."""
-        c = self.config
         buf = self._sum
-        while self._s0 < self._s1 and buf[self._s0, 0] < now - c.online_window:
+        cut = now - self.config.online_window
+        while self._s0 < self._s1 and buf[self._s0, 0] < cut:
             self._s0 += 1
         if self._s1 == buf.shape[0]:
             m = self._s1 - self._s0
@@ -128,6 +130,7 @@ class GazebotTrigger:
             step = math.sqrt(sx * sx + sy * sy + sz * sz)
         buf[self._s1] = (now, gx, gy, gz, rx, ry, rz, dx, dy, dz, d, step)
         self._s1 += 1
+        self._d_last = d
         self._acc = [0.0] * 6
         self._acc_n = [0, 0]
 
@@ -160,7 +163,7 @@ class GazebotTrigger:
         if s1 - s0 < 3 or not state.tracking:
             return True
         buf = self._sum
-        d_last = float(buf[s1 - 1, 10])
+        d_last = self._d_last
         if not math.isfinite(d_last):
             return True
         ts = buf[s0:s1, 0]
