@@ -510,8 +510,8 @@ class PhaseDetector:
         v = s.giver_speed[i_start:]
         rest = np.isfinite(v) & (v < c.rest_speed)
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
-        if need < 1 or rest.size <= need:
-            return None
+        if need < 1 or rest.size <= need or np.count_nonzero(rest) < need:
+            return None  # (no run of need rest samples without need of them in all)
         # the last sample of the last rest at least reach_stall long
         edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
         bounds = edges.tolist()  # (plain ints: iterating the array would box each element)
