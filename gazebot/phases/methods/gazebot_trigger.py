@@ -12,6 +12,7 @@ field of :class:`~gazebot.phases.config.PhaseConfig` (``trigger_*``, ``configs/p
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Sequence
 
 import numpy as np
@@ -37,6 +38,38 @@ def _nanmean2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         n = u_ok + w_ok
         out.append(((u if u_ok else 0.0) + (w if w_ok else 0.0)) / n if n else math.nan)
     return np.array(out)
+
+
+class _SuffixMax:
+    """The largest value of one column over the rows from a first row to the newest, as the
+    rows arrive and the first row moves forward (a phase's start, the window's start): a
+    queue of the rows that may still be the largest (each smaller than the one before), so a
+    period costs a few comparisons however long the span. Rows are numbered from the first
+    ever kept, so the buffer's compaction does not move them."""
+
+    def __init__(self) -> None:
+        self._rows: deque[tuple[int, float]] = deque()  # (row, value), values decreasing
+        self._first = self._end = -1  # the span [first, end) the queue covers
+
+    def update(self, buf: np.ndarray, base: int, first: int, end: int, col: int) -> float:
+        """Extend to buffer rows ``[first, end)`` of column ``col`` (buffer row i is row
+        ``base + i``) and return the largest value that is not NaN, NaN if none."""
+        a0, a_end = base + first, base + end
+        q = self._rows
+        if a0 < self._first or self._end < a0 or a_end < self._end:
+            q.clear()  # the span moved back or skipped rows: start over from its first row
+            self._end = a0
+        new = buf[self._end - base : end, col].tolist()
+        for i, v in enumerate(new, start=self._end):
+            if v != v:
+                continue  # (np.fmax passes over NaN)
+            while q and q[-1][1] <= v:
+                q.pop()
+            q.append((i, v))
+        while q and q[0][0] < a0:
+            q.popleft()
+        self._first, self._end = a0, a_end
+        return q[0][1] if q else math.nan
 
 
 class GazebotTrigger:
@@ -68,9 +101,9 @@ class GazebotTrigger:
         self._base = 0
         self._d_last = math.nan  # the distance of the last row
         # Running values: (first row, rows seen) they cover, and the value.
-        self._dmax: tuple[int, int, float] = (-1, -1, math.nan)  # largest distance
+        self._dmax = _SuffixMax()  # largest distance
         self._held: tuple[int, int, list[float], int] = (-1, -1, [], 0)  # relative sums, count
-        self._smax: tuple[int, int, float] = (-1, -1, math.nan)  # largest giver step
+        self._smax = _SuffixMax()  # largest giver step
 
     def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
         """Accumulate one sample's hand positions (``*_ok``: that hand was seen)."""
@@ -140,18 +173,10 @@ class GazebotTrigger:
         with no row ``trigger_speed_baseline`` before it)."""
         return self._sum[self._s0 : self._s1]
 
-    def _running_max(self, kept: tuple[int, int, float], first: int, col: int
-                     ) -> tuple[int, int, float]:
+    def _running_max(self, kept: _SuffixMax, first: int, col: int) -> float:
         """The largest value that is not NaN (NaN if none) of column ``col`` from buffer row
-        ``first`` on: ``kept`` extended by the rows since it, or recomputed."""
-        a0, end = self._base + first, self._base + self._s1
-        k0, k_end, value = kept
-        if k0 != a0 or k_end > end:
-            return a0, end, float(_nanmax(self._sum[first : self._s1, col]))
-        for v in self._sum[k_end - self._base : self._s1, col].tolist():
-            if v > value or value != value:  # (np.fmax: NaN only where both are)
-                value = v if v == v else value
-        return a0, end, value
+        ``first`` on (what ``np.fmax.reduce`` gives), from ``kept``."""
+        return kept.update(self._sum, self._base, first, self._s1, col)
 
     def _boundary_possible(self, state: OnlineState) -> bool:
         """A necessary condition of the rule that ends the current phase, on the per-period
@@ -199,8 +224,9 @@ class GazebotTrigger:
             if not math.isfinite(last):
                 return True
             # (the steps within the retreat: rows at least k after its first)
-            self._smax = self._running_max(self._smax, first + k, _STEP)
-            return last <= c.trigger_landing_fraction * self._smax[2]
+            return last <= c.trigger_landing_fraction * self._running_max(
+                self._smax, first + k, _STEP
+            )
         return True
 
     def _held_mean(self, first: int) -> list[float] | None:
@@ -232,8 +258,7 @@ class GazebotTrigger:
         first = int(ts.searchsorted(floor - c.online_period))  # (ts increases)
         if ts.shape[0] - first <= k:
             return False
-        self._dmax = self._running_max(self._dmax, self._s0 + first, 10)
-        d_max = self._dmax[2]
+        d_max = self._running_max(self._dmax, self._s0 + first, 10)
         closed = d_max - d_last
         # (the predictive rule confirms a reach from predict_distance of the giver's own travel;
         # the sequential one, in practice, past 1.2 cm: every fidget fits a cubic start up to
