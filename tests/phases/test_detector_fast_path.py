@@ -55,7 +55,23 @@ def _recordings() -> list[Trajectory]:
         rate=30.0, irregular=0.3, noise=0.004, dropouts_per_s=1.0, frozen_per_s=1.0, handovers=3
     )
     out.append(generate(seed=2, options=noisy).trajectory)
+    out.append(_after_long_rest(generate(seed=3, options=SyntheticOptions(rate=60.0)).trajectory))
     return out
+
+
+def _after_long_rest(traj: Trajectory, rest: float = 7.0) -> Trajectory:
+    """``traj`` after ``rest`` s of both hands resting where it starts (2 mm noise): longer
+    than the online window, so the detector's and the trigger's windows slide while idle."""
+    rng = np.random.default_rng(0)
+    dt = float(traj.t[1] - traj.t[0])
+    t0 = np.arange(0.0, rest, dt)
+    g0 = traj.giver_hand[0] + rng.normal(0.0, 0.002, (t0.shape[0], 3))
+    r0 = traj.receiver_hand[0] + rng.normal(0.0, 0.002, (t0.shape[0], 3))
+    return Trajectory(
+        np.concatenate([t0, traj.t - traj.t[0] + rest]),
+        np.concatenate([g0, traj.giver_hand]),
+        np.concatenate([r0, traj.receiver_hand]),
+    )
 
 
 def _events(traj: Trajectory, config: PhaseConfig) -> tuple[list[tuple], str]:
