@@ -403,11 +403,12 @@ class PhaseDetector:
                 self._start(Phase.REACH, restart, now, "motion")
         if s is not None and not predict_only:
             if not self.segmenter.rules_after_contact:
-                self._advance(self.segmenter.online_segments(traj, s, now), now)
+                self._advance(self.segmenter.online_segments(traj, s, now, self.phase), now)
             elif not self._rules_after_contact(s, now):
                 # Once the hands are in contact the method's own end rules run from the
                 # phase's start; before, the whole method finds the next handover.
-                self._advance(self.segmenter.online_segments(traj, s, now), now, True)
+                segs = self.segmenter.online_segments(traj, s, now, self.phase)
+                self._advance(segs, now, True)
                 self._rules_after_contact(s, now)
         self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
 

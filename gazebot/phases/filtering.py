@@ -421,7 +421,7 @@ class SignalCache:
         t = trajectory.t
         g_in, r_in = trajectory.giver_hand, trajectory.receiver_hand
         n, n0 = t.shape[0], self._t.shape[0]
-        if n <= n0 or not (
+        if n <= n0 or t[0] != self._t[0] or not (
             (t[:n0] == self._t).all()
             and (g_in[:n0] == self._g).all()
             and (r_in[:n0] == self._r).all()

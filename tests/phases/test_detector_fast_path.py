@@ -1,8 +1,9 @@
-"""The online detector's fast path (fused signals, the trigger's per-period rows in plain
-floats, samples kept in one array) emits exactly the events and counts of the straightforward
-path it replaced (tests/phases/signals_reference.py, tests/phases/trigger_reference.py) on the
-synthetic set, the issue-20 cases, and on noisy input with NaN, frozen, duplicate, out-of-order
-and timeless samples."""
+"""The online detector's fast path (fused signals computed only where new samples change
+them, the trigger's per-period rows in plain floats with running maxima and sums, samples kept
+in one array, no reach onsets dated during a reach) emits exactly the events and counts of the
+straightforward path it replaced (tests/phases/signals_reference.py,
+tests/phases/trigger_reference.py) on the synthetic set, the issue-20 cases, a long rest, and on
+noisy input with NaN, frozen, duplicate, out-of-order and timeless samples."""
 
 from __future__ import annotations
 
@@ -97,6 +98,13 @@ def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monk
     )
     monkeypatch.setattr(
         gazebot_method.GazebotSegmenter, "trigger", lambda self: ReferenceTrigger(self.config)
+    )
+    # (every analysis dates the reach onsets, in a reach too)
+    segments = gazebot_method.GazebotSegmenter.online_segments
+    monkeypatch.setattr(
+        gazebot_method.GazebotSegmenter,
+        "online_segments",
+        lambda self, traj, s, now, phase=None: segments(self, traj, s, now),
     )
     slow = [_events(tr, config) for tr in recordings]
     assert sum(len(ev) for ev, _ in fast) > 4 * len(recordings)  # the recordings do show phases

@@ -89,8 +89,15 @@ class Segmenter(ABC):
         changed (see :func:`~gazebot.phases.filtering.compute_signals`)."""
         return compute_signals(trajectory, self.config, cache) if len(trajectory) else None
 
-    def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
-        """Segments of the samples seen so far (``s``: :meth:`online_signals` of them)."""
+    def online_segments(
+        self, trajectory: Trajectory, s: Signals, now: float, phase: Phase = Phase.IDLE
+    ) -> list[Segment]:
+        """Segments of the samples seen so far (``s``: :meth:`online_signals` of them).
+
+        ``phase``: the detector's current phase. In a reach, a method with
+        ``rules_after_contact`` is read only for its transfers' starts and its segments' ends
+        (the detector stops at contact), so it may leave its reach segments' starts unknown
+        (NaN) then."""
         return self.segment_sorted(trajectory, partial=True)
 
     def phase_end(
