@@ -380,6 +380,7 @@ class SignalCache:
         self._grid = np.empty(0)
         self._rows = 0  # grid rows kept
         self._buf: dict[str, np.ndarray] = {}
+        self._read_only: dict[str, np.ndarray] = {}  # read-only views of the owned buffers
         self._owned = False  # the buffers are this cache's (else: a returned result's arrays)
 
     def keep(
@@ -482,19 +483,14 @@ class SignalCache:
         self._max_dt = max_dt
         self._grid, self._rows = grid, rows
 
-        def view(name: str) -> np.ndarray:
-            out = b[name][:rows]
-            out.flags.writeable = False
-            return out
-
-        xv, vv = view("x"), view("v")
+        ro = self._read_only
+        xv, vv = ro["x"][:rows], ro["v"][:rows]
+        rel, rel_v, dist, rel_s, g_s, r_s, closing, common, hold = (
+            ro[name][:rows] for name in _DERIVED
+        )
         return Signals(
-            t=grid,
-            giver=xv[:, :3],
-            receiver=xv[:, 3:],
-            giver_v=vv[:, :3],
-            receiver_v=vv[:, 3:],
-            **{name: view(name) for name in _DERIVED},
+            grid, xv[:, :3], xv[:, 3:], vv[:, :3], vv[:, 3:], rel, rel_v, dist, rel_s, g_s,
+            r_s, closing, common, hold,
         )
 
     def _reserve(self, rows: int, keep: int) -> None:
@@ -504,9 +500,11 @@ class SignalCache:
         if self._owned and b["x"].shape[0] >= rows:
             return
         cap = max(2 * rows, 256)
-        new = {}
+        new, ro = {}, {}
         for name, cols in _KEPT.items():
             arr = np.empty((cap, cols) if cols > 1 else cap)
             arr[:keep] = b[name][:keep]
             new[name] = arr
-        self._buf, self._owned = new, True
+            ro[name] = arr.view()
+            ro[name].flags.writeable = False  # (the results' views: read-only)
+        self._buf, self._read_only, self._owned = new, ro, True
