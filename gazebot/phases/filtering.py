@@ -473,9 +473,13 @@ class SignalCache:
         xs, full = smooth(xr, m, self._sigma)
         b["x"][a:rows] = xs[lead:]
         b["full"][a:rows] = full[lead:]
-        # velocities from row a - 1 (its central difference reads row a)
-        x = b["x"]
-        b["v"][a - 1 : rows] = _velocities(x[a - 2 : rows], b["full"][a - 2 : rows], dt)[1:]
+        # velocities from row a - 1 (its central difference reads row a): _velocities'
+        # arithmetic, written in place
+        x, vt = b["x"], b["v"][a - 1 : rows]
+        np.subtract(x[a:rows], x[a - 2 : rows - 2], out=vt[:-1])
+        np.divide(vt[:-1], 2.0 * dt, out=vt[:-1])
+        vt[-1] = (x[rows - 1] - x[rows - 2]) / dt
+        vt.reshape(vt.shape[0], 2, 3)[b["full"][a - 1 : rows] < FULL_WINDOW] = np.nan
         for name, arr in zip(_DERIVED, _derived(x[a - 1 : rows], b["v"][a - 1 : rows]),
                              strict=True):
             b[name][a - 1 : rows] = arr
