@@ -296,6 +296,7 @@ def compute_signals(
     p = np.concatenate((trajectory.giver_hand, trajectory.receiver_hand), axis=1)
     fin = np.isfinite(p)
     ok = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands): every coordinate seen
+    seen = ok.copy() if cache is not None else ok  # (before stale samples are taken out)
     ok_g, ok_r = ok[:, 0], ok[:, 1]
     all_seen = bool(ok_g.all()) and bool(ok_r.all())
     # A stale repeat equals the sample before; with every sample seen and no coordinate equal
@@ -342,8 +343,7 @@ def compute_signals(
         hold_speed=hold,
     )
     if cache is not None:
-        clean = all_seen and n > 1 and float(np.max(np.diff(t))) <= config.max_gap_hold + 1e-9
-        cache.keep(trajectory, config, s if clean else None, x, v, full, sigma_s / dt)
+        cache.keep(trajectory, config, s, x, v, full, sigma_s / dt, seen, ok)
     return s
 
 
@@ -361,20 +361,26 @@ class SignalCache:
     """The last signals :func:`compute_signals` computed for one online caller, so that the
     next call, on the same samples and a few more, computes only the rows the new samples can
     change: every grid row from half a smoothing kernel before the first grid point past the
-    previous last sample (the interpolation there and the smoothing's end padding change), and
-    one more row for the central differences. Older rows keep their values, bit for bit: each
-    step (interpolation between neighbouring samples, a correlation over the kernel, row-wise
-    arithmetic) reads only that neighbourhood.
+    previous last valid sample of either hand (the interpolation there, the gaps' NaN and the
+    smoothing's end padding change), and one more row for the central differences. Older
+    rows keep their values, bit for bit: each step (interpolation between the valid samples
+    around a grid point, a gap's length, a correlation over the kernel, row-wise arithmetic)
+    reads only that neighbourhood, and which samples are stale repeats is decided in time
+    order (a new sample never changes an older one's).
 
-    It is used only on the common path: every sample seen, no repeated coordinates (so no
-    stale samples), no gap longer than ``max_gap_hold``, the same smoothing width and the same
-    first sample; anything else is a full computation that starts the cache afresh."""
+    A full computation starts the cache afresh when the window does not extend the last one
+    (its first sample or an older sample changed), the smoothing width changed, or a hand has
+    no valid sample before the rows to recompute."""
 
     def __init__(self) -> None:
         self._config: PhaseConfig | None = None  # None: nothing kept
         self._t = np.empty(0)  # the samples the kept signals came from
         self._g = np.empty((0, 3))
         self._r = np.empty((0, 3))
+        self._seen = np.empty((0, 2), dtype=bool)  # per sample and hand: every coordinate
+        self._ok = np.empty((0, 2), dtype=bool)  # ... and not a stale repeat
+        self._clean = False  # every sample kept seen and valid (the interpolation's fast path)
+        self._last_seen = [-1, -1]  # per hand: the last sample kept that was seen (-1: none)
         self._max_dt = 0.0
         self._sigma = 0.0
         self._grid = np.empty(0)
@@ -387,24 +393,30 @@ class SignalCache:
         self,
         trajectory: Trajectory,
         config: PhaseConfig,
-        s: Signals | None,
+        s: Signals,
         x: np.ndarray,
         v: np.ndarray,
         full: np.ndarray,
         sigma: float,
+        seen: np.ndarray,
+        ok: np.ndarray,
     ) -> None:
-        """Remember a full computation's result (``s``; ``None``: not on the common path, keep
-        nothing) with its smoothed rows ``x``, velocities ``v``, window shares ``full`` and
-        smoothing width ``sigma`` (grid steps). The arrays are adopted, not copied: the first
-        extension copies what it keeps."""
-        if s is None or s.t.shape[0] < 3:
+        """Remember a full computation's result ``s`` with its smoothed rows ``x``, velocities
+        ``v``, window shares ``full``, smoothing width ``sigma`` (grid steps) and, per sample
+        and hand, which samples were ``seen`` and which were valid (``ok``: seen and not
+        stale). The arrays are adopted, not copied: the first extension copies what it
+        keeps."""
+        t = trajectory.t
+        if s.t.shape[0] < 3 or t.shape[0] < 2:
             self._config = None
             return
         self._config = config
-        t = trajectory.t
         self._t = t.copy()
         self._g = trajectory.giver_hand.copy()
         self._r = trajectory.receiver_hand.copy()
+        self._seen, self._ok = seen, ok
+        self._clean = bool(ok.all())
+        self._last_seen = [self._last_of(seen[:, h]) for h in (0, 1)]
         self._max_dt = float(np.max(np.diff(t)))
         self._sigma = sigma
         self._grid = s.t
@@ -414,29 +426,72 @@ class SignalCache:
             self._buf[name] = getattr(s, name)
         self._owned = False
 
+    @staticmethod
+    def _last_of(mask: np.ndarray) -> int:
+        """Index of the last True of ``mask`` (-1: none), searched from the end."""
+        i = mask.shape[0] - 1
+        while i >= 0 and not mask[i]:
+            i -= 1
+        return i
+
+    def _same_prefix(self, t: np.ndarray, g: np.ndarray, r: np.ndarray) -> bool:
+        """The first samples of ``t``, ``g``, ``r`` are the ones kept, bit for bit (NaN too)."""
+        n0 = self._t.shape[0]
+        if t[0] != self._t[0] or not (t[:n0] == self._t).all():
+            return False
+        bits = np.int64
+        gk, rk = np.ascontiguousarray(g[:n0]), np.ascontiguousarray(r[:n0])
+        return bool(
+            (gk.view(bits) == self._g.view(bits)).all()
+            and (rk.view(bits) == self._r.view(bits)).all()
+        )
+
+    def _new_valid(
+        self, t: np.ndarray, p: np.ndarray, hand: int, frozen_speed: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Which of the new samples of one hand (``p``: all its samples) are seen, and which
+        of those are not stale repeats (:func:`drop_frozen`, whose decisions run in time
+        order: run on the whole window only when a new seen sample repeats the one before)."""
+        n0 = self._t.shape[0]
+        fin = np.isfinite(p[n0:])
+        seen_new = fin[:, 0] & fin[:, 1] & fin[:, 2]
+        rows = np.flatnonzero(seen_new) + n0
+        before = self._last_seen[hand]
+        if before >= 0:
+            rows = np.concatenate(([before], rows))
+        q = p[rows]
+        if rows.size < 2 or not (q[1:] == q[:-1]).all(axis=1).any():
+            return seen_new, seen_new
+        seen_all = np.concatenate((self._seen[:, hand], seen_new))
+        stale = drop_frozen(t, p, frozen_speed, seen_all)[n0:]
+        return seen_new, seen_new & ~stale
+
     def extend(self, trajectory: Trajectory, config: PhaseConfig) -> Signals | None:
-        """The signals of ``trajectory`` if it extends the samples kept on the common path
-        (see the class docstring), else ``None`` (the caller computes them in full)."""
+        """The signals of ``trajectory`` if it extends the samples kept (see the class
+        docstring), else ``None`` (the caller computes them in full)."""
         if self._config is None or (config is not self._config and config != self._config):
             return None
         t = trajectory.t
         g_in, r_in = trajectory.giver_hand, trajectory.receiver_hand
         n, n0 = t.shape[0], self._t.shape[0]
-        if n <= n0 or t[0] != self._t[0] or not (
-            (t[:n0] == self._t).all()
-            and (g_in[:n0] == self._g).all()
-            and (r_in[:n0] == self._r).all()
-        ):
+        if n <= n0 or not self._same_prefix(t, g_in, r_in):
             return None
-        # The new samples (with the last kept one): all seen, none repeating a coordinate of
-        # the one before, no gap longer than max_gap_hold.
+        # The new samples: seen and valid per hand. The usual case, every one seen and none
+        # repeating a coordinate of the one before, needs no per-hand search.
         tail = np.concatenate((g_in[n0 - 1 :], r_in[n0 - 1 :]), axis=1)
-        # (a sum is finite only if every term is; one that overflows only costs the reuse)
-        if not math.isfinite(float(tail.sum())) or (tail[1:] == tail[:-1]).any():
-            return None
+        # (a sum is finite only if every term is; one that overflows only costs the search)
+        clean = (
+            self._clean
+            and math.isfinite(float(tail.sum()))
+            and not (tail[1:] == tail[:-1]).any()
+        )
+        if clean:
+            seen_new = ok_new = np.ones((n - n0, 2), dtype=bool)
+        else:
+            sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
+            sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
+            seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
         max_dt = max(self._max_dt, float((t[n0:] - t[n0 - 1 : -1]).max()))
-        if max_dt > config.max_gap_hold + 1e-9:
-            return None
         dt = 1.0 / config.analysis_rate
         # The smoothing width: half the median sample interval only counts when it exceeds
         # half the smoothing, which needs an interval that long.
@@ -449,25 +504,54 @@ class SignalCache:
         rows, rows0 = grid.shape[0], self._rows
         w = gaussian_weights(self._sigma)
         radius = w.shape[0] // 2
-        # first grid row past the last kept sample (NaN before, or beyond the kept grid)
-        j_c = int(np.searchsorted(self._grid, self._t[-1], side="right"))
+        # the first grid row past the last valid sample kept of either hand: NaN before, or
+        # beyond the kept grid
+        if self._clean:
+            last_valid = float(self._t[-1])
+        else:
+            k_g, k_r = np.flatnonzero(self._ok[:, 0]), np.flatnonzero(self._ok[:, 1])
+            if k_g.size < 2 or k_r.size < 2:
+                return None  # (a hand with fewer was all unknown: its first rows change too)
+            last_valid = float(self._t[min(int(k_g[-1]), int(k_r[-1]))])
+        j_c = int(np.searchsorted(self._grid, last_valid, side="right"))
         a = j_c - radius  # first smoothed row that changes
         # (scipy's correlation of a line that starts at row i0 equals the whole line's only
         # from row i0 + radius + 1 on: the slice starts one row earlier than the kernel needs)
         lead = radius + 1
         if a - lead < 0 or a < 2 or rows < rows0 or grid[rows0 - 1] != self._grid[-1]:
             return None
-        self._reserve(rows, a)
-        b = self._buf
         # interpolate the rows the smoothing of rows a.. reads (from the sample before them)
         gs = grid[a - lead :]
-        i_s = max(int(np.searchsorted(t, gs[0], side="right")) - 1, 0)
-        ts = t[i_s:]
         xr = np.empty((gs.shape[0], 6))
-        for k in range(3):
-            xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
-            xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
-        xr[int(np.searchsorted(gs, t[-1], side="right")) :] = np.nan
+        bar = config.max_gap_hold + 1e-9
+        if clean:
+            i_s = max(int(np.searchsorted(t, gs[0], side="right")) - 1, 0)
+            ts = t[i_s:]
+            for k in range(3):
+                xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
+                xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
+            if ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
+                xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
+            else:
+                xr[int(np.searchsorted(gs, t[-1], side="right")) :] = np.nan
+        else:
+            i_t = int(np.searchsorted(t, gs[0], side="right")) - 1  # the sample at or before
+            for hand, p_in in enumerate((g_in, r_in)):
+                ok_old = self._ok[:, hand]
+                i_s = min(i_t, n0 - 1)
+                while i_s >= 0 and not ok_old[i_s]:  # the valid sample at or before the rows
+                    i_s -= 1
+                if i_s < 0:
+                    return None  # (none: the rows were unknown and may not stay so)
+                valid = np.concatenate((ok_old[i_s:], ok_new[:, hand]))
+                tv, pv = t[i_s:][valid], p_in[i_s:][valid]
+                cols = slice(3 * hand, 3 * hand + 3)
+                for k in range(3):
+                    xr[:, 3 * hand + k] = np.interp(gs, tv, pv[:, k])
+                # (what resample's two ways of marking far grid points both give here)
+                xr[_far_from_samples(tv, gs, bar), cols] = np.nan
+        self._reserve(rows, a)
+        b = self._buf
         fin = np.isfinite(xr)
         m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]
         xs, full = smooth(xr, m, self._sigma)
@@ -484,9 +568,15 @@ class SignalCache:
                              strict=True):
             b[name][a - 1 : rows] = arr
         self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
+        self._seen = np.concatenate((self._seen, seen_new))
+        self._ok = np.concatenate((self._ok, ok_new))
+        if not clean:
+            self._last_seen = [self._last_of(self._seen[:, h]) for h in (0, 1)]
+        else:
+            self._last_seen = [n - 1, n - 1]
+        self._clean = clean
         self._max_dt = max_dt
         self._grid, self._rows = grid, rows
-
         ro = self._read_only
         xv, vv = ro["x"][:rows], ro["v"][:rows]
         rel, rel_v, dist, rel_s, g_s, r_s, closing, common, hold = (
