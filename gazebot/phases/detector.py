@@ -312,8 +312,7 @@ class PhaseDetector:
             self._queue.append(Event(EventKind.TRACKING_RESTORED, t, t, info))
 
         if frame.gripper_closed is None and frame.load_share is None:
-            # No evidence (tracking alone, the usual frame): what _robot_evidence concludes.
-            self._prev_evidence = False
+            self._prev_evidence = False  # no robot evidence (tracking alone, the usual frame)
         elif self._robot_evidence(frame, t):
             return
         if t - self._last_analysis >= c.online_period:
@@ -343,11 +342,8 @@ class PhaseDetector:
             self.expected_phase_end = max(self.expected_phase_end, t)
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
-        """Gripper / load-share evidence; True if it started a phase on this frame."""
-        if frame.gripper_closed is None and frame.load_share is None:
-            # No evidence (tracking alone, the usual frame): what the checks below conclude.
-            self._prev_evidence = False
-            return False
+        """Gripper / load-share evidence of a frame that carries some (the caller handles a
+        frame with neither, the usual one); True if it started a phase on this frame."""
         c = self.config
         grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
         load = frame.load_share

@@ -12,7 +12,9 @@
 Both hands go through each step together (one array of six columns): the online detector runs
 this every few ticks on a few hundred samples, where numpy's per-call overhead, not the
 arithmetic, sets the cost. The result is, bit for bit, what the steps give one hand at a time
-(``tests/phases/signals_reference.py`` keeps that form and the tests compare the two).
+(``tests/phases/signals_reference.py`` keeps that form and the tests compare the two). Online,
+a :class:`SignalCache` keeps the last result, and the next analysis of the same window a few
+samples longer computes only the rows those samples change (the same result, bit for bit).
 """
 
 from __future__ import annotations
