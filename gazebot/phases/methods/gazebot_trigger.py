@@ -100,10 +100,11 @@ class GazebotTrigger:
         self._s0 = self._s1 = 0
         self._base = 0
         self._d_last = math.nan  # the distance of the last row
-        # Running values: (first row, rows seen) they cover, and the value.
+        # Running values over the rows since a phase's start (or the floor):
         self._dmax = _SuffixMax()  # largest distance
-        self._held: tuple[int, int, list[float], int] = (-1, -1, [], 0)  # relative sums, count
         self._smax = _SuffixMax()  # largest giver step
+        # (first row, end row) covered, the relative position's sums and their count
+        self._held: tuple[int, int, list[float], int] = (-1, -1, [], 0)
 
     def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
         """Accumulate one sample's hand positions (``*_ok``: that hand was seen)."""
@@ -206,6 +207,7 @@ class GazebotTrigger:
             mean = self._held_mean(first)
             if mean is None:
                 return True
+            # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
             rel = buf[s1 - 2 : s1, 7:10]
             off = float(np.linalg.norm(_nanmean2(rel[0], rel[1]) - np.array(mean)))
             return off >= c.trigger_distance_factor * c.release_distance
