@@ -51,7 +51,7 @@ class GazebotSegmenter(Segmenter):
             keep = int(np.searchsorted(s.t, cut, side="right"))
             if keep < 3:
                 return None
-            s = Signals(*(getattr(s, f)[:keep] for f in s.__dataclass_fields__))
+            s = Signals(*[a[:keep] for a in vars(s).values()])  # (fields in order)
         return s
 
     # ---- online hooks
