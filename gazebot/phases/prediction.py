@@ -24,13 +24,17 @@ from gazebot.types import Phase
 
 def _mirrored(t: np.ndarray, v: np.ndarray, onset: float, nominal: float, c: PhaseConfig) -> float:
     ok = np.isfinite(v)
-    if not ok.any():
-        return onset + nominal
-    # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its copies
-    # and checks)
-    i = int(np.argmax(np.where(np.isnan(v), -np.inf, v)))
+    if v.shape[0] and ok.all():  # every speed known (the usual case): no NaN to pass over
+        i = int(v.argmax())
+        last = float(v[-1])
+    else:
+        if not ok.any():
+            return onset + nominal
+        # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its
+        # copies and checks)
+        i = int(np.argmax(np.where(np.isnan(v), -np.inf, v)))
+        last = float(v[np.flatnonzero(ok)[-1]])
     peak = float(v[i])
-    last = float(v[np.flatnonzero(ok)[-1]])
     if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
         return onset + 2.0 * max(float(t[i]) - onset, 0.0)
     return onset + nominal
