@@ -13,7 +13,8 @@ goal is refined to the full tolerance. Then:
   acceleration (no jumps), the eyes follow the target directly (smooth pursuit); while the
   target stays within ``IKConfig.goal_deadband`` (seen from the goal's gaze origin) of the one
   the head goal was solved for, the goal is kept (no solve, no re-plan) and the eyes take the
-  difference (until the target stops: then the goal is refined as above);
+  difference as far as their range allows (until the target stops: then the goal is refined
+  as above);
 * the eyes always aim from the neck's *current* pose, so once the saccade lands they
   counter-rotate while the neck catches up and the gaze stays on the target (the iCub gaze
   controller's behaviour), and they take whatever the head cannot do (Sawyer has only pan).
@@ -308,12 +309,13 @@ class GazeController:
 
     def _in_deadband(self, target: tuple[float, float, float]) -> bool:
         """Whether ``target`` is within ``ik.goal_deadband`` of the target the head goal was
-        solved for, seen from the goal's gaze origin, while the eyes keep the gaze on target
-        (the last tick's residual within ``ik.tolerance``: not during a saccade, not with eyes
-        at their range). Never with fixed eyes (``head-only`` mode)."""
+        solved for, seen from the goal's gaze origin, with no saccade under way. The eyes take
+        the difference as far as their range allows: where the target is beyond their reach
+        anyway, the gaze misses by at most the deadband's angle more than with the goal
+        re-solved. Never with fixed eyes (``head-only`` mode)."""
         ref = self._solved_for
         deadband = self._deadband
-        if ref is None or deadband <= 0.0 or not self._residual <= self.ik.tolerance:
+        if ref is None or deadband <= 0.0 or self._saccade is not None:
             return False
         ox, oy, oz, ux, uy, uz = ref
         return angle_of(ux, uy, uz, target[0] - ox, target[1] - oy, target[2] - oz) <= deadband
