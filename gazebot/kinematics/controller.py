@@ -44,6 +44,7 @@ from gazebot.kinematics.shifts import (
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
 _REPLAN_EPS = 1e-6
+_F64 = np.dtype(np.float64)
 
 
 @dataclass(frozen=True)
@@ -274,7 +275,8 @@ class GazeController:
         if target_point is None:
             return None
         p = target_point
-        if type(p) is not np.ndarray or p.dtype != np.float64:
+        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more.
+        if type(p) is not np.ndarray or (p.dtype is not _F64 and p.dtype != _F64):
             p = np.asarray(target_point, dtype=float)
         if p.shape != (3,):
             p = p.reshape(-1)
