@@ -326,16 +326,16 @@ class GazeController:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
         cfg = self.shifts
-        frame = self._gaze_frame()
-        origin = (frame[0][3], frame[1][3], frame[2][3])
-        to_new = (target[0] - origin[0], target[1] - origin[1], target[2] - origin[2])
-        if self._target is None:
-            amplitude = angle_of(*to_new, frame[0][0], frame[1][0], frame[2][0])
+        # The shift's size: from the gaze origin, between the new target and the old one (or
+        # the line of sight); floats unpacked once (this runs every tick the target moves).
+        (r00, _, _, ox), (r10, _, _, oy), (r20, _, _, oz) = self._gaze_frame()
+        nx, ny, nz = target[0] - ox, target[1] - oy, target[2] - oz
+        old = self._target
+        if old is None:
+            amplitude = angle_of(nx, ny, nz, r00, r10, r20)
             new_shift = True
         else:
-            old = self._target
-            to_old = (old[0] - origin[0], old[1] - origin[1], old[2] - origin[2])
-            amplitude = angle_of(*to_new, *to_old)
+            amplitude = angle_of(nx, ny, nz, old[0] - ox, old[1] - oy, old[2] - oz)
             new_shift = amplitude > cfg.saccade_threshold
 
         robot = self.robot
