@@ -73,7 +73,8 @@ class IKSettings(BaseModel):
         tracking_tolerance_deg: Looser stop (deg) while following a target that moved slightly.
         goal_deadband_deg: The gaze controller keeps the head goal while a tracked target's
             direction, seen from the goal's gaze origin, stays within this angle (deg) of the
-            one the goal was solved for; the eyes take the difference. 0 re-solves every move.
+            one the goal was solved for; the eyes take the difference as far as their range
+            allows. 0 re-solves every move.
         max_step_deg: Largest joint change per iteration (deg); keeps far targets stable.
         min_step_deg: A step smaller than this (deg) means the head cannot do better.
         posture_gain: Null-space pull toward the rest posture per iteration (0..1).

@@ -13,7 +13,8 @@ goal is refined to the full tolerance. Then:
   acceleration (no jumps), the eyes follow the target directly (smooth pursuit); while the
   target stays within ``IKConfig.goal_deadband`` (seen from the goal's gaze origin) of the one
   the head goal was solved for, the goal is kept (no solve, no re-plan) and the eyes take the
-  difference (until the target stops: then the goal is refined as above);
+  difference as far as their range allows (until the target stops: then the goal is refined
+  as above);
 * the eyes always aim from the neck's *current* pose, so once the saccade lands they
   counter-rotate while the neck catches up and the gaze stays on the target (the iCub gaze
   controller's behaviour), and they take whatever the head cannot do (Sawyer has only pan).
@@ -43,6 +44,7 @@ from gazebot.kinematics.shifts import (
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
 _REPLAN_EPS = 1e-6
+_F64 = np.dtype(np.float64)
 
 
 @dataclass(frozen=True)
@@ -273,7 +275,8 @@ class GazeController:
         if target_point is None:
             return None
         p = target_point
-        if type(p) is not np.ndarray or p.dtype != np.float64:
+        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more.
+        if type(p) is not np.ndarray or (p.dtype is not _F64 and p.dtype != _F64):
             p = np.asarray(target_point, dtype=float)
         if p.shape != (3,):
             p = p.reshape(-1)
@@ -308,12 +311,13 @@ class GazeController:
 
     def _in_deadband(self, target: tuple[float, float, float]) -> bool:
         """Whether ``target`` is within ``ik.goal_deadband`` of the target the head goal was
-        solved for, seen from the goal's gaze origin, while the eyes keep the gaze on target
-        (the last tick's residual within ``ik.tolerance``: not during a saccade, not with eyes
-        at their range). Never with fixed eyes (``head-only`` mode)."""
+        solved for, seen from the goal's gaze origin, with no saccade under way. The eyes take
+        the difference as far as their range allows: where the target is beyond their reach
+        anyway, the gaze misses by at most the deadband's angle more than with the goal
+        re-solved. Never with fixed eyes (``head-only`` mode)."""
         ref = self._solved_for
         deadband = self._deadband
-        if ref is None or deadband <= 0.0 or not self._residual <= self.ik.tolerance:
+        if ref is None or deadband <= 0.0 or self._saccade is not None:
             return False
         ox, oy, oz, ux, uy, uz = ref
         return angle_of(ux, uy, uz, target[0] - ox, target[1] - oy, target[2] - oz) <= deadband
@@ -322,16 +326,16 @@ class GazeController:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
         cfg = self.shifts
-        frame = self._gaze_frame()
-        origin = (frame[0][3], frame[1][3], frame[2][3])
-        to_new = (target[0] - origin[0], target[1] - origin[1], target[2] - origin[2])
-        if self._target is None:
-            amplitude = angle_of(*to_new, frame[0][0], frame[1][0], frame[2][0])
+        # The shift's size: from the gaze origin, between the new target and the old one (or
+        # the line of sight); floats unpacked once (this runs every tick the target moves).
+        (r00, _, _, ox), (r10, _, _, oy), (r20, _, _, oz) = self._gaze_frame()
+        nx, ny, nz = target[0] - ox, target[1] - oy, target[2] - oz
+        old = self._target
+        if old is None:
+            amplitude = angle_of(nx, ny, nz, r00, r10, r20)
             new_shift = True
         else:
-            old = self._target
-            to_old = (old[0] - origin[0], old[1] - origin[1], old[2] - origin[2])
-            amplitude = angle_of(*to_new, *to_old)
+            amplitude = angle_of(nx, ny, nz, old[0] - ox, old[1] - oy, old[2] - oz)
             new_shift = amplitude > cfg.saccade_threshold
 
         robot = self.robot

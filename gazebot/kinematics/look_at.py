@@ -43,10 +43,11 @@ class IKConfig:
             moving target, where one Gauss-Newton step from the last solution usually meets it.
         goal_deadband: The gaze controller keeps its head goal while a tracked target (one
             that moved without a gaze shift) stays within this angle (rad), seen from the
-            goal's gaze origin, of the target the goal was solved for, and the eyes keep the
-            gaze within ``tolerance`` of it (no saccade under way, eyes not at their range or
-            fixed): the eyes, which always aim from the head's current pose, take the
-            difference, so the gaze stays exact.
+            goal's gaze origin, of the target the goal was solved for (no saccade under way;
+            never with fixed eyes): the eyes, which always aim from the head's current pose,
+            take the difference as far as their range allows, so the gaze stays exact where
+            they can reach the target and, where it is beyond their reach anyway, misses it by
+            at most this angle more than with the goal re-solved.
             A quarter degree keeps the tracker's millimetre noise out of the neck and is below
             a pixel of the drawn eyes; it skips most per-tick solves. 0 re-solves every move.
             (:func:`solve_ik` itself does not use it.)

@@ -72,6 +72,47 @@ def test_within_the_goal_deadband_the_head_goal_is_kept_and_the_eyes_stay_exact(
     assert len(solves) - 240 < 120
 
 
+def test_with_the_eyes_at_their_range_the_goal_deadband_still_keeps_the_head_goal(monkeypatch):
+    """Sawyer cannot tilt its head and its eyes pitch at most 45 deg down: a hand this low is
+    beyond their reach. Moving inside the deadband it keeps the head goal (no solve); every
+    command stays finite and within the limits, and the gaze misses it by at most the
+    deadband more than with the goal re-solved every tick. Leaving the deadband re-solves."""
+    import gazebot.kinematics.controller as controller
+
+    robot = RobotModel.load("sawyer")
+    cfg = IKConfig()
+    ctrl = GazeController(robot)
+    exact = GazeController(robot, ik=IKConfig(goal_deadband=0.0))
+    hand = np.array([0.6, 0.15, 0.6])
+    for i in range(150):  # the gaze shift to the hand lands
+        settled = ctrl.update(i / 120, hand)
+        exact.update(i / 120, hand)
+    assert settled.eyes_saturated and settled.residual > 0.1
+
+    solves = []
+    solve = controller.solve_ik_raw
+    monkeypatch.setattr(controller, "solve_ik_raw",
+                        lambda *a, **k: solves.append(1) or solve(*a, **k))
+    lo, hi = robot.lower, robot.upper
+    for i in range(150, 158):  # 0.25 mm per tick sideways: 2 mm ~ 0.2 deg from the head
+        moved = hand + np.array([0.0, 0.00025 * (i - 149), 0.0])
+        state = ctrl.update(i / 120, moved)
+        assert solves == []
+        reference = exact.update(i / 120, moved)  # solves every tick
+        solves.clear()
+        assert state.eyes_saturated
+        assert state.head_goal == settled.head_goal
+        head = robot.head_vector(state.head)
+        assert np.all(np.isfinite(head)) and np.all((lo <= head) & (head <= hi))
+        assert math.isfinite(state.eye_yaw) and math.isfinite(state.eye_pitch)
+        assert robot.eyes.clip(state.eye_yaw, state.eye_pitch)[:2] == (
+            state.eye_yaw, state.eye_pitch)
+        assert state.residual <= reference.residual + cfg.goal_deadband
+    for i in range(158, 180):  # on to 8 mm (~0.8 deg): out of the deadband
+        state = ctrl.update(i / 120, hand + np.array([0.0, 0.00025 * (i - 149) * 4, 0.0]))
+    assert solves and state.head_goal != settled.head_goal
+
+
 def test_fixed_eyes_get_no_goal_deadband():
     from gazebot.kinematics.config import with_gaze_mode
 
