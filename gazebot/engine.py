@@ -15,6 +15,7 @@ sample or an event makes a stage raise is caught, reported as a ``fault`` event 
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -123,6 +124,9 @@ class GazeEngine:
             "receiver_hand": fixed["rest"],
         }
         self._radius = float(robot.config.workspace_radius_m)
+        # The workspace sphere's squared radius, finite even for an absurd radius (so a sum of
+        # squares that overflowed to inf is always beyond it).
+        self._radius_sq = min(self._radius * self._radius, sys.float_info.max)
         self._seed = seed
         self.reset()
 
@@ -273,7 +277,7 @@ class GazeEngine:
     def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
         """``frame`` with every point beyond the workspace (or not a numeric 3-vector) missing."""
         changed = {}
-        r = self._radius
+        rr = self._radius_sq
         for name in ("giver_hand", "receiver_hand", "giver_face"):
             p = getattr(frame, name)
             if type(p) is np.ndarray and p.shape == (3,) and p.dtype.kind == "f":
@@ -285,13 +289,13 @@ class GazeEngine:
                     changed[name] = NAN3.copy()
                     continue
                 changed[name] = np.array([x, y, z])
-            if x != x or y != y or z != z:
-                continue  # already missing (NaN)
-            # Per coordinate first: a huge finite value must not overflow x * x.
-            if not (-r <= x <= r and -r <= y <= r and -r <= z <= r
-                    and x * x + y * y + z * z <= r * r):
-                self.stats.implausible += 1
-                changed[name] = NAN3.copy()
+            # One comparison for the usual point: a float product overflows to inf (beyond
+            # the radius, as it should be), never raises; any NaN coordinate makes it NaN.
+            s = x * x + y * y + z * z
+            if s <= rr or s != s:
+                continue  # within the workspace, or already missing (NaN)
+            self.stats.implausible += 1
+            changed[name] = NAN3.copy()
         if not changed:
             return frame
         return TrackingFrame(

@@ -2,8 +2,11 @@
 
 ``tests/test_engine_stream_reference.py`` compares what the current code gives against the
 stream recorded from the code before the issue-19 speed-ups (``tests/data/engine_stream.npz``),
-so a speed-up that changes any command by more than float round-off fails. Regenerate (only
-after an intended change of the engine's output, and say so in the commit):
+so a speed-up that changes any command by more than float round-off fails. It was re-recorded
+twice since, for the one speed-up that changes commands on purpose: the gaze controller's head
+goal deadband (``ik: goal_deadband_deg``; with it at 0 the code gives the earlier stream), and
+when that deadband was extended to ticks with the eyes at their range.
+Regenerate (only after an intended change of the engine's output, and say so in the commit):
 
     PYTHONPATH=. .venv/bin/python -m tests.engine_stream
 """

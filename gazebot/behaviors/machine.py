@@ -98,6 +98,9 @@ _RESTORED = "after the loss"
 _STAYS = "due, but before the followed segment's start: the latest start wins, the gaze stays"
 
 
+_F64 = np.dtype(np.float64)
+
+
 def _finite(x: object) -> bool:
     """True for a finite real number (Python or NumPy scalar)."""
     try:
@@ -346,7 +349,19 @@ def diagram(spec: BehaviorSpec) -> str:
         show_conditions=True,
         title=f"gaze behavior {spec.name}",
     )
-    return str(model.get_graph().draw(None))  # type: ignore[attr-defined]
+    text = str(model.get_graph().draw(None))  # type: ignore[attr-defined]
+    return "\n".join(_without_empty_labels(line) for line in text.split("\n"))
+
+
+def _without_empty_labels(line: str) -> str:
+    """``line`` without the empty alternatives in its edge label: ``transitions`` draws a
+    region's initial state as an unlabelled edge from the region, and when a labelled edge joins
+    the same two states it adds ``" | "`` plus nothing (the initial state is drawn as ``[*]``
+    inside the region anyway)."""
+    head, sep, label = line.partition(": ")
+    if not sep or "-->" not in head:
+        return line
+    return head + sep + " | ".join(part for part in label.split(" | ") if part.strip())
 
 
 class _Model:
@@ -695,8 +710,12 @@ class BehaviorMachine:
 
     def target(self, ctx: GazeContext) -> GazeTarget:
         """Where to look at ``ctx.t``: a target kind and its current point."""
-        t = float(ctx.t) if _finite(ctx.t) else self.handover.phase_start
-        end = ctx.tracking_end if _finite(ctx.tracking_end) else math.nan
+        t, end = ctx.t, ctx.tracking_end
+        # (the engine's floats skip the general checks: this runs every tick)
+        if type(t) is not float or not math.isfinite(t):
+            t = float(t) if _finite(t) else self.handover.phase_start
+        if type(end) is not float or not math.isfinite(end):
+            end = end if _finite(end) else math.nan
         self.advance(t, end)
         gaze, tracking = self._model.state
         lost_kind = self.spec.tracking_lost.target
@@ -705,7 +724,9 @@ class BehaviorMachine:
                 return self._held
             return GazeTarget(lost_kind, self._point(lost_kind, ctx))
         kind = self._target_of[self._gaze_leaf[gaze]]
-        target = GazeTarget(kind, self._point(kind, ctx))
+        # GazeTarget(kind, point) without the frozen dataclass's per-field __setattr__
+        target = object.__new__(GazeTarget)
+        target.__dict__.update(kind=kind, point=self._point(kind, ctx))
         if kind != lost_kind:
             self._point(lost_kind, ctx)  # keeps the last known face fresh for a tracking loss
         self._last_target = target
@@ -745,7 +766,8 @@ class BehaviorMachine:
         """``p`` as a finite (3,) float array, or None."""
         if p is None:
             return None
-        arr = p if type(p) is np.ndarray and p.dtype == np.float64 else _as3(p)
+        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more
+        arr = p if type(p) is np.ndarray and (p.dtype is _F64 or p.dtype == _F64) else _as3(p)
         if arr is None or arr.shape != (3,):
             return None
         # Scalar checks on one list: much cheaper than np.isfinite(...).all() on a 3-vector,

@@ -71,6 +71,10 @@ class IKSettings(BaseModel):
         max_iterations: Iteration cap of one solve (a warm start typically needs 1-3).
         tolerance_deg: Head pointing error (deg) at which a solve stops.
         tracking_tolerance_deg: Looser stop (deg) while following a target that moved slightly.
+        goal_deadband_deg: The gaze controller keeps the head goal while a tracked target's
+            direction, seen from the goal's gaze origin, stays within this angle (deg) of the
+            one the goal was solved for; the eyes take the difference as far as their range
+            allows. 0 re-solves every move.
         max_step_deg: Largest joint change per iteration (deg); keeps far targets stable.
         min_step_deg: A step smaller than this (deg) means the head cannot do better.
         posture_gain: Null-space pull toward the rest posture per iteration (0..1).
@@ -85,6 +89,7 @@ class IKSettings(BaseModel):
     max_iterations: int | None = Field(None, ge=1)
     tolerance_deg: float | None = Field(None, gt=0.0)
     tracking_tolerance_deg: float | None = Field(None, gt=0.0)
+    goal_deadband_deg: float | None = Field(None, ge=0.0)
     max_step_deg: float | None = Field(None, gt=0.0)
     min_step_deg: float | None = Field(None, gt=0.0)
     posture_gain: float | None = Field(None, ge=0.0, le=1.0)

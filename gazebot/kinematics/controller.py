@@ -10,7 +10,11 @@ goal is refined to the full tolerance. Then:
   re-plans a minimum-jerk move to the new goal with ``neck_duration_s`` and the eyes saccade
   with ``eye_duration_s`` (both stretched to respect velocity limits);
 * smaller changes are **tracked**: the neck re-plans from its current position, velocity and
-  acceleration (no jumps), the eyes follow the target directly (smooth pursuit);
+  acceleration (no jumps), the eyes follow the target directly (smooth pursuit); while the
+  target stays within ``IKConfig.goal_deadband`` (seen from the goal's gaze origin) of the one
+  the head goal was solved for, the goal is kept (no solve, no re-plan) and the eyes take the
+  difference as far as their range allows (until the target stops: then the goal is refined
+  as above);
 * the eyes always aim from the neck's *current* pose, so once the saccade lands they
   counter-rotate while the neck catches up and the gaze stays on the target (the iCub gaze
   controller's behaviour), and they take whatever the head cannot do (Sawyer has only pan).
@@ -28,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gazebot.kinematics.eyes import angle_between
+from gazebot.kinematics.eyes import angle_of
 from gazebot.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.kinematics.robot import RobotModel
 from gazebot.kinematics.shifts import (
@@ -40,6 +44,7 @@ from gazebot.kinematics.shifts import (
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
 _REPLAN_EPS = 1e-6
+_F64 = np.dtype(np.float64)
 
 
 @dataclass(frozen=True)
@@ -96,6 +101,10 @@ class GazeController:
         self._upper = robot.upper.tolist()
         self._vlim = robot.velocity_limits.tolist()
         self._limits = tuple(zip(self._vlim, self._lower, self._upper, strict=True))
+        # The head goal deadband needs eyes that can take the difference (not head-only).
+        eyes = robot.eyes
+        movable = eyes.yaw_range[0] < eyes.yaw_range[1] or eyes.pitch_range[0] < eyes.pitch_range[1]
+        self._deadband = self.ik.goal_deadband if movable else 0.0
         self.reset()
 
     # --- state --------------------------------------------------------------------------------
@@ -124,6 +133,9 @@ class GazeController:
         # The last IK solution (its q is ``_goal``) and the arm revision it was solved for: its
         # gaze frame and Jacobian seed the next warm start.
         self._solution: tuple[RawSolution, int] | None = None
+        # The goal's gaze origin and the unit direction from it to the target the goal was
+        # solved for (the deadband's reference), or None.
+        self._solved_for: tuple[float, float, float, float, float, float] | None = None
 
     @property
     def head(self) -> dict[str, float]:
@@ -167,30 +179,34 @@ class GazeController:
             shift = self._retarget(target, self._clock - dt)
 
         if self._traj is not None and dt > 0.0:
-            pos = self._traj.sample(self._clock)[0]
+            pos = self._traj.sample_position(self._clock)
             q_prev = self._q
-            q = []
-            vel = []
-            finite = True
-            for p, a, (v, lo, hi) in zip(pos, q_prev, self._limits, strict=True):
-                # Rate limit, then joint limits (comparisons, not min/max calls: this is the hot
-                # path; a NaN stays NaN and is caught below).
-                step = v * dt
-                x = p
-                if x < a - step:
-                    x = a - step
-                if x > a + step:
-                    x = a + step
-                if x < lo:
-                    x = lo
-                if x > hi:
-                    x = hi
-                finite = finite and math.isfinite(x)
-                q.append(x)
-                vel.append((x - a) / dt)
-            if finite:
-                self._vel = vel
-                self._q = q
+            if pos == q_prev:
+                # At rest on the plan's goal (within the limits): what the loop below gives.
+                self._vel = [0.0] * len(q_prev)
+            else:
+                q = []
+                vel = []
+                finite = True
+                for p, a, (v, lo, hi) in zip(pos, q_prev, self._limits, strict=True):
+                    # Rate limit, then joint limits (comparisons, not min/max calls: this is the
+                    # hot path; a NaN stays NaN and is caught below).
+                    step = v * dt
+                    x = p
+                    if x < a - step:
+                        x = a - step
+                    if x > a + step:
+                        x = a + step
+                    if x < lo:
+                        x = lo
+                    if x > hi:
+                        x = hi
+                    finite = finite and math.isfinite(x)
+                    q.append(x)
+                    vel.append((x - a) / dt)
+                if finite:
+                    self._vel = vel
+                    self._q = q
         elif dt > 0.0:
             self._vel = [0.0] * len(self._q)
 
@@ -259,17 +275,18 @@ class GazeController:
         if target_point is None:
             return None
         p = target_point
-        if type(p) is not np.ndarray or p.dtype != np.float64:
+        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more.
+        if type(p) is not np.ndarray or (p.dtype is not _F64 and p.dtype != _F64):
             p = np.asarray(target_point, dtype=float)
         if p.shape != (3,):
             p = p.reshape(-1)
             if p.shape != (3,):
                 raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
         x, y, z = p.tolist()
-        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
-            return None
-        # A corrupted, absurdly far sample is held like a missing one.
-        return (x, y, z) if max(abs(x), abs(y), abs(z)) <= self.ik.max_distance else None
+        # Finite and not absurdly far (a corrupted sample is held like a missing one); a NaN
+        # fails every comparison.
+        m = self.ik.max_distance
+        return (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
 
     def _gaze_frame(self) -> list[list[float]]:
         """Gaze frame rows at the head command (cached: the eyes of one tick and the re-plan of
@@ -292,20 +309,33 @@ class GazeController:
             r02 * dx + r12 * dy + r22 * dz,
         )
 
+    def _in_deadband(self, target: tuple[float, float, float]) -> bool:
+        """Whether ``target`` is within ``ik.goal_deadband`` of the target the head goal was
+        solved for, seen from the goal's gaze origin, with no saccade under way. The eyes take
+        the difference as far as their range allows: where the target is beyond their reach
+        anyway, the gaze misses by at most the deadband's angle more than with the goal
+        re-solved. Never with fixed eyes (``head-only`` mode)."""
+        ref = self._solved_for
+        deadband = self._deadband
+        if ref is None or deadband <= 0.0 or self._saccade is not None:
+            return False
+        ox, oy, oz, ux, uy, uz = ref
+        return angle_of(ux, uy, uz, target[0] - ox, target[1] - oy, target[2] - oz) <= deadband
+
     def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
         cfg = self.shifts
-        frame = self._gaze_frame()
-        origin = (frame[0][3], frame[1][3], frame[2][3])
-        to_new = (target[0] - origin[0], target[1] - origin[1], target[2] - origin[2])
-        if self._target is None:
-            amplitude = angle_between(to_new, (frame[0][0], frame[1][0], frame[2][0]))
+        # The shift's size: from the gaze origin, between the new target and the old one (or
+        # the line of sight); floats unpacked once (this runs every tick the target moves).
+        (r00, _, _, ox), (r10, _, _, oy), (r20, _, _, oz) = self._gaze_frame()
+        nx, ny, nz = target[0] - ox, target[1] - oy, target[2] - oz
+        old = self._target
+        if old is None:
+            amplitude = angle_of(nx, ny, nz, r00, r10, r20)
             new_shift = True
         else:
-            old = self._target
-            to_old = (old[0] - origin[0], old[1] - origin[1], old[2] - origin[2])
-            amplitude = angle_between(to_new, to_old)
+            amplitude = angle_of(nx, ny, nz, old[0] - ox, old[1] - oy, old[2] - oz)
             new_shift = amplitude > cfg.saccade_threshold
 
         robot = self.robot
@@ -315,6 +345,12 @@ class GazeController:
         tracking = not new_shift and target != self._target
         last = self._solution
         if last is not None and last[1] == revision and last[0].q is self._goal:
+            if tracking and self._in_deadband(target):
+                # The head goal stays; the eyes, aimed from the head's pose, take the rest. It
+                # is solved in full once the target stands still.
+                self._target = target
+                self._goal_final = False
+                return 0.0
             warm_frame, warm_rows = last[0].frame, last[0].rows  # the warm start's kinematics
         else:
             warm_frame = warm_rows = None
@@ -332,6 +368,11 @@ class GazeController:
             return 0.0  # at the gaze origin: no direction to look
         self._solution = (sol, revision)
         self._target = target
+        if self._deadband > 0.0:
+            (_, _, _, ox), (_, _, _, oy), (_, _, _, oz) = sol.frame
+            dx, dy, dz = target[0] - ox, target[1] - oy, target[2] - oz
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)  # > 0: the solve was valid
+            self._solved_for = (ox, oy, oz, dx / d, dy / d, dz / d)
         goal = sol.q
         # A solve stopped by the iteration cap or at the tracking tolerance is refined on the
         # next tick even if nothing moved.

@@ -16,7 +16,7 @@ import numpy as np
 
 def eye_angles(v: np.ndarray | Sequence[float]) -> tuple[float, float]:
     """Yaw and pitch (rad) that point the eyes along ``v`` (gaze frame, any length > 0)."""
-    x, y, z = float(v[0]), float(v[1]), float(v[2])
+    x, y, z = v[0], v[1], v[2]  # math's functions take them as floats (no float() calls)
     return math.atan2(y, x), math.atan2(-z, math.hypot(x, y))
 
 
@@ -28,8 +28,12 @@ def eye_direction(yaw: float, pitch: float) -> np.ndarray:
 
 def angle_between(a: np.ndarray | Sequence[float], b: np.ndarray | Sequence[float]) -> float:
     """Angle (rad) between two non-zero 3-vectors, accurate for small and large angles."""
-    ax, ay, az = float(a[0]), float(a[1]), float(a[2])
-    bx, by, bz = float(b[0]), float(b[1]), float(b[2])
+    return angle_of(float(a[0]), float(a[1]), float(a[2]), float(b[0]), float(b[1]), float(b[2]))
+
+
+def angle_of(ax: float, ay: float, az: float, bx: float, by: float, bz: float) -> float:
+    """:func:`angle_between` of ``(ax, ay, az)`` and ``(bx, by, bz)`` given as floats (the gaze
+    controller's per-tick form: no conversions)."""
     cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
     return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
 
@@ -62,6 +66,7 @@ class DisplayEyes:
 
     def residual(self, yaw: float, pitch: float, v: np.ndarray | Sequence[float]) -> float:
         """Angle (rad) between the eyes' line of sight and ``v`` (gaze frame)."""
-        # eye_direction() as a tuple: this runs every controller tick.
+        # eye_direction() as floats: this runs every controller tick.
         cp = math.cos(pitch)
-        return angle_between((cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch)), v)
+        return angle_of(cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch),
+                        float(v[0]), float(v[1]), float(v[2]))

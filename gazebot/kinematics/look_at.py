@@ -41,6 +41,16 @@ class IKConfig:
         tracking_tolerance: Looser stop (rad) for a target that moved slightly since the last
             solve (see :func:`solve_ik_raw`): the gaze controller uses it while following a
             moving target, where one Gauss-Newton step from the last solution usually meets it.
+        goal_deadband: The gaze controller keeps its head goal while a tracked target (one
+            that moved without a gaze shift) stays within this angle (rad), seen from the
+            goal's gaze origin, of the target the goal was solved for (no saccade under way;
+            never with fixed eyes): the eyes, which always aim from the head's current pose,
+            take the difference as far as their range allows, so the gaze stays exact where
+            they can reach the target and, where it is beyond their reach anyway, misses it by
+            at most this angle more than with the goal re-solved.
+            A quarter degree keeps the tracker's millimetre noise out of the neck and is below
+            a pixel of the drawn eyes; it skips most per-tick solves. 0 re-solves every move.
+            (:func:`solve_ik` itself does not use it.)
     """
 
     damping: float = 1e-4
@@ -53,6 +63,7 @@ class IKConfig:
     min_step: float = 1e-9
     posture_off: float = 1e-3
     tracking_tolerance: float = 1e-4
+    goal_deadband: float = math.radians(0.25)
 
     @classmethod
     def from_settings(cls, settings: IKSettings) -> IKConfig:

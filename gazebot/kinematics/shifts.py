@@ -199,8 +199,7 @@ class MinJerkTrajectory(Trajectory):
         """:meth:`evaluate` as tuples of floats (position, velocity, acceleration)."""
         last = self._last
         if last is not None and last[0] == t:
-            # The controller evaluates each plan at the same time twice (the command now, then
-            # the re-plan's start state on the next tick).
+            # A plan asked twice for the same time (e.g. a re-plan's start state) is computed once.
             return last[1]
         s = min(max(t - self.t0, 0.0), self.duration)
         if s >= self.duration:
@@ -216,6 +215,17 @@ class MinJerkTrajectory(Trajectory):
             out = (tuple(pos), tuple(vel), tuple(acc))
         self._last = (t, out)
         return out
+
+    def sample_position(self, t: float) -> list[float]:
+        """The position of :meth:`sample` alone, as a list of floats (the gaze controller's
+        command each tick; velocity and acceleration are needed only to re-plan)."""
+        s = min(max(t - self.t0, 0.0), self.duration)
+        if s >= self.duration:
+            return list(self._goal)
+        return [
+            c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))))
+            for c0, c1, c2, c3, c4, c5 in self._coeffs
+        ]
 
     def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         pos, vel, acc = self.sample(t)

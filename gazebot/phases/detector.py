@@ -49,7 +49,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.durations import REACH_S
-from gazebot.phases.filtering import Signals
+from gazebot.phases.filtering import SignalCache, Signals
 from gazebot.phases.methods import make_segmenter
 from gazebot.phases.methods.base import OnlineState
 from gazebot.phases.prediction import predict_end
@@ -78,6 +78,7 @@ class _Samples:
     def __init__(self) -> None:
         self._buf = np.empty((256, 7))
         self._s0 = self._s1 = 0
+        self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
 
     def __len__(self) -> int:
         return self._s1 - self._s0
@@ -91,14 +92,19 @@ class _Samples:
             self._buf[:m] = buf[self._s0 : self._s1]
             buf, self._s0, self._s1 = self._buf, 0, m
         buf[self._s1] = row
+        if self._s1 == self._s0:
+            self._first_t = row[0]
         self._s1 += 1
 
     def drop_before(self, t0: float) -> None:
         """Forget the samples older than ``t0``."""
+        if self._first_t >= t0:
+            return
         buf, i, end = self._buf, self._s0, self._s1
         while i < end and buf[i, 0] < t0:
             i += 1
         self._s0 = i
+        self._first_t = float(buf[i, 0]) if i < end else math.inf
 
     def time(self, i: int) -> float:
         """Time of the ``i``-th sample kept."""
@@ -155,6 +161,9 @@ class PhaseDetector:
         self._prev_evidence: bool | None = False
         self._robot_reports = False
         self._signals: Signals | None = None
+        # The last analysis's signals, so the next one (on the same window, a few samples
+        # longer) computes only the rows the new samples change.
+        self._signal_cache = SignalCache()
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()
@@ -178,6 +187,8 @@ class PhaseDetector:
     def update_all(self, frame: TrackingFrame) -> list[Event]:
         """Feed one frame; return every new and queued event, oldest first."""
         self._step(frame)
+        if not self._queue:
+            return []
         out = list(self._queue)
         self._queue.clear()
         return out
@@ -278,7 +289,7 @@ class PhaseDetector:
         if r_ok:
             self._seen_r = t
         if self._trigger is not None:
-            self._trigger.add(g, g_ok, r, r_ok)
+            self._trigger.add((gx, gy, gz), g_ok, (rx, ry, rz), r_ok)
         if not (g_ok and r_ok):
             st.held += 1
             if self.tracking:
@@ -300,7 +311,9 @@ class PhaseDetector:
             info = {"handover": max(self.handover, 0)}
             self._queue.append(Event(EventKind.TRACKING_RESTORED, t, t, info))
 
-        if self._robot_evidence(frame, t):
+        if frame.gripper_closed is None and frame.load_share is None:
+            self._prev_evidence = False  # no robot evidence (tracking alone, the usual frame)
+        elif self._robot_evidence(frame, t):
             return
         if t - self._last_analysis >= c.online_period - 1e-9:
             # On a fixed grid of online_period (the first sample at or after each tick), not
@@ -314,13 +327,16 @@ class PhaseDetector:
                 self._last_analysis = t  # the first sample, or after a pause: a new grid
             mode = "full"
             if self._trigger is not None:
-                state = OnlineState(
-                    self.phase,
-                    self.phase_start,
-                    self._floor,
-                    self.tracking,
-                    self._joined_late,
-                    self._last_full,
+                # Every field given, so the frozen dataclass is filled directly (its generated
+                # __init__ sets each field through object.__setattr__: a cost every period).
+                state = object.__new__(OnlineState)
+                state.__dict__.update(
+                    phase=self.phase,
+                    phase_start=self.phase_start,
+                    floor=self._floor,
+                    tracking=self.tracking,
+                    joined_late=self._joined_late,
+                    last_full=self._last_full,
                 )
                 mode = self._trigger.decide(t, state)
             if mode != "skip":
@@ -334,11 +350,8 @@ class PhaseDetector:
             self.expected_phase_end = max(self.expected_phase_end, t)
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
-        """Gripper / load-share evidence; True if it started a phase on this frame."""
-        if frame.gripper_closed is None and frame.load_share is None:
-            # No evidence (tracking alone, the usual frame): what the checks below conclude.
-            self._prev_evidence = False
-            return False
+        """Gripper / load-share evidence of a frame that carries some (the caller handles a
+        frame with neither, the usual one); True if it started a phase on this frame."""
         c = self.config
         grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
         load = frame.load_share
@@ -383,7 +396,7 @@ class PhaseDetector:
         # (the rows are float64 of known shapes: no conversion or check needed)
         traj = Trajectory.of_hands(window[:, 0].copy(), window[:, 1:4].copy(),
                                    window[:, 4:].copy())
-        s = self.segmenter.online_signals(traj)
+        s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
             restart = self._reach_restart()
@@ -394,11 +407,12 @@ class PhaseDetector:
                 self._start(Phase.REACH, restart, now, "motion")
         if s is not None and not predict_only:
             if not self.segmenter.rules_after_contact:
-                self._advance(self.segmenter.online_segments(traj, s, now), now)
+                self._advance(self.segmenter.online_segments(traj, s, now, self.phase), now)
             elif not self._rules_after_contact(s, now):
                 # Once the hands are in contact the method's own end rules run from the
                 # phase's start; before, the whole method finds the next handover.
-                self._advance(self.segmenter.online_segments(traj, s, now), now, True)
+                segs = self.segmenter.online_segments(traj, s, now, self.phase)
+                self._advance(segs, now, True)
                 self._rules_after_contact(s, now)
         self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
 
@@ -506,8 +520,8 @@ class PhaseDetector:
         v = s.giver_speed[i_start:]
         rest = np.isfinite(v) & (v < c.rest_speed)
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
-        if need < 1 or rest.size <= need:
-            return None
+        if need < 1 or rest.size <= need or np.count_nonzero(rest) < need:
+            return None  # (no run of need rest samples without need of them in all)
         # the last sample of the last rest at least reach_stall long
         edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
         bounds = edges.tolist()  # (plain ints: iterating the array would box each element)

@@ -12,7 +12,9 @@
 Both hands go through each step together (one array of six columns): the online detector runs
 this every few ticks on a few hundred samples, where numpy's per-call overhead, not the
 arithmetic, sets the cost. The result is, bit for bit, what the steps give one hand at a time
-(``tests/phases/signals_reference.py`` keeps that form and the tests compare the two).
+(``tests/phases/signals_reference.py`` keeps that form and the tests compare the two). Online,
+a :class:`SignalCache` keeps the last result, and the next analysis of the same window a few
+samples longer computes only the rows those samples change (the same result, bit for bit).
 """
 
 from __future__ import annotations
@@ -234,9 +236,61 @@ def _norms(x: np.ndarray) -> np.ndarray:
     return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])
 
 
-def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
+def _derived(
+    x: np.ndarray, v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray]:
+    """From smoothed positions ``x`` and velocities ``v`` (rows, both hands): ``rel, rel_v,
+    distance, rel_speed, giver_speed, receiver_speed, closing, common_speed, hold_speed``, row
+    by row (a row's values depend on that row alone)."""
+    gv, rv = v[:, :3], v[:, 3:]
+    # The five vectors whose norms are needed, in one block: what _norms computes for each,
+    # in a few numpy calls instead of six per vector.
+    q = np.empty((5, x.shape[0], 3))
+    rel, rel_v = q[0], q[1]
+    np.subtract(x[:, 3:], x[:, :3], out=rel)
+    np.subtract(rv, gv, out=rel_v)
+    q[2] = gv
+    q[3] = rv
+    np.add(gv, rv, out=q[4])
+    sq = q * q
+    norms = np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2])
+    distance, rel_speed, g_speed, r_speed = norms[0], norms[1], norms[2], norms[3]
+    common = 0.5 * norms[4]
+    closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
+    hold = np.maximum(np.abs(closing), rel_speed - np.minimum(g_speed, r_speed))
+    return rel, rel_v, distance, rel_speed, g_speed, r_speed, closing, common, hold
+
+
+def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
+    """Velocities of the smoothed rows ``x`` (at least two): np.gradient's central differences
+    inside, one-sided at the ends (its arithmetic, without its generic set-up), NaN where the
+    smoothing window held less than ``FULL_WINDOW`` data (``full``, per row and hand)."""
+    v = np.empty_like(x)
+    v[1:-1] = (x[2:] - x[:-2]) / (2.0 * dt)
+    v[0] = (x[1] - x[0]) / dt
+    v[-1] = (x[-1] - x[-2]) / dt
+    # Next to a tracking gap the window is one-sided and flattens the motion: velocities
+    # there are unknown, not slow.
+    v = v.reshape(v.shape[0], 2, 3)
+    v[full < FULL_WINDOW] = np.nan
+    return v.reshape(v.shape[0], 6)
+
+
+def compute_signals(
+    trajectory: Trajectory, config: PhaseConfig, cache: SignalCache | None = None
+) -> Signals:
     """Frozen samples out, resample, smooth and differentiate the hands of ``trajectory``
-    (sorted by time, see :meth:`Trajectory.cleaned`)."""
+    (sorted by time, see :meth:`Trajectory.cleaned`).
+
+    ``cache``: an online caller's :class:`SignalCache`: when ``trajectory`` extends the one of
+    the previous call (the same samples, more at the end), only the rows the new samples can
+    change are computed; the result is the same, bit for bit. Its arrays are then read-only
+    views, valid until the cache's next call."""
+    if cache is not None:
+        s = cache.extend(trajectory, config)
+        if s is not None:
+            return s
     t = trajectory.t
     n = t.shape[0]
     dt = 1.0 / config.analysis_rate
@@ -244,6 +298,7 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     p = np.concatenate((trajectory.giver_hand, trajectory.receiver_hand), axis=1)
     fin = np.isfinite(p)
     ok = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands): every coordinate seen
+    seen = ok.copy() if cache is not None else ok  # (before stale samples are taken out)
     ok_g, ok_r = ok[:, 0], ok[:, 1]
     all_seen = bool(ok_g.all()) and bool(ok_r.all())
     # A stale repeat equals the sample before; with every sample seen and no coordinate equal
@@ -271,36 +326,14 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     fin = np.isfinite(x)
     m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands)
     x, full = smooth(x, m, sigma_s / dt)
-    if grid.shape[0] >= 2:
-        # np.gradient's central differences inside, one-sided at the ends (its arithmetic,
-        # without its generic set-up)
-        v = np.empty_like(x)
-        v[1:-1] = (x[2:] - x[:-2]) / (2.0 * dt)
-        v[0] = (x[1] - x[0]) / dt
-        v[-1] = (x[-1] - x[-2]) / dt
-        # Next to a tracking gap the window is one-sided and flattens the motion: velocities
-        # there are unknown, not slow.
-        v = v.reshape(v.shape[0], 2, 3)
-        v[full < FULL_WINDOW] = np.nan
-        v = v.reshape(v.shape[0], 6)
-    else:
-        v = np.full_like(x, np.nan)
-    g, r = x[:, :3], x[:, 3:]
-    gv, rv = v[:, :3], v[:, 3:]
-    rel = r - g
-    rel_v = rv - gv
-    distance = _norms(rel)
-    rel_speed = _norms(rel_v)
-    closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
-    common = 0.5 * _norms(gv + rv)
-    g_speed = _norms(gv)
-    r_speed = _norms(rv)
-    return Signals(
+    v = _velocities(x, full, dt) if grid.shape[0] >= 2 else np.full_like(x, np.nan)
+    rel, rel_v, distance, rel_speed, g_speed, r_speed, closing, common, hold = _derived(x, v)
+    s = Signals(
         t=grid,
-        giver=g,
-        receiver=r,
-        giver_v=gv,
-        receiver_v=rv,
+        giver=x[:, :3],
+        receiver=x[:, 3:],
+        giver_v=v[:, :3],
+        receiver_v=v[:, 3:],
         rel=rel,
         rel_v=rel_v,
         distance=distance,
@@ -309,5 +342,267 @@ def compute_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
         receiver_speed=r_speed,
         closing=closing,
         common_speed=common,
-        hold_speed=np.maximum(np.abs(closing), rel_speed - np.minimum(g_speed, r_speed)),
+        hold_speed=hold,
     )
+    if cache is not None:
+        cache.keep(trajectory, config, s, x, v, full, sigma_s / dt, seen, ok)
+    return s
+
+
+# The columns a SignalCache keeps per grid row, beside the grid: name -> columns (1: a vector).
+_KEPT = {
+    "x": 6, "v": 6, "full": 2, "rel": 3, "rel_v": 3, "distance": 1, "rel_speed": 1,
+    "giver_speed": 1, "receiver_speed": 1, "closing": 1, "common_speed": 1, "hold_speed": 1,
+}
+# The order _derived returns its arrays in.
+_DERIVED = ("rel", "rel_v", "distance", "rel_speed", "giver_speed", "receiver_speed", "closing",
+            "common_speed", "hold_speed")
+
+
+class SignalCache:
+    """The last signals :func:`compute_signals` computed for one online caller, so that the
+    next call, on the same samples and a few more, computes only the rows the new samples can
+    change: every grid row from half a smoothing kernel before the first grid point past the
+    previous last valid sample of either hand (the interpolation there, the gaps' NaN and the
+    smoothing's end padding change), and one more row for the central differences. Older
+    rows keep their values, bit for bit: each step (interpolation between the valid samples
+    around a grid point, a gap's length, a correlation over the kernel, row-wise arithmetic)
+    reads only that neighbourhood, and which samples are stale repeats is decided in time
+    order (a new sample never changes an older one's).
+
+    A full computation starts the cache afresh when the window does not extend the last one
+    (its first sample or an older sample changed), the smoothing width changed, or a hand has
+    no valid sample before the rows to recompute."""
+
+    def __init__(self) -> None:
+        self._config: PhaseConfig | None = None  # None: nothing kept
+        self._t = np.empty(0)  # the samples the kept signals came from
+        self._g = np.empty((0, 3))
+        self._r = np.empty((0, 3))
+        self._seen = np.empty((0, 2), dtype=bool)  # per sample and hand: every coordinate
+        self._ok = np.empty((0, 2), dtype=bool)  # ... and not a stale repeat
+        self._clean = False  # every sample kept seen and valid (the interpolation's fast path)
+        self._last_seen = [-1, -1]  # per hand: the last sample kept that was seen (-1: none)
+        self._max_dt = 0.0
+        self._sigma = 0.0
+        self._grid = np.empty(0)
+        self._rows = 0  # grid rows kept
+        self._buf: dict[str, np.ndarray] = {}
+        self._read_only: dict[str, np.ndarray] = {}  # read-only views of the owned buffers
+        self._owned = False  # the buffers are this cache's (else: a returned result's arrays)
+
+    def keep(
+        self,
+        trajectory: Trajectory,
+        config: PhaseConfig,
+        s: Signals,
+        x: np.ndarray,
+        v: np.ndarray,
+        full: np.ndarray,
+        sigma: float,
+        seen: np.ndarray,
+        ok: np.ndarray,
+    ) -> None:
+        """Remember a full computation's result ``s`` with its smoothed rows ``x``, velocities
+        ``v``, window shares ``full``, smoothing width ``sigma`` (grid steps) and, per sample
+        and hand, which samples were ``seen`` and which were valid (``ok``: seen and not
+        stale). The arrays are adopted, not copied: the first extension copies what it
+        keeps."""
+        t = trajectory.t
+        if s.t.shape[0] < 3 or t.shape[0] < 2:
+            self._config = None
+            return
+        self._config = config
+        self._t = t.copy()
+        self._g = trajectory.giver_hand.copy()
+        self._r = trajectory.receiver_hand.copy()
+        self._seen, self._ok = seen, ok
+        self._clean = bool(ok.all())
+        self._last_seen = [self._last_of(seen[:, h]) for h in (0, 1)]
+        self._max_dt = float(np.max(np.diff(t)))
+        self._sigma = sigma
+        self._grid = s.t
+        self._rows = s.t.shape[0]
+        self._buf = {"x": x, "v": v, "full": full}
+        for name in _DERIVED:
+            self._buf[name] = getattr(s, name)
+        self._owned = False
+
+    @staticmethod
+    def _last_of(mask: np.ndarray) -> int:
+        """Index of the last True of ``mask`` (-1: none), searched from the end."""
+        i = mask.shape[0] - 1
+        while i >= 0 and not mask[i]:
+            i -= 1
+        return i
+
+    def _same_prefix(self, t: np.ndarray, g: np.ndarray, r: np.ndarray) -> bool:
+        """The first samples of ``t``, ``g``, ``r`` are the ones kept, bit for bit (NaN too)."""
+        n0 = self._t.shape[0]
+        if t[0] != self._t[0] or not (t[:n0] == self._t).all():
+            return False
+        if self._clean:  # (no NaN kept: value equality is enough)
+            return bool((g[:n0] == self._g).all() and (r[:n0] == self._r).all())
+        bits = np.int64
+        gk, rk = np.ascontiguousarray(g[:n0]), np.ascontiguousarray(r[:n0])
+        return bool(
+            (gk.view(bits) == self._g.view(bits)).all()
+            and (rk.view(bits) == self._r.view(bits)).all()
+        )
+
+    def _new_valid(
+        self, t: np.ndarray, p: np.ndarray, hand: int, frozen_speed: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Which of the new samples of one hand (``p``: all its samples) are seen, and which
+        of those are not stale repeats (:func:`drop_frozen`, whose decisions run in time
+        order: run on the whole window only when a new seen sample repeats the one before)."""
+        n0 = self._t.shape[0]
+        fin = np.isfinite(p[n0:])
+        seen_new = fin[:, 0] & fin[:, 1] & fin[:, 2]
+        rows = np.flatnonzero(seen_new) + n0
+        before = self._last_seen[hand]
+        if before >= 0:
+            rows = np.concatenate(([before], rows))
+        q = p[rows]
+        if rows.size < 2 or not (q[1:] == q[:-1]).all(axis=1).any():
+            return seen_new, seen_new
+        seen_all = np.concatenate((self._seen[:, hand], seen_new))
+        stale = drop_frozen(t, p, frozen_speed, seen_all)[n0:]
+        return seen_new, seen_new & ~stale
+
+    def extend(self, trajectory: Trajectory, config: PhaseConfig) -> Signals | None:
+        """The signals of ``trajectory`` if it extends the samples kept (see the class
+        docstring), else ``None`` (the caller computes them in full)."""
+        if self._config is None or (config is not self._config and config != self._config):
+            return None
+        t = trajectory.t
+        g_in, r_in = trajectory.giver_hand, trajectory.receiver_hand
+        n, n0 = t.shape[0], self._t.shape[0]
+        if n <= n0 or not self._same_prefix(t, g_in, r_in):
+            return None
+        # The new samples: seen and valid per hand. The usual case, every one seen and none
+        # repeating a coordinate of the one before, needs no per-hand search.
+        tail = np.concatenate((g_in[n0 - 1 :], r_in[n0 - 1 :]), axis=1)
+        # (a sum is finite only if every term is; one that overflows only costs the search)
+        clean = (
+            self._clean
+            and math.isfinite(float(tail.sum()))
+            and not (tail[1:] == tail[:-1]).any()
+        )
+        if clean:
+            seen_new = ok_new = np.ones((n - n0, 2), dtype=bool)
+        else:
+            sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
+            sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
+            seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
+        max_dt = max(self._max_dt, float((t[n0:] - t[n0 - 1 : -1]).max()))
+        dt = 1.0 / config.analysis_rate
+        # The smoothing width: half the median sample interval only counts when it exceeds
+        # half the smoothing, which needs an interval that long.
+        sigma_s = 0.5 * config.smoothing
+        if max_dt > config.smoothing:
+            sigma_s = max(sigma_s, 0.5 * _median(np.diff(t)))
+        if sigma_s / dt != self._sigma:
+            return None
+        grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
+        rows, rows0 = grid.shape[0], self._rows
+        w = gaussian_weights(self._sigma)
+        radius = w.shape[0] // 2
+        # the first grid row past the last valid sample kept of either hand: NaN before, or
+        # beyond the kept grid
+        if self._clean:
+            last_valid = float(self._t[-1])
+        else:
+            k_g, k_r = np.flatnonzero(self._ok[:, 0]), np.flatnonzero(self._ok[:, 1])
+            if k_g.size < 2 or k_r.size < 2:
+                return None  # (a hand with fewer was all unknown: its first rows change too)
+            last_valid = float(self._t[min(int(k_g[-1]), int(k_r[-1]))])
+        j_c = int(np.searchsorted(self._grid, last_valid, side="right"))
+        a = j_c - radius  # first smoothed row that changes
+        # (scipy's correlation of a line that starts at row i0 equals the whole line's only
+        # from row i0 + radius + 1 on: the slice starts one row earlier than the kernel needs)
+        lead = radius + 1
+        if a - lead < 0 or a < 2 or rows < rows0 or grid[rows0 - 1] != self._grid[-1]:
+            return None
+        # interpolate the rows the smoothing of rows a.. reads (from the sample before them)
+        gs = grid[a - lead :]
+        xr = np.empty((gs.shape[0], 6))
+        bar = config.max_gap_hold + 1e-9
+        if clean:
+            i_s = max(int(np.searchsorted(t, gs[0], side="right")) - 1, 0)
+            ts = t[i_s:]
+            for k in range(3):
+                xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
+                xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
+            if ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
+                xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
+            else:
+                xr[int(np.searchsorted(gs, t[-1], side="right")) :] = np.nan
+        else:
+            i_t = int(np.searchsorted(t, gs[0], side="right")) - 1  # the sample at or before
+            for hand, p_in in enumerate((g_in, r_in)):
+                ok_old = self._ok[:, hand]
+                i_s = min(i_t, n0 - 1)
+                while i_s >= 0 and not ok_old[i_s]:  # the valid sample at or before the rows
+                    i_s -= 1
+                if i_s < 0:
+                    return None  # (none: the rows were unknown and may not stay so)
+                valid = np.concatenate((ok_old[i_s:], ok_new[:, hand]))
+                tv, pv = t[i_s:][valid], p_in[i_s:][valid]
+                cols = slice(3 * hand, 3 * hand + 3)
+                for k in range(3):
+                    xr[:, 3 * hand + k] = np.interp(gs, tv, pv[:, k])
+                # (what resample's two ways of marking far grid points both give here)
+                xr[_far_from_samples(tv, gs, bar), cols] = np.nan
+        self._reserve(rows, a)
+        b = self._buf
+        fin = np.isfinite(xr)
+        m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]
+        xs, full = smooth(xr, m, self._sigma)
+        b["x"][a:rows] = xs[lead:]
+        b["full"][a:rows] = full[lead:]
+        # velocities from row a - 1 (its central difference reads row a): _velocities'
+        # arithmetic, written in place
+        x, vt = b["x"], b["v"][a - 1 : rows]
+        np.subtract(x[a:rows], x[a - 2 : rows - 2], out=vt[:-1])
+        np.divide(vt[:-1], 2.0 * dt, out=vt[:-1])
+        vt[-1] = (x[rows - 1] - x[rows - 2]) / dt
+        vt.reshape(vt.shape[0], 2, 3)[b["full"][a - 1 : rows] < FULL_WINDOW] = np.nan
+        for name, arr in zip(_DERIVED, _derived(x[a - 1 : rows], b["v"][a - 1 : rows]),
+                             strict=True):
+            b[name][a - 1 : rows] = arr
+        self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
+        self._seen = np.concatenate((self._seen, seen_new))
+        self._ok = np.concatenate((self._ok, ok_new))
+        if not clean:
+            self._last_seen = [self._last_of(self._seen[:, h]) for h in (0, 1)]
+        else:
+            self._last_seen = [n - 1, n - 1]
+        self._clean = clean
+        self._max_dt = max_dt
+        self._grid, self._rows = grid, rows
+        ro = self._read_only
+        xv, vv = ro["x"][:rows], ro["v"][:rows]
+        rel, rel_v, dist, rel_s, g_s, r_s, closing, common, hold = (
+            ro[name][:rows] for name in _DERIVED
+        )
+        return Signals(
+            grid, xv[:, :3], xv[:, 3:], vv[:, :3], vv[:, 3:], rel, rel_v, dist, rel_s, g_s,
+            r_s, closing, common, hold,
+        )
+
+    def _reserve(self, rows: int, keep: int) -> None:
+        """Buffers of at least ``rows`` rows, owned by the cache, holding the first ``keep``
+        rows kept."""
+        b = self._buf
+        if self._owned and b["x"].shape[0] >= rows:
+            return
+        cap = max(2 * rows, 256)
+        new, ro = {}, {}
+        for name, cols in _KEPT.items():
+            arr = np.empty((cap, cols) if cols > 1 else cap)
+            arr[:keep] = b[name][:keep]
+            new[name] = arr
+            ro[name] = arr.view()
+            ro[name].flags.writeable = False  # (the results' views: read-only)
+        self._buf, self._read_only, self._owned = new, ro, True

@@ -25,18 +25,24 @@ from gazebot.types import Phase
 def _mirrored(
     t: np.ndarray, v: np.ndarray, onset: float, nominal: float, now: float, c: PhaseConfig
 ) -> float:
-    # The speed is read no nearer the newest sample than the smoothing window: the last
-    # stretch of a one-sided Gaussian window sags, and a sag read as "past its peak" would
+    # The speed is read no nearer the newest sample (``now``) than the smoothing window: the
+    # last stretch of a one-sided Gaussian window sags, and a sag read as "past its peak" would
     # mirror the onset about a peak not yet reached (how early depends on when the analysis
-    # happened to run).
-    read = t <= now - c.smoothing
-    ok = np.isfinite(v) & read
-    if not ok.any():
-        return onset + nominal
-    # (np.nanargmax over the samples read, without its copies and checks)
-    i = int(np.argmax(np.where(read & ~np.isnan(v), v, -np.inf)))
+    # happened to run). (t is sorted: the samples read are a prefix.)
+    k = int(np.searchsorted(t, now - c.smoothing, side="right"))
+    t, v = t[:k], v[:k]
+    ok = np.isfinite(v)
+    if v.shape[0] and ok.all():  # every speed known (the usual case): no NaN to pass over
+        i = int(v.argmax())
+        last = float(v[-1])
+    else:
+        if not ok.any():
+            return onset + nominal
+        # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its
+        # copies and checks)
+        i = int(np.argmax(np.where(np.isnan(v), -np.inf, v)))
+        last = float(v[np.flatnonzero(ok)[-1]])
     peak = float(v[i])
-    last = float(v[np.flatnonzero(ok)[-1]])
     if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
         return onset + 2.0 * max(float(t[i]) - onset, 0.0)
     return onset + nominal

@@ -138,6 +138,8 @@ class BlinkModel:
             if self._rng.random() < c.shift_probability and not in_blink:
                 self._begin(t)
                 in_blink = True
-        if not in_blink and t >= self._next:
+        if not in_blink:
+            if t < self._next:
+                return 0.0  # what value_at(t) gives with no blink under way (most calls)
             self._begin(t)
         return self.value_at(t)

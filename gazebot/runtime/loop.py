@@ -232,11 +232,11 @@ class GazeLoop:
         # Blink times never go back (the engine's t never does either).
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
-        return cmd.replaced(
-            blink=blink,
-            distance=distance,
-            answers_sample=answers,
-        )
+        # cmd.replaced(blink=..., distance=..., answers_sample=...) without its field-name
+        # check (these are GazeCommand's fields): this runs every tick.
+        out = object.__new__(GazeCommand)
+        out.__dict__.update(cmd.__dict__, blink=blink, distance=distance, answers_sample=answers)
+        return out
 
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor

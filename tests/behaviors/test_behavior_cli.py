@@ -133,3 +133,14 @@ def test_the_readmes_diagram_is_the_one_the_machine_draws():
 
     readme = Path(__file__).resolve().parents[2] / "README.md"
     assert diagram(load_behavior("face-hand-face")).strip() in readme.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("name", SEED_BEHAVIORS)
+def test_a_seed_behaviors_diagram_has_no_empty_alternative_in_an_edge_label(name):
+    from gazebot.behaviors import load_behavior
+    from gazebot.behaviors.machine import diagram
+
+    for line in diagram(load_behavior(name)).splitlines():
+        if "-->" in line and ": " in line:
+            label = line.partition(": ")[2]
+            assert all(part.strip() for part in label.split(" | ")), line

@@ -272,3 +272,13 @@ def test_of_floats_plans_the_same_trajectory_as_the_constructor():
     assert fast.end_time == ref.end_time and fast.duration == ref.duration == 1.0
     for t in (0.0, 0.25, 0.5, 0.9, 1.25, 2.0):
         assert fast.sample(t) == ref.sample(t)
+
+
+def test_sample_position_is_the_position_sample_gives_before_during_and_after_the_plan():
+    traj = MinJerkTrajectory.of_floats(0.25, 1.0, [0.1, -0.4], [0.6, 0.2], [0.05, -0.3],
+                                       [1.5, 0.0])
+    for t in (0.0, 0.25, 0.5, 0.9, 1.25, 2.0):
+        fresh = MinJerkTrajectory.of_floats(0.25, 1.0, [0.1, -0.4], [0.6, 0.2], [0.05, -0.3],
+                                            [1.5, 0.0])
+        assert traj.sample_position(t) == list(fresh.sample(t)[0])
+    assert traj.sample_position(2.0) == [0.6, 0.2]  # exactly on the goal afterwards

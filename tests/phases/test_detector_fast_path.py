@@ -1,8 +1,9 @@
-"""The online detector's fast path (fused signals, the trigger's per-period rows in plain
-floats, samples kept in one array) emits exactly the events and counts of the straightforward
-path it replaced (tests/phases/signals_reference.py, tests/phases/trigger_reference.py) on the
-synthetic set, the issue-20 cases, and on noisy input with NaN, frozen, duplicate, out-of-order
-and timeless samples."""
+"""The online detector's fast path (fused signals computed only where new samples change
+them, the trigger's per-period rows in plain floats with running maxima and sums, samples kept
+in one array, no reach onsets dated during a reach) emits exactly the events and counts of the
+straightforward path it replaced (tests/phases/signals_reference.py,
+tests/phases/trigger_reference.py) on the synthetic set, the issue-20 cases, a long rest, and on
+noisy input with NaN, frozen, duplicate, out-of-order and timeless samples."""
 
 from __future__ import annotations
 
@@ -55,7 +56,23 @@ def _recordings() -> list[Trajectory]:
         rate=30.0, irregular=0.3, noise=0.004, dropouts_per_s=1.0, frozen_per_s=1.0, handovers=3
     )
     out.append(generate(seed=2, options=noisy).trajectory)
+    out.append(_after_long_rest(generate(seed=3, options=SyntheticOptions(rate=60.0)).trajectory))
     return out
+
+
+def _after_long_rest(traj: Trajectory, rest: float = 7.0) -> Trajectory:
+    """``traj`` after ``rest`` s of both hands resting where it starts (2 mm noise): longer
+    than the online window, so the detector's and the trigger's windows slide while idle."""
+    rng = np.random.default_rng(0)
+    dt = float(traj.t[1] - traj.t[0])
+    t0 = np.arange(0.0, rest, dt)
+    g0 = traj.giver_hand[0] + rng.normal(0.0, 0.002, (t0.shape[0], 3))
+    r0 = traj.receiver_hand[0] + rng.normal(0.0, 0.002, (t0.shape[0], 3))
+    return Trajectory(
+        np.concatenate([t0, traj.t - traj.t[0] + rest]),
+        np.concatenate([g0, traj.giver_hand]),
+        np.concatenate([r0, traj.receiver_hand]),
+    )
 
 
 def _events(traj: Trajectory, config: PhaseConfig) -> tuple[list[tuple], str]:
@@ -73,9 +90,21 @@ def recordings() -> list[Trajectory]:
 def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monkeypatch):
     config = PhaseConfig()
     fast = [_events(tr, config) for tr in recordings]
-    monkeypatch.setattr(gazebot_method, "compute_signals", reference_signals)
+    # (the reference computes every analysis in full: the detector's signal cache is unused)
+    monkeypatch.setattr(
+        gazebot_method,
+        "compute_signals",
+        lambda traj, config, cache=None: reference_signals(traj, config),
+    )
     monkeypatch.setattr(
         gazebot_method.GazebotSegmenter, "trigger", lambda self: ReferenceTrigger(self.config)
+    )
+    # (every analysis dates the reach onsets, in a reach too)
+    segments = gazebot_method.GazebotSegmenter.online_segments
+    monkeypatch.setattr(
+        gazebot_method.GazebotSegmenter,
+        "online_segments",
+        lambda self, traj, s, now, phase=None: segments(self, traj, s, now),
     )
     slow = [_events(tr, config) for tr in recordings]
     assert sum(len(ev) for ev, _ in fast) > 4 * len(recordings)  # the recordings do show phases

@@ -110,8 +110,12 @@ def test_trigger_rows_hold_the_period_means_and_numpys_distances() -> None:
     rows = trig.rows()
     want = np.array(expected)[-rows.shape[0] :]
     want[:, 10] = np.linalg.norm(want[:, 7:10], axis=1)  # as the trigger computed it before
-    np.testing.assert_array_equal(rows, want)
+    np.testing.assert_array_equal(rows[:, :11], want)
     assert np.isnan(rows[:, 10]).any() and np.isfinite(rows[:, 10]).any()
+    # the giver's step over trigger_speed_baseline, as the retreat rule computed it before
+    k = trig._k
+    g = rows[:, 1:4]
+    np.testing.assert_array_equal(rows[k:, 11], np.linalg.norm(g[k:] - g[:-k], axis=1))
 
 
 def test_median_of_the_sample_steps_is_numpys() -> None:
@@ -150,3 +154,30 @@ def test_two_row_nanmean_is_numpys() -> None:
             warnings.simplefilter("ignore", RuntimeWarning)  # numpy warns on an all-NaN column
             want = np.nanmean(ab, axis=0)
         np.testing.assert_array_equal(_nanmean2(ab[0], ab[1]), want)
+
+
+def test_suffix_max_is_numpys_fmax_over_the_span() -> None:
+    """The trigger's running maximum over [first row, newest row) equals ``np.fmax.reduce``
+    of those rows while rows arrive, the first row moves forward (a sliding window), jumps
+    ahead or back (a new phase), the buffer is compacted, and rows are NaN."""
+    from gazebot.phases.methods.gazebot_trigger import _SuffixMax
+
+    rng = np.random.default_rng(4)
+    col = rng.normal(size=400)
+    col[rng.random(400) < 0.15] = np.nan
+    col[100:130] = np.nan  # a span of unknown rows only
+    buf = np.stack([col, col], axis=1)
+    sm = _SuffixMax()
+    first = 0
+    base = 0
+    for end in range(1, 400):
+        r = rng.random()
+        if r < 0.3:
+            first = min(first + int(rng.integers(0, 3)), end - 1)  # slides
+        elif r < 0.33:
+            first = int(rng.integers(base, end))  # moves anywhere kept, back too
+        if r > 0.97 and first > base:
+            base = int(rng.integers(base, first + 1))  # compaction: rows before first dropped
+        got = sm.update(buf[base:], base, first - base, end - base, 1)
+        want = np.fmax.reduce(col[first:end])
+        assert got == want or (np.isnan(got) and np.isnan(want)), (first, end)

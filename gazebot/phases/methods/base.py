@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, compute_signals
+from gazebot.phases.filtering import SignalCache, Signals, compute_signals
 from gazebot.phases.segment import Segment
 from gazebot.phases.trajectory import Trajectory
 from gazebot.types import Phase
@@ -42,7 +43,7 @@ class OnlineState:
 class OnlineTrigger(Protocol):
     """A method's cheap per-period check of whether its analysis needs to run."""
 
-    def add(self, g: np.ndarray, g_ok: bool, r: np.ndarray, r_ok: bool) -> None: ...
+    def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None: ...
 
     def decide(self, now: float, state: OnlineState) -> TriggerMode: ...
 
@@ -80,12 +81,23 @@ class Segmenter(ABC):
         """A fresh cheap trigger for one online detector, or ``None``: analyse every period."""
         return None
 
-    def online_signals(self, trajectory: Trajectory) -> Signals | None:
-        """The signals of the samples seen so far (for the end-of-phase prediction)."""
-        return compute_signals(trajectory, self.config) if len(trajectory) else None
+    def online_signals(
+        self, trajectory: Trajectory, cache: SignalCache | None = None
+    ) -> Signals | None:
+        """The signals of the samples seen so far (for the end-of-phase prediction);
+        ``cache``: the detector's, so a window that only grew is computed only where it
+        changed (see :func:`~gazebot.phases.filtering.compute_signals`)."""
+        return compute_signals(trajectory, self.config, cache) if len(trajectory) else None
 
-    def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
-        """Segments of the samples seen so far (``s``: :meth:`online_signals` of them)."""
+    def online_segments(
+        self, trajectory: Trajectory, s: Signals, now: float, phase: Phase = Phase.IDLE
+    ) -> list[Segment]:
+        """Segments of the samples seen so far (``s``: :meth:`online_signals` of them).
+
+        ``phase``: the detector's current phase. In a reach, a method with
+        ``rules_after_contact`` is read only for its transfers' starts and its segments' ends
+        (the detector stops at contact), so it may leave its reach segments' starts unknown
+        (NaN) then."""
         return self.segment_sorted(trajectory, partial=True)
 
     def phase_end(

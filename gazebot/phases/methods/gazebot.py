@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from gazebot.phases.filtering import Signals, compute_signals
+from gazebot.phases.filtering import SignalCache, Signals, compute_signals
 from gazebot.phases.methods.base import OnlineTrigger, Segmenter
 from gazebot.phases.methods.gazebot_trigger import GazebotTrigger
 from gazebot.phases.rules.directed import directed_reach
@@ -37,18 +37,21 @@ class GazebotSegmenter(Segmenter):
     name = "gazebot"
     rules_after_contact = True
 
-    def signals(self, trajectory: Trajectory, partial: bool = False) -> Signals | None:
-        """The smoothed signals (cut ``edge_guard`` before the last sample when ``partial``)."""
+    def signals(
+        self, trajectory: Trajectory, partial: bool = False, cache: SignalCache | None = None
+    ) -> Signals | None:
+        """The smoothed signals (cut ``edge_guard`` before the last sample when ``partial``;
+        ``cache``: see :func:`~gazebot.phases.filtering.compute_signals`)."""
         if len(trajectory) < 3:
             return None
-        s = compute_signals(trajectory, self.config)
+        s = compute_signals(trajectory, self.config, cache)
         if partial and self.config.edge_guard > 0:
             # (the grid is sorted: the samples kept are a prefix, taken as views)
             cut = float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
             keep = int(np.searchsorted(s.t, cut, side="right"))
             if keep < 3:
                 return None
-            s = Signals(*(getattr(s, f)[:keep] for f in s.__dataclass_fields__))
+            s = Signals(*[a[:keep] for a in vars(s).values()])  # (fields in order)
         return s
 
     # ---- online hooks
@@ -56,18 +59,24 @@ class GazebotSegmenter(Segmenter):
         """The cheap per-period trigger (:mod:`~gazebot.phases.methods.gazebot_trigger`)."""
         return GazebotTrigger(self.config)
 
-    def online_signals(self, trajectory: Trajectory) -> Signals | None:
+    def online_signals(
+        self, trajectory: Trajectory, cache: SignalCache | None = None
+    ) -> Signals | None:
         """The signals cut ``edge_guard`` before the newest sample: the last stretch of the
         smoothed speed sags (one-sided window), so predictions read what the rules read."""
-        return self.signals(trajectory, partial=True)
+        return self.signals(trajectory, partial=True, cache=cache)
 
-    def online_segments(self, trajectory: Trajectory, s: Signals, now: float) -> list[Segment]:
+    def online_segments(
+        self, trajectory: Trajectory, s: Signals, now: float, phase: Phase = Phase.IDLE
+    ) -> list[Segment]:
         """The segments the signals show so far; with no phase under way at their end, a reach
         the raw samples predict before the signals can show it: the giver's hand accelerating
         toward the receiver (:mod:`~gazebot.phases.rules.directed`) where a reach explains the
         samples better than any fidget by ``directed_support`` (the sequential statistic), or,
-        if not, moving in a way no fidget does (:mod:`~gazebot.phases.rules.sequential`)."""
-        segs = self.segment_signals(s, now, True)
+        if not, moving in a way no fidget does (:mod:`~gazebot.phases.rules.sequential`). In a
+        reach (``phase``) the reach onsets are not dated (NaN starts): the detector reads none
+        of them then."""
+        segs = self.segment_signals(s, now, True, onsets=phase is not Phase.REACH)
         if segs and (segs[-1].open or segs[-1].phase is not Phase.RETREAT):
             return segs
         after = segs[-1].end if segs else -math.inf
@@ -107,9 +116,16 @@ class GazebotSegmenter(Segmenter):
             return []
         return self.segment_signals(s, float(trajectory.t[-1]), partial)
 
-    def segment_signals(self, s: Signals, t_last: float, partial: bool = False) -> list[Segment]:
-        """Segments from precomputed signals (``t_last``: the last sample's time)."""
+    def segment_signals(
+        self, s: Signals, t_last: float, partial: bool = False, onsets: bool = True
+    ) -> list[Segment]:
+        """Segments from precomputed signals (``t_last``: the last sample's time; ``onsets``
+        False: the reach segments' starts are left NaN, their onset rule not run)."""
         c = self.config
+
+        def onset_before(lo: int, hi: int) -> float:
+            return reach_start(s, c, lo, hi) if onsets else math.nan
+
         grid_end = float(s.t[-1])
         if partial:
             t_last = grid_end
@@ -136,7 +152,7 @@ class GazebotSegmenter(Segmenter):
             if not math.isfinite(t_start):
                 if partial:
                     # The approach has not settled yet: still a reach.
-                    onset = reach_start(s, c, prev_end_idx, core.start)
+                    onset = onset_before(prev_end_idx, core.start)
                     start = max(onset, out[-1].end) if out else onset
                     out.append(Segment(Phase.REACH, min(start, t_last), t_last, k, open=True))
                     trailing_ok = False
@@ -144,7 +160,7 @@ class GazebotSegmenter(Segmenter):
                 t_start = float(s.t[core.start])
             t_start = min(t_start, t_last)
             i_start = int(np.searchsorted(s.t, t_start))
-            onset = reach_start(s, c, prev_end_idx, max(i_start - 1, prev_end_idx))
+            onset = onset_before(prev_end_idx, max(i_start - 1, prev_end_idx))
             if out:
                 onset = max(onset, out[-1].end)
             out.append(Segment(Phase.REACH, min(onset, t_start), t_start, k))
