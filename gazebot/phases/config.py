@@ -118,6 +118,10 @@ class PhaseConfig(BaseModel):
         sequential_evidence: ... and a reach is confirmed once it explains the window better
             than any fidget by this many noise variances (``2 ln`` of the likelihood ratio); it
             heads and closes the gap as the predictive rule's ``predict_cos`` ... ask.
+        directed_support: The predictive (constant-acceleration) rule's reach stands only if
+            the sequential statistic is at least this (1, noise variances): a reach explains
+            the window at least as well as any fidget (its 0.2 s fit averages the acceleration
+            and reads a 2 cm fidget past its midpoint as still accelerating).
         trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
             the distances its rules need (loose: it fires before the rule can).
         trigger_speed_baseline: ... speeds from mean positions this far apart (s).
@@ -195,6 +199,7 @@ class PhaseConfig(BaseModel):
     sequential_duration_steps: int = Field(9, ge=2)
     fidget_amplitude: float = Field(0.02, gt=0)
     sequential_evidence: float = Field(25.0, gt=0)
+    directed_support: float = 16.0
     trigger_distance_factor: float = Field(0.5, gt=0, le=1)
     trigger_speed_baseline: float = Field(0.1, gt=0)
     trigger_deep_fraction: float = Field(0.8, gt=0, le=1)

@@ -315,8 +315,16 @@ class PhaseDetector:
             self._prev_evidence = False  # no robot evidence (tracking alone, the usual frame)
         elif self._robot_evidence(frame, t):
             return
-        if t - self._last_analysis >= c.online_period:
-            self._last_analysis = t
+        if t - self._last_analysis >= c.online_period - 1e-9:
+            # On a fixed grid of online_period (the first sample at or after each tick), not
+            # online_period after the last analysed sample: that waits up to twice the period
+            # when samples come just faster than it (60 Hz: 33 ms, 100 Hz: 30 ms by rounding),
+            # so more samples would confirm later.
+            since = t - self._last_analysis
+            if c.online_period > 0 and since < 4.0 * c.online_period:
+                self._last_analysis += c.online_period * math.floor(since / c.online_period + 1e-6)
+            else:
+                self._last_analysis = t  # the first sample, or after a pause: a new grid
             mode = "full"
             if self._trigger is not None:
                 # Every field given, so the frozen dataclass is filled directly (its generated
@@ -457,6 +465,11 @@ class PhaseDetector:
                 if tr is not None:
                     self._start(Phase.TRANSFER, tr.start, now, "motion")
                     continue
+                if self._taken_back():
+                    # The hands are farther apart than when the reach began: whatever moved
+                    # was not the approach (the receiver stepped back); the next one is.
+                    self._done(now, now, "aborted")
+                    return
                 alive = any(
                     sg.phase in (Phase.REACH, Phase.TRANSFER)
                     and sg.end >= self._floor - c.online_slack
@@ -529,6 +542,20 @@ class PhaseDetector:
         if not float(d[0]) - float(np.nanmin(d)) >= c.reach_confirm_distance:
             return None
         return float(s.t[i_b])
+
+    def _taken_back(self) -> bool:
+        """The hands are ``reach_confirm_distance`` farther apart than when the current reach
+        started (known only if this detector saw that start)."""
+        s = self._signals
+        if s is None or self._joined_late:
+            return False
+        ok = np.flatnonzero(np.isfinite(s.distance))
+        i0 = int(np.searchsorted(s.t, self.phase_start))
+        before = ok[ok <= i0]
+        if before.size == 0:
+            return False
+        d = s.distance
+        return float(d[ok[-1]]) >= float(d[before[-1]]) + self.config.reach_confirm_distance
 
     def _hands_back_apart(self) -> bool:
         """The hands are (almost) as far apart as when the current reach started: the reach

@@ -22,7 +22,15 @@ from gazebot.phases.filtering import Signals
 from gazebot.types import Phase
 
 
-def _mirrored(t: np.ndarray, v: np.ndarray, onset: float, nominal: float, c: PhaseConfig) -> float:
+def _mirrored(
+    t: np.ndarray, v: np.ndarray, onset: float, nominal: float, now: float, c: PhaseConfig
+) -> float:
+    # The speed is read no nearer the newest sample (``now``) than the smoothing window: the
+    # last stretch of a one-sided Gaussian window sags, and a sag read as "past its peak" would
+    # mirror the onset about a peak not yet reached (how early depends on when the analysis
+    # happened to run). (t is sorted: the samples read are a prefix.)
+    k = int(np.searchsorted(t, now - c.smoothing, side="right"))
+    t, v = t[:k], v[:k]
     ok = np.isfinite(v)
     if v.shape[0] and ok.all():  # every speed known (the usual case): no NaN to pass over
         i = int(v.argmax())
@@ -50,7 +58,7 @@ def predict_end(phase: Phase, start: float, s: Signals | None, now: float, c: Ph
     if s is None or s.t.shape[0] == 0:
         return max(start + nominal, now)
     i0 = int(np.searchsorted(s.t, start))
-    pred = _mirrored(s.t[i0:], s.giver_speed[i0:], start, nominal, c)
+    pred = _mirrored(s.t[i0:], s.giver_speed[i0:], start, nominal, now, c)
     if phase is Phase.REACH:
         j0 = int(np.searchsorted(s.t, start - nominal))
         rv = s.receiver_speed[j0:]
@@ -58,5 +66,5 @@ def predict_end(phase: Phase, start: float, s: Signals | None, now: float, c: Ph
         if moving.size:
             r_on = float(s.t[j0 + int(moving[0])])
             k0 = j0 + int(moving[0])
-            pred = max(pred, _mirrored(s.t[k0:], s.receiver_speed[k0:], r_on, nominal, c))
+            pred = max(pred, _mirrored(s.t[k0:], s.receiver_speed[k0:], r_on, nominal, now, c))
     return max(pred, now)

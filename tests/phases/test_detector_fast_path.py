@@ -128,7 +128,8 @@ def test_of_hands_builds_the_trajectory_the_constructor_builds():
 def test_the_predicted_end_reads_the_peak_np_nanargmax_finds():
     from gazebot.phases.prediction import _mirrored
 
-    def reference(t, v, onset, nominal, c):  # the code before, with np.nanargmax
+    def reference(t, v, onset, nominal, now, c):  # with np.nanargmax, of the speeds read
+        v = np.where(t <= now - c.smoothing, v, np.nan)
         ok = np.isfinite(v)
         if not ok.any():
             return onset + nominal
@@ -148,4 +149,5 @@ def test_the_predicted_end_reads_the_peak_np_nanargmax_finds():
         v[rng.random(n) < 0.05] = np.inf
         if np.isnan(v).all():
             continue
-        assert _mirrored(t, v, 0.05, 0.8, c) == reference(t, v, 0.05, 0.8, c)
+        now = float(t[-1]) + float(rng.uniform(0.0, 0.2))
+        assert _mirrored(t, v, 0.05, 0.8, now, c) == reference(t, v, 0.05, 0.8, now, c)

@@ -133,9 +133,11 @@ def test_expected_reach_end_predicts_contact_halfway_through(varied_set):
                 break
     errs = np.abs(errs)
     assert len(errs) >= 20
-    # Measured: median 0.14 s, p90 0.57 s, for reaches of 0.5-2.5 s (the late ones: reaches
-    # confirmed after their halfway point, predicted from the typical duration).
-    assert np.median(errs) <= 0.16 and np.percentile(errs, 90) <= 0.58
+    # Measured: median 0.11 s, p90 0.26 s, for reaches of 0.5-2.5 s (the late ones: reaches
+    # confirmed after their halfway point, predicted from the typical duration). The speed
+    # sag at the signals' one-sided edge is not read as a passed peak (it made the prediction
+    # depend on when the analysis ran: p90 0.52-0.57 s).
+    assert np.median(errs) <= 0.13 and np.percentile(errs, 90) <= 0.3
 
 
 def test_several_events_in_one_sample_are_queued():

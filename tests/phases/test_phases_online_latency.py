@@ -16,7 +16,7 @@ from gazebot.types import EventKind
 @pytest.mark.parametrize(
     ("kind", "median", "p90", "share"),
     [
-        # Median / p90, share within 250 ms. Measured 227 / 340 ms, 62 % (227 / 349 ms, 60 %
+        # Median / p90, share within 250 ms. Measured 222 / 347 ms, 62 % (227 / 349 ms, 60 %
         # with the predictive rule alone, without the sequential one; 285 / 392 ms, 40 %,
         # before both: 2 cm of closing past the smoothing's edge).
         (EventKind.REACH_STARTED, 0.235, 0.35, 0.6),
@@ -36,8 +36,9 @@ def test_online_latency_on_the_varied_set(varied_set, online_results, kind, medi
 
 def test_predicted_landing_dates_the_end_of_the_retreat(varied_set, online_results):
     err, lat = event_errors(varied_set, online_results, EventKind.HANDOVER_DONE)
-    # Measured |err| median 63, p90 164, max 228 ms.
-    assert np.median(err) <= 0.07 and np.percentile(err, 90) <= 0.17 and err.max() <= 0.25
+    # Measured |err| median 47, p90 121, max 201 ms (63 / 164 / 228 when the landing was
+    # clipped to the signals' last point: dated by when the analysis ran, not the profile).
+    assert np.median(err) <= 0.055 and np.percentile(err, 90) <= 0.14 and err.max() <= 0.23
     assert lat.max() <= 0.12  # never waits for a rest hold
 
 

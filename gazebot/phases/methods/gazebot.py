@@ -71,14 +71,20 @@ class GazebotSegmenter(Segmenter):
     ) -> list[Segment]:
         """The segments the signals show so far; with no phase under way at their end, a reach
         the raw samples predict before the signals can show it: the giver's hand accelerating
-        toward the receiver (:mod:`~gazebot.phases.rules.directed`), or, if not, moving in a
-        way no fidget does (:mod:`~gazebot.phases.rules.sequential`). In a reach (``phase``)
-        the reach onsets are not dated (NaN starts): the detector reads none of them then."""
+        toward the receiver (:mod:`~gazebot.phases.rules.directed`) where a reach explains the
+        samples better than any fidget by ``directed_support`` (the sequential statistic), or,
+        if not, moving in a way no fidget does (:mod:`~gazebot.phases.rules.sequential`). In a
+        reach (``phase``) the reach onsets are not dated (NaN starts): the detector reads none
+        of them then."""
         segs = self.segment_signals(s, now, True, onsets=phase is not Phase.REACH)
         if segs and (segs[-1].open or segs[-1].phase is not Phase.RETREAT):
             return segs
         after = segs[-1].end if segs else -math.inf
         onset = directed_reach(trajectory, self.config, after)
+        if onset is not None and (
+            sequential_reach(trajectory, self.config, after, self.config.directed_support) is None
+        ):
+            onset = None
         if onset is None:
             onset = sequential_reach(trajectory, self.config, after)
         if onset is not None:

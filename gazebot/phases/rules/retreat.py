@@ -93,7 +93,7 @@ def _landing(s: Signals, c: PhaseConfig, i0: int, t_release: float) -> float | N
     """A predicted landing: the giver's hand, having moved ``min_approach`` since the release,
     slowed below ``done_fraction`` of its peak speed. A bell-shaped (minimum-jerk) profile is
     then within a few percent of its end, which mirrors the onset about the peak:
-    ``t_release + 2 (t_peak - t_release)`` (not after the last sample)."""
+    ``t_release + 2 (t_peak - t_release)`` (not after the newest sample)."""
     if t_release < s.t[0]:
         return None
     v = s.giver_speed[i0:]
@@ -108,4 +108,6 @@ def _landing(s: Signals, c: PhaseConfig, i0: int, t_release: float) -> float | N
         return None
     if not v[last] < c.done_fraction * peak:
         return None
-    return min(t_release + 2.0 * (float(s.t[i0 + k]) - t_release), float(s.t[i0 + last]))
+    # (not after the newest sample: online the signals end edge_guard before it, and the
+    # mirror is dated from the whole profile, not from when the analysis happened to run)
+    return min(t_release + 2.0 * (float(s.t[i0 + k]) - t_release), float(s.t[-1]) + c.edge_guard)

@@ -149,10 +149,14 @@ def reach_evidence(
     )
 
 
-def sequential_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | None:
+def sequential_reach(
+    traj: Trajectory, c: PhaseConfig, after: float, evidence: float | None = None
+) -> float | None:
     """The onset of a reach the giver's hand shows toward the receiver at the newest sample of
     ``traj`` (see the module docstring), ``None`` if it shows none. Only samples after
-    ``after`` (s) are read (the previous handover's end)."""
+    ``after`` (s) are read (the previous handover's end). ``evidence``: the bar of the
+    statistic (default ``sequential_evidence``)."""
+    bar = c.sequential_evidence if evidence is None else evidence
     t_all = traj.t
     if t_all.shape[0] < c.predict_min_samples + 2:
         return None
@@ -167,9 +171,14 @@ def sequential_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | 
     win = idx[tv > now - c.sequential_window]
     if win.size < c.predict_min_samples:
         return None
+    # A dropout only matters where the gap's closing is fitted (the last predict_window): the
+    # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
+    # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
     steps = np.diff(t_all[win])
-    if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
-        return None  # a dropout inside the window leaves the model unconstrained there
+    recent = t_all[win][1:] >= now - c.predict_window
+    step = float(np.median(steps))
+    if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
+        return None
     # A fidget fits any cubic start up to its midpoint: a hand not yet half the largest fidget
     # from its rest (the window before every onset tried), or not toward the receiver, cannot
     # be told from one (cheap skips before the test).
@@ -194,7 +203,7 @@ def sequential_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | 
     if not v_c >= c.predict_sigmas * s_v:
         return None
     ev = reach_evidence(t_all[win], g[win], now, noise, c)
-    if ev is None or not ev.statistic >= c.sequential_evidence:
+    if ev is None or not ev.statistic >= bar:
         return None
     # Toward the receiver: the fitted reach within acos(predict_cos) of the line to its hand.
     line = r[-1] - ev.rest
