@@ -1,11 +1,18 @@
 """The engine's full command stream on a fixed set of scenarios, flattened for comparison.
 
 ``tests/test_engine_stream_reference.py`` compares what the current code gives against the
-stream recorded from the code before the issue-19 speed-ups (``tests/data/engine_stream.npz``),
-so a speed-up that changes any command by more than float round-off fails. It was re-recorded
-twice since, for the one speed-up that changes commands on purpose: the gaze controller's head
-goal deadband (``ik: goal_deadband_deg``; with it at 0 the code gives the earlier stream), and
-when that deadband was extended to ticks with the eyes at their range.
+stream in ``tests/data/engine_stream.npz``, so a speed-up that changes any command by more than
+float round-off fails. It was first recorded from the code before the issue-19 speed-ups and
+re-recorded only for changes of the engine's output made on purpose (each one reviewed against
+the stream it replaced):
+
+1. the gaze controller's head goal deadband (``ik: goal_deadband_deg``);
+2. that deadband extended to ticks with the eyes at their range;
+3. issue 20's analysis grid (the detector decides on a fixed ``online_period`` grid), end
+   predictions that read no speed from the smoothing's edge and the retreat's landing dated
+   from the whole speed profile (recorded on main merged with them).
+
+A speed-up that should change nothing is checked against the stream as it stands.
 Regenerate (only after an intended change of the engine's output, and say so in the commit):
 
     PYTHONPATH=. .venv/bin/python -m tests.engine_stream

@@ -1,9 +1,9 @@
 """The engine's speed-ups change no command: on both robots, three behaviors, a clean handover and
 damaged ones (NaN points and times, out-of-order frames, an implausible point, silent ticks, a
 tracking loss) with robot events (a robot-first reach, grasp, retreat, a moving arm joint under
-Sawyer's head), the loop's full command stream equals the one recorded from the code before the
-issue-19 speed-ups (tests/data/engine_stream.npz, written by tests/engine_stream.py; re-recorded
-for the head goal deadband, see there): every label and event exactly, every number to float
+Sawyer's head), the loop's full command stream equals the recorded one
+(tests/data/engine_stream.npz, written by tests/engine_stream.py, which lists the deliberate
+output changes it was re-recorded for): every label and event exactly, every number to float
 round-off (1e-12)."""
 
 from __future__ import annotations

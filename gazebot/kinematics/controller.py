@@ -27,6 +27,7 @@ going backwards holds the pose and re-anchors the clock.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -284,8 +285,8 @@ class GazeController:
                 raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
         x, y, z = p.tolist()
         # Finite and not absurdly far (a corrupted sample is held like a missing one); a NaN
-        # fails every comparison.
-        m = self.ik.max_distance
+        # fails every comparison, and the bound is finite even if max_distance is not.
+        m = min(self.ik.max_distance, sys.float_info.max)
         return (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
 
     def _gaze_frame(self) -> list[list[float]]:

@@ -74,8 +74,9 @@ class PhaseConfig(BaseModel):
             unknown (online: ``tracking_lost``).
         frozen_speed: A sample repeating the last position exactly while the hand was moving
             faster than this (m/s) is a frozen (stale) sample: it counts as missing.
-        online_period: Online, the detector re-analyses the recent samples at most this often
-            (s); between analyses it only stores samples.
+        online_period: Online, the detector decides whether to re-analyse the recent samples
+            on a fixed grid of this period (s): at the first sample at or after each tick (the
+            ``gazebot`` trigger runs then); between ticks it only stores samples.
         online_window: Online, how much history (s) the detector keeps and analyses.
         online_refresh: Online, ``gazebot``: in a reach or retreat the full analysis runs at
             least this often (s) for the end-of-phase prediction; otherwise only when a cheap
@@ -119,8 +120,10 @@ class PhaseConfig(BaseModel):
             than any fidget by this many noise variances (``2 ln`` of the likelihood ratio); it
             heads and closes the gap as the predictive rule's ``predict_cos`` ... ask.
         directed_support: The predictive (constant-acceleration) rule's reach stands only if
-            the sequential statistic is at least this (1, noise variances): a reach explains
-            the window at least as well as any fidget (its 0.2 s fit averages the acceleration
+            the sequential rule confirms the same samples with this bar in place of
+            ``sequential_evidence`` (1, noise variances): a reach explains the window better
+            than any fidget by at least this, and the sequential rule's own checks (samples,
+            travel, heading, no recent dropout) hold (its 0.2 s fit averages the acceleration
             and reads a 2 cm fidget past its midpoint as still accelerating).
         trigger_distance_factor: Online, ``gazebot``'s cheap trigger fires at this share of
             the distances its rules need (loose: it fires before the rule can).
@@ -199,7 +202,7 @@ class PhaseConfig(BaseModel):
     sequential_duration_steps: int = Field(9, ge=2)
     fidget_amplitude: float = Field(0.02, gt=0)
     sequential_evidence: float = Field(25.0, gt=0)
-    directed_support: float = 16.0
+    directed_support: float = Field(16.0, ge=0)
     trigger_distance_factor: float = Field(0.5, gt=0, le=1)
     trigger_speed_baseline: float = Field(0.1, gt=0)
     trigger_deep_fraction: float = Field(0.8, gt=0, le=1)

@@ -172,6 +172,9 @@ class PhaseDetector:
         self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
         self._joined_late = False
+        # The hands' distance when the current reach began, as last read while the analysis
+        # window still held that moment (a reach can outlast the window); NaN: never read.
+        self._reach_d0 = math.nan
 
     # ----------------------------------------------------------------- public API
     @property
@@ -243,6 +246,7 @@ class PhaseDetector:
         self.phase_start = t0
         self._floor = t0
         self._reach_missing_since = math.nan
+        self._reach_d0 = math.nan
         self.expected_phase_end = predict_end(phase, t0, self._signals, t0, self.config)
 
     def _start(self, phase: Phase, t0: float, now: float, source: str) -> None:
@@ -399,6 +403,9 @@ class PhaseDetector:
         s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
+            # Keep the reach's start distance while the window holds it (a reach can outlast
+            # the window; the taken-back checks compare with it).
+            self._reach_start_distance(s, np.flatnonzero(np.isfinite(s.distance)))
             restart = self._reach_restart()
             if restart is not None:
                 # The reach was an earlier movement (the giver lifted the object, waited, and
@@ -543,6 +550,16 @@ class PhaseDetector:
             return None
         return float(s.t[i_b])
 
+    def _reach_start_distance(self, s: Signals, ok: np.ndarray) -> float:
+        """The hands' distance when the current reach began (``ok``: the finite samples of
+        ``s.distance``): read from ``s`` while its window still holds that moment (and kept),
+        else the value kept from the last window that held it; NaN if none did."""
+        if s.t.shape[0] and s.t[0] <= self.phase_start:
+            i0 = int(np.searchsorted(s.t, self.phase_start))
+            before = ok[ok <= i0]
+            self._reach_d0 = float(s.distance[before[-1]]) if before.size else math.nan
+        return self._reach_d0
+
     def _taken_back(self) -> bool:
         """The hands are ``reach_confirm_distance`` farther apart than when the current reach
         started (known only if this detector saw that start)."""
@@ -550,12 +567,10 @@ class PhaseDetector:
         if s is None or self._joined_late:
             return False
         ok = np.flatnonzero(np.isfinite(s.distance))
-        i0 = int(np.searchsorted(s.t, self.phase_start))
-        before = ok[ok <= i0]
-        if before.size == 0:
+        d0 = self._reach_start_distance(s, ok)
+        if not ok.size or d0 != d0:
             return False
-        d = s.distance
-        return float(d[ok[-1]]) >= float(d[before[-1]]) + self.config.reach_confirm_distance
+        return float(s.distance[ok[-1]]) >= d0 + self.config.reach_confirm_distance
 
     def _hands_back_apart(self) -> bool:
         """The hands are (almost) as far apart as when the current reach started: the reach
@@ -572,9 +587,9 @@ class PhaseDetector:
             # unknown, so taken back means the hands left the region around the closest seen.
             near = float(np.min(d[ok]))
             return float(d[ok[-1]]) >= near + self.config.transfer_distance_margin
-        i0 = int(np.searchsorted(s.t, self.phase_start))
-        before = ok[ok <= i0]
-        d0 = float(d[before[-1]] if before.size else d[ok[0]])
+        d0 = self._reach_start_distance(s, ok)
+        if d0 != d0:  # the start was never seen with a finite distance: the first one seen
+            d0 = float(d[ok[0]])
         return float(d[ok[-1]]) >= d0 - self.config.reach_confirm_distance
 
     def _done(self, t0: float, now: float, source: str) -> None:

@@ -108,3 +108,32 @@ def test_a_fidget_the_constant_acceleration_fit_reads_as_accelerating_is_no_reac
     traj = rest_recording(rate, noise, 20.0, seed=seed, fidget=True)
     reaches = [e for e in run_online(traj).events if e.kind is EventKind.REACH_STARTED]
     assert reaches == []
+
+
+
+def test_a_reach_that_outlasts_the_analysis_window_is_not_ended_by_a_small_step_back():
+    # 120 Hz: the giver reaches slowly (15 cm from 1 s, then 45 cm over 7 s) while the receiver
+    # closes 30 cm over 8 s, then steps back 8 cm at 8.8 s. The hands are still ~0.8 m closer
+    # than when the reach began, so the reach goes on, although its start has long left the
+    # 5 s analysis window (the start distance is the one kept while the window held it; read
+    # from the window's first sample instead, the step back looked like a reach taken back).
+    rate = 120.0
+    t = np.arange(0.0, 12.0, 1.0 / rate)
+    rng = np.random.default_rng(1)
+
+    def mj(t0, dur):
+        return min_jerk((t - t0) / dur)[:, None]
+
+    g = (np.array([1.0, 0.0, 1.0]) + mj(1.0, 0.8) * [-0.15, 0.0, 0.0]
+         + mj(1.6, 7.0) * [-0.45, 0.0, 0.0])
+    r = (np.array([-0.3, 0.0, 1.0]) + mj(1.5, 8.0) * [0.3, 0.0, 0.0]
+         + mj(8.8, 0.4) * [-0.08, 0.0, 0.0])
+    g = g + rng.normal(0.0, 0.001, g.shape)
+    r = r + rng.normal(0.0, 0.0003, r.shape)
+    cfg = PhaseConfig()
+    assert 8.8 - 1.0 > cfg.online_window  # the reach's start has left the window
+    events = run_online(Trajectory(t, g, r), cfg).events
+    assert [e.kind for e in events] == [EventKind.REACH_STARTED], [
+        (e.kind.value, e.detected_at, e.info) for e in events
+    ]
+    assert events[0].t < 1.1

@@ -61,11 +61,12 @@ def test_growing_window_equals_the_full_computation(options: SyntheticOptions) -
     rng = np.random.default_rng(1)
     steps = [int(k) for k in rng.integers(1, 12, size=len(traj) // 3)]
     calls, extended = _grow(traj, PhaseConfig(), steps)
-    _grow(traj, PhaseConfig(), steps, start=len(traj) // 4)
     assert extended > calls // 2  # the cache is used, not only the fallback
+    calls, extended = _grow(traj, PhaseConfig(), steps, start=len(traj) // 4)
+    assert extended > calls // 2
 
 
-def test_window_with_new_damage_is_computed_in_full() -> None:
+def test_window_with_new_damage_extended_equals_the_full_computation() -> None:
     traj = generate(seed=4, options=SyntheticOptions(rate=100.0, noise=0.002)).trajectory
     g, r = traj.giver_hand.copy(), traj.receiver_hand.copy()
     g[300] = np.nan  # a missing sample
@@ -73,7 +74,8 @@ def test_window_with_new_damage_is_computed_in_full() -> None:
     t = traj.t.copy()
     t[500:] += 0.4  # a gap longer than max_gap_hold
     damaged = Trajectory(t, g, r)
-    _grow(damaged, PhaseConfig(), [4] * (len(traj) // 4))
+    calls, extended = _grow(damaged, PhaseConfig(), [4] * (len(traj) // 4))
+    assert extended > calls // 2  # damaged windows are extended too, not recomputed
 
 
 def test_window_with_a_long_gap_only_equals_the_full_computation() -> None:

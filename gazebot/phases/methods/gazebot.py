@@ -71,8 +71,8 @@ class GazebotSegmenter(Segmenter):
     ) -> list[Segment]:
         """The segments the signals show so far; with no phase under way at their end, a reach
         the raw samples predict before the signals can show it: the giver's hand accelerating
-        toward the receiver (:mod:`~gazebot.phases.rules.directed`) where a reach explains the
-        samples better than any fidget by ``directed_support`` (the sequential statistic), or,
+        toward the receiver (:mod:`~gazebot.phases.rules.directed`) where the sequential rule
+        also confirms it with ``directed_support`` as its bar, or,
         if not, moving in a way no fidget does (:mod:`~gazebot.phases.rules.sequential`). In a
         reach (``phase``) the reach onsets are not dated (NaN starts): the detector reads none
         of them then."""
@@ -80,13 +80,15 @@ class GazebotSegmenter(Segmenter):
         if segs and (segs[-1].open or segs[-1].phase is not Phase.RETREAT):
             return segs
         after = segs[-1].end if segs else -math.inf
-        onset = directed_reach(trajectory, self.config, after)
-        if onset is not None and (
-            sequential_reach(trajectory, self.config, after, self.config.directed_support) is None
-        ):
-            onset = None
-        if onset is None:
-            onset = sequential_reach(trajectory, self.config, after)
+        c = self.config
+        onset = directed_reach(trajectory, c, after)
+        vetoed = False
+        if onset is not None and sequential_reach(trajectory, c, after, c.directed_support) is None:
+            onset, vetoed = None, True
+        # After a veto the sequential rule with a bar no lower than the support's cannot
+        # confirm either (the same checks, a higher bar): skip it.
+        if onset is None and not (vetoed and c.sequential_evidence >= c.directed_support):
+            onset = sequential_reach(trajectory, c, after)
         if onset is not None:
             k = segs[-1].handover + 1 if segs else 0
             segs.append(Segment(Phase.REACH, min(onset, now), now, k, open=True))

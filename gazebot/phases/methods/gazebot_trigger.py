@@ -284,5 +284,5 @@ class GazebotTrigger:
         gm = g[max(i_max - k, 0 if deep else recent, 0) :]
         if gm.shape[0] <= k:
             return True
-        v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * c.online_period)
+        v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * max(c.online_period, 1e-3))
         return bool(_nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)
