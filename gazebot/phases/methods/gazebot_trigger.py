@@ -209,18 +209,24 @@ class GazebotTrigger:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
             rel = buf[s1 - 2 : s1, 7:10]
-            off = float(np.linalg.norm(_nanmean2(rel[0], rel[1]) - np.array(mean)))
+            off_v = _nanmean2(rel[0], rel[1]) - np.array(mean)
+            # (np.linalg.norm of a vector: the square root of its dot with itself)
+            off = math.sqrt(float(off_v.dot(off_v)))
             return off >= c.trigger_distance_factor * c.release_distance
         if ph is Phase.RETREAT:
             if state.joined_late:
                 return True
             # The retreat ends landing (slowing down), at rest or far away.
             k = self._k
-            gs = buf[first:s1, 1:4]
-            if gs.shape[0] <= k or not np.isfinite(gs[[0, -1]]).all():
+            if s1 - first <= k:
+                return True
+            g0, g1 = buf[first, 1:4], buf[s1 - 1, 1:4]
+            if not all(math.isfinite(v) for v in g0.tolist() + g1.tolist()):
                 return True
             far = c.trigger_far_fraction * c.retreat_far_distance
-            if float(np.linalg.norm(gs[-1] - gs[0])) >= far:
+            moved = g1 - g0
+            # (np.linalg.norm of a vector: the square root of its dot with itself)
+            if math.sqrt(float(moved.dot(moved))) >= far:
                 return True
             last = float(buf[s1 - 1, _STEP])
             if not math.isfinite(last):
@@ -273,10 +279,12 @@ class GazebotTrigger:
         d = rows[:, 10]
         da = d[first:]
         i_max = first + int(np.argmax(da == d_max))  # np.nanargmax: the first largest
-        own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(d_last, 1e-9)
         deep = closed >= c.trigger_deep_fraction * c.min_approach
-        if not deep and not own >= c.trigger_own_fraction * c.reach_confirm_distance:
-            return False  # only the receiver came closer: no reach of the giver's yet
+        if not deep:
+            # (the giver's own share of the closing, read only when the dip is not deep)
+            own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(d_last, 1e-9)
+            if not own >= c.trigger_own_fraction * c.reach_confirm_distance:
+                return False  # only the receiver came closer: no reach of the giver's yet
         # The giver's hand moving fast: since the hands were farthest for a deep dip, else
         # within the window the rule reads (smoothing, before the edge guard).
         span = (c.smoothing + c.edge_guard + c.trigger_speed_baseline) / max(c.online_period, 1e-3)
