@@ -140,6 +140,21 @@ def test_quantile_is_numpys_linear_quantile() -> None:
             assert quantile(x, q) == float(np.quantile(x, q)), (n, q)
 
 
+def test_vector_norm_is_numpys_norm_bit_for_bit() -> None:
+    """The rules' single-vector norm equals ``np.linalg.norm`` exactly (numpy's dot may fuse
+    the products, so a plain sum of squares would not), on rows, strided views, 2-D blocks,
+    NaN, infinity and an empty vector."""
+    from gazebot.phases.filtering import vector_norm
+
+    rng = np.random.default_rng(4)
+    x = rng.normal(size=(4000, 3)) * rng.choice([1e-4, 1.0, 1e3], size=(4000, 1))
+    for v in [*x, *x.T[:, ::7], x[:5], np.array([np.nan, 1.0, 2.0]),
+              np.array([np.inf, 0.0, 1.0]), np.zeros(0)]:
+        want = float(np.linalg.norm(v))
+        got = vector_norm(v)
+        assert got == want or (np.isnan(got) and np.isnan(want))
+
+
 def test_two_row_nanmean_is_numpys() -> None:
     import warnings
 

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import vector_norm
 from gazebot.phases.methods.base import OnlineState, TriggerMode
 from gazebot.types import Phase
 
@@ -209,9 +210,7 @@ class GazebotTrigger:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
             rel = buf[s1 - 2 : s1, 7:10]
-            off_v = _nanmean2(rel[0], rel[1]) - np.array(mean)
-            # (np.linalg.norm of a vector: the square root of its dot with itself)
-            off = math.sqrt(float(off_v.dot(off_v)))
+            off = vector_norm(_nanmean2(rel[0], rel[1]) - np.array(mean))
             return off >= c.trigger_distance_factor * c.release_distance
         if ph is Phase.RETREAT:
             if state.joined_late:
@@ -224,9 +223,7 @@ class GazebotTrigger:
             if not all(math.isfinite(v) for v in g0.tolist() + g1.tolist()):
                 return True
             far = c.trigger_far_fraction * c.retreat_far_distance
-            moved = g1 - g0
-            # (np.linalg.norm of a vector: the square root of its dot with itself)
-            if math.sqrt(float(moved.dot(moved))) >= far:
+            if vector_norm(g1 - g0) >= far:
                 return True
             last = float(buf[s1 - 1, _STEP])
             if not math.isfinite(last):

@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 from gazebot.phases.trajectory import Trajectory
 
@@ -94,7 +95,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     # The line from the giver's resting hand to the receiver's hand now.
     g_rest = g[rest].mean(axis=0)
     line = r[-1] - g_rest
-    gap = float(np.linalg.norm(line))
+    gap = vector_norm(line)
     if gap <= 1e-6:
         return None
     u = line / gap
@@ -127,7 +128,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if any(f is None for f in across):
         return None
     vel = np.array([f[0][1] for f in across if f is not None])
-    speed = float(np.linalg.norm(vel))
+    speed = vector_norm(vel)
     if not speed > 0 or v / speed < c.predict_cos:
         return None
     onset = now - min_jerk_span(x, v, c.max_refine)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals
+from gazebot.phases.filtering import Signals, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -57,7 +57,7 @@ def _onset(
         i_c = lo + int(slow[-1]) + 1
     rest = np.flatnonzero(speed[lo:i_c] < c.rest_speed)
     i_r = lo + int(rest[-1]) if rest.size else lo
-    x = float(np.linalg.norm(pos[i_c] - pos[i_r]))
+    x = vector_norm(pos[i_c] - pos[i_r])
     back = min_jerk_span(x, float(speed[i_c]), c.max_refine)
     floor = float(s.t[lo])
     if i_c - i_r > 1 and not np.isfinite(speed[i_r + 1 : i_c]).all():

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, quantile
+from gazebot.phases.filtering import Signals, quantile, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -273,7 +273,7 @@ def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
     if seen.size == 0:
         return None
     i = int(seen[-1])
-    x = float(np.linalg.norm(s.rel[a] - s.rel[i]))
+    x = vector_norm(s.rel[a] - s.rel[i])
     v = float(s.rel_speed[i])
     if not (math.isfinite(x) and v > 1e-6):
         return t_a
