@@ -119,14 +119,14 @@ def test_trigger_rows_hold_the_period_means_and_numpys_distances() -> None:
 
 
 def test_median_of_the_sample_steps_is_numpys() -> None:
-    from gazebot.phases.filtering import _median
+    from gazebot.phases.filtering import median
 
     rng = np.random.default_rng(1)
     for n in (1, 2, 3, 4, 7, 10, 101):
         x = rng.uniform(0.004, 0.03, size=n)
-        assert _median(x) == float(np.median(x))
+        assert median(x) == float(np.median(x))
         x[n // 2] = np.nan
-        assert np.isnan(_median(x))
+        assert np.isnan(median(x))
 
 
 def test_quantile_is_numpys_linear_quantile() -> None:

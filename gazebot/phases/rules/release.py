@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, vector_norm
+from gazebot.phases.filtering import Signals, median, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 from gazebot.phases.rules.transfer import TransferCore, hold_floor
 
@@ -55,7 +55,8 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     idx = np.arange(max(i0, i_h - window), i_h + 1)
     rows = s.rel[idx]
     rows = rows[np.isfinite(rows).all(axis=1)]
-    held = np.median(rows, axis=0) if rows.size else np.full(3, np.nan)
+    # (np.median(rows, axis=0): each column's median)
+    held = np.array([median(rows[:, k]) for k in range(3)]) if rows.size else np.full(3, np.nan)
     sep_min = release_threshold(s, c, idx, held)
     n = s.t.shape[0]
     j = i_h

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import vector_norm
+from gazebot.phases.filtering import median, vector_norm
 from gazebot.phases.rules.directed import _fit, noise_floor
 from gazebot.phases.trajectory import Trajectory
 
@@ -177,7 +177,7 @@ def sequential_reach(
     # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
     steps = np.diff(t_all[win])
     recent = t_all[win][1:] >= now - c.predict_window
-    step = float(np.median(steps))
+    step = median(steps)
     if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
         return None
     # A fidget fits any cubic start up to its midpoint: a hand not yet half the largest fidget
