@@ -196,6 +196,13 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     return out.reshape(rows, 3 * hands), den
 
 
+# What np.nanmax (np.nanmin) computes for a float array: the largest (smallest) value that is
+# not NaN, NaN if all are, ``initial`` taking part if given. numpy's own reduction, without
+# its argument handling and all-NaN warning (the rules read several per analysis).
+nanmax = np.fmax.reduce
+nanmin = np.fmin.reduce
+
+
 def median(x: np.ndarray) -> float:
     """``np.median`` of a non-empty 1-D float array (the middle value, or the mean of the two
     middle ones; NaN if any is NaN), without its generic machinery (tens of microseconds a

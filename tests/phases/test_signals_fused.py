@@ -155,6 +155,28 @@ def test_vector_norm_is_numpys_norm_bit_for_bit() -> None:
         assert got == want or (np.isnan(got) and np.isnan(want))
 
 
+def test_nanmax_and_nanmin_are_numpys() -> None:
+    """The rules' NaN-skipping extrema equal ``np.nanmax`` / ``np.nanmin``, with and without
+    ``initial``, on rows with NaN, all NaN and (with ``initial``) none."""
+    import warnings
+
+    from gazebot.phases.filtering import nanmax, nanmin
+
+    rng = np.random.default_rng(5)
+    for n in (0, 1, 2, 5, 40):
+        x = rng.normal(size=n)
+        x[rng.random(n) < 0.3] = np.nan
+        for a in (x, np.full(n, np.nan)):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # numpy warns on all NaN
+                for ours, theirs in ((nanmax, np.nanmax), (nanmin, np.nanmin)):
+                    for init in (0.0, -np.inf):
+                        kw = {"initial": init}
+                        np.testing.assert_array_equal(ours(a, **kw), theirs(a, **kw))
+                    if n:
+                        np.testing.assert_array_equal(ours(a), theirs(a))
+
+
 def test_two_row_nanmean_is_numpys() -> None:
     import warnings
 

@@ -18,15 +18,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import vector_norm
+from gazebot.phases.filtering import nanmax, vector_norm
 from gazebot.phases.methods.base import OnlineState, TriggerMode
 from gazebot.types import Phase
 
 _COLUMNS = 12  # t, giver xyz, receiver xyz, relative xyz, distance, giver step
 _STEP = 11  # the giver's step column: |giver - giver trigger_speed_baseline earlier|
-# What np.nanmax computes for a float array (the largest value that is not NaN; NaN if all
-# are), without its argument handling and all-NaN warning: it runs every period.
-_nanmax = np.fmax.reduce
 
 
 def _nanmean2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -201,7 +198,7 @@ class GazebotTrigger:
             # either way the hands are no longer closing fast.
             since = float(ts[-1]) - (c.min_transfer + c.edge_guard + c.online_period)
             recent = buf[s0 + int(ts.searchsorted(since)) : s1, 10]  # (ts increases)
-            return float(_nanmax(recent)) - d_last <= c.trigger_still_factor * c.still_closing
+            return float(nanmax(recent)) - d_last <= c.trigger_still_factor * c.still_closing
         first = s0 + int(ts.searchsorted(state.phase_start))  # (ts increases)
         if ph is Phase.TRANSFER:
             # A release moves the hands' relative position off the held pose.
@@ -290,4 +287,4 @@ class GazebotTrigger:
         if gm.shape[0] <= k:
             return True
         v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * max(c.online_period, 1e-3))
-        return bool(_nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)
+        return bool(nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)

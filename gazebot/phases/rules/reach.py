@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, vector_norm
+from gazebot.phases.filtering import Signals, nanmax, nanmin, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -42,7 +42,7 @@ def _onset(
     """Motion onset of one hand before ``hi`` (see the module docstring), ``None`` if that
     hand never moved faster than ``reach_onset_speed`` in ``[lo, hi]``."""
     v = speed[lo : hi + 1]
-    if not np.nanmax(v, initial=0.0) >= c.reach_onset_speed:
+    if not nanmax(v, initial=0.0) >= c.reach_onset_speed:
         return None
     peak = int(np.nanargmax(v))
     head = v[: peak + 1]
@@ -83,7 +83,7 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     closed = float(d[i_max]) - last
     if (
         closed < c.reach_confirm_distance
-        or last > float(np.nanmin(d[i_max:])) + c.reach_confirm_distance
+        or last > float(nanmin(d[i_max:])) + c.reach_confirm_distance
     ):
         return None
     k = lo + i_last
@@ -96,13 +96,13 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     closing = -np.einsum("ij,ij->i", s.rel_v[j0 : k + 1], s.rel[j0 : k + 1]) / np.maximum(
         s.distance[j0 : k + 1], 1e-9
     )
-    fast = bool(np.nanmax(closing, initial=0.0) >= c.reach_onset_speed) and bool(
-        np.nanmax(s.giver_speed[j0 : k + 1], initial=0.0) >= c.reach_onset_speed
+    fast = bool(nanmax(closing, initial=0.0) >= c.reach_onset_speed) and bool(
+        nanmax(s.giver_speed[j0 : k + 1], initial=0.0) >= c.reach_onset_speed
     )
     moving = fast and own >= c.approach_ratio * c.reach_confirm_distance
     if not moving:
         if closed < c.min_approach:
             return None
-        if not np.nanmax(s.giver_speed[lo + i_max :], initial=0.0) >= c.reach_onset_speed:
+        if not nanmax(s.giver_speed[lo + i_max :], initial=0.0) >= c.reach_onset_speed:
             return None  # only the receiver came closer
     return reach_start(s, c, lo + i_max, k)
