@@ -203,6 +203,18 @@ nanmax = np.fmax.reduce
 nanmin = np.fmin.reduce
 
 
+def nanargmax(x: np.ndarray) -> int:
+    """``int(np.nanargmax(x))`` of a 1-D float array: the index of the first largest value
+    that is not NaN (NaN read as -inf; ``ValueError`` if all are NaN or none are given, as
+    numpy), without numpy's copy and fill when no value is NaN."""
+    nan = np.isnan(x)
+    if not nan.any():
+        return int(x.argmax())
+    if nan.all():
+        raise ValueError("All-NaN slice encountered")
+    return int(np.where(nan, -np.inf, x).argmax())
+
+
 def median(x: np.ndarray) -> float:
     """``np.median`` of a non-empty 1-D float array (the middle value, or the mean of the two
     middle ones; NaN if any is NaN), without its generic machinery (tens of microseconds a

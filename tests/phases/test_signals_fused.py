@@ -177,6 +177,24 @@ def test_nanmax_and_nanmin_are_numpys() -> None:
                         np.testing.assert_array_equal(ours(a), theirs(a))
 
 
+def test_nanargmax_is_numpys() -> None:
+    """The rules' NaN-skipping argmax equals ``np.nanargmax`` (ties: the first; -inf values
+    and NaN), and fails like it on all NaN and on nothing."""
+    from gazebot.phases.filtering import nanargmax
+
+    rng = np.random.default_rng(6)
+    for n in (1, 2, 5, 40):
+        for _ in range(50):
+            x = rng.choice([-np.inf, -1.0, 0.0, 1.0, 2.0, np.nan], size=n)
+            if not np.isnan(x).all():
+                assert nanargmax(x) == int(np.nanargmax(x)), x
+    for bad in (np.full(3, np.nan), np.zeros(0)):
+        with pytest.raises(ValueError):
+            np.nanargmax(bad)
+        with pytest.raises(ValueError):
+            nanargmax(bad)
+
+
 def test_two_row_nanmean_is_numpys() -> None:
     import warnings
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, nanmax, nanmin, vector_norm
+from gazebot.phases.filtering import Signals, nanargmax, nanmax, nanmin, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -44,7 +44,7 @@ def _onset(
     v = speed[lo : hi + 1]
     if not nanmax(v, initial=0.0) >= c.reach_onset_speed:
         return None
-    peak = int(np.nanargmax(v))
+    peak = nanargmax(v)
     head = v[: peak + 1]
     seen = np.isfinite(head)
     slow = np.flatnonzero(seen & (head < c.reach_onset_speed))
@@ -77,7 +77,7 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     seen = np.flatnonzero(np.isfinite(d))
     if seen.size < 3:
         return None
-    i_max = int(np.nanargmax(d))
+    i_max = nanargmax(d)
     i_last = int(seen[-1])
     last = float(d[i_last])
     closed = float(d[i_max]) - last

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, vector_norm
+from gazebot.phases.filtering import Signals, nanargmax, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -100,7 +100,7 @@ def _landing(s: Signals, c: PhaseConfig, i0: int, t_release: float) -> float | N
     ok = np.isfinite(v)
     if not ok.any():
         return None
-    k = int(np.nanargmax(v))
+    k = nanargmax(v)
     peak = float(v[k])
     last = int(np.flatnonzero(ok)[-1])
     moved = vector_norm(s.giver[i0 + last] - s.giver[i0])
