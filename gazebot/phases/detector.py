@@ -49,7 +49,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.durations import REACH_S
-from gazebot.phases.filtering import SignalCache, Signals
+from gazebot.phases.filtering import SignalCache, Signals, nanmax, nanmin, vector_norm
 from gazebot.phases.methods import make_segmenter
 from gazebot.phases.methods.base import OnlineState
 from gazebot.phases.prediction import predict_end
@@ -540,13 +540,13 @@ class PhaseDetector:
         i_a, i_b = i_start + a, i_start + b
         if not np.isfinite(s.giver[[i_start, i_a]]).all():
             return None
-        if float(np.linalg.norm(s.giver[i_a] - s.giver[i_start])) >= c.stall_travel:
+        if vector_norm(s.giver[i_a] - s.giver[i_start]) >= c.stall_travel:
             return None  # the hand was held out at the handover place: the reach goes on
         after = s.giver_speed[i_b + 1 :]
         d = s.distance[i_b:]
-        if not np.nanmax(after, initial=0.0) >= c.reach_onset_speed:
+        if not nanmax(after, initial=0.0) >= c.reach_onset_speed:
             return None
-        if not float(d[0]) - float(np.nanmin(d)) >= c.reach_confirm_distance:
+        if not float(d[0]) - float(nanmin(d)) >= c.reach_confirm_distance:
             return None
         return float(s.t[i_b])
 

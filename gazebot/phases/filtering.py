@@ -102,7 +102,7 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
             continue
         i0, i1 = idx[prev_fresh], idx[last_fresh]
         dt = t[i1] - t[i0]
-        v = float(np.linalg.norm(p[i1] - p[i0]) / dt) if dt > 0 else 0.0
+        v = vector_norm(p[i1] - p[i0]) / dt if dt > 0 else 0.0
         if v > moving_speed:
             stale[idx[k]] = True
     return stale
@@ -196,9 +196,29 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     return out.reshape(rows, 3 * hands), den
 
 
-def _median(x: np.ndarray) -> float:
+# What np.nanmax (np.nanmin) computes for a float array: the largest (smallest) value that is
+# not NaN, NaN if all are, ``initial`` taking part if given. numpy's own reduction, without
+# its argument handling and all-NaN warning (the rules read several per analysis).
+nanmax = np.fmax.reduce
+nanmin = np.fmin.reduce
+
+
+def nanargmax(x: np.ndarray) -> int:
+    """``int(np.nanargmax(x))`` of a 1-D float array: the index of the first largest value
+    that is not NaN (NaN read as -inf; ``ValueError`` if all are NaN or none are given, as
+    numpy), without numpy's copy and fill when no value is NaN."""
+    nan = np.isnan(x)
+    if not nan.any():
+        return int(x.argmax())
+    if nan.all():
+        raise ValueError("All-NaN slice encountered")
+    return int(np.where(nan, -np.inf, x).argmax())
+
+
+def median(x: np.ndarray) -> float:
     """``np.median`` of a non-empty 1-D float array (the middle value, or the mean of the two
-    middle ones; NaN if any is NaN), without its generic machinery."""
+    middle ones; NaN if any is NaN), without its generic machinery (tens of microseconds a
+    call: the analysis reads several)."""
     n = x.shape[0]
     h = n // 2
     kth = [h, n - 1] if n % 2 else [h - 1, h, n - 1]
@@ -227,6 +247,16 @@ def quantile(x: np.ndarray, q: float) -> float:
     # numpy's _lerp: from the nearer end
     diff = b - a
     return b - diff * (1.0 - gamma) if gamma >= 0.5 else a + diff * gamma
+
+
+def vector_norm(v: np.ndarray) -> float:
+    """``float(np.linalg.norm(v))`` of a float64 array (its entries' 2-norm): numpy's own
+    arithmetic for it, the square root of the flattened array's dot with itself, without its
+    argument handling (a few microseconds a call: the rules read single vectors' norms in
+    loops). Not a sum of squares in another order: numpy's dot may fuse them, so only this is
+    bit-equal."""
+    x = v.ravel(order="K")
+    return math.sqrt(float(x.dot(x)))
 
 
 def _norms(x: np.ndarray) -> np.ndarray:
@@ -321,7 +351,7 @@ def compute_signals(
         )
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
     # corners at every sample that would otherwise show up as speed spikes.
-    med_dt = _median(np.diff(t)) if n > 1 else dt
+    med_dt = median(np.diff(t)) if n > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
     fin = np.isfinite(x)
     m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands)
@@ -501,7 +531,7 @@ class SignalCache:
         # half the smoothing, which needs an interval that long.
         sigma_s = 0.5 * config.smoothing
         if max_dt > config.smoothing:
-            sigma_s = max(sigma_s, 0.5 * _median(np.diff(t)))
+            sigma_s = max(sigma_s, 0.5 * median(np.diff(t)))
         if sigma_s / dt != self._sigma:
             return None
         grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)

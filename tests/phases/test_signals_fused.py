@@ -119,14 +119,14 @@ def test_trigger_rows_hold_the_period_means_and_numpys_distances() -> None:
 
 
 def test_median_of_the_sample_steps_is_numpys() -> None:
-    from gazebot.phases.filtering import _median
+    from gazebot.phases.filtering import median
 
     rng = np.random.default_rng(1)
     for n in (1, 2, 3, 4, 7, 10, 101):
         x = rng.uniform(0.004, 0.03, size=n)
-        assert _median(x) == float(np.median(x))
+        assert median(x) == float(np.median(x))
         x[n // 2] = np.nan
-        assert np.isnan(_median(x))
+        assert np.isnan(median(x))
 
 
 def test_quantile_is_numpys_linear_quantile() -> None:
@@ -138,6 +138,61 @@ def test_quantile_is_numpys_linear_quantile() -> None:
         x[rng.random(n) < 0.1] = 0.05  # ties
         for q in (0.0, 0.1, 0.25, 0.3333, 0.5, 0.75, 0.9, 1.0, float(rng.random())):
             assert quantile(x, q) == float(np.quantile(x, q)), (n, q)
+
+
+def test_vector_norm_is_numpys_norm_bit_for_bit() -> None:
+    """The rules' single-vector norm equals ``np.linalg.norm`` exactly (numpy's dot may fuse
+    the products, so a plain sum of squares would not), on rows, strided views, 2-D blocks,
+    NaN, infinity and an empty vector."""
+    from gazebot.phases.filtering import vector_norm
+
+    rng = np.random.default_rng(4)
+    x = rng.normal(size=(4000, 3)) * rng.choice([1e-4, 1.0, 1e3], size=(4000, 1))
+    for v in [*x, *x.T[:, ::7], x[:5], np.array([np.nan, 1.0, 2.0]),
+              np.array([np.inf, 0.0, 1.0]), np.zeros(0)]:
+        want = float(np.linalg.norm(v))
+        got = vector_norm(v)
+        assert got == want or (np.isnan(got) and np.isnan(want))
+
+
+def test_nanmax_and_nanmin_are_numpys() -> None:
+    """The rules' NaN-skipping extrema equal ``np.nanmax`` / ``np.nanmin``, with and without
+    ``initial``, on rows with NaN, all NaN and (with ``initial``) none."""
+    import warnings
+
+    from gazebot.phases.filtering import nanmax, nanmin
+
+    rng = np.random.default_rng(5)
+    for n in (0, 1, 2, 5, 40):
+        x = rng.normal(size=n)
+        x[rng.random(n) < 0.3] = np.nan
+        for a in (x, np.full(n, np.nan)):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # numpy warns on all NaN
+                for ours, theirs in ((nanmax, np.nanmax), (nanmin, np.nanmin)):
+                    for init in (0.0, -np.inf):
+                        kw = {"initial": init}
+                        np.testing.assert_array_equal(ours(a, **kw), theirs(a, **kw))
+                    if n:
+                        np.testing.assert_array_equal(ours(a), theirs(a))
+
+
+def test_nanargmax_is_numpys() -> None:
+    """The rules' NaN-skipping argmax equals ``np.nanargmax`` (ties: the first; -inf values
+    and NaN), and fails like it on all NaN and on nothing."""
+    from gazebot.phases.filtering import nanargmax
+
+    rng = np.random.default_rng(6)
+    for n in (1, 2, 5, 40):
+        for _ in range(50):
+            x = rng.choice([-np.inf, -1.0, 0.0, 1.0, 2.0, np.nan], size=n)
+            if not np.isnan(x).all():
+                assert nanargmax(x) == int(np.nanargmax(x)), x
+    for bad in (np.full(3, np.nan), np.zeros(0)):
+        with pytest.raises(ValueError):
+            np.nanargmax(bad)
+        with pytest.raises(ValueError):
+            nanargmax(bad)
 
 
 def test_two_row_nanmean_is_numpys() -> None:

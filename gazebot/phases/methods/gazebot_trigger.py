@@ -18,14 +18,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import nanmax, vector_norm
 from gazebot.phases.methods.base import OnlineState, TriggerMode
 from gazebot.types import Phase
 
 _COLUMNS = 12  # t, giver xyz, receiver xyz, relative xyz, distance, giver step
 _STEP = 11  # the giver's step column: |giver - giver trigger_speed_baseline earlier|
-# What np.nanmax computes for a float array (the largest value that is not NaN; NaN if all
-# are), without its argument handling and all-NaN warning: it runs every period.
-_nanmax = np.fmax.reduce
 
 
 def _nanmean2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -200,7 +198,7 @@ class GazebotTrigger:
             # either way the hands are no longer closing fast.
             since = float(ts[-1]) - (c.min_transfer + c.edge_guard + c.online_period)
             recent = buf[s0 + int(ts.searchsorted(since)) : s1, 10]  # (ts increases)
-            return float(_nanmax(recent)) - d_last <= c.trigger_still_factor * c.still_closing
+            return float(nanmax(recent)) - d_last <= c.trigger_still_factor * c.still_closing
         first = s0 + int(ts.searchsorted(state.phase_start))  # (ts increases)
         if ph is Phase.TRANSFER:
             # A release moves the hands' relative position off the held pose.
@@ -209,18 +207,20 @@ class GazebotTrigger:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
             rel = buf[s1 - 2 : s1, 7:10]
-            off = float(np.linalg.norm(_nanmean2(rel[0], rel[1]) - np.array(mean)))
+            off = vector_norm(_nanmean2(rel[0], rel[1]) - np.array(mean))
             return off >= c.trigger_distance_factor * c.release_distance
         if ph is Phase.RETREAT:
             if state.joined_late:
                 return True
             # The retreat ends landing (slowing down), at rest or far away.
             k = self._k
-            gs = buf[first:s1, 1:4]
-            if gs.shape[0] <= k or not np.isfinite(gs[[0, -1]]).all():
+            if s1 - first <= k:
+                return True
+            g0, g1 = buf[first, 1:4], buf[s1 - 1, 1:4]
+            if not all(math.isfinite(v) for v in g0.tolist() + g1.tolist()):
                 return True
             far = c.trigger_far_fraction * c.retreat_far_distance
-            if float(np.linalg.norm(gs[-1] - gs[0])) >= far:
+            if vector_norm(g1 - g0) >= far:
                 return True
             last = float(buf[s1 - 1, _STEP])
             if not math.isfinite(last):
@@ -273,10 +273,12 @@ class GazebotTrigger:
         d = rows[:, 10]
         da = d[first:]
         i_max = first + int(np.argmax(da == d_max))  # np.nanargmax: the first largest
-        own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(d_last, 1e-9)
         deep = closed >= c.trigger_deep_fraction * c.min_approach
-        if not deep and not own >= c.trigger_own_fraction * c.reach_confirm_distance:
-            return False  # only the receiver came closer: no reach of the giver's yet
+        if not deep:
+            # (the giver's own share of the closing, read only when the dip is not deep)
+            own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(d_last, 1e-9)
+            if not own >= c.trigger_own_fraction * c.reach_confirm_distance:
+                return False  # only the receiver came closer: no reach of the giver's yet
         # The giver's hand moving fast: since the hands were farthest for a deep dip, else
         # within the window the rule reads (smoothing, before the edge guard).
         span = (c.smoothing + c.edge_guard + c.trigger_speed_baseline) / max(c.online_period, 1e-3)
@@ -285,4 +287,4 @@ class GazebotTrigger:
         if gm.shape[0] <= k:
             return True
         v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * max(c.online_period, 1e-3))
-        return bool(_nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)
+        return bool(nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)

@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import median, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 from gazebot.phases.trajectory import Trajectory
 
@@ -64,7 +65,7 @@ def noise_floor(x: np.ndarray) -> float:
     if x.shape[0] < 4:
         return 0.0
     d2 = np.diff(x, n=2, axis=0).reshape(-1)
-    mad = float(np.median(np.abs(d2 - np.median(d2))))
+    mad = median(np.abs(d2 - median(d2)))
     return 1.4826 * mad / math.sqrt(6.0)
 
 
@@ -89,12 +90,12 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if fit.size < c.predict_min_samples or rest.size == 0:
         return None
     steps = np.diff(t_all[fit])
-    if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
+    if float(steps.max()) > c.predict_gap_factor * median(steps):
         return None  # a dropout inside the window leaves the model unconstrained there
     # The line from the giver's resting hand to the receiver's hand now.
     g_rest = g[rest].mean(axis=0)
     line = r[-1] - g_rest
-    gap = float(np.linalg.norm(line))
+    gap = vector_norm(line)
     if gap <= 1e-6:
         return None
     u = line / gap
@@ -127,7 +128,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if any(f is None for f in across):
         return None
     vel = np.array([f[0][1] for f in across if f is not None])
-    speed = float(np.linalg.norm(vel))
+    speed = vector_norm(vel)
     if not speed > 0 or v / speed < c.predict_cos:
         return None
     onset = now - min_jerk_span(x, v, c.max_refine)

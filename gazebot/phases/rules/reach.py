@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals
+from gazebot.phases.filtering import Signals, nanargmax, nanmax, nanmin, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -42,9 +42,9 @@ def _onset(
     """Motion onset of one hand before ``hi`` (see the module docstring), ``None`` if that
     hand never moved faster than ``reach_onset_speed`` in ``[lo, hi]``."""
     v = speed[lo : hi + 1]
-    if not np.nanmax(v, initial=0.0) >= c.reach_onset_speed:
+    if not nanmax(v, initial=0.0) >= c.reach_onset_speed:
         return None
-    peak = int(np.nanargmax(v))
+    peak = nanargmax(v)
     head = v[: peak + 1]
     seen = np.isfinite(head)
     slow = np.flatnonzero(seen & (head < c.reach_onset_speed))
@@ -57,7 +57,7 @@ def _onset(
         i_c = lo + int(slow[-1]) + 1
     rest = np.flatnonzero(speed[lo:i_c] < c.rest_speed)
     i_r = lo + int(rest[-1]) if rest.size else lo
-    x = float(np.linalg.norm(pos[i_c] - pos[i_r]))
+    x = vector_norm(pos[i_c] - pos[i_r])
     back = min_jerk_span(x, float(speed[i_c]), c.max_refine)
     floor = float(s.t[lo])
     if i_c - i_r > 1 and not np.isfinite(speed[i_r + 1 : i_c]).all():
@@ -77,13 +77,13 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     seen = np.flatnonzero(np.isfinite(d))
     if seen.size < 3:
         return None
-    i_max = int(np.nanargmax(d))
+    i_max = nanargmax(d)
     i_last = int(seen[-1])
     last = float(d[i_last])
     closed = float(d[i_max]) - last
     if (
         closed < c.reach_confirm_distance
-        or last > float(np.nanmin(d[i_max:])) + c.reach_confirm_distance
+        or last > float(nanmin(d[i_max:])) + c.reach_confirm_distance
     ):
         return None
     k = lo + i_last
@@ -96,13 +96,13 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     closing = -np.einsum("ij,ij->i", s.rel_v[j0 : k + 1], s.rel[j0 : k + 1]) / np.maximum(
         s.distance[j0 : k + 1], 1e-9
     )
-    fast = bool(np.nanmax(closing, initial=0.0) >= c.reach_onset_speed) and bool(
-        np.nanmax(s.giver_speed[j0 : k + 1], initial=0.0) >= c.reach_onset_speed
+    fast = bool(nanmax(closing, initial=0.0) >= c.reach_onset_speed) and bool(
+        nanmax(s.giver_speed[j0 : k + 1], initial=0.0) >= c.reach_onset_speed
     )
     moving = fast and own >= c.approach_ratio * c.reach_confirm_distance
     if not moving:
         if closed < c.min_approach:
             return None
-        if not np.nanmax(s.giver_speed[lo + i_max :], initial=0.0) >= c.reach_onset_speed:
+        if not nanmax(s.giver_speed[lo + i_max :], initial=0.0) >= c.reach_onset_speed:
             return None  # only the receiver came closer
     return reach_start(s, c, lo + i_max, k)

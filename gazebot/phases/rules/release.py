@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals
+from gazebot.phases.filtering import Signals, median, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 from gazebot.phases.rules.transfer import TransferCore, hold_floor
 
@@ -55,13 +55,14 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     idx = np.arange(max(i0, i_h - window), i_h + 1)
     rows = s.rel[idx]
     rows = rows[np.isfinite(rows).all(axis=1)]
-    held = np.median(rows, axis=0) if rows.size else np.full(3, np.nan)
+    # (np.median(rows, axis=0): each column's median)
+    held = np.array([median(rows[:, k]) for k in range(3)]) if rows.size else np.full(3, np.nan)
     sep_min = release_threshold(s, c, idx, held)
     n = s.t.shape[0]
     j = i_h
-    while j + 1 < n and not np.linalg.norm(s.rel[j] - held) >= sep_min:
+    while j + 1 < n and not vector_norm(s.rel[j] - held) >= sep_min:
         if not np.isfinite(s.rel_speed[j + 1]):
-            sep = float(np.linalg.norm(s.rel[j] - held))
+            sep = vector_norm(s.rel[j] - held)
             if sep >= 0.5 * sep_min and s.rel_speed[j] > 1e-6:
                 back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
                 return max(float(s.t[j]) - back, t_start), False
@@ -70,9 +71,9 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
                 return float(s.t[-1]), True  # tracking lost until the end, nothing moved
             return max(float(s.t[j]) if onset is None else onset, t_start), False
         j += 1
-    if j == n - 1 and not np.linalg.norm(s.rel[j] - held) >= sep_min:
+    if j == n - 1 and not vector_norm(s.rel[j] - held) >= sep_min:
         return float(s.t[-1]), True
-    sep = float(np.linalg.norm(s.rel[j] - held))
+    sep = vector_norm(s.rel[j] - held)
     back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
     return max(float(s.t[j]) - back, t_start, float(s.t[i_h])), False
 
@@ -84,7 +85,7 @@ def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
     if fast.size == 0:
         return None
     i = j + int(fast[0])
-    x = float(np.linalg.norm(s.giver[i] - s.giver[j]))
+    x = vector_norm(s.giver[i] - s.giver[j])
     # Across a tracking gap the motion may have started anywhere in it.
     unseen = float(np.count_nonzero(~np.isfinite(v[: fast[0]]))) / c.analysis_rate
     back = min_jerk_span(x, float(v[fast[0]]), c.max_refine + unseen)

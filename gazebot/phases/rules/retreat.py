@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals
+from gazebot.phases.filtering import Signals, nanargmax, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -32,7 +32,7 @@ def rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> tuple[float, boo
     i_r = lo + int(fast[0]) + (int(rest[0]) if rest.size else tail.size - 1)
     moving = np.flatnonzero(s.giver_speed[lo + int(fast[0]) : i_r + 1] >= c.reach_onset_speed)
     i_c = lo + int(fast[0]) + int(moving[-1])
-    x = float(np.linalg.norm(s.giver[i_r] - s.giver[i_c]))
+    x = vector_norm(s.giver[i_r] - s.giver[i_c])
     fwd = min_jerk_span(x, float(s.giver_speed[i_c]), c.max_refine)
     seen = rest.size > 0 or hi < s.t.shape[0] - 1
     return min(float(s.t[i_c]) + fwd, float(s.t[hi])), seen
@@ -100,10 +100,10 @@ def _landing(s: Signals, c: PhaseConfig, i0: int, t_release: float) -> float | N
     ok = np.isfinite(v)
     if not ok.any():
         return None
-    k = int(np.nanargmax(v))
+    k = nanargmax(v)
     peak = float(v[k])
     last = int(np.flatnonzero(ok)[-1])
-    moved = float(np.linalg.norm(s.giver[i0 + last] - s.giver[i0]))
+    moved = vector_norm(s.giver[i0 + last] - s.giver[i0])
     if peak < c.reach_onset_speed or last <= k or not moved >= c.min_approach:
         return None
     if not v[last] < c.done_fraction * peak:

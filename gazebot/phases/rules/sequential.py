@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
+from gazebot.phases.filtering import median, vector_norm
 from gazebot.phases.rules.directed import _fit, noise_floor
 from gazebot.phases.trajectory import Trajectory
 
@@ -129,13 +130,13 @@ def reach_evidence(
     best_fidget = float(fidget.max())
     rss0 = float(np.einsum("ij,ij->", x - mean_x, x - mean_x))
     dof = max(3 * n - 7, 1)
-    norm = float(np.linalg.norm(prod[k]))
+    norm = vector_norm(prod[k])
     amp = m_reach[k] * prod[k] / norm if norm > 0 else np.zeros(3)
     # The grids' own resolution: an onset off by half a step misplaces a motion moving at
     # speed v by up to v step / 2 (uniform: / sqrt 3), noise or not (with none, the fits'
     # tiny misfits alone would otherwise decide).
     s_now = min((now - float(onsets[k[0]])) / float(durations[k[1]]), 1.0)
-    speed = float(np.linalg.norm(amp)) * 30.0 * s_now**2 * (1.0 - s_now) ** 2 / durations[k[1]]
+    speed = vector_norm(amp) * 30.0 * s_now**2 * (1.0 - s_now) ** 2 / durations[k[1]]
     grid = speed * 0.5 * c.sequential_onset_step
     sigma2 = max(noise * noise, (rss0 - float(reach[k])) / dof, grid * grid / 3.0, 1e-12)
     rest = mean_x - amp * mean_b[k]
@@ -176,7 +177,7 @@ def sequential_reach(
     # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
     steps = np.diff(t_all[win])
     recent = t_all[win][1:] >= now - c.predict_window
-    step = float(np.median(steps))
+    step = median(steps)
     if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
         return None
     # A fidget fits any cubic start up to its midpoint: a hand not yet half the largest fidget
@@ -188,7 +189,7 @@ def sequential_reach(
     if rest.size:
         moved = g[last].mean(axis=0) - g[rest].mean(axis=0)
         toward = float(moved @ (r[-1] - g[rest].mean(axis=0)))
-        if np.linalg.norm(moved) < 0.5 * c.fidget_amplitude or toward <= 0.0:
+        if vector_norm(moved) < 0.5 * c.fidget_amplitude or toward <= 0.0:
             return None
     noise = noise_floor(g[idx[tv <= now - c.sequential_window]])
     # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted
@@ -207,14 +208,14 @@ def sequential_reach(
         return None
     # Toward the receiver: the fitted reach within acos(predict_cos) of the line to its hand.
     line = r[-1] - ev.rest
-    gap = float(np.linalg.norm(line))
-    amp = float(np.linalg.norm(ev.amplitude))
+    gap = vector_norm(line)
+    amp = vector_norm(ev.amplitude)
     if gap <= 1e-6 or amp <= 0 or float(ev.amplitude @ line) < c.predict_cos * amp * gap:
         return None
     # ... and, extrapolated predict_horizon ahead, closes a share of the gap the hands started
     # from.
     h = c.predict_horizon
-    closed = float(np.linalg.norm(r[-1] - ev.rest)) - float(np.linalg.norm(r[-1] - g[-1]))
+    closed = vector_norm(r[-1] - ev.rest) - vector_norm(r[-1] - g[-1])
     ahead = closed + v_c * h + 0.5 * max(a_c, 0.0) * h * h
     if not ahead >= c.predict_gap_share * gap:
         return None

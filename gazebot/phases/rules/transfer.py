@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, quantile
+from gazebot.phases.filtering import Signals, nanmax, quantile, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -148,10 +148,10 @@ def is_handover_dip(s: Signals, c: PhaseConfig, lo: int, p: int, a: int) -> bool
     """The dip ``[lo .. p]`` closes ``approach_fraction`` of where the hands started and the
     giver's hand moved (``reach_onset_speed``) before grid index ``a``."""
     d = s.distance
-    top = float(np.nanmax(d[lo : p + 1]))
+    top = float(nanmax(d[lo : p + 1]))
     if top - d[p] < c.approach_fraction * top:
         return False  # the hands paused while still far apart (relative to where they started)
-    return bool(np.nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed)
+    return bool(nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed)
 
 
 def pass_core(
@@ -170,7 +170,7 @@ def pass_core(
     b = p
     while b < hi and near[b + 1]:
         b += 1
-    if b >= n - 1 or not np.nanmax(d[p:], initial=-np.inf) >= d[p] + c.min_approach:
+    if b >= n - 1 or not nanmax(d[p:], initial=-np.inf) >= d[p] + c.min_approach:
         return None  # not yet seen parting
     k = a + int(np.argmin(rs[a : b + 1]))
     if not rs[k] < c.transfer_exit_speed:
@@ -195,12 +195,12 @@ def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
 
 def v_settle_fraction(s: Signals, c: PhaseConfig, lo: int, a: int) -> float:
     """``settle_fraction`` of the approach's peak relative speed (m/s)."""
-    return c.settle_fraction * float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
+    return c.settle_fraction * float(nanmax(s.rel_speed[lo : a + 1], initial=0.0))
 
 
 def settle_speed(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
     """The relative speed below which the approach of the core ``[a, b]`` has stopped (m/s)."""
-    peak = float(np.nanmax(s.rel_speed[lo : a + 1], initial=0.0))
+    peak = float(nanmax(s.rel_speed[lo : a + 1], initial=0.0))
     floor = c.settle_floor_factor * hold_floor(s, c, a, b)
     return min(max(c.settle_fraction * peak, floor), c.transfer_speed_max)
 
@@ -273,7 +273,7 @@ def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
     if seen.size == 0:
         return None
     i = int(seen[-1])
-    x = float(np.linalg.norm(s.rel[a] - s.rel[i]))
+    x = vector_norm(s.rel[a] - s.rel[i])
     v = float(s.rel_speed[i])
     if not (math.isfinite(x) and v > 1e-6):
         return t_a
