@@ -16,6 +16,16 @@ from gazebot.phases.synthetic import min_jerk, rest_recording, synthetic_set
 from gazebot.types import EventKind
 
 
+def _motions(rate: float, seconds: float, seed: int):
+    """Sample times at ``rate``, a noise generator, and ``mj(t0, dur)``: a minimum-jerk 0 -> 1
+    profile from ``t0`` over ``dur`` at those times (a column, to scale a displacement)."""
+    t = np.arange(0.0, seconds, 1.0 / rate)
+
+    def mj(t0: float, dur: float) -> np.ndarray:
+        return min_jerk((t - t0) / dur)[:, None]
+
+    return t, np.random.default_rng(seed), mj
+
 @pytest.mark.parametrize("rate", [30.0, 60.0, 100.0, 120.0, 240.0])
 def test_the_detector_decides_once_per_online_period_at_any_rate(rate):
     c = PhaseConfig()
@@ -61,12 +71,7 @@ def test_a_reach_the_receiver_steps_back_from_ends_and_the_next_approach_is_the_
     # the giver reaches 30 cm (from 1.4 s). The first reach was not the approach: it ends
     # (aborted) once the hands are farther apart than when it began, and the approach is
     # reported as a new reach, not folded into the first.
-    rate = 30.0
-    t = np.arange(0.0, 6.0, 1.0 / rate)
-    rng = np.random.default_rng(0)
-
-    def mj(t0, dur):
-        return min_jerk((t - t0) / dur)[:, None]
+    t, rng, mj = _motions(30.0, 6.0, seed=0)
 
     g = (
         np.array([1.0, 0.0, 1.0])
@@ -110,19 +115,13 @@ def test_a_fidget_the_constant_acceleration_fit_reads_as_accelerating_is_no_reac
     assert reaches == []
 
 
-
 def test_a_reach_that_outlasts_the_analysis_window_is_not_ended_by_a_small_step_back():
     # 120 Hz: the giver reaches slowly (15 cm from 1 s, then 45 cm over 7 s) while the receiver
     # closes 30 cm over 8 s, then steps back 8 cm at 8.8 s. The hands are still ~0.8 m closer
     # than when the reach began, so the reach goes on, although its start has long left the
     # 5 s analysis window (the start distance is the one kept while the window held it; read
     # from the window's first sample instead, the step back looked like a reach taken back).
-    rate = 120.0
-    t = np.arange(0.0, 12.0, 1.0 / rate)
-    rng = np.random.default_rng(1)
-
-    def mj(t0, dur):
-        return min_jerk((t - t0) / dur)[:, None]
+    t, rng, mj = _motions(120.0, 12.0, seed=1)
 
     g = (np.array([1.0, 0.0, 1.0]) + mj(1.0, 0.8) * [-0.15, 0.0, 0.0]
          + mj(1.6, 7.0) * [-0.45, 0.0, 0.0])
