@@ -47,6 +47,7 @@ from gazebot.types import (
     Status,
     TrackingFrame,
     TrackingState,
+    filled,
 )
 
 # Targets the engine fills from tracking each tick; all others come from the robot config.
@@ -207,9 +208,7 @@ class GazeEngine:
         tracking_end = (
             detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
-        # Every field given, so the frozen dataclass is filled directly (see _command).
-        ctx = object.__new__(GazeContext)
-        ctx.__dict__.update(t=t, points=self._points(frame), tracking_end=tracking_end)
+        ctx = filled(GazeContext, t=t, points=self._points(frame), tracking_end=tracking_end)
         try:
             target = self.behavior.target(ctx)
             kind, point = target.kind, target.point
@@ -377,10 +376,8 @@ class GazeEngine:
         self._last_target = (kind, point)
         status: Status = "degraded" if faults or not ok else "ok"
         handover = self.handover
-        # Every field given, so the frozen dataclass is filled directly: its generated
-        # ``__init__`` sets each field through ``object.__setattr__`` (microseconds per tick).
-        cmd = object.__new__(GazeCommand)
-        cmd.__dict__.update(
+        cmd = filled(
+            GazeCommand,
             t=t,
             phase=handover.phase,
             target=kind,

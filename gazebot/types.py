@@ -10,11 +10,24 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 from enum import Enum
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 
 NAN3 = np.full(3, np.nan)
+
+_T = TypeVar("_T")
+
+
+def filled(cls: type[_T], /, **values: Any) -> _T:
+    """An instance of the frozen dataclass ``cls`` with its fields set straight from
+    ``values``: the per-tick stages (engine, controller, behavior, detector, loop) build their
+    values this way, because a frozen dataclass's generated ``__init__`` sets each field through
+    ``object.__setattr__`` (microseconds per tick). No defaults and no checks: the caller
+    passes every field."""
+    obj = object.__new__(cls)
+    obj.__dict__.update(values)
+    return obj
 
 
 def as_point(value: Any) -> np.ndarray:
@@ -249,10 +262,7 @@ class GazeCommand:
         unknown = changes.keys() - _COMMAND_FIELDS
         if unknown:
             raise TypeError(f"GazeCommand has no fields {sorted(unknown)}")
-        new = object.__new__(GazeCommand)
-        new.__dict__.update(self.__dict__)
-        new.__dict__.update(changes)
-        return new
+        return filled(GazeCommand, **{**self.__dict__, **changes})
 
     def is_finite(self) -> bool:
         """True when every joint and eye value (and the time) is finite."""

@@ -88,6 +88,7 @@ from gazebot.types import (
     GazeContext,
     GazeTarget,
     Phase,
+    filled,
 )
 
 _ROOT, _GAZE, _TRACKING = "behavior", "behavior_gaze", "behavior_tracking"
@@ -724,9 +725,7 @@ class BehaviorMachine:
                 return self._held
             return GazeTarget(lost_kind, self._point(lost_kind, ctx))
         kind = self._target_of[self._gaze_leaf[gaze]]
-        # GazeTarget(kind, point) without the frozen dataclass's per-field __setattr__
-        target = object.__new__(GazeTarget)
-        target.__dict__.update(kind=kind, point=self._point(kind, ctx))
+        target = filled(GazeTarget, kind=kind, point=self._point(kind, ctx))
         if kind != lost_kind:
             self._point(lost_kind, ctx)  # keeps the last known face fresh for a tracking loss
         self._last_target = target

@@ -42,6 +42,7 @@ from gazebot.kinematics.shifts import (
     MinJerkTrajectory,
     min_jerk,
 )
+from gazebot.types import filled
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
 _REPLAN_EPS = 1e-6
@@ -240,10 +241,8 @@ class GazeController:
                 self._eyes = (yaw, pitch)
                 self._residual = eyes.residual(yaw, pitch, v)
         names = self._names
-        # Every field given, so the frozen dataclass is filled directly: its generated
-        # ``__init__`` sets each field through ``object.__setattr__`` (microseconds per tick).
-        state = object.__new__(HeadEyeState)
-        state.__dict__.update(
+        state = filled(
+            HeadEyeState,
             head=dict(zip(names, self._q, strict=True)),
             eye_yaw=float(self._eyes[0]),
             eye_pitch=float(self._eyes[1]),

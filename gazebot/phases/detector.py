@@ -57,7 +57,7 @@ from gazebot.phases.segment import Segment, segments_from_events
 from gazebot.phases.trajectory import Trajectory
 from gazebot.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
 from gazebot.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
-from gazebot.types import Event, EventKind, Phase, TrackingFrame
+from gazebot.types import Event, EventKind, Phase, TrackingFrame, filled
 
 
 def _point(p: object) -> np.ndarray:
@@ -331,10 +331,8 @@ class PhaseDetector:
                 self._last_analysis = t  # the first sample, or after a pause: a new grid
             mode = "full"
             if self._trigger is not None:
-                # Every field given, so the frozen dataclass is filled directly (its generated
-                # __init__ sets each field through object.__setattr__: a cost every period).
-                state = object.__new__(OnlineState)
-                state.__dict__.update(
+                state = filled(
+                    OnlineState,
                     phase=self.phase,
                     phase_start=self.phase_start,
                     floor=self._floor,

@@ -44,6 +44,7 @@ from gazebot.types import (
     Phase,
     TrackingFrame,
     TrackingState,
+    filled,
     is_valid_point,
 )
 
@@ -232,11 +233,9 @@ class GazeLoop:
         # Blink times never go back (the engine's t never does either).
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
-        # cmd.replaced(blink=..., distance=..., answers_sample=...) without its field-name
-        # check (these are GazeCommand's fields): this runs every tick.
-        out = object.__new__(GazeCommand)
-        out.__dict__.update(cmd.__dict__, blink=blink, distance=distance, answers_sample=answers)
-        return out
+        # cmd.replaced(...) without its field-name check (these are GazeCommand's fields).
+        return filled(GazeCommand, **{**cmd.__dict__, "blink": blink, "distance": distance,
+                                      "answers_sample": answers})
 
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
