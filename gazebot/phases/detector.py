@@ -168,6 +168,8 @@ class PhaseDetector:
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()
         self._last_full = -math.inf
+        self._state_key: tuple[object, ...] = ()  # the values self._state was made of
+        self._state: OnlineState | None = None
         self._reach_missing_since = math.nan
         self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
@@ -331,16 +333,7 @@ class PhaseDetector:
                 self._last_analysis = t  # the first sample, or after a pause: a new grid
             mode = "full"
             if self._trigger is not None:
-                state = filled(
-                    OnlineState,
-                    phase=self.phase,
-                    phase_start=self.phase_start,
-                    floor=self._floor,
-                    tracking=self.tracking,
-                    joined_late=self._joined_late,
-                    last_full=self._last_full,
-                )
-                mode = self._trigger.decide(t, state)
+                mode = self._trigger.decide(t, self._online_state())
             if mode != "skip":
                 self._last_full = t
                 self._analyse(t, predict_only=mode == "refresh")
@@ -350,6 +343,25 @@ class PhaseDetector:
                 self._done(t, t, "timeout")
         if math.isfinite(self.expected_phase_end):
             self.expected_phase_end = max(self.expected_phase_end, t)
+
+    def _online_state(self) -> OnlineState:
+        """What the trigger reads of the detector: the last one while it holds (these change a
+        few times per handover; a new value costs more than comparing them)."""
+        key = (self.phase, self.phase_start, self._floor, self.tracking, self._joined_late,
+               self._last_full)
+        state = self._state
+        if state is None or key != self._state_key:  # (a NaN not the same object: rebuilt)
+            self._state_key = key
+            self._state = state = filled(
+                OnlineState,
+                phase=self.phase,
+                phase_start=self.phase_start,
+                floor=self._floor,
+                tracking=self.tracking,
+                joined_late=self._joined_late,
+                last_full=self._last_full,
+            )
+        return state
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
         """Gripper / load-share evidence of a frame that carries some (the caller handles a

@@ -221,7 +221,7 @@ def test_suffix_max_is_numpys_fmax_over_the_span() -> None:
     col = rng.normal(size=400)
     col[rng.random(400) < 0.15] = np.nan
     col[100:130] = np.nan  # a span of unknown rows only
-    buf = np.stack([col, col], axis=1)
+    values = col.tolist()
     sm = _SuffixMax()
     first = 0
     base = 0
@@ -233,6 +233,6 @@ def test_suffix_max_is_numpys_fmax_over_the_span() -> None:
             first = int(rng.integers(base, end))  # moves anywhere kept, back too
         if r > 0.97 and first > base:
             base = int(rng.integers(base, first + 1))  # compaction: rows before first dropped
-        got = sm.update(buf[base:], base, first - base, end - base, 1)
+        got = sm.update(values[base:], base, first - base, end - base)
         want = np.fmax.reduce(col[first:end])
         assert got == want or (np.isnan(got) and np.isnan(want)), (first, end)
