@@ -403,7 +403,7 @@ class PhaseDetector:
             # grows with the samples; after a handover, re-analysing it is wasted).
             look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
             back = REACH_S * look
-            i0 = int(np.searchsorted(t, self.phase_start - back))
+            i0 = int(t.searchsorted(self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
         window = rows[i0:]
@@ -415,7 +415,7 @@ class PhaseDetector:
         if s is not None and self.phase is Phase.REACH:
             # Keep the reach's start distance while the window holds it (a reach can outlast
             # the window; the taken-back checks compare with it).
-            self._reach_start_distance(s, np.flatnonzero(np.isfinite(s.distance)))
+            self._reach_start_distance(s, np.isfinite(s.distance).nonzero()[0])
             restart = self._reach_restart()
             if restart is not None:
                 # The reach was an earlier movement (the giver lifted the object, waited, and
@@ -533,14 +533,14 @@ class PhaseDetector:
         s = self._signals
         if s is None or s.t.shape[0] < 3:
             return None
-        i_start = int(np.searchsorted(s.t, self.phase_start))
+        i_start = int(s.t.searchsorted(self.phase_start))
         v = s.giver_speed[i_start:]
         rest = np.isfinite(v) & (v < c.rest_speed)
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
         if need < 1 or rest.size <= need or np.count_nonzero(rest) < need:
             return None  # (no run of need rest samples without need of them in all)
         # the last sample of the last rest at least reach_stall long
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
+        edges = np.diff(np.concatenate([[0], rest.astype(int), [0]])).nonzero()[0]
         bounds = edges.tolist()  # (plain ints: iterating the array would box each element)
         runs = [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
         runs = [(a, b) for a, b in runs if b - a + 1 >= need and b < rest.size - 1]
@@ -565,7 +565,7 @@ class PhaseDetector:
         ``s.distance``): read from ``s`` while its window still holds that moment (and kept),
         else the value kept from the last window that held it; NaN if none did."""
         if s.t.shape[0] and s.t[0] <= self.phase_start:
-            i0 = int(np.searchsorted(s.t, self.phase_start))
+            i0 = int(s.t.searchsorted(self.phase_start))
             before = ok[ok <= i0]
             self._reach_d0 = float(s.distance[before[-1]]) if before.size else math.nan
         return self._reach_d0
@@ -576,7 +576,7 @@ class PhaseDetector:
         s = self._signals
         if s is None or self._joined_late:
             return False
-        ok = np.flatnonzero(np.isfinite(s.distance))
+        ok = np.isfinite(s.distance).nonzero()[0]
         d0 = self._reach_start_distance(s, ok)
         if not ok.size or d0 != d0:
             return False
@@ -589,7 +589,7 @@ class PhaseDetector:
         if s is None or s.t.shape[0] == 0:
             return True
         d = s.distance
-        ok = np.flatnonzero(np.isfinite(d))
+        ok = np.isfinite(d).nonzero()[0]
         if ok.size == 0:
             return True
         if self._joined_late and not (ok.size and s.t[ok[0]] < self.phase_start):

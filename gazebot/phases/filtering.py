@@ -15,6 +15,11 @@ arithmetic, sets the cost. The result is, bit for bit, what the steps give one h
 (``tests/phases/signals_reference.py`` keeps that form and the tests compare the two). Online,
 a :class:`SignalCache` keeps the last result, and the next analysis of the same window a few
 samples longer computes only the rows those samples change (the same result, bit for bit).
+
+Here and in the rules, the arrays' own methods (``a.searchsorted(x)``, ``m.nonzero()[0]``,
+``a.argmax()``) stand for numpy's functions of the same name (``np.searchsorted``,
+``np.flatnonzero``, ``np.argmax``): the same computation without the functions' Python-level
+dispatch, which costs more than the work on these short arrays.
 """
 
 from __future__ import annotations
@@ -85,7 +90,7 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
     previous valid one (``ok``: the valid rows), while the hand moved faster than
     ``moving_speed`` between the two valid samples before."""
     stale = np.zeros(p.shape[0], dtype=bool)
-    idx = np.flatnonzero(ok)
+    idx = ok.nonzero()[0]
     if idx.size < 3:
         return stale
     pv = p[idx]
@@ -111,13 +116,13 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
 def _far_from_samples(tv: np.ndarray, grid: np.ndarray, bar: float) -> np.ndarray:
     """Grid points inside a gap longer than ``bar`` between the valid sample times ``tv`` (or
     outside them), unless the point is a sample itself."""
-    j = np.searchsorted(tv, grid, side="right")
+    j = tv.searchsorted(grid, side="right")
     gap = np.full(grid.shape[0], np.inf)
     inside = (j > 0) & (j < tv.shape[0])
     ji = j[inside]
     gap[inside] = tv[ji] - tv[ji - 1]
     # grid points that are samples (both sorted: a searchsorted, not np.isin's sort)
-    k = np.minimum(np.searchsorted(tv, grid), tv.shape[0] - 1)
+    k = np.minimum(tv.searchsorted(grid), tv.shape[0] - 1)
     return (gap > bar) & (tv[k] != grid)
 
 
@@ -136,8 +141,8 @@ def resample(
     if float(np.max(np.diff(tv))) <= bar:
         # No gap between the samples is that long (the usual case): only the grid points
         # before the first sample or after the last one are far from them.
-        out[: int(np.searchsorted(grid, tv[0], side="left"))] = np.nan
-        out[int(np.searchsorted(grid, tv[-1], side="right")) :] = np.nan
+        out[: int(grid.searchsorted(tv[0], side="left"))] = np.nan
+        out[int(grid.searchsorted(tv[-1], side="right")) :] = np.nan
     else:
         out[_far_from_samples(tv, grid, bar)] = np.nan
     return out
@@ -259,10 +264,10 @@ def vector_norm(v: np.ndarray) -> float:
     return math.sqrt(float(x.dot(x)))
 
 
-def _norms(x: np.ndarray) -> np.ndarray:
+def row_norms(x: np.ndarray) -> np.ndarray:
     """Row norms of real (N, 3) ``x``: what ``np.linalg.norm(x, axis=1)`` computes (the squares
     summed in its order, pinned by the tests against it), column by column: numpy's reduction
-    over a length-3 axis costs more than the three columns."""
+    over a length-3 axis (and its argument handling) costs more than the three columns."""
     return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])
 
 
@@ -274,7 +279,7 @@ def _derived(
     distance, rel_speed, giver_speed, receiver_speed, closing, common_speed, hold_speed``, row
     by row (a row's values depend on that row alone)."""
     gv, rv = v[:, :3], v[:, 3:]
-    # The five vectors whose norms are needed, in one block: what _norms computes for each,
+    # The five vectors whose norms are needed, in one block: what row_norms computes for each,
     # in a few numpy calls instead of six per vector.
     q = np.empty((5, x.shape[0], 3))
     rel, rel_v = q[0], q[1]
@@ -489,7 +494,7 @@ class SignalCache:
         n0 = self._t.shape[0]
         fin = np.isfinite(p[n0:])
         seen_new = fin[:, 0] & fin[:, 1] & fin[:, 2]
-        rows = np.flatnonzero(seen_new) + n0
+        rows = seen_new.nonzero()[0] + n0
         before = self._last_seen[hand]
         if before >= 0:
             rows = np.concatenate(([before], rows))
@@ -543,11 +548,11 @@ class SignalCache:
         if self._clean:
             last_valid = float(self._t[-1])
         else:
-            k_g, k_r = np.flatnonzero(self._ok[:, 0]), np.flatnonzero(self._ok[:, 1])
+            k_g, k_r = self._ok[:, 0].nonzero()[0], self._ok[:, 1].nonzero()[0]
             if k_g.size < 2 or k_r.size < 2:
                 return None  # (a hand with fewer was all unknown: its first rows change too)
             last_valid = float(self._t[min(int(k_g[-1]), int(k_r[-1]))])
-        j_c = int(np.searchsorted(self._grid, last_valid, side="right"))
+        j_c = int(self._grid.searchsorted(last_valid, side="right"))
         a = j_c - radius  # first smoothed row that changes
         # (scipy's correlation of a line that starts at row i0 equals the whole line's only
         # from row i0 + radius + 1 on: the slice starts one row earlier than the kernel needs)
@@ -559,7 +564,7 @@ class SignalCache:
         xr = np.empty((gs.shape[0], 6))
         bar = config.max_gap_hold + 1e-9
         if clean:
-            i_s = max(int(np.searchsorted(t, gs[0], side="right")) - 1, 0)
+            i_s = max(int(t.searchsorted(gs[0], side="right")) - 1, 0)
             ts = t[i_s:]
             for k in range(3):
                 xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
@@ -567,9 +572,9 @@ class SignalCache:
             if ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
                 xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
             else:
-                xr[int(np.searchsorted(gs, t[-1], side="right")) :] = np.nan
+                xr[int(gs.searchsorted(t[-1], side="right")) :] = np.nan
         else:
-            i_t = int(np.searchsorted(t, gs[0], side="right")) - 1  # the sample at or before
+            i_t = int(t.searchsorted(gs[0], side="right")) - 1  # the sample at or before
             for hand, p_in in enumerate((g_in, r_in)):
                 ok_old = self._ok[:, hand]
                 i_s = min(i_t, n0 - 1)

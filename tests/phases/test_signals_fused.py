@@ -236,3 +236,17 @@ def test_suffix_max_is_numpys_fmax_over_the_span() -> None:
         got = sm.update(values[base:], base, first - base, end - base)
         want = np.fmax.reduce(col[first:end])
         assert got == want or (np.isnan(got) and np.isnan(want)), (first, end)
+
+
+def test_row_norms_are_numpys_row_norms() -> None:
+    """``row_norms`` (the rules' per-row 3-vector norms, column by column) equals
+    ``np.linalg.norm(x, axis=1)`` bit for bit, NaN and infinite entries and extreme scales too."""
+    from gazebot.phases.filtering import row_norms
+
+    rng = np.random.default_rng(5)
+    for scale in (1e-160, 1e-3, 1.0, 1e3, 1e160):
+        x = rng.normal(size=(20000, 3)) * scale
+        x[rng.random(x.shape) < 0.01] = np.nan
+        x[rng.random(x.shape) < 0.005] = np.inf
+        with np.errstate(over="ignore"):  # (1e160 squared overflows in both)
+            np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=1))
