@@ -163,7 +163,7 @@ class PhaseDetector:
         self._signals: Signals | None = None
         # The last analysis's signals, so the next one (on the same window, a few samples
         # longer) computes only the rows the new samples change.
-        self._signal_cache = SignalCache()
+        self._signal_cache = SignalCache(append_only=True)
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()

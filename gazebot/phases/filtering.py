@@ -33,6 +33,7 @@ from scipy.ndimage import correlate1d, gaussian_filter1d
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.trajectory import Trajectory
+from gazebot.types import filled
 
 # Share of the smoothing window that must hold data for a velocity to be known.
 FULL_WINDOW = 0.6
@@ -271,30 +272,48 @@ def row_norms(x: np.ndarray) -> np.ndarray:
     return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])
 
 
+def _derived_into(
+    x: np.ndarray,
+    v: np.ndarray,
+    q: np.ndarray,
+    norms: np.ndarray,
+    closing: np.ndarray,
+    common: np.ndarray,
+    hold: np.ndarray,
+) -> None:
+    """From smoothed positions ``x`` and velocities ``v`` (rows, both hands), row by row (a
+    row's values depend on that row alone), written into: ``q`` (5, rows, 3) the relative
+    position, relative velocity, giver's and receiver's velocities and their sum; ``norms``
+    (5, rows) their norms (distance, relative speed, giver speed, receiver speed, and twice the
+    common speed); ``closing``, ``common`` and ``hold`` (rows,) the closing, common and hold
+    speeds (see :class:`Signals`). Each ``q[i]`` must be contiguous (as the einsum reads it)."""
+    gv, rv = v[:, :3], v[:, 3:]
+    # The five vectors whose norms are needed, in one block: what row_norms computes for each,
+    # in a few numpy calls instead of six per vector.
+    np.subtract(x[:, 3:], x[:, :3], out=q[0])
+    np.subtract(rv, gv, out=q[1])
+    q[2] = gv
+    q[3] = rv
+    np.add(gv, rv, out=q[4])
+    sq = q * q
+    np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2], out=norms)
+    np.multiply(0.5, norms[4], out=common)
+    np.negative(np.einsum("ij,ij->i", q[1], q[0]), out=closing)
+    np.divide(closing, np.maximum(norms[0], 1e-9), out=closing)
+    np.maximum(np.abs(closing), norms[1] - np.minimum(norms[2], norms[3]), out=hold)
+
+
 def _derived(
     x: np.ndarray, v: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
            np.ndarray, np.ndarray]:
     """From smoothed positions ``x`` and velocities ``v`` (rows, both hands): ``rel, rel_v,
-    distance, rel_speed, giver_speed, receiver_speed, closing, common_speed, hold_speed``, row
-    by row (a row's values depend on that row alone)."""
-    gv, rv = v[:, :3], v[:, 3:]
-    # The five vectors whose norms are needed, in one block: what row_norms computes for each,
-    # in a few numpy calls instead of six per vector.
-    q = np.empty((5, x.shape[0], 3))
-    rel, rel_v = q[0], q[1]
-    np.subtract(x[:, 3:], x[:, :3], out=rel)
-    np.subtract(rv, gv, out=rel_v)
-    q[2] = gv
-    q[3] = rv
-    np.add(gv, rv, out=q[4])
-    sq = q * q
-    norms = np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2])
-    distance, rel_speed, g_speed, r_speed = norms[0], norms[1], norms[2], norms[3]
-    common = 0.5 * norms[4]
-    closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
-    hold = np.maximum(np.abs(closing), rel_speed - np.minimum(g_speed, r_speed))
-    return rel, rel_v, distance, rel_speed, g_speed, r_speed, closing, common, hold
+    distance, rel_speed, giver_speed, receiver_speed, closing, common_speed, hold_speed``
+    (:func:`_derived_into`, into new arrays)."""
+    rows = x.shape[0]
+    q, norms, speeds = np.empty((5, rows, 3)), np.empty((5, rows)), np.empty((3, rows))
+    _derived_into(x, v, q, norms, speeds[0], speeds[1], speeds[2])
+    return q[0], q[1], norms[0], norms[1], norms[2], norms[3], speeds[0], speeds[1], speeds[2]
 
 
 def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
@@ -313,7 +332,10 @@ def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
 
 
 def compute_signals(
-    trajectory: Trajectory, config: PhaseConfig, cache: SignalCache | None = None
+    trajectory: Trajectory,
+    config: PhaseConfig,
+    cache: SignalCache | None = None,
+    until: float = math.inf,
 ) -> Signals:
     """Frozen samples out, resample, smooth and differentiate the hands of ``trajectory``
     (sorted by time, see :meth:`Trajectory.cleaned`).
@@ -321,9 +343,10 @@ def compute_signals(
     ``cache``: an online caller's :class:`SignalCache`: when ``trajectory`` extends the one of
     the previous call (the same samples, more at the end), only the rows the new samples can
     change are computed; the result is the same, bit for bit. Its arrays are then read-only
-    views, valid until the cache's next call."""
+    views, valid until the cache's next call. ``until``: only the grid rows at or before this
+    time are returned (views of the whole result's first rows)."""
     if cache is not None:
-        s = cache.extend(trajectory, config)
+        s = cache.extend(trajectory, config, until)
         if s is not None:
             return s
     t = trajectory.t
@@ -381,17 +404,27 @@ def compute_signals(
     )
     if cache is not None:
         cache.keep(trajectory, config, s, x, v, full, sigma_s / dt, seen, ok)
+    if until < math.inf:
+        s = _first_rows(s, int(grid.searchsorted(until, side="right")))
     return s
 
 
-# The columns a SignalCache keeps per grid row, beside the grid: name -> columns (1: a vector).
-_KEPT = {
-    "x": 6, "v": 6, "full": 2, "rel": 3, "rel_v": 3, "distance": 1, "rel_speed": 1,
-    "giver_speed": 1, "receiver_speed": 1, "closing": 1, "common_speed": 1, "hold_speed": 1,
+def _first_rows(s: Signals, rows: int) -> Signals:
+    """The first ``rows`` grid rows of ``s`` (views)."""
+    return filled(Signals, **{name: a[:rows] for name, a in vars(s).items()})
+
+
+# The per-row blocks a SignalCache keeps beside the grid: name -> row shape (one row per grid
+# row; the derived blocks are laid out as _derived_into writes them).
+_BLOCKS = {"x": (6,), "v": (6,), "full": (2,), "q": (5, 3), "norms": (5,), "speeds": (3,)}
+# Where each Signals field derived from the rows sits: (block, index in the block's first axis).
+_IN_BLOCK = {
+    "rel": ("q", 0), "rel_v": ("q", 1), "distance": ("norms", 0), "rel_speed": ("norms", 1),
+    "giver_speed": ("norms", 2), "receiver_speed": ("norms", 3), "closing": ("speeds", 0),
+    "common_speed": ("speeds", 1), "hold_speed": ("speeds", 2),
 }
-# The order _derived returns its arrays in.
-_DERIVED = ("rel", "rel_v", "distance", "rel_speed", "giver_speed", "receiver_speed", "closing",
-            "common_speed", "hold_speed")
+# The blocks _derived_into writes, laid out (block axis, rows, ...).
+_DERIVED_BLOCKS = ("q", "norms", "speeds")
 
 
 class SignalCache:
@@ -407,24 +440,34 @@ class SignalCache:
 
     A full computation starts the cache afresh when the window does not extend the last one
     (its first sample or an older sample changed), the smoothing width changed, or a hand has
-    no valid sample before the rows to recompute."""
+    no valid sample before the rows to recompute.
 
-    def __init__(self) -> None:
+    ``append_only``: the caller's windows are all cut from one stream of samples that only
+    grows at its end (the online detector's): a window with the kept first sample's time and
+    more samples then holds the kept samples unchanged, so they are not compared (nor kept).
+    """
+
+    def __init__(self, append_only: bool = False) -> None:
+        self._append_only = append_only
         self._config: PhaseConfig | None = None  # None: nothing kept
-        self._t = np.empty(0)  # the samples the kept signals came from
+        self._n = 0  # samples kept
+        self._t_first = self._t_last = math.nan  # their first and last times
+        self._t = np.empty(0)  # the samples the kept signals came from (unless append_only)
         self._g = np.empty((0, 3))
         self._r = np.empty((0, 3))
-        self._seen = np.empty((0, 2), dtype=bool)  # per sample and hand: every coordinate
-        self._ok = np.empty((0, 2), dtype=bool)  # ... and not a stale repeat
-        self._clean = False  # every sample kept seen and valid (the interpolation's fast path)
+        # per sample and hand: every coordinate seen, and also not a stale repeat; None while
+        # every sample kept is both (_clean: the interpolation's fast path)
+        self._seen: np.ndarray | None = None
+        self._ok: np.ndarray | None = None
+        self._clean = False
         self._last_seen = [-1, -1]  # per hand: the last sample kept that was seen (-1: none)
         self._max_dt = 0.0
         self._sigma = 0.0
         self._grid = np.empty(0)
         self._rows = 0  # grid rows kept
-        self._buf: dict[str, np.ndarray] = {}
-        self._read_only: dict[str, np.ndarray] = {}  # read-only views of the owned buffers
-        self._owned = False  # the buffers are this cache's (else: a returned result's arrays)
+        self._buf: dict[str, np.ndarray] = {}  # the blocks (owned, or a full result's arrays)
+        self._owned = False  # the blocks are this cache's (else: a returned result's arrays)
+        self._read_only: dict[str, np.ndarray] = {}  # read-only views: the results' fields
 
     def keep(
         self,
@@ -448,19 +491,21 @@ class SignalCache:
             self._config = None
             return
         self._config = config
-        self._t = t.copy()
-        self._g = trajectory.giver_hand.copy()
-        self._r = trajectory.receiver_hand.copy()
-        self._seen, self._ok = seen, ok
+        self._n = t.shape[0]
+        self._t_first, self._t_last = float(t[0]), float(t[-1])
+        if not self._append_only:
+            self._t = t.copy()
+            self._g = trajectory.giver_hand.copy()
+            self._r = trajectory.receiver_hand.copy()
         self._clean = bool(ok.all())
+        self._seen, self._ok = (None, None) if self._clean else (seen, ok)
         self._last_seen = [self._last_of(seen[:, h]) for h in (0, 1)]
         self._max_dt = float(np.max(np.diff(t)))
         self._sigma = sigma
         self._grid = s.t
         self._rows = s.t.shape[0]
         self._buf = {"x": x, "v": v, "full": full}
-        for name in _DERIVED:
-            self._buf[name] = getattr(s, name)
+        self._buf.update({name: getattr(s, name) for name in _IN_BLOCK})
         self._owned = False
 
     @staticmethod
@@ -471,10 +516,21 @@ class SignalCache:
             i -= 1
         return i
 
+    def _masks(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per sample kept and hand: seen, and valid (all True while the cache is clean)."""
+        if self._seen is None or self._ok is None:
+            every = np.ones((self._n, 2), dtype=bool)
+            return every, every
+        return self._seen, self._ok
+
     def _same_prefix(self, t: np.ndarray, g: np.ndarray, r: np.ndarray) -> bool:
         """The first samples of ``t``, ``g``, ``r`` are the ones kept, bit for bit (NaN too)."""
-        n0 = self._t.shape[0]
-        if t[0] != self._t[0] or not (t[:n0] == self._t).all():
+        n0 = self._n
+        if t[0] != self._t_first or t[n0 - 1] != self._t_last:
+            return False
+        if self._append_only:
+            return True  # (the same first sample of one growing stream: the same samples)
+        if not (t[:n0] == self._t).all():
             return False
         if self._clean:  # (no NaN kept: value equality is enough)
             return bool((g[:n0] == self._g).all() and (r[:n0] == self._r).all())
@@ -491,7 +547,7 @@ class SignalCache:
         """Which of the new samples of one hand (``p``: all its samples) are seen, and which
         of those are not stale repeats (:func:`drop_frozen`, whose decisions run in time
         order: run on the whole window only when a new seen sample repeats the one before)."""
-        n0 = self._t.shape[0]
+        n0 = self._n
         fin = np.isfinite(p[n0:])
         seen_new = fin[:, 0] & fin[:, 1] & fin[:, 2]
         rows = seen_new.nonzero()[0] + n0
@@ -501,18 +557,21 @@ class SignalCache:
         q = p[rows]
         if rows.size < 2 or not (q[1:] == q[:-1]).all(axis=1).any():
             return seen_new, seen_new
-        seen_all = np.concatenate((self._seen[:, hand], seen_new))
+        seen_all = np.concatenate((self._masks()[0][:, hand], seen_new))
         stale = drop_frozen(t, p, frozen_speed, seen_all)[n0:]
         return seen_new, seen_new & ~stale
 
-    def extend(self, trajectory: Trajectory, config: PhaseConfig) -> Signals | None:
+    def extend(
+        self, trajectory: Trajectory, config: PhaseConfig, until: float = math.inf
+    ) -> Signals | None:
         """The signals of ``trajectory`` if it extends the samples kept (see the class
-        docstring), else ``None`` (the caller computes them in full)."""
+        docstring), else ``None`` (the caller computes them in full); ``until``: see
+        :func:`compute_signals`."""
         if self._config is None or (config is not self._config and config != self._config):
             return None
         t = trajectory.t
         g_in, r_in = trajectory.giver_hand, trajectory.receiver_hand
-        n, n0 = t.shape[0], self._t.shape[0]
+        n, n0 = t.shape[0], self._n
         if n <= n0 or not self._same_prefix(t, g_in, r_in):
             return None
         # The new samples: seen and valid per hand. The usual case, every one seen and none
@@ -524,13 +583,13 @@ class SignalCache:
             and math.isfinite(float(tail.sum()))
             and not (tail[1:] == tail[:-1]).any()
         )
-        if clean:
-            seen_new = ok_new = np.ones((n - n0, 2), dtype=bool)
-        else:
+        if not clean:
             sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
             sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
             seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
-        max_dt = max(self._max_dt, float((t[n0:] - t[n0 - 1 : -1]).max()))
+        # (few new samples: their largest step in plain floats)
+        new_t = t[n0 - 1 :].tolist()
+        max_dt = max(self._max_dt, max(b - a for a, b in zip(new_t, new_t[1:], strict=False)))
         dt = 1.0 / config.analysis_rate
         # The smoothing width: half the median sample interval only counts when it exceeds
         # half the smoothing, which needs an interval that long.
@@ -546,12 +605,13 @@ class SignalCache:
         # the first grid row past the last valid sample kept of either hand: NaN before, or
         # beyond the kept grid
         if self._clean:
-            last_valid = float(self._t[-1])
+            last_valid = self._t_last
         else:
-            k_g, k_r = self._ok[:, 0].nonzero()[0], self._ok[:, 1].nonzero()[0]
+            ok_old = self._masks()[1]
+            k_g, k_r = ok_old[:, 0].nonzero()[0], ok_old[:, 1].nonzero()[0]
             if k_g.size < 2 or k_r.size < 2:
                 return None  # (a hand with fewer was all unknown: its first rows change too)
-            last_valid = float(self._t[min(int(k_g[-1]), int(k_r[-1]))])
+            last_valid = float(t[min(int(k_g[-1]), int(k_r[-1]))])
         j_c = int(self._grid.searchsorted(last_valid, side="right"))
         a = j_c - radius  # first smoothed row that changes
         # (scipy's correlation of a line that starts at row i0 equals the whole line's only
@@ -575,14 +635,15 @@ class SignalCache:
                 xr[int(gs.searchsorted(t[-1], side="right")) :] = np.nan
         else:
             i_t = int(t.searchsorted(gs[0], side="right")) - 1  # the sample at or before
+            ok_old = self._masks()[1]
             for hand, p_in in enumerate((g_in, r_in)):
-                ok_old = self._ok[:, hand]
+                ok_hand = ok_old[:, hand]
                 i_s = min(i_t, n0 - 1)
-                while i_s >= 0 and not ok_old[i_s]:  # the valid sample at or before the rows
+                while i_s >= 0 and not ok_hand[i_s]:  # the valid sample at or before the rows
                     i_s -= 1
                 if i_s < 0:
                     return None  # (none: the rows were unknown and may not stay so)
-                valid = np.concatenate((ok_old[i_s:], ok_new[:, hand]))
+                valid = np.concatenate((ok_hand[i_s:], ok_new[:, hand]))
                 tv, pv = t[i_s:][valid], p_in[i_s:][valid]
                 cols = slice(3 * hand, 3 * hand + 3)
                 for k in range(3):
@@ -603,41 +664,56 @@ class SignalCache:
         np.divide(vt[:-1], 2.0 * dt, out=vt[:-1])
         vt[-1] = (x[rows - 1] - x[rows - 2]) / dt
         vt.reshape(vt.shape[0], 2, 3)[b["full"][a - 1 : rows] < FULL_WINDOW] = np.nan
-        for name, arr in zip(_DERIVED, _derived(x[a - 1 : rows], b["v"][a - 1 : rows]),
-                             strict=True):
-            b[name][a - 1 : rows] = arr
-        self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
-        self._seen = np.concatenate((self._seen, seen_new))
-        self._ok = np.concatenate((self._ok, ok_new))
-        if not clean:
-            self._last_seen = [self._last_of(self._seen[:, h]) for h in (0, 1)]
-        else:
+        sp = b["speeds"][:, a - 1 : rows]
+        _derived_into(x[a - 1 : rows], vt, b["q"][:, a - 1 : rows], b["norms"][:, a - 1 : rows],
+                      sp[0], sp[1], sp[2])
+        if not self._append_only:
+            self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
+        if clean:
             self._last_seen = [n - 1, n - 1]
+        else:
+            seen_old, ok_old = self._masks()
+            self._seen = np.concatenate((seen_old, seen_new))
+            self._ok = np.concatenate((ok_old, ok_new))
+            self._last_seen = [self._last_of(self._seen[:, h]) for h in (0, 1)]
+        self._n, self._t_last = n, new_t[-1]
         self._clean = clean
         self._max_dt = max_dt
         self._grid, self._rows = grid, rows
+        keep = rows if until == math.inf else int(grid.searchsorted(until, side="right"))
         ro = self._read_only
-        xv, vv = ro["x"][:rows], ro["v"][:rows]
-        rel, rel_v, dist, rel_s, g_s, r_s, closing, common, hold = (
-            ro[name][:rows] for name in _DERIVED
-        )
-        return Signals(
-            grid, xv[:, :3], xv[:, 3:], vv[:, :3], vv[:, 3:], rel, rel_v, dist, rel_s, g_s,
-            r_s, closing, common, hold,
+        xv, vv = ro["x"][:keep], ro["v"][:keep]
+        return filled(
+            Signals,
+            t=grid[:keep],
+            giver=xv[:, :3],
+            receiver=xv[:, 3:],
+            giver_v=vv[:, :3],
+            receiver_v=vv[:, 3:],
+            **{name: ro[name][:keep] for name in _IN_BLOCK},
         )
 
     def _reserve(self, rows: int, keep: int) -> None:
-        """Buffers of at least ``rows`` rows, owned by the cache, holding the first ``keep``
+        """Blocks of at least ``rows`` rows, owned by the cache, holding the first ``keep``
         rows kept."""
-        b = self._buf
-        if self._owned and b["x"].shape[0] >= rows:
+        if self._owned and self._buf["x"].shape[0] >= rows:
             return
         cap = max(2 * rows, 256)
-        new, ro = {}, {}
-        for name, cols in _KEPT.items():
-            arr = np.empty((cap, cols) if cols > 1 else cap)
-            arr[:keep] = b[name][:keep]
-            new[name] = arr
-            ro[name] = arr.view()
-            ro[name].flags.writeable = False  # (the results' views: read-only)
+        old = {**self._buf, **self._read_only} if self._owned else self._buf
+        new: dict[str, np.ndarray] = {}
+        for name, shape in _BLOCKS.items():
+            # (the row axis after the block axis, so each field's rows are contiguous)
+            new[name] = np.empty((shape[0], cap, *shape[1:]) if name in _DERIVED_BLOCKS
+                                 else (cap, *shape))
+        ro: dict[str, np.ndarray] = {}
+        for name in ("x", "v", "full"):
+            new[name][:keep] = old[name][:keep]
+            ro[name] = new[name].view()
+        for name, (block, i) in _IN_BLOCK.items():
+            field = new[block][i]
+            field[:keep] = old[name][:keep]
+            ro[name] = field.view()
+        for view in ro.values():
+            view.flags.writeable = False  # (the results' views: read-only)
         self._buf, self._read_only, self._owned = new, ro, True
+

@@ -13,6 +13,7 @@ import pytest
 import gazebot.phases.methods.gazebot as gazebot_method
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.detector import run_online
+from gazebot.phases.filtering import Signals
 from gazebot.phases.synthetic import (
     SyntheticOptions,
     case_set,
@@ -82,6 +83,12 @@ def _events(traj: Trajectory, config: PhaseConfig) -> tuple[list[tuple], str]:
     )
 
 
+def _first_rows(s: Signals, until: float) -> Signals:
+    """The grid rows of ``s`` at or before ``until`` (the edge guard's cut, in full)."""
+    keep = int(np.searchsorted(s.t, until, side="right"))
+    return Signals(*[np.array(a[:keep]) for a in vars(s).values()])
+
+
 @pytest.fixture(scope="module")
 def recordings() -> list[Trajectory]:
     return _recordings()
@@ -94,7 +101,9 @@ def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monk
     monkeypatch.setattr(
         gazebot_method,
         "compute_signals",
-        lambda traj, config, cache=None: reference_signals(traj, config),
+        lambda traj, config, cache=None, until=np.inf: _first_rows(
+            reference_signals(traj, config), until
+        ),
     )
     monkeypatch.setattr(
         gazebot_method.GazebotSegmenter, "trigger", lambda self: ReferenceTrigger(self.config)

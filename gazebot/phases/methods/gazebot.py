@@ -44,15 +44,12 @@ class GazebotSegmenter(Segmenter):
         ``cache``: see :func:`~gazebot.phases.filtering.compute_signals`)."""
         if len(trajectory) < 3:
             return None
-        s = compute_signals(trajectory, self.config, cache)
-        if partial and self.config.edge_guard > 0:
-            # (the grid is sorted: the samples kept are a prefix, taken as views)
-            cut = float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
-            keep = int(s.t.searchsorted(cut, side="right"))
-            if keep < 3:
-                return None
-            s = Signals(*[a[:keep] for a in vars(s).values()])  # (fields in order)
-        return s
+        if not (partial and self.config.edge_guard > 0):
+            return compute_signals(trajectory, self.config, cache)
+        # (the grid is sorted: the rows kept are a prefix, taken as views)
+        cut = float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
+        s = compute_signals(trajectory, self.config, cache, until=cut)
+        return s if s.t.shape[0] >= 3 else None
 
     # ---- online hooks
     def trigger(self) -> OnlineTrigger:
