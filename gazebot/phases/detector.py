@@ -59,11 +59,13 @@ from gazebot.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
 from gazebot.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
 from gazebot.types import Event, EventKind, Phase, TrackingFrame, filled
 
+_F64 = np.dtype(np.float64)
+
 
 def _point(p: object) -> np.ndarray:
     """A point as a float 3-vector (NaNs if it is not a numeric 3-vector)."""
-    if type(p) is np.ndarray and p.dtype == np.float64 and p.shape == (3,):
-        return p  # the usual case (the engine's frames): no conversion
+    if type(p) is np.ndarray and p.dtype is _F64 and p.shape == (3,):
+        return p  # the usual case (the engine's frames): no conversion (an identity check)
     try:
         v = np.asarray(p, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -73,28 +75,23 @@ def _point(p: object) -> np.ndarray:
 
 class _Samples:
     """The samples kept (rows ``[t, giver xyz, receiver xyz]``) in one array that grows and is
-    compacted in place: the analysis reads them as views, with no per-sample conversion."""
+    compacted in place: the analysis reads them as views, with no per-sample conversion. A new
+    sample waits in a list until the rows are read (a list append per sample; one conversion
+    of the few new rows per analysis)."""
 
     def __init__(self) -> None:
         self._buf = np.empty((256, 7))
         self._s0 = self._s1 = 0
+        self._new: list[tuple[float, ...]] = []  # the newest rows, not yet in _buf
         self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
 
     def __len__(self) -> int:
-        return self._s1 - self._s0
+        return self._s1 - self._s0 + len(self._new)
 
-    def append(self, row: list[float]) -> None:
-        buf = self._buf
-        if self._s1 == buf.shape[0]:
-            m = self._s1 - self._s0
-            if 2 * m > buf.shape[0]:
-                self._buf = np.empty((2 * buf.shape[0], 7))
-            self._buf[:m] = buf[self._s0 : self._s1]
-            buf, self._s0, self._s1 = self._buf, 0, m
-        buf[self._s1] = row
-        if self._s1 == self._s0:
+    def append(self, row: tuple[float, ...]) -> None:
+        if self._s1 == self._s0 and not self._new:
             self._first_t = row[0]
-        self._s1 += 1
+        self._new.append(row)
 
     def drop_before(self, t0: float) -> None:
         """Forget the samples older than ``t0``."""
@@ -104,14 +101,37 @@ class _Samples:
         while i < end and buf[i, 0] < t0:
             i += 1
         self._s0 = i
-        self._first_t = float(buf[i, 0]) if i < end else math.inf
+        if i < end:
+            self._first_t = float(buf[i, 0])
+            return
+        new = self._new  # (every row in the array is gone: the new rows next)
+        k = 0
+        while k < len(new) and new[k][0] < t0:
+            k += 1
+        del new[:k]
+        self._first_t = new[0][0] if new else math.inf
 
     def time(self, i: int) -> float:
         """Time of the ``i``-th sample kept."""
-        return float(self._buf[self._s0 + i, 0])
+        m = self._s1 - self._s0
+        return float(self._buf[self._s0 + i, 0]) if i < m else self._new[i - m][0]
 
     def rows(self) -> np.ndarray:
         """The samples kept (a view: valid until the next :meth:`append`)."""
+        new = self._new
+        if new:
+            k, buf = len(new), self._buf
+            if self._s1 + k > buf.shape[0]:
+                m = self._s1 - self._s0
+                cap = buf.shape[0]
+                while 2 * (m + k) > cap:
+                    cap *= 2
+                self._buf = np.empty((cap, 7)) if cap != buf.shape[0] else buf
+                self._buf[:m] = buf[self._s0 : self._s1]
+                self._s0, self._s1 = 0, m
+            self._buf[self._s1 : self._s1 + k] = new
+            self._s1 += k
+            new.clear()
         return self._buf[self._s0 : self._s1]
 
 
@@ -281,21 +301,21 @@ class PhaseDetector:
         self._last_t = t
         st.samples += 1
         c = self.config
-        g, r = _point(frame.giver_hand), _point(frame.receiver_hand)
-        gx, gy, gz = g.tolist()
-        rx, ry, rz = r.tolist()
+        g, r = _point(frame.giver_hand).tolist(), _point(frame.receiver_hand).tolist()
+        gx, gy, gz = g
+        rx, ry, rz = r
         finite = math.isfinite
         g_ok = finite(gx) and finite(gy) and finite(gz)
         r_ok = finite(rx) and finite(ry) and finite(rz)
         samples = self._samples
-        samples.append([t, gx, gy, gz, rx, ry, rz])
+        samples.append((t, gx, gy, gz, rx, ry, rz))
         samples.drop_before(t - c.online_window)
         if g_ok:
             self._seen_g = t
         if r_ok:
             self._seen_r = t
         if self._trigger is not None:
-            self._trigger.add((gx, gy, gz), g_ok, (rx, ry, rz), r_ok)
+            self._trigger.add(g, g_ok, r, r_ok)
         if not (g_ok and r_ok):
             st.held += 1
             if self.tracking:
