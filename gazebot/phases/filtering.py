@@ -629,7 +629,8 @@ class SignalCache:
             for k in range(3):
                 xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
                 xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
-            if ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
+            # (no step of the window is longer than bar: none of ts's is)
+            if max_dt > bar and ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
                 xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
             else:
                 xr[int(gs.searchsorted(t[-1], side="right")) :] = np.nan
@@ -663,7 +664,9 @@ class SignalCache:
         np.subtract(x[a:rows], x[a - 2 : rows - 2], out=vt[:-1])
         np.divide(vt[:-1], 2.0 * dt, out=vt[:-1])
         vt[-1] = (x[rows - 1] - x[rows - 2]) / dt
-        vt.reshape(vt.shape[0], 2, 3)[b["full"][a - 1 : rows] < FULL_WINDOW] = np.nan
+        shares = b["full"][a - 1 : rows]
+        if shares.min() < FULL_WINDOW:  # (away from tracking gaps, none is)
+            vt.reshape(vt.shape[0], 2, 3)[shares < FULL_WINDOW] = np.nan
         sp = b["speeds"][:, a - 1 : rows]
         _derived_into(x[a - 1 : rows], vt, b["q"][:, a - 1 : rows], b["norms"][:, a - 1 : rows],
                       sp[0], sp[1], sp[2])
