@@ -192,8 +192,7 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
         return out, den
     # per row and hand: x, y, z (0 where unseen) and whether seen; smoothed in one call
     stack = np.empty((rows, hands, 4))
-    stack[:, :, :3] = x.reshape(rows, hands, 3)
-    np.copyto(stack[:, :, :3], 0.0, where=~m[:, :, None])
+    stack[:, :, :3] = np.where(m[:, :, None], x.reshape(rows, hands, 3), 0.0)
     stack[:, :, 3] = m
     both = correlate1d(stack, w, axis=0, mode="nearest")
     den = both[:, :, 3]

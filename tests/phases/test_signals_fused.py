@@ -250,3 +250,21 @@ def test_row_norms_are_numpys_row_norms() -> None:
         x[rng.random(x.shape) < 0.005] = np.inf
         with np.errstate(over="ignore"):  # (1e160 squared overflows in both)
             np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=1))
+
+
+def test_trigger_norm_bar_decides_as_numpys_norm() -> None:
+    """The trigger's plain-float test ``|v| >= bar`` decides as ``vector_norm`` (numpy's dot)
+    does, at near ties, NaN, infinite and zero vectors too."""
+    from gazebot.phases.filtering import vector_norm
+    from gazebot.phases.methods.gazebot_trigger import _norm_at_least
+
+    rng = np.random.default_rng(7)
+    vs = rng.normal(size=(20000, 3)) * rng.choice([1e-3, 1.0, 1e3], size=(20000, 1))
+    vs[::50] = [0.0, 0.0, 0.0]
+    vs[1::97, 1] = np.nan
+    vs[2::89, 0] = np.inf
+    for v in vs:
+        norm = vector_norm(v)
+        for bar in (0.0, 0.005, norm, np.nextafter(norm, 0.0), np.nextafter(norm, np.inf)):
+            if np.isfinite(bar):
+                assert _norm_at_least(v.tolist(), float(bar)) == (norm >= bar), (v, bar)

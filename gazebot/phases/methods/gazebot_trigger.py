@@ -39,6 +39,20 @@ def _nanmean2(a: Sequence[float], b: Sequence[float]) -> list[float]:
     return out
 
 
+def _norm_at_least(v: Sequence[float], bar: float) -> bool:
+    """``vector_norm(np.array(v)) >= bar`` (a 3-vector, ``bar`` >= 0), decided in plain floats
+    unless the squares' sum is within rounding of ``bar``'s square: numpy's dot may sum the
+    squares in another order, which moves the norm by a few ulps, so only a near tie needs
+    it."""
+    x, y, z = v
+    sq, b2 = x * x + y * y + z * z, bar * bar
+    if sq < b2 * (1.0 - 1e-9):
+        return False
+    if sq > b2 * (1.0 + 1e-9):
+        return True
+    return vector_norm(np.array(v)) >= bar  # (a near tie, or NaN)
+
+
 def _search(times: list[float], x: float, lo: int, hi: int) -> int:
     """``np.searchsorted`` (side left) of ``x`` in the increasing ``times[lo:hi]``, as an
     index of ``times``: NaN sorts after every time, as numpy sorts it."""
@@ -236,8 +250,8 @@ class GazebotTrigger:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
             now_rel = _nanmean2(self._rel[-2], self._rel[-1])
-            off = vector_norm(np.array([u - m for u, m in zip(now_rel, mean, strict=True)]))
-            return off >= c.trigger_distance_factor * c.release_distance
+            off = [u - m for u, m in zip(now_rel, mean, strict=True)]
+            return _norm_at_least(off, c.trigger_distance_factor * c.release_distance)
         if ph is Phase.RETREAT:
             if state.joined_late:
                 return True
@@ -246,10 +260,10 @@ class GazebotTrigger:
             if s1 - first <= k:
                 return True
             g0, g1 = self._g[first], self._g[-1]
-            if not all(math.isfinite(v) for v in g0 + g1):
+            if not all(map(math.isfinite, g0 + g1)):
                 return True
             far = c.trigger_far_fraction * c.retreat_far_distance
-            if vector_norm(np.array([u - v for u, v in zip(g1, g0, strict=True)])) >= far:
+            if _norm_at_least([u - v for u, v in zip(g1, g0, strict=True)], far):
                 return True
             last = self._step[-1]
             if not math.isfinite(last):

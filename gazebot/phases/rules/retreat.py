@@ -41,10 +41,13 @@ def rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> tuple[float, boo
 def far_after(s: Signals, c: PhaseConfig, i_end: int) -> float:
     """First time after grid index ``i_end`` (the release) that the giver's hand is
     ``retreat_far_distance`` from where the transfer happened (``inf`` if never)."""
-    seen = np.isfinite(s.giver[: i_end + 1]).all(axis=1).nonzero()[0]
-    if seen.size == 0:
+    # the last sample seen at or before the release, searched from it (usually that one)
+    k = min(i_end, s.t.shape[0] - 1)
+    while k >= 0 and not all(map(math.isfinite, s.giver[k].tolist())):
+        k -= 1
+    if k < 0:
         return math.inf
-    moved = row_norms(s.giver[i_end:] - s.giver[int(seen[-1])])
+    moved = row_norms(s.giver[i_end:] - s.giver[k])
     far = (moved >= c.retreat_far_distance).nonzero()[0]
     return float(s.t[i_end + int(far[0])]) if far.size else math.inf
 

@@ -239,12 +239,12 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
             return float(s.t[a + int(seen.argmin())]) if seen.size else float(s.t[a])
         return math.nan
     i = a + int(below[0])
-    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
+    v_frac = v_settle_fraction(s, c, lo, a)
     # The core's first part is the approach's tail: once the crossing is known, the hold's
     # floor is measured on the samples after it (a short, early hold otherwise reads high).
     for _ in range(2):
         v_f = c.settle_floor_factor * hold_floor(s, c, i, b)
-        v_new = min(max(v_f, v_settle_fraction(s, c, lo, a)), c.transfer_speed_max)
+        v_new = min(max(v_f, v_frac), c.transfer_speed_max)
         below = (seen < v_new).nonzero()[0]
         if v_new >= v_settle or below.size == 0:
             break
