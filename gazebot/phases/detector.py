@@ -181,6 +181,8 @@ class PhaseDetector:
         self._prev_evidence: bool | None = False
         self._robot_reports = False
         self._signals: Signals | None = None
+        self._finite_of: Signals | None = None  # the signals self._finite indexes
+        self._finite = np.empty(0, dtype=np.intp)
         # The last analysis's signals, so the next one (on the same window, a few samples
         # longer) computes only the rows the new samples change.
         self._signal_cache = SignalCache(append_only=True)
@@ -435,7 +437,7 @@ class PhaseDetector:
         if s is not None and self.phase is Phase.REACH:
             # Keep the reach's start distance while the window holds it (a reach can outlast
             # the window; the taken-back checks compare with it).
-            self._reach_start_distance(s, np.isfinite(s.distance).nonzero()[0])
+            self._reach_start_distance(s, self._finite_distances(s))
             restart = self._reach_restart()
             if restart is not None:
                 # The reach was an earlier movement (the giver lifted the object, waited, and
@@ -555,9 +557,11 @@ class PhaseDetector:
             return None
         i_start = int(s.t.searchsorted(self.phase_start))
         v = s.giver_speed[i_start:]
-        rest = np.isfinite(v) & (v < c.rest_speed)
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
-        if need < 1 or rest.size <= need or np.count_nonzero(rest) < need:
+        if need < 1 or v.shape[0] <= need:
+            return None  # (a reach younger than reach_stall: no rest that long in it)
+        rest = np.isfinite(v) & (v < c.rest_speed)
+        if np.count_nonzero(rest) < need:
             return None  # (no run of need rest samples without need of them in all)
         # the last sample of the last rest at least reach_stall long
         edges = np.diff(np.concatenate([[0], rest.astype(int), [0]])).nonzero()[0]
@@ -580,14 +584,21 @@ class PhaseDetector:
             return None
         return float(s.t[i_b])
 
+    def _finite_distances(self, s: Signals) -> np.ndarray:
+        """Grid indices of the finite distances of ``s`` (found once per analysis's signals:
+        the reach's checks read them several times)."""
+        if self._finite_of is not s:
+            self._finite_of, self._finite = s, np.isfinite(s.distance).nonzero()[0]
+        return self._finite
+
     def _reach_start_distance(self, s: Signals, ok: np.ndarray) -> float:
         """The hands' distance when the current reach began (``ok``: the finite samples of
         ``s.distance``): read from ``s`` while its window still holds that moment (and kept),
         else the value kept from the last window that held it; NaN if none did."""
         if s.t.shape[0] and s.t[0] <= self.phase_start:
             i0 = int(s.t.searchsorted(self.phase_start))
-            before = ok[ok <= i0]
-            self._reach_d0 = float(s.distance[before[-1]]) if before.size else math.nan
+            k = int(ok.searchsorted(i0, side="right"))  # (ok increases: those <= i0)
+            self._reach_d0 = float(s.distance[ok[k - 1]]) if k else math.nan
         return self._reach_d0
 
     def _taken_back(self) -> bool:
@@ -596,7 +607,7 @@ class PhaseDetector:
         s = self._signals
         if s is None or self._joined_late:
             return False
-        ok = np.isfinite(s.distance).nonzero()[0]
+        ok = self._finite_distances(s)
         d0 = self._reach_start_distance(s, ok)
         if not ok.size or d0 != d0:
             return False
@@ -609,7 +620,7 @@ class PhaseDetector:
         if s is None or s.t.shape[0] == 0:
             return True
         d = s.distance
-        ok = np.isfinite(d).nonzero()[0]
+        ok = self._finite_distances(s)
         if ok.size == 0:
             return True
         if self._joined_late and not (ok.size and s.t[ok[0]] < self.phase_start):

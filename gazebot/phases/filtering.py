@@ -185,7 +185,8 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
         # Every row seen (the usual case): only the positions need smoothing; the seen share
         # is the same at every row.
         share = _seen_share(sigma)
-        den = np.full((rows, hands), share)
+        den = np.empty((rows, hands))
+        den.fill(share)  # (np.full's work without its argument handling)
         out = correlate1d(x, w, axis=0, mode="nearest") / max(share, 1e-12)
         if share < 0.5:
             out[:] = np.nan
