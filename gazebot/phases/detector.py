@@ -184,7 +184,8 @@ class PhaseDetector:
         self._finite_of: Signals | None = None  # the signals self._finite indexes
         self._finite = np.empty(0, dtype=np.intp)
         # The last analysis's signals, so the next one (on the same window, a few samples
-        # longer) computes only the rows the new samples change.
+        # longer) computes only the rows the new samples change. (append_only: the windows
+        # are cut from the samples kept, which only grow at their end.)
         self._signal_cache = SignalCache(append_only=True)
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
         # boundary may have passed.

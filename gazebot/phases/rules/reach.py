@@ -93,9 +93,7 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     own = float(np.dot(s.giver[k] - s.giver[lo + i_max], u))
     # ... and the hands closing at a reach's speed now (a drift or fidget is slower).
     j0 = max(lo + i_max, k - int(round(c.smoothing * c.analysis_rate)))
-    closing = -np.einsum("ij,ij->i", s.rel_v[j0 : k + 1], s.rel[j0 : k + 1]) / np.maximum(
-        s.distance[j0 : k + 1], 1e-9
-    )
+    closing = s.closing[j0 : k + 1]  # (-d distance / dt: rel_v along rel)
     fast = bool(nanmax(closing, initial=0.0) >= c.reach_onset_speed) and bool(
         nanmax(s.giver_speed[j0 : k + 1], initial=0.0) >= c.reach_onset_speed
     )

@@ -59,9 +59,10 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Inclusive index ranges of the True runs of ``mask``."""
     if mask.size == 0:
         return []
-    padded = np.concatenate([[False], mask, [False]])
-    edges = (padded[1:] != padded[:-1]).nonzero()[0]
-    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+    padded = np.zeros(mask.size + 2, dtype=bool)  # (not a concatenation of converted lists)
+    padded[1:-1] = mask
+    bounds = (padded[1:] != padded[:-1]).nonzero()[0].tolist()
+    return [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
 
 
 def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
@@ -107,8 +108,8 @@ def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
     if n < 3 or not np.isfinite(d).any():
         return []
     out: list[TransferCore] = []
-    rs = np.where(np.isfinite(s.rel_speed), s.rel_speed, np.inf)
     unknown = ~np.isfinite(s.rel_speed)
+    rs = np.where(unknown, np.inf, s.rel_speed)
     min_len = max(1, int(round(c.min_transfer * c.analysis_rate)))
     for lo, p, hi in dips(d, c.min_approach):
         near = np.zeros(n, dtype=bool)
