@@ -268,3 +268,22 @@ def test_trigger_norm_bar_decides_as_numpys_norm() -> None:
         for bar in (0.0, 0.005, norm, np.nextafter(norm, 0.0), np.nextafter(norm, np.inf)):
             if np.isfinite(bar):
                 assert _norm_at_least(v.tolist(), float(bar)) == (norm >= bar), (v, bar)
+
+
+def test_trigger_dot_bar_decides_as_numpys_dot() -> None:
+    """The trigger's plain-float test ``a . b / d >= bar`` (the giver's own share of the
+    closing) decides as numpy's dot does, at near ties, cancellation, NaN and infinities."""
+    from gazebot.phases.methods.gazebot_trigger import _dot_over_at_least
+
+    rng = np.random.default_rng(8)
+    ab = rng.normal(size=(20000, 2, 3)) * rng.choice([1e-3, 1.0, 1e3], size=(20000, 1, 1))
+    ab[::7, 1] = ab[::7, 0] * [1.0, -1.0, 0.0]  # (products that cancel)
+    ab[::14, 0, 1] = ab[::14, 0, 0]  # (... exactly)
+    ab[1::97, 0, 1] = np.nan
+    ab[2::89, 1, 0] = np.inf
+    for (a, b), d in zip(ab, rng.uniform(1e-9, 2.0, size=20000), strict=True):
+        own = float(np.dot(a, b)) / d
+        for bar in (0.005, own, np.nextafter(own, -np.inf), np.nextafter(own, np.inf)):
+            if np.isfinite(bar):
+                got = _dot_over_at_least(a.tolist(), b.tolist(), float(d), float(bar))
+                assert got == (own >= bar), (a, b, d, bar)

@@ -53,6 +53,21 @@ def _norm_at_least(v: Sequence[float], bar: float) -> bool:
     return vector_norm(np.array(v)) >= bar  # (a near tie, or NaN)
 
 
+def _dot_over_at_least(a: Sequence[float], b: Sequence[float], d: float, bar: float) -> bool:
+    """``float(np.dot(np.array(a), np.array(b))) / d >= bar`` (3-vectors, ``d`` > 0), decided
+    in plain floats unless within rounding: numpy's dot may sum the products in another
+    order, which moves the sum by a few ulps of the products' magnitudes, so only a near tie
+    needs it."""
+    p0, p1, p2 = a[0] * b[0], a[1] * b[1], a[2] * b[2]
+    gap = (p0 + p1 + p2) - bar * d
+    tol = 1e-9 * (abs(p0) + abs(p1) + abs(p2) + abs(bar * d))
+    if gap > tol:
+        return True
+    if gap < -tol:
+        return False
+    return float(np.dot(np.array(a), np.array(b))) / d >= bar  # (a near tie, or NaN)
+
+
 def _search(times: list[float], x: float, lo: int, hi: int) -> int:
     """``np.searchsorted`` (side left) of ``x`` in the increasing ``times[lo:hi]``, as an
     index of ``times``: NaN sorts after every time, as numpy sorts it."""
@@ -318,9 +333,9 @@ class GazebotTrigger:
         if not deep:
             # (the giver's own share of the closing, read only when the dip is not deep)
             g1, g0 = self._g[-1], self._g[i_max]
-            moved = np.array([u - v for u, v in zip(g1, g0, strict=True)])
-            own = float(np.dot(moved, np.array(self._rel[-1]))) / max(d_last, 1e-9)
-            if not own >= c.trigger_own_fraction * c.reach_confirm_distance:
+            moved = [u - v for u, v in zip(g1, g0, strict=True)]
+            own_bar = c.trigger_own_fraction * c.reach_confirm_distance
+            if not _dot_over_at_least(moved, self._rel[-1], max(d_last, 1e-9), own_bar):
                 return False  # only the receiver came closer: no reach of the giver's yet
         # The giver's hand moving fast: since the hands were farthest for a deep dip, else
         # within the window the rule reads (smoothing, before the edge guard).
