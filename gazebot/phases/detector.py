@@ -430,9 +430,9 @@ class PhaseDetector:
             if n - i0 < 3:
                 i0 = 0
         window = rows[i0:]
-        # (the rows are float64 of known shapes: no conversion or check needed)
-        traj = Trajectory.of_hands(window[:, 0].copy(), window[:, 1:4].copy(),
-                                   window[:, 4:].copy())
+        # (the rows are float64 of known shapes: no conversion or check needed; views, not
+        # copies: only this analysis reads them, and nothing writes to a trajectory's arrays)
+        traj = Trajectory.of_hands(window[:, 0], window[:, 1:4], window[:, 4:])
         s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
