@@ -274,26 +274,24 @@ def row_norms(x: np.ndarray) -> np.ndarray:
 
 def _derived_into(
     x: np.ndarray,
-    v: np.ndarray,
     q: np.ndarray,
     norms: np.ndarray,
     closing: np.ndarray,
     common: np.ndarray,
     hold: np.ndarray,
 ) -> None:
-    """From smoothed positions ``x`` and velocities ``v`` (rows, both hands), row by row (a
-    row's values depend on that row alone), written into: ``q`` (5, rows, 3) the relative
-    position, relative velocity, giver's and receiver's velocities and their sum; ``norms``
-    (5, rows) their norms (distance, relative speed, giver speed, receiver speed, and twice the
-    common speed); ``closing``, ``common`` and ``hold`` (rows,) the closing, common and hold
-    speeds (see :class:`Signals`). Each ``q[i]`` must be contiguous (as the einsum reads it)."""
-    gv, rv = v[:, :3], v[:, 3:]
+    """From smoothed positions ``x`` (rows, both hands) and the velocities in ``q[2]`` (giver)
+    and ``q[3]`` (receiver), row by row (a row's values depend on that row alone), written
+    into: ``q`` (5, rows, 3) the relative position, relative velocity and the velocities' sum;
+    ``norms`` (5, rows) the five vectors' norms (distance, relative speed, giver speed,
+    receiver speed, and twice the common speed); ``closing``, ``common`` and ``hold`` (rows,)
+    the closing, common and hold speeds (see :class:`Signals`). Each ``q[i]`` must be
+    contiguous (as the einsum reads it)."""
+    gv, rv = q[2], q[3]
     # The five vectors whose norms are needed, in one block: what row_norms computes for each,
     # in a few numpy calls instead of six per vector.
     np.subtract(x[:, 3:], x[:, :3], out=q[0])
     np.subtract(rv, gv, out=q[1])
-    q[2] = gv
-    q[3] = rv
     np.add(gv, rv, out=q[4])
     sq = q * q
     np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2], out=norms)
@@ -312,8 +310,15 @@ def _derived(
     (:func:`_derived_into`, into new arrays)."""
     rows = x.shape[0]
     q, norms, speeds = np.empty((5, rows, 3)), np.empty((5, rows)), np.empty((3, rows))
-    _derived_into(x, v, q, norms, speeds[0], speeds[1], speeds[2])
+    q[2] = v[:, :3]
+    q[3] = v[:, 3:]
+    _derived_into(x, q, norms, speeds[0], speeds[1], speeds[2])
     return q[0], q[1], norms[0], norms[1], norms[2], norms[3], speeds[0], speeds[1], speeds[2]
+
+
+def _by_hand(rows: np.ndarray) -> np.ndarray:
+    """Contiguous rows (N, 6) of both hands as a (2, N, 3) view: hand, row, coordinate."""
+    return rows.reshape(rows.shape[0], 2, 3).transpose(1, 0, 2)
 
 
 def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
@@ -403,7 +408,7 @@ def compute_signals(
         hold_speed=hold,
     )
     if cache is not None:
-        cache.keep(trajectory, config, s, x, v, full, sigma_s / dt, seen, ok)
+        cache.keep(trajectory, config, s, x, full, sigma_s / dt, seen, ok)
     if until < math.inf:
         s = _first_rows(s, int(grid.searchsorted(until, side="right")))
     return s
@@ -416,12 +421,14 @@ def _first_rows(s: Signals, rows: int) -> Signals:
 
 # The per-row blocks a SignalCache keeps beside the grid: name -> row shape (one row per grid
 # row; the derived blocks are laid out as _derived_into writes them).
-_BLOCKS = {"x": (6,), "v": (6,), "full": (2,), "q": (5, 3), "norms": (5,), "speeds": (3,)}
-# Where each Signals field derived from the rows sits: (block, index in the block's first axis).
+_BLOCKS = {"x": (6,), "full": (2,), "q": (5, 3), "norms": (5,), "speeds": (3,)}
+# Where each Signals field derived from the rows sits: (block, index in the block's first axis),
+# in the fields' order.
 _IN_BLOCK = {
-    "rel": ("q", 0), "rel_v": ("q", 1), "distance": ("norms", 0), "rel_speed": ("norms", 1),
-    "giver_speed": ("norms", 2), "receiver_speed": ("norms", 3), "closing": ("speeds", 0),
-    "common_speed": ("speeds", 1), "hold_speed": ("speeds", 2),
+    "giver_v": ("q", 2), "receiver_v": ("q", 3), "rel": ("q", 0), "rel_v": ("q", 1),
+    "distance": ("norms", 0), "rel_speed": ("norms", 1), "giver_speed": ("norms", 2),
+    "receiver_speed": ("norms", 3), "closing": ("speeds", 0), "common_speed": ("speeds", 1),
+    "hold_speed": ("speeds", 2),
 }
 # The blocks _derived_into writes, laid out (block axis, rows, ...).
 _DERIVED_BLOCKS = ("q", "norms", "speeds")
@@ -475,14 +482,13 @@ class SignalCache:
         config: PhaseConfig,
         s: Signals,
         x: np.ndarray,
-        v: np.ndarray,
         full: np.ndarray,
         sigma: float,
         seen: np.ndarray,
         ok: np.ndarray,
     ) -> None:
-        """Remember a full computation's result ``s`` with its smoothed rows ``x``, velocities
-        ``v``, window shares ``full``, smoothing width ``sigma`` (grid steps) and, per sample
+        """Remember a full computation's result ``s`` with its smoothed rows ``x``, window
+        shares ``full``, smoothing width ``sigma`` (grid steps) and, per sample
         and hand, which samples were ``seen`` and which were valid (``ok``: seen and not
         stale). The arrays are adopted, not copied: the first extension copies what it
         keeps."""
@@ -504,7 +510,7 @@ class SignalCache:
         self._sigma = sigma
         self._grid = s.t
         self._rows = s.t.shape[0]
-        self._buf = {"x": x, "v": v, "full": full}
+        self._buf = {"x": x, "full": full}
         self._buf.update({name: getattr(s, name) for name in _IN_BLOCK})
         self._owned = False
 
@@ -659,17 +665,17 @@ class SignalCache:
         b["x"][a:rows] = xs[lead:]
         b["full"][a:rows] = full[lead:]
         # velocities from row a - 1 (its central difference reads row a): _velocities'
-        # arithmetic, written in place
-        x, vt = b["x"], b["v"][a - 1 : rows]
-        np.subtract(x[a:rows], x[a - 2 : rows - 2], out=vt[:-1])
-        np.divide(vt[:-1], 2.0 * dt, out=vt[:-1])
-        vt[-1] = (x[rows - 1] - x[rows - 2]) / dt
+        # arithmetic, written in place where _derived_into reads them (giver, receiver)
+        x, q = b["x"], b["q"][:, a - 1 : rows]
+        vq = q[2:4]
+        np.subtract(_by_hand(x[a:rows]), _by_hand(x[a - 2 : rows - 2]), out=vq[:, :-1])
+        np.divide(vq[:, :-1], 2.0 * dt, out=vq[:, :-1])
+        vq[:, -1] = ((x[rows - 1] - x[rows - 2]) / dt).reshape(2, 3)
         shares = b["full"][a - 1 : rows]
         if shares.min() < FULL_WINDOW:  # (away from tracking gaps, none is)
-            vt.reshape(vt.shape[0], 2, 3)[shares < FULL_WINDOW] = np.nan
+            vq[shares.T < FULL_WINDOW] = np.nan
         sp = b["speeds"][:, a - 1 : rows]
-        _derived_into(x[a - 1 : rows], vt, b["q"][:, a - 1 : rows], b["norms"][:, a - 1 : rows],
-                      sp[0], sp[1], sp[2])
+        _derived_into(x[a - 1 : rows], q, b["norms"][:, a - 1 : rows], sp[0], sp[1], sp[2])
         if not self._append_only:
             self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
         if clean:
@@ -685,14 +691,12 @@ class SignalCache:
         self._grid, self._rows = grid, rows
         keep = rows if until == math.inf else int(grid.searchsorted(until, side="right"))
         ro = self._read_only
-        xv, vv = ro["x"][:keep], ro["v"][:keep]
+        xv = ro["x"][:keep]
         return filled(
             Signals,
             t=grid[:keep],
             giver=xv[:, :3],
             receiver=xv[:, 3:],
-            giver_v=vv[:, :3],
-            receiver_v=vv[:, 3:],
             **{name: ro[name][:keep] for name in _IN_BLOCK},
         )
 
@@ -709,7 +713,7 @@ class SignalCache:
             new[name] = np.empty((shape[0], cap, *shape[1:]) if name in _DERIVED_BLOCKS
                                  else (cap, *shape))
         ro: dict[str, np.ndarray] = {}
-        for name in ("x", "v", "full"):
+        for name in ("x", "full"):
             new[name][:keep] = old[name][:keep]
             ro[name] = new[name].view()
         for name, (block, i) in _IN_BLOCK.items():
