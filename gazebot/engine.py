@@ -115,6 +115,7 @@ class GazeEngine:
         self.behavior_spec = behavior
         self._phase_config = phases or PhaseConfig()
         self.gaze = GazeController(robot, shifts, ik)
+        self._head_names = tuple(robot.head_joints)
         self._fixed_points = {k: np.asarray(v, float) for k, v in robot.points.items()}
         fixed = self._fixed_points
         # A tracked point never seen yet: the robot's default for it.
@@ -357,12 +358,11 @@ class GazeEngine:
         """The command for ``kind`` at ``point``; the last safe one (or rest) if the kinematics
         fail or give a non-finite value."""
         try:
-            state = self.gaze.update(t, point, arm=arm)
-            head, yaw, pitch = state.head, state.eye_yaw, state.eye_pitch
-            residual, shift = state.residual, state.shift_amplitude
+            q, yaw, pitch, residual, shift = self.gaze.update_raw(t, point, arm=arm)
             # One float sum instead of a check per value: finite values of these sizes (angles,
             # rad) cannot overflow, so the sum is finite exactly when every value is.
-            ok = math.isfinite(yaw + pitch + residual + shift + sum(head.values()))
+            ok = math.isfinite(yaw + pitch + residual + shift + sum(q))
+            head = dict(zip(self._head_names, q, strict=True))
         except Exception as err:  # noqa: BLE001 - e.g. a joint reading that is no number
             faults.append(self._fault(t, "kinematics", err))
             events = (*events, faults[-1])
