@@ -376,24 +376,28 @@ class GazeEngine:
         self._last_target = (kind, point)
         status: Status = "degraded" if faults or not ok else "ok"
         handover = self.handover
+        if type(point) is not np.ndarray or point.dtype != np.float64:
+            point = np.asarray(point, float)  # (the behavior's points already are)
         cmd = filled(
             GazeCommand,
-            t=t,
-            phase=handover.phase,
-            target=kind,
-            target_point=np.asarray(point, float),
-            head=head,
-            eye_yaw=yaw,
-            eye_pitch=pitch,
-            residual=residual,
-            phase_source=handover.source,
-            gaze_shift=shift,
-            tracking=self.behavior.tracking,
-            status=status,
-            blink=0.0,
-            distance=None,
-            answers_sample=True,
-            events=events,
+            {  # every field, in field order (GazeCommand's dataclass fields)
+                "t": t,
+                "phase": handover.phase,
+                "target": kind,
+                "target_point": point,
+                "head": head,
+                "eye_yaw": yaw,
+                "eye_pitch": pitch,
+                "residual": residual,
+                "phase_source": handover.source,
+                "gaze_shift": shift,
+                "tracking": self.behavior.tracking,
+                "status": status,
+                "blink": 0.0,
+                "distance": None,
+                "answers_sample": True,
+                "events": events,
+            },
         )
         if ok:
             self._last_safe = cmd

@@ -234,8 +234,8 @@ class GazeLoop:
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
         # cmd.replaced(...) without its field-name check (these are GazeCommand's fields).
-        return filled(GazeCommand, **{**cmd.__dict__, "blink": blink, "distance": distance,
-                                      "answers_sample": answers})
+        fields = dict(cmd.__dict__, blink=blink, distance=distance, answers_sample=answers)
+        return filled(GazeCommand, fields)
 
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
