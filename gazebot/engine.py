@@ -196,8 +196,9 @@ class GazeEngine:
         except Exception as err:  # noqa: BLE001 - a sample must never kill the engine
             events = []
             faults.append(self._fault(t, "phases", err))
-        events.extend(self._pending)
-        self._pending.clear()
+        if self._pending:
+            events.extend(self._pending)
+            self._pending.clear()
         stream: list[Event] = []  # the tick's events, phase events as the handover state's
         for event in events:
             try:
@@ -216,7 +217,7 @@ class GazeEngine:
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
-        return self._command(t, kind, point, arm, tuple(stream) + tuple(faults), faults)
+        return self._command(t, kind, point, arm, (*stream, *faults), faults)
 
     def look_at(
         self,
@@ -332,14 +333,14 @@ class GazeEngine:
         return out
 
     def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
-        points = dict(self._fixed_points)
-        points.update(
-            face=frame.giver_face,
-            hand=frame.giver_hand,
-            object=frame.giver_hand,
-            receiver_hand=frame.receiver_hand,
-        )
-        return points
+        hand = frame.giver_hand
+        return {
+            **self._fixed_points,
+            "face": frame.giver_face,
+            "hand": hand,
+            "object": hand,
+            "receiver_hand": frame.receiver_hand,
+        }
 
     def _fault(self, t: float, stage: str, err: BaseException) -> Event:
         self.stats.faults += 1
