@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gazebot.kinematics.eyes import angle_of
+from gazebot.kinematics.eyes import angle_of, eye_angles
 from gazebot.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.kinematics.robot import RobotModel
 from gazebot.kinematics.shifts import (
@@ -276,7 +276,8 @@ class GazeController:
             return False  # too close for a direction (or not a number): the eyes stay
         eyes = self._eyes_model
         v = (x, y, z)
-        yaw, pitch, saturated = eyes.look(v)
+        yaw, pitch = eye_angles(v)
+        yaw, pitch, saturated = eyes.clip(yaw, pitch)  # eyes.look(v), one call less
         if self._saccade is not None:
             t0, dur, (y0, p0) = self._saccade
             s = min_jerk((self._clock - t0) / dur)
