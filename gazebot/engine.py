@@ -267,12 +267,14 @@ class GazeEngine:
     def _time(self, frame: TrackingFrame) -> float:
         """The tick's time: the frame's, never earlier than the last one; a frame without a
         usable time is answered at the last known time."""
-        try:
-            t = float(frame.t)
-        except (TypeError, ValueError, OverflowError):
-            t = math.nan
-        if math.isfinite(t):
-            self._last_t = max(t, self._last_t)
+        t = frame.t
+        if type(t) is not float:  # (a frame's usual t already is one)
+            try:
+                t = float(t)
+            except (TypeError, ValueError, OverflowError):
+                t = math.nan
+        if math.isfinite(t) and t > self._last_t:  # max() as a comparison (the hot path)
+            self._last_t = t
         return self._last_t if math.isfinite(self._last_t) else 0.0
 
     def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
