@@ -8,7 +8,8 @@ rule (``seed-7.2.5``, dissertation section 7.2.5) measured in the same run.
 - Online reach onset (issue 20): how long after the giver's true onset the reach is confirmed
   (median and p90 over a varied synthetic set, 8-240 Hz), and the false reaches on recordings
   with no handover (resting and fidgeting hands under 2 and 5 mm of noise, 8-240 Hz, and 120
-  more fidgeting ones), with and without the predictive rule in the same run.
+  more fidgeting ones), with and without the predictive rule in the same run, beside the lower
+  bound any detector silent on those fidgets has (``benchmarks/reach_bound.py``).
 - Issue 20's hold kinds (joint carry, still hold, quick 30 Hz / 5 mm): transfer start and end
   errors against the generator's truth.
 - Offline throughput: recordings segmented per second over a synthetic set (100 Hz, ~8 s).
@@ -23,6 +24,7 @@ import numpy as np
 
 from benchmarks.common import Result
 from benchmarks.kth_data import RATE, force_truth, kth_dir
+from benchmarks.reach_bound import bound_latencies
 from gazebot.phases import PhaseConfig, PhaseDetector, Trajectory, run_online, segment
 from gazebot.phases.methods import PHASE_METHODS
 from gazebot.phases.synthetic import CASE_KINDS, case_set, rest_recording, synthetic_set
@@ -119,6 +121,13 @@ def _reach_onset(cfg: PhaseConfig) -> tuple[float, float, int, int, dict[float, 
     return med, p90, _false(cfg, rests), len(rests), per_rate
 
 
+def _bound(bar: float) -> tuple[float, float]:
+    """(median, p90 ms) of the ideal observer's reach confirmation on the synthetic set
+    (:func:`benchmarks.reach_bound.bound_latencies` at ``bar``)."""
+    lat = [1e3 * x for c in synthetic_set(40, seed=7) for x in bound_latencies(c, bar)]
+    return float(np.median(lat)), float(np.percentile(lat, 90))
+
+
 def _false(cfg: PhaseConfig, recordings: list[Trajectory]) -> int:
     """Reaches reported on recordings without a handover."""
     return sum(
@@ -146,6 +155,7 @@ def _by_rate(per_rate: dict[float, list[float]]) -> str:
 
 def _reach_results() -> list[Result]:
     med, p90, false, n, per_rate = _reach_onset(PhaseConfig())
+    bound = {bar: _bound(bar) for bar in (1.0, 9.0)}
     # The same method without its predictive rules (predict_distance and sequential_evidence
     # out of reach): the smoothed signals alone (2 cm of closing past the edge guard), as
     # before issue 20's rules.
@@ -174,7 +184,10 @@ def _reach_results() -> list[Result]:
                 f"Without the predictive rules: {smed:.0f} / {sp90:.0f} ms, {sfalse} false. "
                 f"{len(fidgets)} more fidgeting recordings: {wide} false ({swide} without them). "
                 f"Median/p90 ms per rate: {_by_rate(per_rate)} (different givers at each rate); "
-                f"the same 14 motions at every rate: {_by_rate(same)}"
+                f"the same 14 motions at every rate: {_by_rate(same)}. Lower bound for any "
+                f"detector silent on the fidgets (benchmarks/reach_bound.py, noise-free motion, "
+                f"1 / 9 noise variances from every fidget): median {bound[1.0][0]:.0f} / "
+                f"{bound[9.0][0]:.0f} ms, p90 {bound[1.0][1]:.0f} / {bound[9.0][1]:.0f} ms"
             ),
         )
     ]

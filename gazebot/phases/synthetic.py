@@ -173,12 +173,18 @@ _HOLD_TIME = {"pull": (0.3, 1.2), "carry": (0.9, 1.1), "still": (1.2, 1.4)}
 
 @dataclass
 class SyntheticHandover:
-    """A generated recording and its ground truth."""
+    """A generated recording and its ground truth.
+
+    ``giver_motion``: the giver's hand at the recording's sample times as the generator moved
+    it (m, N x 3), before sway, marker noise, carrying wobble, marker offsets and dropouts:
+    what an ideal observer would have to tell apart from a fidget
+    (``benchmarks/bench_phases.py``'s reach onset bound)."""
 
     trajectory: Trajectory
     truth: list[HandoverTruth]
     options: SyntheticOptions
     seed: int
+    giver_motion: np.ndarray
 
     def truth_segments(self) -> list[Segment]:
         return [s for i, h in enumerate(self.truth) for s in h.segments(i)]
@@ -286,7 +292,8 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
     ts = _sample_times(rng, t_end, opts)
     n = ts.shape[0]
     sway = 0.004 * np.sin(2 * np.pi * u(0.2, 0.4) * ts + u(0, 6))[:, None] * np.array([1, 0.5, 0.3])
-    gh = hand.at(ts) + sway + rng.normal(0.0, opts.noise, (n, 3))
+    motion = hand.at(ts)
+    gh = motion + sway + rng.normal(0.0, opts.noise, (n, 3))
     turn = np.zeros(n)  # the pair's turn about the vertical while carrying (rad)
     for t0, dur, cycles, amp, turn_amp in wobbles:
         wave = np.sin(np.pi * cycles * np.clip((ts - t0) / dur, 0.0, 1.0))
@@ -323,7 +330,7 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
             after = (ts >= release) & (ts < t_open)
             load[after] = np.minimum(1.0, 0.85 + 3.0 * (ts[after] - release))
     traj = Trajectory(ts, gh, rh, gf, closed, load)
-    return SyntheticHandover(traj, truth, replace(opts, posture=posture), seed)
+    return SyntheticHandover(traj, truth, replace(opts, posture=posture), seed, motion)
 
 
 def synthetic_set(n: int = 40, seed: int = 0, **overrides: object) -> list[SyntheticHandover]:
@@ -389,6 +396,12 @@ def case_set(kind: CaseKind, n: int = 12, seed: int = 0) -> list[SyntheticHandov
     return out
 
 
+# A resting giver's fidgets (rest_recording): minimum-jerk adjustments of this size (m) and
+# duration (s), in any direction, half of them toward the receiver.
+FIDGET_AMPLITUDE = (0.008, 0.02)
+FIDGET_DURATION = (0.25, 0.6)
+
+
 def rest_recording(
     rate: float,
     noise: float,
@@ -400,7 +413,8 @@ def rest_recording(
     """A recording with no handover: the giver's hand at rest (0.4 cm of sway) under ``noise``
     (m) at ``rate`` (Hz, ``jitter`` relative sampling jitter), the robot's gripper at home.
 
-    ``fidget``: small adjustments at rest, 0.8-2 cm in 0.25-0.6 s (peak speed up to 0.15 m/s),
+    ``fidget``: small adjustments at rest, 0.8-2 cm (:data:`FIDGET_AMPLITUDE`) in 0.25-0.6 s
+    (:data:`FIDGET_DURATION`; peak speed up to 0.15 m/s),
     in any direction, half of them toward the receiver; a handover detector must report
     nothing on either kind."""
     rng = np.random.default_rng(seed)
@@ -411,12 +425,12 @@ def rest_recording(
     if fidget:
         t0 = 1.0
         while t0 < seconds - 2.0:
-            dur = rng.uniform(0.25, 0.6)
+            dur = rng.uniform(*FIDGET_DURATION)
             way = rng.normal(size=3)
             if rng.random() < 0.5:
                 way[0] = -abs(way[0])  # toward the receiver (at -x)
             g += min_jerk((t - t0) / dur)[:, None] * (
-                rng.uniform(0.008, 0.02) * way / np.linalg.norm(way)
+                rng.uniform(*FIDGET_AMPLITUDE) * way / np.linalg.norm(way)
             )
             t0 += dur + rng.uniform(0.2, 1.0)
     r = np.array([0.35, -0.3, 0.25]) + rng.normal(0.0, 0.0003, (n, 3))
