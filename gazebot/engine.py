@@ -115,6 +115,7 @@ class GazeEngine:
         self.behavior_spec = behavior
         self._phase_config = phases or PhaseConfig()
         self.gaze = GazeController(robot, shifts, ik)
+        self._head_names = tuple(robot.head_joints)
         self._fixed_points = {k: np.asarray(v, float) for k, v in robot.points.items()}
         fixed = self._fixed_points
         # A tracked point never seen yet: the robot's default for it.
@@ -195,8 +196,9 @@ class GazeEngine:
         except Exception as err:  # noqa: BLE001 - a sample must never kill the engine
             events = []
             faults.append(self._fault(t, "phases", err))
-        events.extend(self._pending)
-        self._pending.clear()
+        if self._pending:
+            events.extend(self._pending)
+            self._pending.clear()
         stream: list[Event] = []  # the tick's events, phase events as the handover state's
         for event in events:
             try:
@@ -215,7 +217,7 @@ class GazeEngine:
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
-        return self._command(t, kind, point, arm, tuple(stream) + tuple(faults), faults)
+        return self._command(t, kind, point, arm, (*stream, *faults), faults)
 
     def look_at(
         self,
@@ -265,12 +267,14 @@ class GazeEngine:
     def _time(self, frame: TrackingFrame) -> float:
         """The tick's time: the frame's, never earlier than the last one; a frame without a
         usable time is answered at the last known time."""
-        try:
-            t = float(frame.t)
-        except (TypeError, ValueError, OverflowError):
-            t = math.nan
-        if math.isfinite(t):
-            self._last_t = max(t, self._last_t)
+        t = frame.t
+        if type(t) is not float:  # (a frame's usual t already is one)
+            try:
+                t = float(t)
+            except (TypeError, ValueError, OverflowError):
+                t = math.nan
+        if math.isfinite(t) and t > self._last_t:  # max() as a comparison (the hot path)
+            self._last_t = t
         return self._last_t if math.isfinite(self._last_t) else 0.0
 
     def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
@@ -331,14 +335,14 @@ class GazeEngine:
         return out
 
     def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
-        points = dict(self._fixed_points)
-        points.update(
-            face=frame.giver_face,
-            hand=frame.giver_hand,
-            object=frame.giver_hand,
-            receiver_hand=frame.receiver_hand,
-        )
-        return points
+        hand = frame.giver_hand
+        return {
+            **self._fixed_points,
+            "face": frame.giver_face,
+            "hand": hand,
+            "object": hand,
+            "receiver_hand": frame.receiver_hand,
+        }
 
     def _fault(self, t: float, stage: str, err: BaseException) -> Event:
         self.stats.faults += 1
@@ -357,12 +361,11 @@ class GazeEngine:
         """The command for ``kind`` at ``point``; the last safe one (or rest) if the kinematics
         fail or give a non-finite value."""
         try:
-            state = self.gaze.update(t, point, arm=arm)
-            head, yaw, pitch = state.head, state.eye_yaw, state.eye_pitch
-            residual, shift = state.residual, state.shift_amplitude
+            q, yaw, pitch, residual, shift = self.gaze.update_raw(t, point, arm=arm)
             # One float sum instead of a check per value: finite values of these sizes (angles,
             # rad) cannot overflow, so the sum is finite exactly when every value is.
-            ok = math.isfinite(yaw + pitch + residual + shift + sum(head.values()))
+            ok = math.isfinite(yaw + pitch + residual + shift + sum(q))
+            head = dict(zip(self._head_names, q, strict=True))
         except Exception as err:  # noqa: BLE001 - e.g. a joint reading that is no number
             faults.append(self._fault(t, "kinematics", err))
             events = (*events, faults[-1])
@@ -376,24 +379,28 @@ class GazeEngine:
         self._last_target = (kind, point)
         status: Status = "degraded" if faults or not ok else "ok"
         handover = self.handover
+        if type(point) is not np.ndarray or point.dtype != np.float64:
+            point = np.asarray(point, float)  # (the behavior's points already are)
         cmd = filled(
             GazeCommand,
-            t=t,
-            phase=handover.phase,
-            target=kind,
-            target_point=np.asarray(point, float),
-            head=head,
-            eye_yaw=yaw,
-            eye_pitch=pitch,
-            residual=residual,
-            phase_source=handover.source,
-            gaze_shift=shift,
-            tracking=self.behavior.tracking,
-            status=status,
-            blink=0.0,
-            distance=None,
-            answers_sample=True,
-            events=events,
+            {  # every field, in field order (GazeCommand's dataclass fields)
+                "t": t,
+                "phase": handover.phase,
+                "target": kind,
+                "target_point": point,
+                "head": head,
+                "eye_yaw": yaw,
+                "eye_pitch": pitch,
+                "residual": residual,
+                "phase_source": handover.source,
+                "gaze_shift": shift,
+                "tracking": self.behavior.tracking,
+                "status": status,
+                "blink": 0.0,
+                "distance": None,
+                "answers_sample": True,
+                "events": events,
+            },
         )
         if ok:
             self._last_safe = cmd

@@ -409,6 +409,10 @@ class BehaviorMachine:
         )
         self._gaze_leaf = {f"{_GAZE}_{s}": s for s in self._target_of}
         self._tracking_leaf = {f"{_TRACKING}_{s}": s for s in _TRACKING_STATES}
+        # Per-tick lookups done once (the spec is frozen): the gaze target of each gaze-region
+        # state, and the target while tracking is lost.
+        self._kind_of_state = {leaf: self._target_of[s] for leaf, s in self._gaze_leaf.items()}
+        self._lost_kind = spec.tracking_lost.target
         self.reset(seed)
 
     # ----------------------------------------------------------------- the machine's rules
@@ -719,12 +723,12 @@ class BehaviorMachine:
             end = end if _finite(end) else math.nan
         self.advance(t, end)
         gaze, tracking = self._model.state
-        lost_kind = self.spec.tracking_lost.target
+        lost_kind = self._lost_kind
         if tracking != _TRACKING_OK:
             if tracking == _TRACKING_HOLD and self._held is not None:
                 return self._held
             return GazeTarget(lost_kind, self._point(lost_kind, ctx))
-        kind = self._target_of[self._gaze_leaf[gaze]]
+        kind = self._kind_of_state[gaze]
         target = filled(GazeTarget, kind=kind, point=self._point(kind, ctx))
         if kind != lost_kind:
             self._point(lost_kind, ctx)  # keeps the last known face fresh for a tracking loss

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gazebot.kinematics.eyes import angle_of
+from gazebot.kinematics.eyes import angle_of, eye_angles
 from gazebot.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.kinematics.robot import RobotModel
 from gazebot.kinematics.shifts import (
@@ -107,6 +107,14 @@ class GazeController:
         eyes = robot.eyes
         movable = eyes.yaw_range[0] < eyes.yaw_range[1] or eyes.pitch_range[0] < eyes.pitch_range[1]
         self._deadband = self.ik.goal_deadband if movable else 0.0
+        # Per-tick constants read once (both configs are frozen): attribute chains and
+        # properties cost more than the arithmetic they feed.
+        self._eyes_model = eyes
+        self._eye_vlim = robot.eye_velocity_limit
+        self._min_distance = self.ik.min_distance
+        # Finite even if max_distance is not (see _parse).
+        self._max_abs = min(self.ik.max_distance, sys.float_info.max)
+        self._saccade_threshold = self.shifts.saccade_threshold
         self.reset()
 
     # --- state --------------------------------------------------------------------------------
@@ -170,76 +178,7 @@ class GazeController:
             ValueError: ``target_point`` is not a 3D point or ``t`` not a number (programming
                 errors, unlike NaN values, which are held).
         """
-        dt = self._advance(t)
-        arm_moved = self.robot.set_arm(arm) if arm is not None else False
-        target = self._parse(target_point)
-        valid = target is not None
-        shift = 0.0
-        unchanged = target == self._target and not arm_moved and self._goal_final
-        if valid and not unchanged:
-            # Plans start where the last command left off (previous tick) and are evaluated now.
-            shift = self._retarget(target, self._clock - dt)
-
-        if self._traj is not None and dt > 0.0:
-            pos = self._traj.sample_position(self._clock)
-            q_prev = self._q
-            if pos == q_prev:
-                # At rest on the plan's goal (within the limits): what the loop below gives.
-                self._vel = [0.0] * len(q_prev)
-            else:
-                q = []
-                vel = []
-                finite = True
-                for p, a, (v, lo, hi) in zip(pos, q_prev, self._limits, strict=True):
-                    # Rate limit, then joint limits (comparisons, not min/max calls: this is the
-                    # hot path; a NaN stays NaN and is caught below).
-                    step = v * dt
-                    x = p
-                    if x < a - step:
-                        x = a - step
-                    if x > a + step:
-                        x = a + step
-                    if x < lo:
-                        x = lo
-                    if x > hi:
-                        x = hi
-                    finite = finite and math.isfinite(x)
-                    q.append(x)
-                    vel.append((x - a) / dt)
-                if finite:
-                    self._vel = vel
-                    self._q = q
-        elif dt > 0.0:
-            self._vel = [0.0] * len(self._q)
-
-        eyes_saturated = False
-        if self._target is not None:
-            v = self._to_local(self._target)
-            if math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) >= self.ik.min_distance:
-                eyes = self.robot.eyes
-                yaw, pitch, eyes_saturated = eyes.look(v)
-                if self._saccade is not None:
-                    t0, dur, (y0, p0) = self._saccade
-                    s = min_jerk((self._clock - t0) / dur)
-                    yaw, pitch = y0 + s * (yaw - y0), p0 + s * (pitch - p0)
-                    if s >= 1.0:
-                        self._saccade = None
-                limit = self.robot.eye_velocity_limit * dt
-                e0, e1 = self._eyes
-                # min(max(v, lo), hi) as comparisons (the same result, NaN included)
-                lo, hi = e0 - limit, e0 + limit
-                if yaw < lo:
-                    yaw = lo
-                if yaw > hi:
-                    yaw = hi
-                lo, hi = e1 - limit, e1 + limit
-                if pitch < lo:
-                    pitch = lo
-                if pitch > hi:
-                    pitch = hi
-                yaw, pitch, _ = eyes.clip(yaw, pitch)
-                self._eyes = (yaw, pitch)
-                self._residual = eyes.residual(yaw, pitch, v)
+        shift, valid, eyes_saturated = self._tick(t, target_point, arm)
         names = self._names
         state = filled(
             HeadEyeState,
@@ -255,6 +194,113 @@ class GazeController:
             eyes_saturated=eyes_saturated,
         )
         return state
+
+    def update_raw(
+        self,
+        t: float,
+        target_point: np.ndarray | None,
+        arm: Mapping[str, float] | None = None,
+    ) -> tuple[list[float], float, float, float, float]:
+        """:meth:`update` for the engine's tick: the head command (``robot.head_joints``
+        order; a list the controller replaces, never changes), eye yaw, eye pitch, residual and
+        shift amplitude, the same floats as the :class:`HeadEyeState` fields (building that
+        value and its three dicts costs microseconds the engine does not need)."""
+        shift = self._tick(t, target_point, arm)[0]
+        yaw, pitch = self._eyes
+        return self._q, yaw, pitch, self._residual, shift
+
+    def _tick(
+        self,
+        t: float,
+        target_point: np.ndarray | None,
+        arm: Mapping[str, float] | None,
+    ) -> tuple[float, bool, bool]:
+        """The work of :meth:`update`; returns the shift amplitude, whether the target was
+        valid and whether the eyes are at their range."""
+        dt = self._advance(t)
+        arm_moved = self.robot.set_arm(arm) if arm is not None else False
+        target = self._parse(target_point)
+        valid = target is not None
+        shift = 0.0
+        if valid and not (target == self._target and not arm_moved and self._goal_final):
+            # Plans start where the last command left off (previous tick) and are evaluated now.
+            shift = self._retarget(target, self._clock - dt)
+
+        if dt > 0.0:
+            if self._traj is not None:
+                self._follow(self._traj.sample_position(self._clock), dt)
+            else:
+                self._vel = [0.0] * len(self._q)
+
+        eyes_saturated = False
+        if self._target is not None:
+            eyes_saturated = self._aim_eyes(dt)
+        return shift, valid, eyes_saturated
+
+    def _follow(self, pos: list[float], dt: float) -> None:
+        """Move the head command toward the plan's position ``pos`` within the velocity and
+        joint limits (a non-finite result keeps the last command)."""
+        q_prev = self._q
+        if pos == q_prev:
+            # At rest on the plan's goal (within the limits): what the loop below gives.
+            self._vel = [0.0] * len(q_prev)
+            return
+        q = []
+        vel = []
+        finite = True
+        for p, a, (v, lo, hi) in zip(pos, q_prev, self._limits, strict=True):
+            # Rate limit, then joint limits (comparisons, not min/max calls: this is the
+            # hot path; a NaN stays NaN and is caught below).
+            step = v * dt
+            x = p
+            if x < a - step:
+                x = a - step
+            if x > a + step:
+                x = a + step
+            if x < lo:
+                x = lo
+            if x > hi:
+                x = hi
+            finite = finite and math.isfinite(x)
+            q.append(x)
+            vel.append((x - a) / dt)
+        if finite:
+            self._vel = vel
+            self._q = q
+
+    def _aim_eyes(self, dt: float) -> bool:
+        """Aim the eyes at the target from the head command (saccade profile, speed limit,
+        range); returns whether they are at their range."""
+        x, y, z = self._to_local(self._target)  # type: ignore[arg-type]
+        if not math.sqrt(x * x + y * y + z * z) >= self._min_distance:
+            return False  # too close for a direction (or not a number): the eyes stay
+        eyes = self._eyes_model
+        v = (x, y, z)
+        yaw, pitch = eye_angles(v)
+        yaw, pitch, saturated = eyes.clip(yaw, pitch)  # eyes.look(v), one call less
+        if self._saccade is not None:
+            t0, dur, (y0, p0) = self._saccade
+            s = min_jerk((self._clock - t0) / dur)
+            yaw, pitch = y0 + s * (yaw - y0), p0 + s * (pitch - p0)
+            if s >= 1.0:
+                self._saccade = None
+        limit = self._eye_vlim * dt
+        e0, e1 = self._eyes
+        # min(max(v, lo), hi) as comparisons (the same result, NaN included)
+        lo, hi = e0 - limit, e0 + limit
+        if yaw < lo:
+            yaw = lo
+        if yaw > hi:
+            yaw = hi
+        lo, hi = e1 - limit, e1 + limit
+        if pitch < lo:
+            pitch = lo
+        if pitch > hi:
+            pitch = hi
+        yaw, pitch, _ = eyes.clip(yaw, pitch)
+        self._eyes = (yaw, pitch)
+        self._residual = eyes.residual(yaw, pitch, v)
+        return saturated
 
     def _advance(self, t: float) -> float:
         """Step the internal clock; returns dt >= 0 (0 for the first call, NaN or backward time)."""
@@ -285,7 +331,7 @@ class GazeController:
         x, y, z = p.tolist()
         # Finite and not absurdly far (a corrupted sample is held like a missing one); a NaN
         # fails every comparison, and the bound is finite even if max_distance is not.
-        m = min(self.ik.max_distance, sys.float_info.max)
+        m = self._max_abs
         return (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
 
     def _gaze_frame(self) -> list[list[float]]:
@@ -336,7 +382,7 @@ class GazeController:
             new_shift = True
         else:
             amplitude = angle_of(nx, ny, nz, old[0] - ox, old[1] - oy, old[2] - oz)
-            new_shift = amplitude > cfg.saccade_threshold
+            new_shift = amplitude > self._saccade_threshold
 
         robot = self.robot
         revision = robot.arm_revision

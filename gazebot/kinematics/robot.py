@@ -264,7 +264,8 @@ class RobotModel:
         pin.forwardKinematics(self.model, self.data, q)
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
         self._kinematics_of = key
-        rows = M.homogeneous[:3].tolist()
+        rows = M.homogeneous.tolist()
+        del rows[3]  # (0, 0, 0, 1): cheaper than converting a sliced copy of the matrix
         self._last_frame = (key, rows)
         return rows
 

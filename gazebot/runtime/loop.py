@@ -114,7 +114,7 @@ class GazeLoop:
         self._t = -math.inf
         self._frame_key: tuple | None = None
         self._frame_rows: list[list[float]] = []
-        robot = engine.robot
+        robot = self._robot = engine.robot  # (the engine's robot never changes)
         self._limits = [(str(n), float(lo), float(hi))
                         for n, lo, hi in zip(robot.head_joints, robot.lower, robot.upper,
                                              strict=True)]
@@ -216,9 +216,10 @@ class GazeLoop:
         distance = None
         point = cmd.target_point
         if type(point) is np.ndarray and point.shape == (3,) and point.dtype.kind == "f":
-            # is_valid_point on the floats read once (the engine's points are such arrays)
+            # The engine's points are such arrays. No finiteness check: a NaN or infinite
+            # coordinate makes the distance NaN or infinite, which the range test below refuses.
             x, y, z = point.tolist()
-            valid = isfinite(x) and isfinite(y) and isfinite(z)
+            valid = True
         elif is_valid_point(point):
             x, y, z = np.asarray(point, dtype=float).tolist()
             valid = True
@@ -234,16 +235,17 @@ class GazeLoop:
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
         # cmd.replaced(...) without its field-name check (these are GazeCommand's fields).
-        return filled(GazeCommand, **{**cmd.__dict__, "blink": blink, "distance": distance,
-                                      "answers_sample": answers})
+        fields = dict(cmd.__dict__, blink=blink, distance=distance, answers_sample=answers)
+        return filled(GazeCommand, fields)
 
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
         the arm carrying the head moved (a head at rest: no forward kinematics)."""
-        key = (*pose, getattr(self.robot, "arm_revision", None))
+        robot = self._robot
+        key = (*pose, getattr(robot, "arm_revision", None))
         if key != self._frame_key:
             self._frame_key = key
-            self._frame_rows = self.robot.gaze_frame_lists(pose)
+            self._frame_rows = robot.gaze_frame_lists(pose)
         return self._frame_rows
 
     def _display_pose(

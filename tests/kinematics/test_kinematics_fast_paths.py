@@ -80,3 +80,25 @@ def test_head_state_has_every_dataclass_field_and_compares_like_one(sawyer):
     assert rebuilt == state and repr(rebuilt) == repr(state)
     with pytest.raises(dataclasses.FrozenInstanceError):
         state.eye_yaw = 1.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize("name", ["sawyer", "jaco2"])
+def test_update_raw_gives_the_floats_of_update(name):
+    robot_a, robot_b = RobotModel.load(name), RobotModel.load(name)
+    full, raw = GazeController(robot_a), GazeController(robot_b)
+    shifts = []
+    for i in range(240):  # a drifting hand, a gaze shift, a missing sample, time going back
+        t = i / 120 if i != 150 else 100 / 120
+        target = np.array([0.9, -0.2 + 0.5 * t, 1.0 + 0.05 * math.sin(4 * t)])
+        if i >= 120:
+            target = np.array([1.1, 0.4, 1.5])
+        if i == 100:
+            target = np.full(3, math.nan)
+        state = full.update(t, target)
+        head, yaw, pitch, residual, shift = raw.update_raw(t, target)
+        assert head == list(state.head.values())  # bit for bit, in head_joints order
+        assert (yaw, pitch, residual, shift) == (
+            state.eye_yaw, state.eye_pitch, state.residual, state.shift_amplitude
+        )
+        shifts.append(shift)
+    assert max(shifts) > 0.0  # the shift at i = 120 went through both
