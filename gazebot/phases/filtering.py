@@ -416,7 +416,7 @@ def compute_signals(
 
 def _first_rows(s: Signals, rows: int) -> Signals:
     """The first ``rows`` grid rows of ``s`` (views)."""
-    return filled(Signals, **{name: a[:rows] for name, a in vars(s).items()})
+    return filled(Signals, {name: a[:rows] for name, a in vars(s).items()})
 
 
 # The per-row blocks a SignalCache keeps beside the grid: name -> row shape (one row per grid
@@ -692,13 +692,10 @@ class SignalCache:
         keep = rows if until == math.inf else int(grid.searchsorted(until, side="right"))
         ro = self._read_only
         xv = ro["x"][:keep]
-        return filled(
-            Signals,
-            t=grid[:keep],
-            giver=xv[:, :3],
-            receiver=xv[:, 3:],
-            **{name: ro[name][:keep] for name in _IN_BLOCK},
-        )
+        fields = {"t": grid[:keep], "giver": xv[:, :3], "receiver": xv[:, 3:]}
+        for name in _IN_BLOCK:  # (in the fields' order)
+            fields[name] = ro[name][:keep]
+        return filled(Signals, fields)
 
     def _reserve(self, rows: int, keep: int) -> None:
         """Blocks of at least ``rows`` rows, owned by the cache, holding the first ``keep``
