@@ -59,11 +59,13 @@ from gazebot.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
 from gazebot.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
 from gazebot.types import Event, EventKind, Phase, TrackingFrame, filled
 
+_F64 = np.dtype(np.float64)
+
 
 def _point(p: object) -> np.ndarray:
     """A point as a float 3-vector (NaNs if it is not a numeric 3-vector)."""
-    if type(p) is np.ndarray and p.dtype == np.float64 and p.shape == (3,):
-        return p  # the usual case (the engine's frames): no conversion
+    if type(p) is np.ndarray and p.dtype is _F64 and p.shape == (3,):
+        return p  # the usual case (the engine's frames): no conversion (an identity check)
     try:
         v = np.asarray(p, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -73,28 +75,23 @@ def _point(p: object) -> np.ndarray:
 
 class _Samples:
     """The samples kept (rows ``[t, giver xyz, receiver xyz]``) in one array that grows and is
-    compacted in place: the analysis reads them as views, with no per-sample conversion."""
+    compacted in place: the analysis reads them as views, with no per-sample conversion. A new
+    sample waits in a list until the rows are read (a list append per sample; one conversion
+    of the few new rows per analysis)."""
 
     def __init__(self) -> None:
         self._buf = np.empty((256, 7))
         self._s0 = self._s1 = 0
+        self._new: list[tuple[float, ...]] = []  # the newest rows, not yet in _buf
         self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
 
     def __len__(self) -> int:
-        return self._s1 - self._s0
+        return self._s1 - self._s0 + len(self._new)
 
-    def append(self, row: list[float]) -> None:
-        buf = self._buf
-        if self._s1 == buf.shape[0]:
-            m = self._s1 - self._s0
-            if 2 * m > buf.shape[0]:
-                self._buf = np.empty((2 * buf.shape[0], 7))
-            self._buf[:m] = buf[self._s0 : self._s1]
-            buf, self._s0, self._s1 = self._buf, 0, m
-        buf[self._s1] = row
-        if self._s1 == self._s0:
+    def append(self, row: tuple[float, ...]) -> None:
+        if self._s1 == self._s0 and not self._new:
             self._first_t = row[0]
-        self._s1 += 1
+        self._new.append(row)
 
     def drop_before(self, t0: float) -> None:
         """Forget the samples older than ``t0``."""
@@ -104,14 +101,37 @@ class _Samples:
         while i < end and buf[i, 0] < t0:
             i += 1
         self._s0 = i
-        self._first_t = float(buf[i, 0]) if i < end else math.inf
+        if i < end:
+            self._first_t = float(buf[i, 0])
+            return
+        new = self._new  # (every row in the array is gone: the new rows next)
+        k = 0
+        while k < len(new) and new[k][0] < t0:
+            k += 1
+        del new[:k]
+        self._first_t = new[0][0] if new else math.inf
 
     def time(self, i: int) -> float:
         """Time of the ``i``-th sample kept."""
-        return float(self._buf[self._s0 + i, 0])
+        m = self._s1 - self._s0
+        return float(self._buf[self._s0 + i, 0]) if i < m else self._new[i - m][0]
 
     def rows(self) -> np.ndarray:
         """The samples kept (a view: valid until the next :meth:`append`)."""
+        new = self._new
+        if new:
+            k, buf = len(new), self._buf
+            if self._s1 + k > buf.shape[0]:
+                m = self._s1 - self._s0
+                cap = buf.shape[0]
+                while 2 * (m + k) > cap:
+                    cap *= 2
+                self._buf = np.empty((cap, 7)) if cap != buf.shape[0] else buf
+                self._buf[:m] = buf[self._s0 : self._s1]
+                self._s0, self._s1 = 0, m
+            self._buf[self._s1 : self._s1 + k] = new
+            self._s1 += k
+            new.clear()
         return self._buf[self._s0 : self._s1]
 
 
@@ -161,13 +181,18 @@ class PhaseDetector:
         self._prev_evidence: bool | None = False
         self._robot_reports = False
         self._signals: Signals | None = None
+        self._finite_of: Signals | None = None  # the signals self._finite indexes
+        self._finite = np.empty(0, dtype=np.intp)
         # The last analysis's signals, so the next one (on the same window, a few samples
-        # longer) computes only the rows the new samples change.
-        self._signal_cache = SignalCache()
+        # longer) computes only the rows the new samples change. (append_only: the windows
+        # are cut from the samples kept, which only grow at their end.)
+        self._signal_cache = SignalCache(append_only=True)
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()
         self._last_full = -math.inf
+        self._state_key: tuple[object, ...] = ()  # the values self._state was made of
+        self._state: OnlineState | None = None
         self._reach_missing_since = math.nan
         self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
@@ -279,21 +304,21 @@ class PhaseDetector:
         self._last_t = t
         st.samples += 1
         c = self.config
-        g, r = _point(frame.giver_hand), _point(frame.receiver_hand)
-        gx, gy, gz = g.tolist()
-        rx, ry, rz = r.tolist()
+        g, r = _point(frame.giver_hand).tolist(), _point(frame.receiver_hand).tolist()
+        gx, gy, gz = g
+        rx, ry, rz = r
         finite = math.isfinite
         g_ok = finite(gx) and finite(gy) and finite(gz)
         r_ok = finite(rx) and finite(ry) and finite(rz)
         samples = self._samples
-        samples.append([t, gx, gy, gz, rx, ry, rz])
+        samples.append((t, gx, gy, gz, rx, ry, rz))
         samples.drop_before(t - c.online_window)
         if g_ok:
             self._seen_g = t
         if r_ok:
             self._seen_r = t
         if self._trigger is not None:
-            self._trigger.add((gx, gy, gz), g_ok, (rx, ry, rz), r_ok)
+            self._trigger.add(g, g_ok, r, r_ok)
         if not (g_ok and r_ok):
             st.held += 1
             if self.tracking:
@@ -331,16 +356,7 @@ class PhaseDetector:
                 self._last_analysis = t  # the first sample, or after a pause: a new grid
             mode = "full"
             if self._trigger is not None:
-                state = filled(
-                    OnlineState,
-                    phase=self.phase,
-                    phase_start=self.phase_start,
-                    floor=self._floor,
-                    tracking=self.tracking,
-                    joined_late=self._joined_late,
-                    last_full=self._last_full,
-                )
-                mode = self._trigger.decide(t, state)
+                mode = self._trigger.decide(t, self._online_state())
             if mode != "skip":
                 self._last_full = t
                 self._analyse(t, predict_only=mode == "refresh")
@@ -350,6 +366,25 @@ class PhaseDetector:
                 self._done(t, t, "timeout")
         if math.isfinite(self.expected_phase_end):
             self.expected_phase_end = max(self.expected_phase_end, t)
+
+    def _online_state(self) -> OnlineState:
+        """What the trigger reads of the detector: the last one while it holds (these change a
+        few times per handover; a new value costs more than comparing them)."""
+        key = (self.phase, self.phase_start, self._floor, self.tracking, self._joined_late,
+               self._last_full)
+        state = self._state
+        if state is None or key != self._state_key:  # (a NaN not the same object: rebuilt)
+            self._state_key = key
+            self._state = state = filled(
+                OnlineState,
+                phase=self.phase,
+                phase_start=self.phase_start,
+                floor=self._floor,
+                tracking=self.tracking,
+                joined_late=self._joined_late,
+                last_full=self._last_full,
+            )
+        return state
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
         """Gripper / load-share evidence of a frame that carries some (the caller handles a
@@ -391,19 +426,19 @@ class PhaseDetector:
             # grows with the samples; after a handover, re-analysing it is wasted).
             look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
             back = REACH_S * look
-            i0 = int(np.searchsorted(t, self.phase_start - back))
+            i0 = int(t.searchsorted(self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
         window = rows[i0:]
-        # (the rows are float64 of known shapes: no conversion or check needed)
-        traj = Trajectory.of_hands(window[:, 0].copy(), window[:, 1:4].copy(),
-                                   window[:, 4:].copy())
+        # (the rows are float64 of known shapes: no conversion or check needed; views, not
+        # copies: only this analysis reads them, and nothing writes to a trajectory's arrays)
+        traj = Trajectory.of_hands(window[:, 0], window[:, 1:4], window[:, 4:])
         s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
             # Keep the reach's start distance while the window holds it (a reach can outlast
             # the window; the taken-back checks compare with it).
-            self._reach_start_distance(s, np.flatnonzero(np.isfinite(s.distance)))
+            self._reach_start_distance(s, self._finite_distances(s))
             restart = self._reach_restart()
             if restart is not None:
                 # The reach was an earlier movement (the giver lifted the object, waited, and
@@ -521,14 +556,16 @@ class PhaseDetector:
         s = self._signals
         if s is None or s.t.shape[0] < 3:
             return None
-        i_start = int(np.searchsorted(s.t, self.phase_start))
+        i_start = int(s.t.searchsorted(self.phase_start))
         v = s.giver_speed[i_start:]
-        rest = np.isfinite(v) & (v < c.rest_speed)
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
-        if need < 1 or rest.size <= need or np.count_nonzero(rest) < need:
+        if need < 1 or v.shape[0] <= need:
+            return None  # (a reach younger than reach_stall: no rest that long in it)
+        rest = np.isfinite(v) & (v < c.rest_speed)
+        if np.count_nonzero(rest) < need:
             return None  # (no run of need rest samples without need of them in all)
         # the last sample of the last rest at least reach_stall long
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
+        edges = np.diff(np.concatenate([[0], rest.astype(int), [0]])).nonzero()[0]
         bounds = edges.tolist()  # (plain ints: iterating the array would box each element)
         runs = [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
         runs = [(a, b) for a, b in runs if b - a + 1 >= need and b < rest.size - 1]
@@ -548,14 +585,21 @@ class PhaseDetector:
             return None
         return float(s.t[i_b])
 
+    def _finite_distances(self, s: Signals) -> np.ndarray:
+        """Grid indices of the finite distances of ``s`` (found once per analysis's signals:
+        the reach's checks read them several times)."""
+        if self._finite_of is not s:
+            self._finite_of, self._finite = s, np.isfinite(s.distance).nonzero()[0]
+        return self._finite
+
     def _reach_start_distance(self, s: Signals, ok: np.ndarray) -> float:
         """The hands' distance when the current reach began (``ok``: the finite samples of
         ``s.distance``): read from ``s`` while its window still holds that moment (and kept),
         else the value kept from the last window that held it; NaN if none did."""
         if s.t.shape[0] and s.t[0] <= self.phase_start:
-            i0 = int(np.searchsorted(s.t, self.phase_start))
-            before = ok[ok <= i0]
-            self._reach_d0 = float(s.distance[before[-1]]) if before.size else math.nan
+            i0 = int(s.t.searchsorted(self.phase_start))
+            k = int(ok.searchsorted(i0, side="right"))  # (ok increases: those <= i0)
+            self._reach_d0 = float(s.distance[ok[k - 1]]) if k else math.nan
         return self._reach_d0
 
     def _taken_back(self) -> bool:
@@ -564,7 +608,7 @@ class PhaseDetector:
         s = self._signals
         if s is None or self._joined_late:
             return False
-        ok = np.flatnonzero(np.isfinite(s.distance))
+        ok = self._finite_distances(s)
         d0 = self._reach_start_distance(s, ok)
         if not ok.size or d0 != d0:
             return False
@@ -577,7 +621,7 @@ class PhaseDetector:
         if s is None or s.t.shape[0] == 0:
             return True
         d = s.distance
-        ok = np.flatnonzero(np.isfinite(d))
+        ok = self._finite_distances(s)
         if ok.size == 0:
             return True
         if self._joined_late and not (ok.size and s.t[ok[0]] < self.phase_start):

@@ -15,6 +15,11 @@ arithmetic, sets the cost. The result is, bit for bit, what the steps give one h
 (``tests/phases/signals_reference.py`` keeps that form and the tests compare the two). Online,
 a :class:`SignalCache` keeps the last result, and the next analysis of the same window a few
 samples longer computes only the rows those samples change (the same result, bit for bit).
+
+Here and in the rules, the arrays' own methods (``a.searchsorted(x)``, ``m.nonzero()[0]``,
+``a.argmax()``) stand for numpy's functions of the same name (``np.searchsorted``,
+``np.flatnonzero``, ``np.argmax``): the same computation without the functions' Python-level
+dispatch, which costs more than the work on these short arrays.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ from scipy.ndimage import correlate1d, gaussian_filter1d
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.trajectory import Trajectory
+from gazebot.types import filled
 
 # Share of the smoothing window that must hold data for a velocity to be known.
 FULL_WINDOW = 0.6
@@ -85,7 +91,7 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
     previous valid one (``ok``: the valid rows), while the hand moved faster than
     ``moving_speed`` between the two valid samples before."""
     stale = np.zeros(p.shape[0], dtype=bool)
-    idx = np.flatnonzero(ok)
+    idx = ok.nonzero()[0]
     if idx.size < 3:
         return stale
     pv = p[idx]
@@ -111,13 +117,13 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
 def _far_from_samples(tv: np.ndarray, grid: np.ndarray, bar: float) -> np.ndarray:
     """Grid points inside a gap longer than ``bar`` between the valid sample times ``tv`` (or
     outside them), unless the point is a sample itself."""
-    j = np.searchsorted(tv, grid, side="right")
+    j = tv.searchsorted(grid, side="right")
     gap = np.full(grid.shape[0], np.inf)
     inside = (j > 0) & (j < tv.shape[0])
     ji = j[inside]
     gap[inside] = tv[ji] - tv[ji - 1]
     # grid points that are samples (both sorted: a searchsorted, not np.isin's sort)
-    k = np.minimum(np.searchsorted(tv, grid), tv.shape[0] - 1)
+    k = np.minimum(tv.searchsorted(grid), tv.shape[0] - 1)
     return (gap > bar) & (tv[k] != grid)
 
 
@@ -136,8 +142,8 @@ def resample(
     if float(np.max(np.diff(tv))) <= bar:
         # No gap between the samples is that long (the usual case): only the grid points
         # before the first sample or after the last one are far from them.
-        out[: int(np.searchsorted(grid, tv[0], side="left"))] = np.nan
-        out[int(np.searchsorted(grid, tv[-1], side="right")) :] = np.nan
+        out[: int(grid.searchsorted(tv[0], side="left"))] = np.nan
+        out[int(grid.searchsorted(tv[-1], side="right")) :] = np.nan
     else:
         out[_far_from_samples(tv, grid, bar)] = np.nan
     return out
@@ -179,15 +185,15 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
         # Every row seen (the usual case): only the positions need smoothing; the seen share
         # is the same at every row.
         share = _seen_share(sigma)
-        den = np.full((rows, hands), share)
+        den = np.empty((rows, hands))
+        den.fill(share)  # (np.full's work without its argument handling)
         out = correlate1d(x, w, axis=0, mode="nearest") / max(share, 1e-12)
         if share < 0.5:
             out[:] = np.nan
         return out, den
     # per row and hand: x, y, z (0 where unseen) and whether seen; smoothed in one call
     stack = np.empty((rows, hands, 4))
-    stack[:, :, :3] = x.reshape(rows, hands, 3)
-    np.copyto(stack[:, :, :3], 0.0, where=~m[:, :, None])
+    stack[:, :, :3] = np.where(m[:, :, None], x.reshape(rows, hands, 3), 0.0)
     stack[:, :, 3] = m
     both = correlate1d(stack, w, axis=0, mode="nearest")
     den = both[:, :, 3]
@@ -259,11 +265,40 @@ def vector_norm(v: np.ndarray) -> float:
     return math.sqrt(float(x.dot(x)))
 
 
-def _norms(x: np.ndarray) -> np.ndarray:
+def row_norms(x: np.ndarray) -> np.ndarray:
     """Row norms of real (N, 3) ``x``: what ``np.linalg.norm(x, axis=1)`` computes (the squares
     summed in its order, pinned by the tests against it), column by column: numpy's reduction
-    over a length-3 axis costs more than the three columns."""
+    over a length-3 axis (and its argument handling) costs more than the three columns."""
     return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])
+
+
+def _derived_into(
+    x: np.ndarray,
+    q: np.ndarray,
+    norms: np.ndarray,
+    closing: np.ndarray,
+    common: np.ndarray,
+    hold: np.ndarray,
+) -> None:
+    """From smoothed positions ``x`` (rows, both hands) and the velocities in ``q[2]`` (giver)
+    and ``q[3]`` (receiver), row by row (a row's values depend on that row alone), written
+    into: ``q`` (5, rows, 3) the relative position, relative velocity and the velocities' sum;
+    ``norms`` (5, rows) the five vectors' norms (distance, relative speed, giver speed,
+    receiver speed, and twice the common speed); ``closing``, ``common`` and ``hold`` (rows,)
+    the closing, common and hold speeds (see :class:`Signals`). Each ``q[i]`` must be
+    contiguous (as the einsum reads it)."""
+    gv, rv = q[2], q[3]
+    # The five vectors whose norms are needed, in one block: what row_norms computes for each,
+    # in a few numpy calls instead of six per vector.
+    np.subtract(x[:, 3:], x[:, :3], out=q[0])
+    np.subtract(rv, gv, out=q[1])
+    np.add(gv, rv, out=q[4])
+    sq = q * q
+    np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2], out=norms)
+    np.multiply(0.5, norms[4], out=common)
+    np.negative(np.einsum("ij,ij->i", q[1], q[0]), out=closing)
+    np.divide(closing, np.maximum(norms[0], 1e-9), out=closing)
+    np.maximum(np.abs(closing), norms[1] - np.minimum(norms[2], norms[3]), out=hold)
 
 
 def _derived(
@@ -271,25 +306,19 @@ def _derived(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
            np.ndarray, np.ndarray]:
     """From smoothed positions ``x`` and velocities ``v`` (rows, both hands): ``rel, rel_v,
-    distance, rel_speed, giver_speed, receiver_speed, closing, common_speed, hold_speed``, row
-    by row (a row's values depend on that row alone)."""
-    gv, rv = v[:, :3], v[:, 3:]
-    # The five vectors whose norms are needed, in one block: what _norms computes for each,
-    # in a few numpy calls instead of six per vector.
-    q = np.empty((5, x.shape[0], 3))
-    rel, rel_v = q[0], q[1]
-    np.subtract(x[:, 3:], x[:, :3], out=rel)
-    np.subtract(rv, gv, out=rel_v)
-    q[2] = gv
-    q[3] = rv
-    np.add(gv, rv, out=q[4])
-    sq = q * q
-    norms = np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2])
-    distance, rel_speed, g_speed, r_speed = norms[0], norms[1], norms[2], norms[3]
-    common = 0.5 * norms[4]
-    closing = -np.einsum("ij,ij->i", rel_v, rel) / np.maximum(distance, 1e-9)
-    hold = np.maximum(np.abs(closing), rel_speed - np.minimum(g_speed, r_speed))
-    return rel, rel_v, distance, rel_speed, g_speed, r_speed, closing, common, hold
+    distance, rel_speed, giver_speed, receiver_speed, closing, common_speed, hold_speed``
+    (:func:`_derived_into`, into new arrays)."""
+    rows = x.shape[0]
+    q, norms, speeds = np.empty((5, rows, 3)), np.empty((5, rows)), np.empty((3, rows))
+    q[2] = v[:, :3]
+    q[3] = v[:, 3:]
+    _derived_into(x, q, norms, speeds[0], speeds[1], speeds[2])
+    return q[0], q[1], norms[0], norms[1], norms[2], norms[3], speeds[0], speeds[1], speeds[2]
+
+
+def _by_hand(rows: np.ndarray) -> np.ndarray:
+    """Contiguous rows (N, 6) of both hands as a (2, N, 3) view: hand, row, coordinate."""
+    return rows.reshape(rows.shape[0], 2, 3).transpose(1, 0, 2)
 
 
 def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
@@ -308,7 +337,10 @@ def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
 
 
 def compute_signals(
-    trajectory: Trajectory, config: PhaseConfig, cache: SignalCache | None = None
+    trajectory: Trajectory,
+    config: PhaseConfig,
+    cache: SignalCache | None = None,
+    until: float = math.inf,
 ) -> Signals:
     """Frozen samples out, resample, smooth and differentiate the hands of ``trajectory``
     (sorted by time, see :meth:`Trajectory.cleaned`).
@@ -316,9 +348,10 @@ def compute_signals(
     ``cache``: an online caller's :class:`SignalCache`: when ``trajectory`` extends the one of
     the previous call (the same samples, more at the end), only the rows the new samples can
     change are computed; the result is the same, bit for bit. Its arrays are then read-only
-    views, valid until the cache's next call."""
+    views, valid until the cache's next call. ``until``: only the grid rows at or before this
+    time are returned (views of the whole result's first rows)."""
     if cache is not None:
-        s = cache.extend(trajectory, config)
+        s = cache.extend(trajectory, config, until)
         if s is not None:
             return s
     t = trajectory.t
@@ -375,18 +408,30 @@ def compute_signals(
         hold_speed=hold,
     )
     if cache is not None:
-        cache.keep(trajectory, config, s, x, v, full, sigma_s / dt, seen, ok)
+        cache.keep(trajectory, config, s, x, full, sigma_s / dt, seen, ok)
+    if until < math.inf:
+        s = _first_rows(s, int(grid.searchsorted(until, side="right")))
     return s
 
 
-# The columns a SignalCache keeps per grid row, beside the grid: name -> columns (1: a vector).
-_KEPT = {
-    "x": 6, "v": 6, "full": 2, "rel": 3, "rel_v": 3, "distance": 1, "rel_speed": 1,
-    "giver_speed": 1, "receiver_speed": 1, "closing": 1, "common_speed": 1, "hold_speed": 1,
+def _first_rows(s: Signals, rows: int) -> Signals:
+    """The first ``rows`` grid rows of ``s`` (views)."""
+    return filled(Signals, {name: a[:rows] for name, a in vars(s).items()})
+
+
+# The per-row blocks a SignalCache keeps beside the grid: name -> row shape (one row per grid
+# row; the derived blocks are laid out as _derived_into writes them).
+_BLOCKS = {"x": (6,), "full": (2,), "q": (5, 3), "norms": (5,), "speeds": (3,)}
+# Where each Signals field derived from the rows sits: (block, index in the block's first axis),
+# in the fields' order.
+_IN_BLOCK = {
+    "giver_v": ("q", 2), "receiver_v": ("q", 3), "rel": ("q", 0), "rel_v": ("q", 1),
+    "distance": ("norms", 0), "rel_speed": ("norms", 1), "giver_speed": ("norms", 2),
+    "receiver_speed": ("norms", 3), "closing": ("speeds", 0), "common_speed": ("speeds", 1),
+    "hold_speed": ("speeds", 2),
 }
-# The order _derived returns its arrays in.
-_DERIVED = ("rel", "rel_v", "distance", "rel_speed", "giver_speed", "receiver_speed", "closing",
-            "common_speed", "hold_speed")
+# The blocks _derived_into writes, laid out (block axis, rows, ...).
+_DERIVED_BLOCKS = ("q", "norms", "speeds")
 
 
 class SignalCache:
@@ -402,24 +447,34 @@ class SignalCache:
 
     A full computation starts the cache afresh when the window does not extend the last one
     (its first sample or an older sample changed), the smoothing width changed, or a hand has
-    no valid sample before the rows to recompute."""
+    no valid sample before the rows to recompute.
 
-    def __init__(self) -> None:
+    ``append_only``: the caller's windows are all cut from one stream of samples that only
+    grows at its end (the online detector's): a window with the kept first sample's time and
+    more samples then holds the kept samples unchanged, so they are not compared (nor kept).
+    """
+
+    def __init__(self, append_only: bool = False) -> None:
+        self._append_only = append_only
         self._config: PhaseConfig | None = None  # None: nothing kept
-        self._t = np.empty(0)  # the samples the kept signals came from
+        self._n = 0  # samples kept
+        self._t_first = self._t_last = math.nan  # their first and last times
+        self._t = np.empty(0)  # the samples the kept signals came from (unless append_only)
         self._g = np.empty((0, 3))
         self._r = np.empty((0, 3))
-        self._seen = np.empty((0, 2), dtype=bool)  # per sample and hand: every coordinate
-        self._ok = np.empty((0, 2), dtype=bool)  # ... and not a stale repeat
-        self._clean = False  # every sample kept seen and valid (the interpolation's fast path)
+        # per sample and hand: every coordinate seen, and also not a stale repeat; None while
+        # every sample kept is both (_clean: the interpolation's fast path)
+        self._seen: np.ndarray | None = None
+        self._ok: np.ndarray | None = None
+        self._clean = False
         self._last_seen = [-1, -1]  # per hand: the last sample kept that was seen (-1: none)
         self._max_dt = 0.0
         self._sigma = 0.0
         self._grid = np.empty(0)
         self._rows = 0  # grid rows kept
-        self._buf: dict[str, np.ndarray] = {}
-        self._read_only: dict[str, np.ndarray] = {}  # read-only views of the owned buffers
-        self._owned = False  # the buffers are this cache's (else: a returned result's arrays)
+        self._buf: dict[str, np.ndarray] = {}  # the blocks (owned, or a full result's arrays)
+        self._owned = False  # the blocks are this cache's (else: a returned result's arrays)
+        self._read_only: dict[str, np.ndarray] = {}  # read-only views: the results' fields
 
     def keep(
         self,
@@ -427,14 +482,13 @@ class SignalCache:
         config: PhaseConfig,
         s: Signals,
         x: np.ndarray,
-        v: np.ndarray,
         full: np.ndarray,
         sigma: float,
         seen: np.ndarray,
         ok: np.ndarray,
     ) -> None:
-        """Remember a full computation's result ``s`` with its smoothed rows ``x``, velocities
-        ``v``, window shares ``full``, smoothing width ``sigma`` (grid steps) and, per sample
+        """Remember a full computation's result ``s`` with its smoothed rows ``x``, window
+        shares ``full``, smoothing width ``sigma`` (grid steps) and, per sample
         and hand, which samples were ``seen`` and which were valid (``ok``: seen and not
         stale). The arrays are adopted, not copied: the first extension copies what it
         keeps."""
@@ -443,19 +497,21 @@ class SignalCache:
             self._config = None
             return
         self._config = config
-        self._t = t.copy()
-        self._g = trajectory.giver_hand.copy()
-        self._r = trajectory.receiver_hand.copy()
-        self._seen, self._ok = seen, ok
+        self._n = t.shape[0]
+        self._t_first, self._t_last = float(t[0]), float(t[-1])
+        if not self._append_only:
+            self._t = t.copy()
+            self._g = trajectory.giver_hand.copy()
+            self._r = trajectory.receiver_hand.copy()
         self._clean = bool(ok.all())
+        self._seen, self._ok = (None, None) if self._clean else (seen, ok)
         self._last_seen = [self._last_of(seen[:, h]) for h in (0, 1)]
         self._max_dt = float(np.max(np.diff(t)))
         self._sigma = sigma
         self._grid = s.t
         self._rows = s.t.shape[0]
-        self._buf = {"x": x, "v": v, "full": full}
-        for name in _DERIVED:
-            self._buf[name] = getattr(s, name)
+        self._buf = {"x": x, "full": full}
+        self._buf.update({name: getattr(s, name) for name in _IN_BLOCK})
         self._owned = False
 
     @staticmethod
@@ -466,10 +522,21 @@ class SignalCache:
             i -= 1
         return i
 
+    def _masks(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per sample kept and hand: seen, and valid (all True while the cache is clean)."""
+        if self._seen is None or self._ok is None:
+            every = np.ones((self._n, 2), dtype=bool)
+            return every, every
+        return self._seen, self._ok
+
     def _same_prefix(self, t: np.ndarray, g: np.ndarray, r: np.ndarray) -> bool:
         """The first samples of ``t``, ``g``, ``r`` are the ones kept, bit for bit (NaN too)."""
-        n0 = self._t.shape[0]
-        if t[0] != self._t[0] or not (t[:n0] == self._t).all():
+        n0 = self._n
+        if t[0] != self._t_first or t[n0 - 1] != self._t_last:
+            return False
+        if self._append_only:
+            return True  # (the same first sample of one growing stream: the same samples)
+        if not (t[:n0] == self._t).all():
             return False
         if self._clean:  # (no NaN kept: value equality is enough)
             return bool((g[:n0] == self._g).all() and (r[:n0] == self._r).all())
@@ -486,28 +553,31 @@ class SignalCache:
         """Which of the new samples of one hand (``p``: all its samples) are seen, and which
         of those are not stale repeats (:func:`drop_frozen`, whose decisions run in time
         order: run on the whole window only when a new seen sample repeats the one before)."""
-        n0 = self._t.shape[0]
+        n0 = self._n
         fin = np.isfinite(p[n0:])
         seen_new = fin[:, 0] & fin[:, 1] & fin[:, 2]
-        rows = np.flatnonzero(seen_new) + n0
+        rows = seen_new.nonzero()[0] + n0
         before = self._last_seen[hand]
         if before >= 0:
             rows = np.concatenate(([before], rows))
         q = p[rows]
         if rows.size < 2 or not (q[1:] == q[:-1]).all(axis=1).any():
             return seen_new, seen_new
-        seen_all = np.concatenate((self._seen[:, hand], seen_new))
+        seen_all = np.concatenate((self._masks()[0][:, hand], seen_new))
         stale = drop_frozen(t, p, frozen_speed, seen_all)[n0:]
         return seen_new, seen_new & ~stale
 
-    def extend(self, trajectory: Trajectory, config: PhaseConfig) -> Signals | None:
+    def extend(
+        self, trajectory: Trajectory, config: PhaseConfig, until: float = math.inf
+    ) -> Signals | None:
         """The signals of ``trajectory`` if it extends the samples kept (see the class
-        docstring), else ``None`` (the caller computes them in full)."""
+        docstring), else ``None`` (the caller computes them in full); ``until``: see
+        :func:`compute_signals`."""
         if self._config is None or (config is not self._config and config != self._config):
             return None
         t = trajectory.t
         g_in, r_in = trajectory.giver_hand, trajectory.receiver_hand
-        n, n0 = t.shape[0], self._t.shape[0]
+        n, n0 = t.shape[0], self._n
         if n <= n0 or not self._same_prefix(t, g_in, r_in):
             return None
         # The new samples: seen and valid per hand. The usual case, every one seen and none
@@ -519,13 +589,13 @@ class SignalCache:
             and math.isfinite(float(tail.sum()))
             and not (tail[1:] == tail[:-1]).any()
         )
-        if clean:
-            seen_new = ok_new = np.ones((n - n0, 2), dtype=bool)
-        else:
+        if not clean:
             sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
             sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
             seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
-        max_dt = max(self._max_dt, float((t[n0:] - t[n0 - 1 : -1]).max()))
+        # (few new samples: their largest step in plain floats)
+        new_t = t[n0 - 1 :].tolist()
+        max_dt = max(self._max_dt, max(b - a for a, b in zip(new_t, new_t[1:], strict=False)))
         dt = 1.0 / config.analysis_rate
         # The smoothing width: half the median sample interval only counts when it exceeds
         # half the smoothing, which needs an interval that long.
@@ -541,13 +611,14 @@ class SignalCache:
         # the first grid row past the last valid sample kept of either hand: NaN before, or
         # beyond the kept grid
         if self._clean:
-            last_valid = float(self._t[-1])
+            last_valid = self._t_last
         else:
-            k_g, k_r = np.flatnonzero(self._ok[:, 0]), np.flatnonzero(self._ok[:, 1])
+            ok_old = self._masks()[1]
+            k_g, k_r = ok_old[:, 0].nonzero()[0], ok_old[:, 1].nonzero()[0]
             if k_g.size < 2 or k_r.size < 2:
                 return None  # (a hand with fewer was all unknown: its first rows change too)
-            last_valid = float(self._t[min(int(k_g[-1]), int(k_r[-1]))])
-        j_c = int(np.searchsorted(self._grid, last_valid, side="right"))
+            last_valid = float(t[min(int(k_g[-1]), int(k_r[-1]))])
+        j_c = int(self._grid.searchsorted(last_valid, side="right"))
         a = j_c - radius  # first smoothed row that changes
         # (scipy's correlation of a line that starts at row i0 equals the whole line's only
         # from row i0 + radius + 1 on: the slice starts one row earlier than the kernel needs)
@@ -559,25 +630,27 @@ class SignalCache:
         xr = np.empty((gs.shape[0], 6))
         bar = config.max_gap_hold + 1e-9
         if clean:
-            i_s = max(int(np.searchsorted(t, gs[0], side="right")) - 1, 0)
+            i_s = max(int(t.searchsorted(gs[0], side="right")) - 1, 0)
             ts = t[i_s:]
             for k in range(3):
                 xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
                 xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
-            if ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
+            # (no step of the window is longer than bar: none of ts's is)
+            if max_dt > bar and ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
                 xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
             else:
-                xr[int(np.searchsorted(gs, t[-1], side="right")) :] = np.nan
+                xr[int(gs.searchsorted(t[-1], side="right")) :] = np.nan
         else:
-            i_t = int(np.searchsorted(t, gs[0], side="right")) - 1  # the sample at or before
+            i_t = int(t.searchsorted(gs[0], side="right")) - 1  # the sample at or before
+            ok_old = self._masks()[1]
             for hand, p_in in enumerate((g_in, r_in)):
-                ok_old = self._ok[:, hand]
+                ok_hand = ok_old[:, hand]
                 i_s = min(i_t, n0 - 1)
-                while i_s >= 0 and not ok_old[i_s]:  # the valid sample at or before the rows
+                while i_s >= 0 and not ok_hand[i_s]:  # the valid sample at or before the rows
                     i_s -= 1
                 if i_s < 0:
                     return None  # (none: the rows were unknown and may not stay so)
-                valid = np.concatenate((ok_old[i_s:], ok_new[:, hand]))
+                valid = np.concatenate((ok_hand[i_s:], ok_new[:, hand]))
                 tv, pv = t[i_s:][valid], p_in[i_s:][valid]
                 cols = slice(3 * hand, 3 * hand + 3)
                 for k in range(3):
@@ -592,47 +665,59 @@ class SignalCache:
         b["x"][a:rows] = xs[lead:]
         b["full"][a:rows] = full[lead:]
         # velocities from row a - 1 (its central difference reads row a): _velocities'
-        # arithmetic, written in place
-        x, vt = b["x"], b["v"][a - 1 : rows]
-        np.subtract(x[a:rows], x[a - 2 : rows - 2], out=vt[:-1])
-        np.divide(vt[:-1], 2.0 * dt, out=vt[:-1])
-        vt[-1] = (x[rows - 1] - x[rows - 2]) / dt
-        vt.reshape(vt.shape[0], 2, 3)[b["full"][a - 1 : rows] < FULL_WINDOW] = np.nan
-        for name, arr in zip(_DERIVED, _derived(x[a - 1 : rows], b["v"][a - 1 : rows]),
-                             strict=True):
-            b[name][a - 1 : rows] = arr
-        self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
-        self._seen = np.concatenate((self._seen, seen_new))
-        self._ok = np.concatenate((self._ok, ok_new))
-        if not clean:
-            self._last_seen = [self._last_of(self._seen[:, h]) for h in (0, 1)]
-        else:
+        # arithmetic, written in place where _derived_into reads them (giver, receiver)
+        x, q = b["x"], b["q"][:, a - 1 : rows]
+        vq = q[2:4]
+        np.subtract(_by_hand(x[a:rows]), _by_hand(x[a - 2 : rows - 2]), out=vq[:, :-1])
+        np.divide(vq[:, :-1], 2.0 * dt, out=vq[:, :-1])
+        vq[:, -1] = ((x[rows - 1] - x[rows - 2]) / dt).reshape(2, 3)
+        shares = b["full"][a - 1 : rows]
+        if shares.min() < FULL_WINDOW:  # (away from tracking gaps, none is)
+            vq[shares.T < FULL_WINDOW] = np.nan
+        sp = b["speeds"][:, a - 1 : rows]
+        _derived_into(x[a - 1 : rows], q, b["norms"][:, a - 1 : rows], sp[0], sp[1], sp[2])
+        if not self._append_only:
+            self._t, self._g, self._r = t.copy(), g_in.copy(), r_in.copy()
+        if clean:
             self._last_seen = [n - 1, n - 1]
+        else:
+            seen_old, ok_old = self._masks()
+            self._seen = np.concatenate((seen_old, seen_new))
+            self._ok = np.concatenate((ok_old, ok_new))
+            self._last_seen = [self._last_of(self._seen[:, h]) for h in (0, 1)]
+        self._n, self._t_last = n, new_t[-1]
         self._clean = clean
         self._max_dt = max_dt
         self._grid, self._rows = grid, rows
+        keep = rows if until == math.inf else int(grid.searchsorted(until, side="right"))
         ro = self._read_only
-        xv, vv = ro["x"][:rows], ro["v"][:rows]
-        rel, rel_v, dist, rel_s, g_s, r_s, closing, common, hold = (
-            ro[name][:rows] for name in _DERIVED
-        )
-        return Signals(
-            grid, xv[:, :3], xv[:, 3:], vv[:, :3], vv[:, 3:], rel, rel_v, dist, rel_s, g_s,
-            r_s, closing, common, hold,
-        )
+        xv = ro["x"][:keep]
+        fields = {"t": grid[:keep], "giver": xv[:, :3], "receiver": xv[:, 3:]}
+        for name in _IN_BLOCK:  # (in the fields' order)
+            fields[name] = ro[name][:keep]
+        return filled(Signals, fields)
 
     def _reserve(self, rows: int, keep: int) -> None:
-        """Buffers of at least ``rows`` rows, owned by the cache, holding the first ``keep``
+        """Blocks of at least ``rows`` rows, owned by the cache, holding the first ``keep``
         rows kept."""
-        b = self._buf
-        if self._owned and b["x"].shape[0] >= rows:
+        if self._owned and self._buf["x"].shape[0] >= rows:
             return
         cap = max(2 * rows, 256)
-        new, ro = {}, {}
-        for name, cols in _KEPT.items():
-            arr = np.empty((cap, cols) if cols > 1 else cap)
-            arr[:keep] = b[name][:keep]
-            new[name] = arr
-            ro[name] = arr.view()
-            ro[name].flags.writeable = False  # (the results' views: read-only)
+        old = {**self._buf, **self._read_only} if self._owned else self._buf
+        new: dict[str, np.ndarray] = {}
+        for name, shape in _BLOCKS.items():
+            # (the row axis after the block axis, so each field's rows are contiguous)
+            new[name] = np.empty((shape[0], cap, *shape[1:]) if name in _DERIVED_BLOCKS
+                                 else (cap, *shape))
+        ro: dict[str, np.ndarray] = {}
+        for name in ("x", "full"):
+            new[name][:keep] = old[name][:keep]
+            ro[name] = new[name].view()
+        for name, (block, i) in _IN_BLOCK.items():
+            field = new[block][i]
+            field[:keep] = old[name][:keep]
+            ro[name] = field.view()
+        for view in ro.values():
+            view.flags.writeable = False  # (the results' views: read-only)
         self._buf, self._read_only, self._owned = new, ro, True
+

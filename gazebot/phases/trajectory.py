@@ -72,15 +72,16 @@ class Trajectory:
         """``Trajectory(t, giver_hand, receiver_hand)`` from float64 arrays already shaped
         ``(N,)``, ``(N, 3)``, ``(N, 3)`` (the samples the online detector keeps), without the
         constructor's conversions and checks: it builds one per analysis. Face, gripper and
-        load share are unknown (NaN), as the constructor makes them."""
+        load share are unknown (NaN), as the constructor makes them (views of one array)."""
         traj = cls.__new__(cls)
-        n = t.shape[0]
         traj.t = t
         traj.giver_hand = giver_hand
         traj.receiver_hand = receiver_hand
-        traj.giver_face = _nan_points(n)
-        traj.gripper_closed = np.full(n, np.nan)
-        traj.load_share = np.full(n, np.nan)
+        unknown = np.empty((t.shape[0], 5))  # (one block for the three: one allocation)
+        unknown.fill(np.nan)
+        traj.giver_face = unknown[:, :3]
+        traj.gripper_closed = unknown[:, 3]
+        traj.load_share = unknown[:, 4]
         return traj
 
     def __len__(self) -> int:

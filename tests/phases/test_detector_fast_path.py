@@ -13,6 +13,7 @@ import pytest
 import gazebot.phases.methods.gazebot as gazebot_method
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.detector import run_online
+from gazebot.phases.filtering import Signals
 from gazebot.phases.synthetic import (
     SyntheticOptions,
     case_set,
@@ -82,6 +83,12 @@ def _events(traj: Trajectory, config: PhaseConfig) -> tuple[list[tuple], str]:
     )
 
 
+def _first_rows(s: Signals, until: float) -> Signals:
+    """The grid rows of ``s`` at or before ``until`` (the edge guard's cut, in full)."""
+    keep = int(np.searchsorted(s.t, until, side="right"))
+    return Signals(*[np.array(a[:keep]) for a in vars(s).values()])
+
+
 @pytest.fixture(scope="module")
 def recordings() -> list[Trajectory]:
     return _recordings()
@@ -94,7 +101,9 @@ def test_fast_detector_emits_what_the_straightforward_one_emits(recordings, monk
     monkeypatch.setattr(
         gazebot_method,
         "compute_signals",
-        lambda traj, config, cache=None: reference_signals(traj, config),
+        lambda traj, config, cache=None, until=np.inf: _first_rows(
+            reference_signals(traj, config), until
+        ),
     )
     monkeypatch.setattr(
         gazebot_method.GazebotSegmenter, "trigger", lambda self: ReferenceTrigger(self.config)
@@ -151,3 +160,27 @@ def test_the_predicted_end_reads_the_peak_np_nanargmax_finds():
             continue
         now = float(t[-1]) + float(rng.uniform(0.0, 0.2))
         assert _mirrored(t, v, 0.05, 0.8, now, c) == reference(t, v, 0.05, 0.8, now, c)
+
+
+def test_kept_samples_are_the_window_of_the_samples_appended():
+    """The detector's sample store (new rows wait in a list until read; the array grows and is
+    compacted) holds exactly the samples not older than each cut, in order, however the reads
+    and cuts interleave."""
+    from gazebot.phases.detector import _Samples
+
+    rng = np.random.default_rng(6)
+    kept = _Samples()
+    rows: list[tuple[float, ...]] = []
+    t = 0.0
+    for i in range(3000):
+        t += float(rng.uniform(0.001, 0.02))
+        row = (t, *rng.normal(size=6).tolist())
+        kept.append(row)
+        rows.append(row)
+        cut = t - float(rng.choice([0.5, 2.0, 5.0]))
+        kept.drop_before(cut)
+        rows = [r for r in rows if r[0] >= cut]
+        assert len(kept) == len(rows)
+        assert kept.time(0) == rows[0][0] and kept.time(len(rows) - 1) == rows[-1][0]
+        if i % int(rng.integers(1, 40)) == 0:
+            np.testing.assert_array_equal(kept.rows(), np.array(rows))

@@ -27,11 +27,17 @@ def _assert_same(a: Signals, b: Signals, where: str) -> None:
 
 
 def _grow(
-    traj: Trajectory, config: PhaseConfig, steps: list[int], start: int = 0
+    traj: Trajectory,
+    config: PhaseConfig,
+    steps: list[int],
+    start: int = 0,
+    append_only: bool = False,
+    guard: float | None = None,
 ) -> tuple[int, int]:
-    """Feed growing windows through one cache; each must equal the full computation. Returns
+    """Feed growing windows through one cache; each must equal the full computation (``guard``:
+    both cut ``guard`` before the newest sample, the online detector's edge guard). Returns
     how many windows there were and how many were extensions of the previous one."""
-    cache = SignalCache()
+    cache = SignalCache(append_only=append_only)
     extended = calls = 0
     n = start + 3
     for step in steps:
@@ -40,9 +46,17 @@ def _grow(
         n += step
         calls += 1
         before = cache._rows
-        ours = compute_signals(_window(traj, start, n), config, cache)
+        if guard is None:
+            ours = compute_signals(_window(traj, start, n), config, cache)
+            want = compute_signals(_window(traj, start, n), config)
+        else:
+            until = float(traj.t[n - 1]) - guard
+            ours = compute_signals(_window(traj, start, n), config, cache, until=until)
+            whole = compute_signals(_window(traj, start, n), config)
+            keep = int(np.searchsorted(whole.t, until, side="right"))
+            want = Signals(*[a[:keep] for a in vars(whole).values()])
         extended += int(cache._owned and cache._rows > before)
-        _assert_same(ours, compute_signals(_window(traj, start, n), config), f"n={n} ")
+        _assert_same(ours, want, f"n={n} ")
     return calls, extended
 
 
@@ -55,18 +69,26 @@ CASES = [
 ]
 
 
+@pytest.mark.parametrize("append_only", [False, True], ids=["compared", "append-only"])
 @pytest.mark.parametrize("options", CASES, ids=["120Hz", "30Hz", "8Hz", "240Hz", "60Hz-damaged"])
-def test_growing_window_equals_the_full_computation(options: SyntheticOptions) -> None:
+def test_growing_window_equals_the_full_computation(
+    options: SyntheticOptions, append_only: bool
+) -> None:
+    """Also with ``append_only`` (the detector's: the kept samples are not compared), and with
+    the rows cut at the edge guard."""
     traj = generate(seed=4, options=options).trajectory
     rng = np.random.default_rng(1)
     steps = [int(k) for k in rng.integers(1, 12, size=len(traj) // 3)]
-    calls, extended = _grow(traj, PhaseConfig(), steps)
+    calls, extended = _grow(traj, PhaseConfig(), steps, append_only=append_only)
     assert extended > calls // 2  # the cache is used, not only the fallback
-    calls, extended = _grow(traj, PhaseConfig(), steps, start=len(traj) // 4)
+    calls, extended = _grow(
+        traj, PhaseConfig(), steps, start=len(traj) // 4, append_only=append_only, guard=0.04
+    )
     assert extended > calls // 2
 
 
-def test_window_with_new_damage_extended_equals_the_full_computation() -> None:
+@pytest.mark.parametrize("append_only", [False, True], ids=["compared", "append-only"])
+def test_window_with_new_damage_extended_equals_the_full_computation(append_only: bool) -> None:
     traj = generate(seed=4, options=SyntheticOptions(rate=100.0, noise=0.002)).trajectory
     g, r = traj.giver_hand.copy(), traj.receiver_hand.copy()
     g[300] = np.nan  # a missing sample
@@ -74,7 +96,7 @@ def test_window_with_new_damage_extended_equals_the_full_computation() -> None:
     t = traj.t.copy()
     t[500:] += 0.4  # a gap longer than max_gap_hold
     damaged = Trajectory(t, g, r)
-    calls, extended = _grow(damaged, PhaseConfig(), [4] * (len(traj) // 4))
+    calls, extended = _grow(damaged, PhaseConfig(), [4] * (len(traj) // 4), append_only=append_only)
     assert extended > calls // 2  # damaged windows are extended too, not recomputed
 
 

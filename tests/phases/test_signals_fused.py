@@ -221,7 +221,7 @@ def test_suffix_max_is_numpys_fmax_over_the_span() -> None:
     col = rng.normal(size=400)
     col[rng.random(400) < 0.15] = np.nan
     col[100:130] = np.nan  # a span of unknown rows only
-    buf = np.stack([col, col], axis=1)
+    values = col.tolist()
     sm = _SuffixMax()
     first = 0
     base = 0
@@ -233,6 +233,57 @@ def test_suffix_max_is_numpys_fmax_over_the_span() -> None:
             first = int(rng.integers(base, end))  # moves anywhere kept, back too
         if r > 0.97 and first > base:
             base = int(rng.integers(base, first + 1))  # compaction: rows before first dropped
-        got = sm.update(buf[base:], base, first - base, end - base, 1)
+        got = sm.update(values[base:], base, first - base, end - base)
         want = np.fmax.reduce(col[first:end])
         assert got == want or (np.isnan(got) and np.isnan(want)), (first, end)
+
+
+def test_row_norms_are_numpys_row_norms() -> None:
+    """``row_norms`` (the rules' per-row 3-vector norms, column by column) equals
+    ``np.linalg.norm(x, axis=1)`` bit for bit, NaN and infinite entries and extreme scales too."""
+    from gazebot.phases.filtering import row_norms
+
+    rng = np.random.default_rng(5)
+    for scale in (1e-160, 1e-3, 1.0, 1e3, 1e160):
+        x = rng.normal(size=(20000, 3)) * scale
+        x[rng.random(x.shape) < 0.01] = np.nan
+        x[rng.random(x.shape) < 0.005] = np.inf
+        with np.errstate(over="ignore"):  # (1e160 squared overflows in both)
+            np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=1))
+
+
+def test_trigger_norm_bar_decides_as_numpys_norm() -> None:
+    """The trigger's plain-float test ``|v| >= bar`` decides as ``vector_norm`` (numpy's dot)
+    does, at near ties, NaN, infinite and zero vectors too."""
+    from gazebot.phases.filtering import vector_norm
+    from gazebot.phases.methods.gazebot_trigger import _norm_at_least
+
+    rng = np.random.default_rng(7)
+    vs = rng.normal(size=(20000, 3)) * rng.choice([1e-3, 1.0, 1e3], size=(20000, 1))
+    vs[::50] = [0.0, 0.0, 0.0]
+    vs[1::97, 1] = np.nan
+    vs[2::89, 0] = np.inf
+    for v in vs:
+        norm = vector_norm(v)
+        for bar in (0.0, 0.005, norm, np.nextafter(norm, 0.0), np.nextafter(norm, np.inf)):
+            if np.isfinite(bar):
+                assert _norm_at_least(v.tolist(), float(bar)) == (norm >= bar), (v, bar)
+
+
+def test_trigger_dot_bar_decides_as_numpys_dot() -> None:
+    """The trigger's plain-float test ``a . b / d >= bar`` (the giver's own share of the
+    closing) decides as numpy's dot does, at near ties, cancellation, NaN and infinities."""
+    from gazebot.phases.methods.gazebot_trigger import _dot_over_at_least
+
+    rng = np.random.default_rng(8)
+    ab = rng.normal(size=(20000, 2, 3)) * rng.choice([1e-3, 1.0, 1e3], size=(20000, 1, 1))
+    ab[::7, 1] = ab[::7, 0] * [1.0, -1.0, 0.0]  # (products that cancel)
+    ab[::14, 0, 1] = ab[::14, 0, 0]  # (... exactly)
+    ab[1::97, 0, 1] = np.nan
+    ab[2::89, 1, 0] = np.inf
+    for (a, b), d in zip(ab, rng.uniform(1e-9, 2.0, size=20000), strict=True):
+        own = float(np.dot(a, b)) / d
+        for bar in (0.005, own, np.nextafter(own, -np.inf), np.nextafter(own, np.inf)):
+            if np.isfinite(bar):
+                got = _dot_over_at_least(a.tolist(), b.tolist(), float(d), float(bar))
+                assert got == (own >= bar), (a, b, d, bar)

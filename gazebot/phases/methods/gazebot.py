@@ -44,15 +44,12 @@ class GazebotSegmenter(Segmenter):
         ``cache``: see :func:`~gazebot.phases.filtering.compute_signals`)."""
         if len(trajectory) < 3:
             return None
-        s = compute_signals(trajectory, self.config, cache)
-        if partial and self.config.edge_guard > 0:
-            # (the grid is sorted: the samples kept are a prefix, taken as views)
-            cut = float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
-            keep = int(np.searchsorted(s.t, cut, side="right"))
-            if keep < 3:
-                return None
-            s = Signals(*[a[:keep] for a in vars(s).values()])  # (fields in order)
-        return s
+        if not (partial and self.config.edge_guard > 0):
+            return compute_signals(trajectory, self.config, cache)
+        # (the grid is sorted: the rows kept are a prefix, taken as views)
+        cut = float(trajectory.t[-1]) - self.config.edge_guard + 1e-9
+        s = compute_signals(trajectory, self.config, cache, until=cut)
+        return s if s.t.shape[0] >= 3 else None
 
     # ---- online hooks
     def trigger(self) -> OnlineTrigger:
@@ -102,7 +99,7 @@ class GazebotSegmenter(Segmenter):
         ends like any other); before, the whole method finds the next handover."""
         if phase is Phase.TRANSFER:
             n = s.t.shape[0]
-            i0 = min(int(np.searchsorted(s.t, phase_start)), n - 1)
+            i0 = min(int(s.t.searchsorted(phase_start)), n - 1)
             core = TransferCore(0, i0, n - 1, n - 1, max(phase_start, float(s.t[0])))
             t_end, open_end = transfer_end(s, self.config, core)
             if open_end or t_end >= float(s.t[-1]):
@@ -146,7 +143,7 @@ class GazebotSegmenter(Segmenter):
                 # Online: a transfer is confirmed once the hands have held for min_transfer
                 # (the hold's floor, which dates the start, needs a few samples of it) without
                 # closing further (a giver waiting for a slowly arriving receiver).
-                recent = s.distance[int(np.searchsorted(s.t, grid_end - c.min_transfer)) :]
+                recent = s.distance[int(s.t.searchsorted(grid_end - c.min_transfer)) :]
                 recent = recent[np.isfinite(recent)]
                 closing = float(recent[0] - recent.min()) if recent.size else 0.0
                 if t_start > grid_end - c.min_transfer or closing > c.still_closing:
@@ -161,7 +158,7 @@ class GazebotSegmenter(Segmenter):
                     break
                 t_start = float(s.t[core.start])
             t_start = min(t_start, t_last)
-            i_start = int(np.searchsorted(s.t, t_start))
+            i_start = int(s.t.searchsorted(t_start))
             onset = onset_before(prev_end_idx, max(i_start - 1, prev_end_idx))
             if out:
                 onset = max(onset, out[-1].end)
@@ -176,7 +173,7 @@ class GazebotSegmenter(Segmenter):
                 # the seed rule's own run stands.
                 t_start, t_end = float(s.t[core.start]), float(s.t[core.end])
                 out[-1] = Segment(Phase.REACH, out[-1].start, t_start, k)
-            i_end = min(int(np.searchsorted(s.t, t_end)), n - 1)
+            i_end = min(int(s.t.searchsorted(t_end)), n - 1)
             nxt = cores[k + 1].start if k + 1 < len(cores) else n - 1
             t_rest, seen = rest_after(s, c, i_end, max(nxt, i_end))
             t_far = far_after(s, c, i_end)
@@ -187,7 +184,7 @@ class GazebotSegmenter(Segmenter):
             retreat_end = at_end(max(retreat_end, t_end))
             out.append(Segment(Phase.TRANSFER, t_start, t_end, k))
             out.append(Segment(Phase.RETREAT, t_end, retreat_end, k, open=not seen))
-            prev_end_idx = int(np.searchsorted(s.t, retreat_end))
+            prev_end_idx = int(s.t.searchsorted(retreat_end))
         if trailing_ok and (not out or out[-1].phase is Phase.RETREAT):
             onset = trailing_reach(s, c, min(prev_end_idx, n - 1))
             if onset is not None:

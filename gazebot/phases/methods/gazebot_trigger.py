@@ -12,13 +12,14 @@ field of :class:`~gazebot.phases.config.PhaseConfig` (``trigger_*``, ``configs/p
 from __future__ import annotations
 
 import math
+from bisect import bisect_left
 from collections import deque
 from collections.abc import Sequence
 
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import nanmax, vector_norm
+from gazebot.phases.filtering import vector_norm
 from gazebot.phases.methods.base import OnlineState, TriggerMode
 from gazebot.types import Phase
 
@@ -26,16 +27,51 @@ _COLUMNS = 12  # t, giver xyz, receiver xyz, relative xyz, distance, giver step
 _STEP = 11  # the giver's step column: |giver - giver trigger_speed_baseline earlier|
 
 
-def _nanmean2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _nanmean2(a: Sequence[float], b: Sequence[float]) -> list[float]:
     """``np.nanmean([a, b], axis=0)`` of two 3-vectors: per coordinate the sum of the values
     that are not NaN (NaN counted as 0) over their count, NaN if none (numpy's arithmetic,
     without its generic machinery and warning)."""
     out = []
-    for u, w in zip(a.tolist(), b.tolist(), strict=True):
+    for u, w in zip(map(float, a), map(float, b), strict=True):  # (bools that add to 2)
         u_ok, w_ok = u == u, w == w
         n = u_ok + w_ok
         out.append(((u if u_ok else 0.0) + (w if w_ok else 0.0)) / n if n else math.nan)
-    return np.array(out)
+    return out
+
+
+def _norm_at_least(v: Sequence[float], bar: float) -> bool:
+    """``vector_norm(np.array(v)) >= bar`` (a 3-vector, ``bar`` >= 0), decided in plain floats
+    unless the squares' sum is within rounding of ``bar``'s square: numpy's dot may sum the
+    squares in another order, which moves the norm by a few ulps, so only a near tie needs
+    it."""
+    x, y, z = v
+    sq, b2 = x * x + y * y + z * z, bar * bar
+    if sq < b2 * (1.0 - 1e-9):
+        return False
+    if sq > b2 * (1.0 + 1e-9):
+        return True
+    return vector_norm(np.array(v)) >= bar  # (a near tie, or NaN)
+
+
+def _dot_over_at_least(a: Sequence[float], b: Sequence[float], d: float, bar: float) -> bool:
+    """``float(np.dot(np.array(a), np.array(b))) / d >= bar`` (3-vectors, ``d`` > 0), decided
+    in plain floats unless within rounding: numpy's dot may sum the products in another
+    order, which moves the sum by a few ulps of the products' magnitudes, so only a near tie
+    needs it."""
+    p0, p1, p2 = a[0] * b[0], a[1] * b[1], a[2] * b[2]
+    gap = (p0 + p1 + p2) - bar * d
+    tol = 1e-9 * (abs(p0) + abs(p1) + abs(p2) + abs(bar * d))
+    if gap > tol:
+        return True
+    if gap < -tol:
+        return False
+    return float(np.dot(np.array(a), np.array(b))) / d >= bar  # (a near tie, or NaN)
+
+
+def _search(times: list[float], x: float, lo: int, hi: int) -> int:
+    """``np.searchsorted`` (side left) of ``x`` in the increasing ``times[lo:hi]``, as an
+    index of ``times``: NaN sorts after every time, as numpy sorts it."""
+    return bisect_left(times, x, lo, hi) if x == x else hi
 
 
 class _SuffixMax:
@@ -43,22 +79,22 @@ class _SuffixMax:
     rows arrive and the first row moves forward (a phase's start, the window's start): a
     queue of the rows that may still be the largest (each smaller than the one before), so a
     period costs a few comparisons however long the span. Rows are numbered from the first
-    ever kept, so the buffer's compaction does not move them."""
+    ever kept, so dropping old rows does not move them."""
 
     def __init__(self) -> None:
         self._rows: deque[tuple[int, float]] = deque()  # (row, value), values decreasing
         self._first = self._end = -1  # the span [first, end) the queue covers
 
-    def update(self, buf: np.ndarray, base: int, first: int, end: int, col: int) -> float:
-        """Extend to buffer rows ``[first, end)`` of column ``col`` (buffer row i is row
+    def update(self, col: list[float], base: int, first: int, end: int) -> float:
+        """Extend to rows ``[first, end)`` of the column ``col`` (its item i is row
         ``base + i``) and return the largest value that is not NaN, NaN if none."""
         a0, a_end = base + first, base + end
         q = self._rows
         if a0 < self._first or self._end < a0 or a_end < self._end:
             q.clear()  # the span moved back or skipped rows: start over from its first row
             self._end = a0
-        new = buf[self._end - base : end, col].tolist()
-        for i, v in enumerate(new, start=self._end):
+        for i in range(self._end, a_end):
+            v = col[i - base]
             if v != v:
                 continue  # (np.fmax passes over NaN)
             while q and q[-1][1] <= v:
@@ -70,12 +106,23 @@ class _SuffixMax:
         return q[0][1] if q else math.nan
 
 
+def _fmax(values: list[float]) -> float:
+    """``np.fmax.reduce`` of plain floats: the largest that is not NaN, NaN if none."""
+    out = math.nan
+    for v in values:
+        if v > out or out != out:
+            out = v
+    return out
+
+
 class GazebotTrigger:
     """Per-period mean positions of both hands, and the loosened rule of the current phase.
 
-    The rules read maxima and means over the rows since a time that stays put while a phase
-    lasts (its start, the floor): those are kept as running values, extended by each new row,
-    and recomputed from the rows only when that time or the window's start moved (so a period
+    The rows are kept in plain Python lists (a column each): a period appends one row and
+    reads a few, where numpy's per-call overhead would cost more than the arithmetic. The rules
+    read maxima and means over the rows since a time that stays put while a phase lasts (its
+    start, the floor): those are kept as running values, extended by each new row, and
+    recomputed from the rows only when that time or the window's start moved (so a period
     costs a few float operations, not a pass over the window).
 
     Attributes:
@@ -91,13 +138,18 @@ class GazebotTrigger:
         # plain floats: a sample costs a few additions, not numpy calls.
         self._acc = [0.0] * 6
         self._acc_n = [0, 0]
-        # rows [t, giver xyz, receiver xyz, relative xyz, distance, giver step] in
-        # _sum[_s0:_s1] (grown and compacted in place); the relative position, distance and
-        # step are computed once per row. Row i of the buffer is row _base + i of all rows.
-        self._sum = np.empty((64, _COLUMNS))
-        self._s0 = self._s1 = 0
+        # The rows kept are items _s0.. of each column (times, giver means, receiver means,
+        # relative positions, distances, giver steps: |giver - giver trigger_speed_baseline
+        # earlier|); the relative position, distance and step are computed once per row. Item
+        # i is row _base + i of all rows (old items are deleted in blocks).
+        self._t: list[float] = []
+        self._g: list[tuple[float, float, float]] = []
+        self._r: list[tuple[float, float, float]] = []
+        self._rel: list[tuple[float, float, float]] = []
+        self._d: list[float] = []
+        self._step: list[float] = []
+        self._s0 = 0
         self._base = 0
-        self._d_last = math.nan  # the distance of the last row
         # Running values over the rows since a phase's start (or the floor):
         self._dmax = _SuffixMax()  # largest distance
         self._smax = _SuffixMax()  # largest giver step
@@ -136,17 +188,18 @@ class GazebotTrigger:
         """Append the mean hand positions since the last period (NaN: none seen), their
         relative position, distance and the giver's step, and drop rows older than
         ``online_window``."""
-        buf = self._sum
+        times = self._t
         cut = now - self.config.online_window
-        while self._s0 < self._s1 and buf[self._s0, 0] < cut:
-            self._s0 += 1
-        if self._s1 == buf.shape[0]:
-            m = self._s1 - self._s0
-            if 2 * m > buf.shape[0]:
-                self._sum = np.empty((2 * buf.shape[0], _COLUMNS))
-            self._sum[:m] = buf[self._s0 : self._s1]
-            buf, self._base = self._sum, self._base + self._s0
-            self._s0, self._s1 = 0, m
+        s0, end = self._s0, len(times)
+        while s0 < end and times[s0] < cut:
+            s0 += 1
+        if s0 >= 256 and 2 * s0 >= end:
+            # (deleting a block now and then: the lists stay about a window long)
+            for col in (times, self._g, self._r, self._rel, self._d, self._step):
+                del col[:s0]
+            self._base += s0
+            s0, end = 0, end - s0
+        self._s0 = s0
         a = self._acc
         ng, nr = self._acc_n
         nan = math.nan
@@ -156,26 +209,32 @@ class GazebotTrigger:
         # (the sum in this order is what np.linalg.norm(rel, axis=1) computes; a test pins it)
         d = math.sqrt(dx * dx + dy * dy + dz * dz)
         step = nan
-        if self._s1 - self._k >= self._s0:
-            px, py, pz = buf[self._s1 - self._k, 1:4].tolist()
+        if end - self._k >= s0:
+            px, py, pz = self._g[end - self._k]
             sx, sy, sz = gx - px, gy - py, gz - pz
             step = math.sqrt(sx * sx + sy * sy + sz * sz)
-        buf[self._s1] = (now, gx, gy, gz, rx, ry, rz, dx, dy, dz, d, step)
-        self._s1 += 1
-        self._d_last = d
+        times.append(now)
+        self._g.append((gx, gy, gz))
+        self._r.append((rx, ry, rz))
+        self._rel.append((dx, dy, dz))
+        self._d.append(d)
+        self._step.append(step)
         self._acc = [0.0] * 6
         self._acc_n = [0, 0]
 
     def rows(self) -> np.ndarray:
         """The per-period rows kept: ``[t, giver xyz, receiver xyz, relative xyz, distance,
-        giver step]`` (a view, valid until the next :meth:`decide`; the step is NaN for a row
-        with no row ``trigger_speed_baseline`` before it)."""
-        return self._sum[self._s0 : self._s1]
-
-    def _running_max(self, kept: _SuffixMax, first: int, col: int) -> float:
-        """The largest value that is not NaN (NaN if none) of column ``col`` from buffer row
-        ``first`` on (what ``np.fmax.reduce`` gives), from ``kept``."""
-        return kept.update(self._sum, self._base, first, self._s1, col)
+        giver step]`` (a new array; the step is NaN for a row with no row
+        ``trigger_speed_baseline`` before it)."""
+        s0 = self._s0
+        out = np.empty((len(self._t) - s0, _COLUMNS))
+        out[:, 0] = self._t[s0:]
+        out[:, 1:4] = self._g[s0:]
+        out[:, 4:7] = self._r[s0:]
+        out[:, 7:10] = self._rel[s0:]
+        out[:, 10] = self._d[s0:]
+        out[:, _STEP] = self._step[s0:]
+        return out
 
     def _boundary_possible(self, state: OnlineState) -> bool:
         """A necessary condition of the rule that ends the current phase, on the per-period
@@ -183,32 +242,31 @@ class GazebotTrigger:
         can)."""
         c = self.config
         ph = state.phase
-        s0, s1 = self._s0, self._s1
+        times = self._t
+        s0, s1 = self._s0, len(times)
         if s1 - s0 < 3 or not state.tracking:
             return True
-        buf = self._sum
-        d_last = self._d_last
+        d_last = self._d[-1]
         if not math.isfinite(d_last):
             return True
-        ts = buf[s0:s1, 0]
         if ph in (Phase.IDLE, Phase.DONE):
-            return self._reach_possible(ts, d_last, state.floor)
+            return self._reach_possible(d_last, state.floor)
         if ph is Phase.REACH:
             # A transfer needs the approach to have stopped, an aborted reach the hands apart:
             # either way the hands are no longer closing fast.
-            since = float(ts[-1]) - (c.min_transfer + c.edge_guard + c.online_period)
-            recent = buf[s0 + int(ts.searchsorted(since)) : s1, 10]  # (ts increases)
-            return float(nanmax(recent)) - d_last <= c.trigger_still_factor * c.still_closing
-        first = s0 + int(ts.searchsorted(state.phase_start))  # (ts increases)
+            since = times[-1] - (c.min_transfer + c.edge_guard + c.online_period)
+            recent = _fmax(self._d[_search(times, since, s0, s1) : s1])
+            return recent - d_last <= c.trigger_still_factor * c.still_closing
+        first = _search(times, state.phase_start, s0, s1)
         if ph is Phase.TRANSFER:
             # A release moves the hands' relative position off the held pose.
             mean = self._held_mean(first)
             if mean is None:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
-            rel = buf[s1 - 2 : s1, 7:10]
-            off = vector_norm(_nanmean2(rel[0], rel[1]) - np.array(mean))
-            return off >= c.trigger_distance_factor * c.release_distance
+            now_rel = _nanmean2(self._rel[-2], self._rel[-1])
+            off = [u - m for u, m in zip(now_rel, mean, strict=True)]
+            return _norm_at_least(off, c.trigger_distance_factor * c.release_distance)
         if ph is Phase.RETREAT:
             if state.joined_late:
                 return True
@@ -216,75 +274,78 @@ class GazebotTrigger:
             k = self._k
             if s1 - first <= k:
                 return True
-            g0, g1 = buf[first, 1:4], buf[s1 - 1, 1:4]
-            if not all(math.isfinite(v) for v in g0.tolist() + g1.tolist()):
+            g0, g1 = self._g[first], self._g[-1]
+            if not all(map(math.isfinite, g0 + g1)):
                 return True
             far = c.trigger_far_fraction * c.retreat_far_distance
-            if vector_norm(g1 - g0) >= far:
+            if _norm_at_least([u - v for u, v in zip(g1, g0, strict=True)], far):
                 return True
-            last = float(buf[s1 - 1, _STEP])
+            last = self._step[-1]
             if not math.isfinite(last):
                 return True
             # (the steps within the retreat: rows at least k after its first)
-            return last <= c.trigger_landing_fraction * self._running_max(
-                self._smax, first + k, _STEP
+            return last <= c.trigger_landing_fraction * self._smax.update(
+                self._step, self._base, first + k, s1
             )
         return True
 
     def _held_mean(self, first: int) -> list[float] | None:
-        """The mean relative position over the rows from buffer row ``first`` on where it is
+        """The mean relative position over the rows from item ``first`` on where it is
         known (numpy's ``mean(axis=0)``: the rows summed in order), ``None`` if fewer than two;
         a running sum extended by the rows since the last call, or recomputed."""
-        a0, end = self._base + first, self._base + self._s1
+        end = len(self._t)
+        a0, a_end = self._base + first, self._base + end
         k0, k_end, sums, count = self._held
-        if k0 != a0 or k_end > end:
+        if k0 != a0 or k_end > a_end:
             k_end, sums, count = a0, [0.0, 0.0, 0.0], 0
-        for x, y, z in self._sum[k_end - self._base : self._s1, 7:10].tolist():
+        for x, y, z in self._rel[k_end - self._base : end]:
             if x == x and y == y and z == z and abs(x) + abs(y) + abs(z) < math.inf:
                 if count:
                     sums = [sums[0] + x, sums[1] + y, sums[2] + z]
                 else:
                     sums = [x, y, z]
                 count += 1
-        self._held = (a0, end, sums, count)
+        self._held = (a0, a_end, sums, count)
         if count < 2:
             return None
         return [v / count for v in sums]
 
-    def _reach_possible(self, ts: np.ndarray, d_last: float, floor: float) -> bool:
+    def _reach_possible(self, d_last: float, floor: float) -> bool:
         """A reach (or a transfer) needs the hands closer than they were since the last phase
         began and the giver's hand moving since they were farthest."""
         c = self.config
         k = self._k
         loose = c.trigger_distance_factor
-        first = int(ts.searchsorted(floor - c.online_period))  # (ts increases)
-        if ts.shape[0] - first <= k:
+        times = self._t
+        s0, end = self._s0, len(times)
+        first = _search(times, floor - c.online_period, s0, end)
+        if end - first <= k:
             return False
-        d_max = self._running_max(self._dmax, self._s0 + first, 10)
+        d_max = self._dmax.update(self._d, self._base, first, end)
         closed = d_max - d_last
         # (the predictive rule confirms a reach from predict_distance of the giver's own travel;
         # the sequential one, in practice, past 1.2 cm: every fidget fits a cubic start up to
         # its midpoint, so it waits for more than half the largest fidget)
         if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
             return False
-        rows = self._sum[self._s0 : self._s1]
-        g = rows[:, 1:4]
-        rel = rows[:, 7:10]
-        d = rows[:, 10]
-        da = d[first:]
-        i_max = first + int(np.argmax(da == d_max))  # np.nanargmax: the first largest
+        i_max = self._d.index(d_max, first)  # np.nanargmax: the first largest
         deep = closed >= c.trigger_deep_fraction * c.min_approach
         if not deep:
             # (the giver's own share of the closing, read only when the dip is not deep)
-            own = float(np.dot(g[-1] - g[i_max], rel[-1])) / max(d_last, 1e-9)
-            if not own >= c.trigger_own_fraction * c.reach_confirm_distance:
+            g1, g0 = self._g[-1], self._g[i_max]
+            moved = [u - v for u, v in zip(g1, g0, strict=True)]
+            own_bar = c.trigger_own_fraction * c.reach_confirm_distance
+            if not _dot_over_at_least(moved, self._rel[-1], max(d_last, 1e-9), own_bar):
                 return False  # only the receiver came closer: no reach of the giver's yet
         # The giver's hand moving fast: since the hands were farthest for a deep dip, else
         # within the window the rule reads (smoothing, before the edge guard).
         span = (c.smoothing + c.edge_guard + c.trigger_speed_baseline) / max(c.online_period, 1e-3)
-        recent = ts.shape[0] - 1 - int(span)
-        gm = g[max(i_max - k, 0 if deep else recent, 0) :]
-        if gm.shape[0] <= k:
+        recent = end - 1 - int(span)
+        g_first = max(i_max - k, s0 if deep else recent, s0)
+        if end - g_first <= k:
             return True
-        v = np.linalg.norm(gm[k:] - gm[:-k], axis=1) / (k * max(c.online_period, 1e-3))
-        return bool(nanmax(v, initial=0.0) >= loose * c.reach_onset_speed)
+        # The speeds over k rows from g_first on are the steps of the rows k after it (each
+        # row's step is from the row k before it, there when the row arrived), divided by the
+        # same positive number: the largest speed is the largest step's.
+        v_max = _fmax(self._step[g_first + k : end]) / (k * max(c.online_period, 1e-3))
+        return bool(max(0.0, v_max) >= loose * c.reach_onset_speed)

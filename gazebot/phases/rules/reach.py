@@ -47,15 +47,15 @@ def _onset(
     peak = nanargmax(v)
     head = v[: peak + 1]
     seen = np.isfinite(head)
-    slow = np.flatnonzero(seen & (head < c.reach_onset_speed))
+    slow = (seen & (head < c.reach_onset_speed)).nonzero()[0]
     if slow.size:
-        i_c = lo + int(slow[-1]) + 1 + int(np.argmax(seen[slow[-1] + 1 :]))
+        i_c = lo + int(slow[-1]) + 1 + int(seen[slow[-1] + 1 :].argmax())
     else:
-        slow = np.flatnonzero(~seen)  # only a gap before the motion: it may hide the onset
+        slow = (~seen).nonzero()[0]  # only a gap before the motion: it may hide the onset
         if slow.size == 0:
             return float(s.t[lo])  # already moving when the data start
         i_c = lo + int(slow[-1]) + 1
-    rest = np.flatnonzero(speed[lo:i_c] < c.rest_speed)
+    rest = (speed[lo:i_c] < c.rest_speed).nonzero()[0]
     i_r = lo + int(rest[-1]) if rest.size else lo
     x = vector_norm(pos[i_c] - pos[i_r])
     back = min_jerk_span(x, float(speed[i_c]), c.max_refine)
@@ -74,7 +74,7 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     the receiver did the closing, the giver's hand moved faster than ``reach_onset_speed``
     and the hands closed by ``min_approach``)."""
     d = s.distance[lo:]
-    seen = np.flatnonzero(np.isfinite(d))
+    seen = np.isfinite(d).nonzero()[0]
     if seen.size < 3:
         return None
     i_max = nanargmax(d)
@@ -93,9 +93,7 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     own = float(np.dot(s.giver[k] - s.giver[lo + i_max], u))
     # ... and the hands closing at a reach's speed now (a drift or fidget is slower).
     j0 = max(lo + i_max, k - int(round(c.smoothing * c.analysis_rate)))
-    closing = -np.einsum("ij,ij->i", s.rel_v[j0 : k + 1], s.rel[j0 : k + 1]) / np.maximum(
-        s.distance[j0 : k + 1], 1e-9
-    )
+    closing = s.closing[j0 : k + 1]  # (-d distance / dt: rel_v along rel)
     fast = bool(nanmax(closing, initial=0.0) >= c.reach_onset_speed) and bool(
         nanmax(s.giver_speed[j0 : k + 1], initial=0.0) >= c.reach_onset_speed
     )

@@ -22,14 +22,14 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, median, vector_norm
+from gazebot.phases.filtering import Signals, median, row_norms, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 from gazebot.phases.rules.transfer import TransferCore, hold_floor
 
 
 def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np.ndarray) -> float:
     """Separation from the held pose that marks the release (m)."""
-    dev = np.linalg.norm(s.rel[held_idx] - held, axis=1)
+    dev = row_norms(s.rel[held_idx] - held)
     dev = dev[np.isfinite(dev)]
     jitter = float(np.sqrt(np.mean(dev**2))) if dev.size else 0.0
     return max(c.release_distance, c.release_noise_factor * jitter)
@@ -48,8 +48,8 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # The hands were still together (within the hold's own noise) up to i_h: the release is
     # not before it.
     v_still = c.settle_floor_factor * hold_floor(s, c, a, b)
-    i0 = min(max(a, int(np.searchsorted(s.t, t_start))), b)
-    still = np.flatnonzero(s.hold_speed[i0 : b + 1] <= v_still) + i0
+    i0 = min(max(a, int(s.t.searchsorted(t_start))), b)
+    still = (s.hold_speed[i0 : b + 1] <= v_still).nonzero()[0] + i0
     i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)
@@ -81,7 +81,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
 def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
     """Start of the giver's first motion after grid index ``j`` (``None`` if none is seen)."""
     v = s.giver_speed[j:]
-    fast = np.flatnonzero(v >= c.reach_onset_speed)
+    fast = (v >= c.reach_onset_speed).nonzero()[0]
     if fast.size == 0:
         return None
     i = j + int(fast[0])

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from gazebot.phases.config import PhaseConfig
-from gazebot.phases.filtering import Signals, nanargmax, vector_norm
+from gazebot.phases.filtering import Signals, nanargmax, row_norms, vector_norm
 from gazebot.phases.rules.onset import min_jerk_span
 
 
@@ -22,15 +22,15 @@ def rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> tuple[float, boo
     whether that end was seen (``False``: still moving when the data or window end)."""
     hi = min(hi, lo + int(c.max_retreat * c.analysis_rate), s.t.shape[0] - 1)
     v = s.giver_speed[lo : hi + 1]
-    fast = np.flatnonzero(v >= c.reach_onset_speed)
+    fast = (v >= c.reach_onset_speed).nonzero()[0]
     if hi <= lo or fast.size == 0:
         return float(s.t[hi]), hi < s.t.shape[0] - 1
     tail = v[fast[0] :]
-    rest = np.flatnonzero(tail < c.rest_speed)
+    rest = (tail < c.rest_speed).nonzero()[0]
     if rest.size == 0 and not (tail[-1] < c.reach_onset_speed):
         return float(s.t[hi]), hi < s.t.shape[0] - 1
     i_r = lo + int(fast[0]) + (int(rest[0]) if rest.size else tail.size - 1)
-    moving = np.flatnonzero(s.giver_speed[lo + int(fast[0]) : i_r + 1] >= c.reach_onset_speed)
+    moving = (s.giver_speed[lo + int(fast[0]) : i_r + 1] >= c.reach_onset_speed).nonzero()[0]
     i_c = lo + int(fast[0]) + int(moving[-1])
     x = vector_norm(s.giver[i_r] - s.giver[i_c])
     fwd = min_jerk_span(x, float(s.giver_speed[i_c]), c.max_refine)
@@ -41,11 +41,14 @@ def rest_after(s: Signals, c: PhaseConfig, lo: int, hi: int) -> tuple[float, boo
 def far_after(s: Signals, c: PhaseConfig, i_end: int) -> float:
     """First time after grid index ``i_end`` (the release) that the giver's hand is
     ``retreat_far_distance`` from where the transfer happened (``inf`` if never)."""
-    seen = np.flatnonzero(np.isfinite(s.giver[: i_end + 1]).all(axis=1))
-    if seen.size == 0:
+    # the last sample seen at or before the release, searched from it (usually that one)
+    k = min(i_end, s.t.shape[0] - 1)
+    while k >= 0 and not all(map(math.isfinite, s.giver[k].tolist())):
+        k -= 1
+    if k < 0:
         return math.inf
-    moved = np.linalg.norm(s.giver[i_end:] - s.giver[int(seen[-1])], axis=1)
-    far = np.flatnonzero(moved >= c.retreat_far_distance)
+    moved = row_norms(s.giver[i_end:] - s.giver[k])
+    far = (moved >= c.retreat_far_distance).nonzero()[0]
     return float(s.t[i_end + int(far[0])]) if far.size else math.inf
 
 
@@ -63,7 +66,7 @@ def retreat_done(
     n = s.t.shape[0]
     if n < 2:
         return None
-    i0 = int(np.searchsorted(s.t, t_release))
+    i0 = int(s.t.searchsorted(t_release))
     if i0 >= n - 1:
         return None
     t_rest, seen = rest_after(s, c, i0, n - 1)
@@ -102,7 +105,7 @@ def _landing(s: Signals, c: PhaseConfig, i0: int, t_release: float) -> float | N
         return None
     k = nanargmax(v)
     peak = float(v[k])
-    last = int(np.flatnonzero(ok)[-1])
+    last = int(ok.nonzero()[0][-1])
     moved = vector_norm(s.giver[i0 + last] - s.giver[i0])
     if peak < c.reach_onset_speed or last <= k or not moved >= c.min_approach:
         return None

@@ -59,9 +59,10 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Inclusive index ranges of the True runs of ``mask``."""
     if mask.size == 0:
         return []
-    padded = np.concatenate([[False], mask, [False]])
-    edges = np.flatnonzero(padded[1:] != padded[:-1])
-    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+    padded = np.zeros(mask.size + 2, dtype=bool)  # (not a concatenation of converted lists)
+    padded[1:-1] = mask
+    bounds = (padded[1:] != padded[:-1]).nonzero()[0].tolist()
+    return [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
 
 
 def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
@@ -70,7 +71,7 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
     count as high ground, so a recording that starts or ends mid-handover keeps its dip.
     NaN samples are skipped."""
     out: list[tuple[int, int, int]] = []
-    idx = np.flatnonzero(np.isfinite(d))
+    idx = np.isfinite(d).nonzero()[0]
     if idx.size == 0:
         return out
     left = int(idx[0])
@@ -107,8 +108,8 @@ def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
     if n < 3 or not np.isfinite(d).any():
         return []
     out: list[TransferCore] = []
-    rs = np.where(np.isfinite(s.rel_speed), s.rel_speed, np.inf)
     unknown = ~np.isfinite(s.rel_speed)
+    rs = np.where(unknown, np.inf, s.rel_speed)
     min_len = max(1, int(round(c.min_transfer * c.analysis_rate)))
     for lo, p, hi in dips(d, c.min_approach):
         near = np.zeros(n, dtype=bool)
@@ -172,7 +173,7 @@ def pass_core(
         b += 1
     if b >= n - 1 or not nanmax(d[p:], initial=-np.inf) >= d[p] + c.min_approach:
         return None  # not yet seen parting
-    k = a + int(np.argmin(rs[a : b + 1]))
+    k = a + int(rs[a : b + 1].argmin())
     if not rs[k] < c.transfer_exit_speed:
         return None
     i, j = k, k
@@ -231,21 +232,21 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
     if hidden is not None:
         return hidden
     seg = s.rel_speed[a : b + 1]
-    gaps = np.flatnonzero(~np.isfinite(seg))
+    gaps = (~np.isfinite(seg)).nonzero()[0]
     seen = seg[: int(gaps[0])] if gaps.size else seg
-    below = np.flatnonzero(seen < v_settle)
+    below = (seen < v_settle).nonzero()[0]
     if below.size == 0:
         if gaps.size:
-            return float(s.t[a + int(np.argmin(seen))]) if seen.size else float(s.t[a])
+            return float(s.t[a + int(seen.argmin())]) if seen.size else float(s.t[a])
         return math.nan
     i = a + int(below[0])
-    v_f = c.settle_floor_factor * hold_floor(s, c, a, b)
+    v_frac = v_settle_fraction(s, c, lo, a)
     # The core's first part is the approach's tail: once the crossing is known, the hold's
     # floor is measured on the samples after it (a short, early hold otherwise reads high).
     for _ in range(2):
         v_f = c.settle_floor_factor * hold_floor(s, c, i, b)
-        v_new = min(max(v_f, v_settle_fraction(s, c, lo, a)), c.transfer_speed_max)
-        below = np.flatnonzero(seen < v_new)
+        v_new = min(max(v_f, v_frac), c.transfer_speed_max)
+        below = (seen < v_new).nonzero()[0]
         if v_new >= v_settle or below.size == 0:
             break
         v_settle, i = v_new, a + int(below[0])
@@ -268,7 +269,7 @@ def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
     gap ends."""
     if a == 0 or np.isfinite(s.rel_speed[a - 1]) or not s.rel_speed[a] < v_settle:
         return None
-    seen = np.flatnonzero(np.isfinite(s.rel_speed[:a]))
+    seen = np.isfinite(s.rel_speed[:a]).nonzero()[0]
     t_a = float(s.t[a])
     if seen.size == 0:
         return None
