@@ -46,7 +46,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import median, vector_norm
-from gazebot.phases.rules.directed import _fit, noise_floor
+from gazebot.phases.rules.directed import _Quadratic, noise_floor
 from gazebot.phases.trajectory import Trajectory
 
 
@@ -191,17 +191,23 @@ def sequential_reach(
         toward = float(moved @ (r[-1] - g[rest].mean(axis=0)))
         if vector_norm(moved) < 0.5 * c.fidget_amplitude or toward <= 0.0:
             return None
-    noise = noise_floor(g[idx[tv <= now - c.sequential_window]])
     # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted
     # sideways at arm's length, closes it slower than the hand moves): a constant-acceleration
     # model of the gap closes faster than predict_sigmas of its standard error ...
     w0 = min(now - c.predict_window, float(t_all[win[-c.predict_min_samples]]))
     fit = win[t_all[win] >= w0]
-    gap_fit = _fit(t_all[fit] - now, -np.linalg.norm(r[fit] - g[fit], axis=1), noise)
-    if gap_fit is None:
+    q = _Quadratic(t_all[fit] - now)
+    x_gap = -np.linalg.norm(r[fit] - g[fit], axis=1)
+    coef = q.coefficients(x_gap)
+    if coef is None:
         return None
-    (_, v_c, a_c, _), (_, s_v, _, _) = gap_fit
-    if not v_c >= c.predict_sigmas * s_v:
+    _, v_c, a_c, _ = q.state(coef)
+    # (a gap not closing fails that bar whatever its error: the error, the noise floor and the
+    # test are only measured for one that closes)
+    if not v_c >= 0.0:
+        return None
+    noise = noise_floor(g[idx[tv <= now - c.sequential_window]])
+    if not v_c >= c.predict_sigmas * q.errors(x_gap, coef, noise)[1]:
         return None
     ev = reach_evidence(t_all[win], g[win], now, noise, c)
     if ev is None or not ev.statistic >= bar:
