@@ -39,6 +39,7 @@ confirms first.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -72,20 +73,30 @@ class ReachEvidence:
     sigma: float
 
 
-def min_jerk_profile(s: np.ndarray) -> np.ndarray:
-    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (clipped to 0..1)."""
-    s = np.clip(s, 0.0, 1.0)
-    return s * s * s * (10.0 + s * (6.0 * s - 15.0))
+def min_jerk_profile(s: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
+    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (float, clipped to
+    0..1). ``overwrite``: ``s`` may be used as scratch (the test's templates are large: fewer
+    temporary arrays; the same operations in the same order, so the same values)."""
+    s = np.clip(s, 0.0, 1.0, out=s if overwrite else None)
+    # s^3 (10 + s (6 s - 15)), evaluated as ((s s) s) (10 + s (6 s - 15))
+    inner = s * 6.0
+    inner -= 15.0
+    inner *= s
+    inner += 10.0
+    out = s * s
+    out *= s
+    out *= inner
+    return out
 
 
 def _best_reduction(
-    s: np.ndarray, b: np.ndarray, lo: float, hi: float
+    norm: np.ndarray, b: np.ndarray, ratio: np.ndarray, lo: float, hi: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """The largest drop of the residual sum of squares ``2 m |S| - m^2 B`` over amplitudes
-    ``m`` in ``[lo, hi]`` (``S`` (..., 3): template-data products, ``B``: template energy), and
-    that ``m``."""
-    norm = np.linalg.norm(s, axis=-1)
-    m = np.clip(norm / np.maximum(b, 1e-12), lo, hi)
+    ``m`` in ``[lo, hi]`` (``norm``: ``|S|``, the template-data products' norms; ``b``: ``B``,
+    the template energy; ``ratio``: ``|S| / max(B, 1e-12)``, the unbounded best ``m``, shared
+    by both classes), and that ``m``."""
+    m = np.clip(ratio, lo, hi)
     return 2.0 * m * norm - m * m * b, m
 
 
@@ -94,12 +105,31 @@ def _binned(t: np.ndarray, x: np.ndarray, step: float) -> tuple[np.ndarray, np.n
     templates are smooth on that scale, so the test loses nothing; at 240 Hz it reads a
     third as many rows."""
     key = np.floor((t - t[0]) / step).astype(np.int64)
-    cuts = np.flatnonzero(np.diff(key)) + 1
-    counts = np.diff(np.concatenate([[0], cuts, [t.shape[0]]])).astype(float)
-    starts = np.concatenate([[0], cuts])
+    cuts = (key[1:] != key[:-1]).nonzero()[0]
+    bounds = np.empty(cuts.shape[0] + 2, dtype=np.int64)  # 0, the cuts, n
+    bounds[0] = 0
+    np.add(cuts, 1, out=bounds[1:-1])
+    bounds[-1] = t.shape[0]
+    counts = (bounds[1:] - bounds[:-1]).astype(float)
+    starts = bounds[:-1]
     tb = np.add.reduceat(t, starts) / counts
     xb = np.add.reduceat(x, starts, axis=0) / counts[:, None]
     return tb, xb, counts
+
+
+@functools.lru_cache(maxsize=8)
+def _grids(
+    durations: tuple[float, float], steps: int, span: float, step: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The test's grids, which depend on the configuration alone (computed once per
+    configuration): ``steps`` geometric durations (s) over ``durations`` and the onsets' lags
+    (s) before the newest sample, ``0, step, ...`` short of ``span``. Read-only."""
+    lo, hi = durations
+    grid = np.geomspace(lo, hi, steps)
+    lags = np.arange(0.0, span, step)
+    grid.flags.writeable = False
+    lags.flags.writeable = False
+    return grid, lags
 
 
 def reach_evidence(
@@ -111,24 +141,33 @@ def reach_evidence(
     n = t.shape[0]
     if n < c.predict_min_samples:
         return None
-    lo_t, hi_t = c.sequential_durations
-    durations = np.geomspace(lo_t, hi_t, c.sequential_duration_steps)
-    onsets = now - np.arange(0.0, c.sequential_onset_span, c.sequential_onset_step)
+    durations, lags = _grids(
+        c.sequential_durations,
+        c.sequential_duration_steps,
+        c.sequential_onset_span,
+        c.sequential_onset_step,
+    )
+    onsets = now - lags
     tb, xb, w = _binned(t, x, 0.5 * c.sequential_onset_step)
     mean_x = w @ xb / n
     xc = xb - mean_x
     # templates (onset, duration, bin), centred (weighted): the rest position is free
-    tmpl = min_jerk_profile((tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None])
+    tmpl = min_jerk_profile(
+        (tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None], overwrite=True
+    )
     mean_b = tmpl @ w / n
     tmpl -= mean_b[..., None]
     wt = tmpl * w
     energy = np.einsum("abn,abn->ab", wt, tmpl)
     prod = wt @ xc  # (onset, duration, 3)
-    reach, m_reach = _best_reduction(prod, energy, c.min_approach, math.inf)
-    fidget, _ = _best_reduction(prod, energy, 0.0, c.fidget_amplitude)
-    k = np.unravel_index(int(np.argmax(reach)), reach.shape)
+    norms = np.linalg.norm(prod, axis=-1)
+    ratio = norms / np.maximum(energy, 1e-12)
+    reach, m_reach = _best_reduction(norms, energy, ratio, c.min_approach, math.inf)
+    fidget, _ = _best_reduction(norms, energy, ratio, 0.0, c.fidget_amplitude)
+    k = divmod(int(reach.argmax()), reach.shape[1])
     best_fidget = float(fidget.max())
-    rss0 = float(np.einsum("ij,ij->", x - mean_x, x - mean_x))
+    dx = x - mean_x
+    rss0 = float(np.einsum("ij,ij->", dx, dx))
     dof = max(3 * n - 7, 1)
     norm = vector_norm(prod[k])
     amp = m_reach[k] * prod[k] / norm if norm > 0 else np.zeros(3)
