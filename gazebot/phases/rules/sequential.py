@@ -211,30 +211,31 @@ def sequential_reach(
     win = idx[tv > now - c.sequential_window]
     if win.size < c.predict_min_samples:
         return None
-    # A dropout only matters where the gap's closing is fitted (the last predict_window): the
-    # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
-    # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
-    steps = np.diff(t_all[win])
-    recent = t_all[win][1:] >= now - c.predict_window
-    step = median(steps)
-    if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
-        return None
     # A fidget fits any cubic start up to its midpoint: a hand not yet half the largest fidget
     # from its rest (the window before every onset tried), or not toward the receiver, cannot
-    # be told from one (cheap skips before the test).
+    # be told from one (cheap skips before the test; first, as a hand at rest fails them).
     tw = t_all[win]
     rest = win[tw <= now - c.sequential_onset_span]
     last = win[tw >= now - 0.5 * c.sequential_onset_step]
     if rest.size:
-        moved = g[last].mean(axis=0) - g[rest].mean(axis=0)
-        toward = float(moved @ (r[-1] - g[rest].mean(axis=0)))
+        g_rest = g[rest].mean(axis=0)
+        moved = g[last].mean(axis=0) - g_rest
+        toward = float(moved @ (r[-1] - g_rest))
         if vector_norm(moved) < 0.5 * c.fidget_amplitude or toward <= 0.0:
             return None
+    # A dropout only matters where the gap's closing is fitted (the last predict_window): the
+    # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
+    # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
+    steps = np.diff(tw)
+    recent = tw[1:] >= now - c.predict_window
+    step = median(steps)
+    if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
+        return None
     # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted
     # sideways at arm's length, closes it slower than the hand moves): a constant-acceleration
     # model of the gap closes faster than predict_sigmas of its standard error ...
-    w0 = min(now - c.predict_window, float(t_all[win[-c.predict_min_samples]]))
-    fit = win[t_all[win] >= w0]
+    w0 = min(now - c.predict_window, float(tw[-c.predict_min_samples]))
+    fit = win[tw >= w0]
     q = _Quadratic(t_all[fit] - now)
     x_gap = -np.linalg.norm(r[fit] - g[fit], axis=1)
     coef = q.coefficients(x_gap)
