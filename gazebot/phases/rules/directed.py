@@ -91,19 +91,47 @@ def noise_floor(x: np.ndarray) -> float:
     return 1.4826 * mad / math.sqrt(6.0)
 
 
+def _seen(traj: Trajectory, after: float, lo: int) -> np.ndarray:
+    """The indices, from ``lo`` on, of ``traj``'s samples with both hands seen after ``after``."""
+    t, g, r = traj.t, traj.giver_hand, traj.receiver_hand
+    ok = np.isfinite(g[lo:]).all(axis=1) & np.isfinite(r[lo:]).all(axis=1) & (t[lo:] > after)
+    return lo + ok.nonzero()[0]
+
+
 def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | None:
     """The back-dated onset of a reach the giver's hand shows toward the receiver at the newest
-    sample of ``traj`` (see the module docstring), ``None`` if it shows none. Only samples
-    after ``after`` (s) are read (the previous handover's end)."""
+    sample of ``traj`` (times increasing, as the online window's do; see the module
+    docstring), ``None`` if it shows none. Only samples after ``after`` (s) are read (the
+    previous handover's end)."""
     t_all = traj.t
-    if t_all.shape[0] < c.predict_min_samples + 2:
+    n = t_all.shape[0]
+    if n < c.predict_min_samples + 2:
         return None
     g, r = traj.giver_hand, traj.receiver_hand
     now = float(t_all[-1])
-    ok = np.isfinite(g).all(axis=1) & np.isfinite(r).all(axis=1) & (t_all > after)
-    idx = np.flatnonzero(ok)
-    if idx.size < c.predict_min_samples + 2 or not ok[-1]:
+    # The windows below reach back from the fit window's start (predict_window, or further at
+    # low rates) over the longer of predict_rest_window and predict_noise_window: the samples
+    # before that (most of a long idle window) are not read unless the fit window widens past
+    # it, or too few samples are seen after it (then all are).
+    back = max(c.predict_rest_window, c.predict_noise_window)
+    lo = int(t_all.searchsorted(now - c.predict_window - back))
+    idx = _seen(traj, after, lo)
+    if idx.size == 0 or idx[-1] != n - 1:
         return None  # both hands seen now: the model is not extrapolated across a dropout
+    if lo:
+        w0 = math.nan
+        if idx.size >= c.predict_min_samples + 2:
+            w0 = min(now - c.predict_window, float(t_all[idx[-c.predict_min_samples]]))
+        edge = float(t_all[lo - 1])  # the newest sample skipped
+        if not (
+            edge < w0 - 1e-9
+            and edge < w0 - c.predict_rest_window
+            and edge < w0 - c.predict_noise_window
+        ):
+            lo = 0
+            idx = _seen(traj, after, 0)
+    if idx.size < c.predict_min_samples + 2:
+        return None
     tv = t_all[idx]
     # The fit window: predict_window, widened to predict_min_samples at low rates.
     w0 = min(now - c.predict_window, float(tv[-c.predict_min_samples]))
@@ -170,4 +198,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if not speed > 0 or v / speed < c.predict_cos:
         return None
     onset = now - min_jerk_span(x, v, c.max_refine)
-    return max(onset, float(tv[0]), after) if math.isfinite(onset) else None
+    if not math.isfinite(onset):
+        return None
+    first = tv[0] if lo == 0 else t_all[_seen(traj, after, 0)[0]]  # the first sample seen
+    return max(onset, float(first), after)
