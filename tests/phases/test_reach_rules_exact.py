@@ -123,3 +123,93 @@ def test_a_reach_ends_no_earlier_than_the_receivers_first_fast_sample_predicts()
         got = predict_end(Phase.REACH, start, s, now, c)
         want = reference(start, s, now, c)
         assert got == want or (math.isnan(got) and math.isnan(want))
+
+
+def _directed_reference(traj, c, after):
+    """The constant-acceleration rule in its straightforward form: every sample read, every
+    fit with its errors (the form the rule had before it skipped work)."""
+    from gazebot.phases.filtering import median, vector_norm
+    from gazebot.phases.rules.directed import noise_floor
+    from gazebot.phases.rules.onset import min_jerk_span
+
+    t_all = traj.t
+    if t_all.shape[0] < c.predict_min_samples + 2:
+        return None
+    g, r = traj.giver_hand, traj.receiver_hand
+    now = float(t_all[-1])
+    ok = np.isfinite(g).all(axis=1) & np.isfinite(r).all(axis=1) & (t_all > after)
+    idx = np.flatnonzero(ok)
+    if idx.size < c.predict_min_samples + 2 or not ok[-1]:
+        return None
+    tv = t_all[idx]
+    w0 = min(now - c.predict_window, float(tv[-c.predict_min_samples]))
+    fit = idx[tv >= w0 - 1e-9]
+    rest = idx[(tv < w0 - 1e-9) & (tv >= w0 - c.predict_rest_window)]
+    if fit.size < c.predict_min_samples or rest.size == 0:
+        return None
+    steps = np.diff(t_all[fit])
+    if float(steps.max()) > c.predict_gap_factor * median(steps):
+        return None
+    g_rest = g[rest].mean(axis=0)
+    line = r[-1] - g_rest
+    gap = vector_norm(line)
+    if gap <= 1e-6:
+        return None
+    u = line / gap
+    hist = idx[(tv < w0 - 1e-9) & (tv >= w0 - c.predict_noise_window)]
+    noise = noise_floor(g[hist])
+    tf = t_all[fit] - now
+    along = _fit_reference(tf, (g[fit] - g_rest) @ u, noise)
+    if along is None:
+        return None
+    (_, v, a, x), (_, sv, sa, sx) = along
+    k = c.predict_sigmas
+    if not (x >= max(c.predict_distance, k * sx) and v >= max(c.reach_onset_speed, k * sv)):
+        return None
+    if not a >= k * sa:
+        return None
+    gap_fit = _fit_reference(tf, -np.linalg.norm(r[fit] - g[fit], axis=1), noise)
+    if gap_fit is None or not gap_fit[0][1] >= max(c.reach_onset_speed, k * gap_fit[1][1]):
+        return None
+    (minus_d, v_c, a_c, closed), _ = gap_fit
+    h = c.predict_horizon
+    ahead = closed + v_c * h + 0.5 * max(a_c, 0.0) * h * h
+    if not ahead >= c.predict_gap_share * (closed - minus_d):
+        return None
+    across = [_fit_reference(tf, g[fit, j], noise) for j in range(3)]
+    if any(f is None for f in across):
+        return None
+    vel = np.array([f[0][1] for f in across if f is not None])
+    speed = vector_norm(vel)
+    if not speed > 0 or v / speed < c.predict_cos:
+        return None
+    onset = now - min_jerk_span(x, v, c.max_refine)
+    return max(onset, float(tv[0]), after) if math.isfinite(onset) else None
+
+
+def test_the_directed_rule_reads_as_its_straightforward_form_on_every_prefix():
+    """Skipping the samples before its windows (all read when a low rate or a dropout widens
+    the fit window past them) and the errors of fits short of the bars' floors changes no
+    onset, on reaches, fidgets, dropouts and sparse samples."""
+    from gazebot.phases.rules.directed import directed_reach
+    from gazebot.phases.synthetic import SyntheticOptions, generate, rest_recording
+
+    sparse = SyntheticOptions(
+        rate=30.0, irregular=0.3, noise=0.004, dropouts_per_s=1.0, frozen_per_s=1.0, handovers=2
+    )
+    recordings = [
+        generate(seed=3, options=SyntheticOptions(rate=120.0)).trajectory,
+        generate(seed=1, options=sparse).trajectory,
+        generate(seed=2, options=SyntheticOptions(rate=12.0, noise=0.003)).trajectory,
+        rest_recording(60.0, 0.002, seconds=6.0, seed=2, fidget=True),
+    ]
+    c = PhaseConfig()
+    onsets = 0
+    for traj in recordings:
+        for i in range(8, len(traj) + 1, 2):
+            sub = traj.take(np.arange(max(0, i - 600), i))
+            for after in (-math.inf, float(sub.t[0]) + 0.5):
+                got, want = directed_reach(sub, c, after), _directed_reference(sub, c, after)
+                assert repr(got) == repr(want)
+                onsets += want is not None
+    assert onsets > 10  # reaches were confirmed, not only rejected
