@@ -202,11 +202,11 @@ def sequential_reach(
         return None
     g, r = traj.giver_hand, traj.receiver_hand
     now = float(t_all[-1])
-    lo = int(np.searchsorted(t_all, max(now - c.sequential_window - c.predict_noise_window, after)))
+    lo = int(t_all.searchsorted(max(now - c.sequential_window - c.predict_noise_window, after)))
     ok = np.isfinite(g[lo:]).all(axis=1) & np.isfinite(r[lo:]).all(axis=1) & (t_all[lo:] > after)
     if not ok[-1]:
         return None  # both hands seen now: the model is not extrapolated across a dropout
-    idx = lo + np.flatnonzero(ok)
+    idx = lo + ok.nonzero()[0]
     tv = t_all[idx]
     win = idx[tv > now - c.sequential_window]
     if win.size < c.predict_min_samples:
