@@ -1,5 +1,10 @@
-"""A lower bound on online reach confirmation latency: when could *any* detector that reports no
-reach on the generator's fidgets have confirmed a synthetic reach?
+"""A lower bound on online reach confirmation latency: when could any detector that reads the
+giver's hand, and reports no reach on the generator's fidgets, have confirmed a synthetic reach?
+
+(gazebot's reach is the giver's: the robot's own reach reaches the engine as an event. The
+synthetic robot is scripted to set off 50-400 ms after the giver's true onset, so a detector
+reading its gripper would measure that script, and on a robot that waits for the reported reach,
+its own output.)
 
 A fidget of the generator's class (:data:`~gazebot.phases.synthetic.FIDGET_AMPLITUDE`,
 :data:`~gazebot.phases.synthetic.FIDGET_DURATION`: a minimum-jerk move of at most 2 cm in 0.25-0.6

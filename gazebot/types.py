@@ -27,6 +27,8 @@ def filled(cls: type[_T], fields: dict[str, Any] | None = None, /, **values: Any
     ``object.__setattr__`` (microseconds per tick). No defaults and no checks: the caller
     passes every field. A value with many fields is cheaper from a dict literal than from
     keywords (Python's keyword-argument handling costs about 50 ns a name)."""
+    if fields is not None and values:
+        raise TypeError("filled() takes a fields dict or keywords, not both")
     obj = object.__new__(cls)
     # The dict becomes the instance's attributes, uncopied: a keywords dict is always new.
     object.__setattr__(obj, "__dict__", values if fields is None else fields)

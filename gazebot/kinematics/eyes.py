@@ -66,7 +66,8 @@ class DisplayEyes:
 
     def residual(self, yaw: float, pitch: float, v: np.ndarray | Sequence[float]) -> float:
         """Angle (rad) between the eyes' line of sight and ``v`` (gaze frame)."""
-        # eye_direction() as floats: this runs every controller tick. (No float() on v: the
-        # arithmetic gives the same values for NumPy scalars, and atan2 returns a float.)
+        # eye_direction() as floats: this runs every controller tick. (float() on v: a float32
+        # or float16 component would otherwise keep the products in its own precision.)
         cp = math.cos(pitch)
-        return angle_of(cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch), v[0], v[1], v[2])
+        return angle_of(cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch),
+                        float(v[0]), float(v[1]), float(v[2]))

@@ -117,7 +117,8 @@ class _Samples:
         return float(self._buf[self._s0 + i, 0]) if i < m else self._new[i - m][0]
 
     def rows(self) -> np.ndarray:
-        """The samples kept (a view: valid until the next :meth:`append`)."""
+        """The samples kept (a view of the buffer: valid until the next call that grows or
+        compacts it; :meth:`append` only queues)."""
         new = self._new
         if new:
             k, buf = len(new), self._buf

@@ -102,3 +102,9 @@ def test_update_raw_gives_the_floats_of_update(name):
         )
         shifts.append(shift)
     assert max(shifts) > 0.0  # the shift at i = 120 went through both
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float16])
+def test_eye_residual_of_a_narrow_float_vector_is_computed_in_double(sawyer, dtype):
+    v = np.array([1.0, 0.3, -0.2], dtype)
+    assert sawyer.eyes.residual(0.1, 0.05, v) == sawyer.eyes.residual(0.1, 0.05, v.astype(float))

@@ -12,7 +12,7 @@ import pytest
 
 from gazebot import GazeEngine
 from gazebot.runtime import GazeLoop
-from gazebot.types import GazeCommand, Phase, TrackingFrame
+from gazebot.types import GazeCommand, Phase, TrackingFrame, filled
 
 
 def _frames(n: int = 60):
@@ -65,3 +65,9 @@ def test_the_loop_refuses_any_non_finite_value_is_finite_would(field, bad):
     unsafe = loop.unsafe
     assert loop.tick(TrackingFrame(t=2.0)) is None
     assert loop.unsafe == unsafe + 1
+
+
+def test_filled_refuses_a_fields_dict_and_keywords_together():
+    # (one of them would be dropped silently)
+    with pytest.raises(TypeError, match="not both"):
+        filled(GazeCommand, {"t": 0.0}, t=1.0)
