@@ -29,7 +29,7 @@ def _mirrored(
     # last stretch of a one-sided Gaussian window sags, and a sag read as "past its peak" would
     # mirror the onset about a peak not yet reached (how early depends on when the analysis
     # happened to run). (t is sorted: the samples read are a prefix.)
-    k = int(np.searchsorted(t, now - c.smoothing, side="right"))
+    k = int(t.searchsorted(now - c.smoothing, side="right"))
     t, v = t[:k], v[:k]
     ok = np.isfinite(v)
     if v.shape[0] and ok.all():  # every speed known (the usual case): no NaN to pass over
@@ -40,8 +40,8 @@ def _mirrored(
             return onset + nominal
         # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its
         # copies and checks)
-        i = int(np.argmax(np.where(np.isnan(v), -np.inf, v)))
-        last = float(v[np.flatnonzero(ok)[-1]])
+        i = int(np.where(np.isnan(v), -np.inf, v).argmax())
+        last = float(v[ok.shape[0] - 1 - int(ok[::-1].argmax())])  # the last known
     peak = float(v[i])
     if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
         return onset + 2.0 * max(float(t[i]) - onset, 0.0)
@@ -57,14 +57,14 @@ def predict_end(phase: Phase, start: float, s: Signals | None, now: float, c: Ph
     nominal = REACH_S if phase is Phase.REACH else RETREAT_S
     if s is None or s.t.shape[0] == 0:
         return max(start + nominal, now)
-    i0 = int(np.searchsorted(s.t, start))
+    i0 = int(s.t.searchsorted(start))
     pred = _mirrored(s.t[i0:], s.giver_speed[i0:], start, nominal, now, c)
     if phase is Phase.REACH:
-        j0 = int(np.searchsorted(s.t, start - nominal))
-        rv = s.receiver_speed[j0:]
-        moving = np.flatnonzero(rv >= c.reach_onset_speed)
-        if moving.size:
-            r_on = float(s.t[j0 + int(moving[0])])
-            k0 = j0 + int(moving[0])
+        j0 = int(s.t.searchsorted(start - nominal))
+        moving = s.receiver_speed[j0:] >= c.reach_onset_speed
+        first = int(moving.argmax()) if moving.shape[0] else 0  # the first True, if any
+        if moving.shape[0] and moving[first]:
+            k0 = j0 + first
+            r_on = float(s.t[k0])
             pred = max(pred, _mirrored(s.t[k0:], s.receiver_speed[k0:], r_on, nominal, now, c))
     return max(pred, now)

@@ -39,23 +39,45 @@ from gazebot.phases.rules.onset import min_jerk_span
 from gazebot.phases.trajectory import Trajectory
 
 
-def _fit(t: np.ndarray, x: np.ndarray, noise: float) -> tuple[np.ndarray, np.ndarray] | None:
-    """Least-squares ``x ~ c0 + c1 t + c2 t^2`` (``t`` relative to the newest sample): ``(x, v,
-    a)`` at ``t = 0`` and the travel ``x(0) - x(t[0])`` over the window, with their standard
-    errors from the larger of the noise floor ``noise`` (m) and the fit's own residuals (a
-    motion the model does not follow); ``None`` if singular."""
-    n = t.shape[0]
-    m = np.stack([np.ones(n), t, t * t], axis=1)
-    coef, _, rank, _ = np.linalg.lstsq(m, x, rcond=None)
-    if rank < 3:
-        return None
-    res = x - m @ coef
-    var = max(noise * noise, float(res @ res) / max(n - 3, 1))
-    cov = var * np.linalg.inv(m.T @ m)
-    # (x, v, a) at t = 0, and x(0) - x(t[0]): the travel within the window
-    lin = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0], [0.0, -t[0], -(t[0] ** 2)]])
-    se = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", lin, cov, lin), 0.0))
-    return lin @ coef, se
+class _Quadratic:
+    """The least-squares design of ``x ~ c0 + c1 t + c2 t^2`` at times ``t`` (relative to the
+    newest sample), shared by every fit at those times: the rule fits several signals at the
+    same times, and the design matrix and its normal matrix's inverse are the same for all."""
+
+    def __init__(self, t: np.ndarray) -> None:
+        n = t.shape[0]
+        m = np.empty((n, 3))  # the columns (1, t, t^2), as np.stack would lay them out
+        m[:, 0] = 1.0
+        m[:, 1] = t
+        m[:, 2] = t * t
+        self.m = m
+        # (x, v, a) at t = 0, and x(0) - x(t[0]): the travel within the window
+        self.lin = np.array(
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0], [0.0, -t[0], -(t[0] ** 2)]]
+        )
+        self._inverse: np.ndarray | None = None
+
+    def coefficients(self, x: np.ndarray) -> np.ndarray | None:
+        """``(c0, c1, c2)`` fitted to ``x``; ``None`` if the design is singular."""
+        coef, _, rank, _ = np.linalg.lstsq(self.m, x, rcond=None)
+        return None if rank < 3 else coef
+
+    def state(self, coef: np.ndarray) -> np.ndarray:
+        """``(x, v, a)`` at ``t = 0`` and the travel ``x(0) - x(t[0])`` of the fit ``coef``."""
+        return self.lin @ coef
+
+    def errors(self, x: np.ndarray, coef: np.ndarray, noise: float) -> np.ndarray:
+        """The standard errors of :meth:`state` from the larger of the noise floor ``noise``
+        (m) and the fit's own residuals (a motion the model does not follow)."""
+        m = self.m
+        n = m.shape[0]
+        res = x - m @ coef
+        var = max(noise * noise, float(res @ res) / max(n - 3, 1))
+        if self._inverse is None:
+            self._inverse = np.linalg.inv(m.T @ m)
+        cov = var * self._inverse
+        lin = self.lin
+        return np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", lin, cov, lin), 0.0))
 
 
 def noise_floor(x: np.ndarray) -> float:
@@ -69,19 +91,47 @@ def noise_floor(x: np.ndarray) -> float:
     return 1.4826 * mad / math.sqrt(6.0)
 
 
+def _seen(traj: Trajectory, after: float, lo: int) -> np.ndarray:
+    """The indices, from ``lo`` on, of ``traj``'s samples with both hands seen after ``after``."""
+    t, g, r = traj.t, traj.giver_hand, traj.receiver_hand
+    ok = np.isfinite(g[lo:]).all(axis=1) & np.isfinite(r[lo:]).all(axis=1) & (t[lo:] > after)
+    return lo + ok.nonzero()[0]
+
+
 def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | None:
     """The back-dated onset of a reach the giver's hand shows toward the receiver at the newest
-    sample of ``traj`` (see the module docstring), ``None`` if it shows none. Only samples
-    after ``after`` (s) are read (the previous handover's end)."""
+    sample of ``traj`` (times increasing, as the online window's do; see the module
+    docstring), ``None`` if it shows none. Only samples after ``after`` (s) are read (the
+    previous handover's end)."""
     t_all = traj.t
-    if t_all.shape[0] < c.predict_min_samples + 2:
+    n = t_all.shape[0]
+    if n < c.predict_min_samples + 2:
         return None
     g, r = traj.giver_hand, traj.receiver_hand
     now = float(t_all[-1])
-    ok = np.isfinite(g).all(axis=1) & np.isfinite(r).all(axis=1) & (t_all > after)
-    idx = np.flatnonzero(ok)
-    if idx.size < c.predict_min_samples + 2 or not ok[-1]:
+    # The windows below reach back from the fit window's start (predict_window, or further at
+    # low rates) over the longer of predict_rest_window and predict_noise_window: the samples
+    # before that (most of a long idle window) are not read unless the fit window widens past
+    # it, or too few samples are seen after it (then all are).
+    back = max(c.predict_rest_window, c.predict_noise_window)
+    lo = int(t_all.searchsorted(now - c.predict_window - back))
+    idx = _seen(traj, after, lo)
+    if idx.size == 0 or idx[-1] != n - 1:
         return None  # both hands seen now: the model is not extrapolated across a dropout
+    if lo:
+        w0 = math.nan
+        if idx.size >= c.predict_min_samples + 2:
+            w0 = min(now - c.predict_window, float(t_all[idx[-c.predict_min_samples]]))
+        edge = float(t_all[lo - 1])  # the newest sample skipped
+        if not (
+            edge < w0 - 1e-9
+            and edge < w0 - c.predict_rest_window
+            and edge < w0 - c.predict_noise_window
+        ):
+            lo = 0
+            idx = _seen(traj, after, 0)
+    if idx.size < c.predict_min_samples + 2:
+        return None
     tv = t_all[idx]
     # The fit window: predict_window, widened to predict_min_samples at low rates.
     w0 = min(now - c.predict_window, float(tv[-c.predict_min_samples]))
@@ -99,37 +149,56 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if gap <= 1e-6:
         return None
     u = line / gap
+    tf = t_all[fit] - now
+    q = _Quadratic(tf)
+    x_along = (g[fit] - g_rest) @ u
+    coef = q.coefficients(x_along)
+    if coef is None:
+        return None
+    _, v, a, x = q.state(coef)
+    k = c.predict_sigmas
+    # Each bar below is at least its floor (predict_distance, reach_onset_speed, 0): a fit
+    # short of one fails whatever its errors, so those (and the noise floor) are only measured
+    # for a fit past all three.
+    if not (x >= c.predict_distance and v >= c.reach_onset_speed and a >= 0.0):
+        return None
     hist = idx[(tv < w0 - 1e-9) & (tv >= w0 - c.predict_noise_window)]
     noise = noise_floor(g[hist])
-    tf = t_all[fit] - now
-    along = _fit(tf, (g[fit] - g_rest) @ u, noise)
-    if along is None:
-        return None
-    (_, v, a, x), (_, sv, sa, sx) = along
-    k = c.predict_sigmas
+    _, sv, sa, sx = q.errors(x_along, coef, noise)
     if not (x >= max(c.predict_distance, k * sx) and v >= max(c.reach_onset_speed, k * sv)):
         return None
     if not a >= k * sa:
         return None  # past its speed peak (or not known to be before it): a fidget may stop
     # ... and the hands' gap closing at a reach's speed (the receiver moving away, or a hand
     # adjusted sideways at arm's length, closes it slower than the hand moves)
-    gap_fit = _fit(tf, -np.linalg.norm(r[fit] - g[fit], axis=1), noise)
-    if gap_fit is None or not gap_fit[0][1] >= max(c.reach_onset_speed, k * gap_fit[1][1]):
+    x_gap = -np.linalg.norm(r[fit] - g[fit], axis=1)  # (the fit is of minus the distance)
+    coef_gap = q.coefficients(x_gap)
+    if coef_gap is None:
+        return None
+    minus_d, v_c, a_c, closed = q.state(coef_gap)
+    if not v_c >= c.reach_onset_speed:
+        return None  # short of the bar's floor, whatever the error
+    if not v_c >= max(c.reach_onset_speed, k * q.errors(x_gap, coef_gap, noise)[1]):
         return None
     # The model's prediction: over the next predict_horizon the hands close a share of the gap
     # they started from (a hand adjusted at arm's length closes a few cm of a metre).
-    (minus_d, v_c, a_c, closed), _ = gap_fit  # (the fit is of minus the distance)
     h = c.predict_horizon
     ahead = closed + v_c * h + 0.5 * max(a_c, 0.0) * h * h
     if not ahead >= c.predict_gap_share * (closed - minus_d):
         return None
-    # Within acos(predict_cos) of the line: the velocity's other components, fitted alike.
-    across = [_fit(tf, g[fit, j], noise) for j in range(3)]
-    if any(f is None for f in across):
-        return None
-    vel = np.array([f[0][1] for f in across if f is not None])
+    # Within acos(predict_cos) of the line: the velocity's other components, fitted alike
+    # (only their velocities are read: no errors).
+    vel = np.empty(3)
+    for j in range(3):
+        coef_j = q.coefficients(g[fit, j])
+        if coef_j is None:
+            return None
+        vel[j] = q.state(coef_j)[1]
     speed = vector_norm(vel)
     if not speed > 0 or v / speed < c.predict_cos:
         return None
     onset = now - min_jerk_span(x, v, c.max_refine)
-    return max(onset, float(tv[0]), after) if math.isfinite(onset) else None
+    if not math.isfinite(onset):
+        return None
+    first = tv[0] if lo == 0 else t_all[_seen(traj, after, 0)[0]]  # the first sample seen
+    return max(onset, float(first), after)

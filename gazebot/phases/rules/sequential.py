@@ -39,6 +39,7 @@ confirms first.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -46,7 +47,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import median, vector_norm
-from gazebot.phases.rules.directed import _fit, noise_floor
+from gazebot.phases.rules.directed import _Quadratic, noise_floor
 from gazebot.phases.trajectory import Trajectory
 
 
@@ -72,20 +73,30 @@ class ReachEvidence:
     sigma: float
 
 
-def min_jerk_profile(s: np.ndarray) -> np.ndarray:
-    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (clipped to 0..1)."""
-    s = np.clip(s, 0.0, 1.0)
-    return s * s * s * (10.0 + s * (6.0 * s - 15.0))
+def min_jerk_profile(s: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
+    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (float, clipped to
+    0..1). ``overwrite``: ``s`` may be used as scratch (the test's templates are large: fewer
+    temporary arrays; the same operations in the same order, so the same values)."""
+    s = np.clip(s, 0.0, 1.0, out=s if overwrite else None)
+    # s^3 (10 + s (6 s - 15)), evaluated as ((s s) s) (10 + s (6 s - 15))
+    inner = s * 6.0
+    inner -= 15.0
+    inner *= s
+    inner += 10.0
+    out = s * s
+    out *= s
+    out *= inner
+    return out
 
 
 def _best_reduction(
-    s: np.ndarray, b: np.ndarray, lo: float, hi: float
+    norm: np.ndarray, b: np.ndarray, ratio: np.ndarray, lo: float, hi: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """The largest drop of the residual sum of squares ``2 m |S| - m^2 B`` over amplitudes
-    ``m`` in ``[lo, hi]`` (``S`` (..., 3): template-data products, ``B``: template energy), and
-    that ``m``."""
-    norm = np.linalg.norm(s, axis=-1)
-    m = np.clip(norm / np.maximum(b, 1e-12), lo, hi)
+    ``m`` in ``[lo, hi]`` (``norm``: ``|S|``, the template-data products' norms; ``b``: ``B``,
+    the template energy; ``ratio``: ``|S| / max(B, 1e-12)``, the unbounded best ``m``, shared
+    by both classes), and that ``m``."""
+    m = np.clip(ratio, lo, hi)
     return 2.0 * m * norm - m * m * b, m
 
 
@@ -94,12 +105,31 @@ def _binned(t: np.ndarray, x: np.ndarray, step: float) -> tuple[np.ndarray, np.n
     templates are smooth on that scale, so the test loses nothing; at 240 Hz it reads a
     third as many rows."""
     key = np.floor((t - t[0]) / step).astype(np.int64)
-    cuts = np.flatnonzero(np.diff(key)) + 1
-    counts = np.diff(np.concatenate([[0], cuts, [t.shape[0]]])).astype(float)
-    starts = np.concatenate([[0], cuts])
+    cuts = (key[1:] != key[:-1]).nonzero()[0]
+    bounds = np.empty(cuts.shape[0] + 2, dtype=np.int64)  # 0, the cuts, n
+    bounds[0] = 0
+    np.add(cuts, 1, out=bounds[1:-1])
+    bounds[-1] = t.shape[0]
+    counts = (bounds[1:] - bounds[:-1]).astype(float)
+    starts = bounds[:-1]
     tb = np.add.reduceat(t, starts) / counts
     xb = np.add.reduceat(x, starts, axis=0) / counts[:, None]
     return tb, xb, counts
+
+
+@functools.lru_cache(maxsize=8)
+def _grids(
+    durations: tuple[float, float], steps: int, span: float, step: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The test's grids, which depend on the configuration alone (computed once per
+    configuration): ``steps`` geometric durations (s) over ``durations`` and the onsets' lags
+    (s) before the newest sample, ``0, step, ...`` short of ``span``. Read-only."""
+    lo, hi = durations
+    grid = np.geomspace(lo, hi, steps)
+    lags = np.arange(0.0, span, step)
+    grid.flags.writeable = False
+    lags.flags.writeable = False
+    return grid, lags
 
 
 def reach_evidence(
@@ -111,24 +141,33 @@ def reach_evidence(
     n = t.shape[0]
     if n < c.predict_min_samples:
         return None
-    lo_t, hi_t = c.sequential_durations
-    durations = np.geomspace(lo_t, hi_t, c.sequential_duration_steps)
-    onsets = now - np.arange(0.0, c.sequential_onset_span, c.sequential_onset_step)
+    durations, lags = _grids(
+        c.sequential_durations,
+        c.sequential_duration_steps,
+        c.sequential_onset_span,
+        c.sequential_onset_step,
+    )
+    onsets = now - lags
     tb, xb, w = _binned(t, x, 0.5 * c.sequential_onset_step)
     mean_x = w @ xb / n
     xc = xb - mean_x
     # templates (onset, duration, bin), centred (weighted): the rest position is free
-    tmpl = min_jerk_profile((tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None])
+    tmpl = min_jerk_profile(
+        (tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None], overwrite=True
+    )
     mean_b = tmpl @ w / n
     tmpl -= mean_b[..., None]
     wt = tmpl * w
     energy = np.einsum("abn,abn->ab", wt, tmpl)
     prod = wt @ xc  # (onset, duration, 3)
-    reach, m_reach = _best_reduction(prod, energy, c.min_approach, math.inf)
-    fidget, _ = _best_reduction(prod, energy, 0.0, c.fidget_amplitude)
-    k = np.unravel_index(int(np.argmax(reach)), reach.shape)
+    norms = np.linalg.norm(prod, axis=-1)
+    ratio = norms / np.maximum(energy, 1e-12)
+    reach, m_reach = _best_reduction(norms, energy, ratio, c.min_approach, math.inf)
+    fidget, _ = _best_reduction(norms, energy, ratio, 0.0, c.fidget_amplitude)
+    k = divmod(int(reach.argmax()), reach.shape[1])
     best_fidget = float(fidget.max())
-    rss0 = float(np.einsum("ij,ij->", x - mean_x, x - mean_x))
+    dx = x - mean_x
+    rss0 = float(np.einsum("ij,ij->", dx, dx))
     dof = max(3 * n - 7, 1)
     norm = vector_norm(prod[k])
     amp = m_reach[k] * prod[k] / norm if norm > 0 else np.zeros(3)
@@ -163,45 +202,52 @@ def sequential_reach(
         return None
     g, r = traj.giver_hand, traj.receiver_hand
     now = float(t_all[-1])
-    lo = int(np.searchsorted(t_all, max(now - c.sequential_window - c.predict_noise_window, after)))
+    lo = int(t_all.searchsorted(max(now - c.sequential_window - c.predict_noise_window, after)))
     ok = np.isfinite(g[lo:]).all(axis=1) & np.isfinite(r[lo:]).all(axis=1) & (t_all[lo:] > after)
     if not ok[-1]:
         return None  # both hands seen now: the model is not extrapolated across a dropout
-    idx = lo + np.flatnonzero(ok)
+    idx = lo + ok.nonzero()[0]
     tv = t_all[idx]
     win = idx[tv > now - c.sequential_window]
     if win.size < c.predict_min_samples:
         return None
-    # A dropout only matters where the gap's closing is fitted (the last predict_window): the
-    # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
-    # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
-    steps = np.diff(t_all[win])
-    recent = t_all[win][1:] >= now - c.predict_window
-    step = median(steps)
-    if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
-        return None
     # A fidget fits any cubic start up to its midpoint: a hand not yet half the largest fidget
     # from its rest (the window before every onset tried), or not toward the receiver, cannot
-    # be told from one (cheap skips before the test).
+    # be told from one (cheap skips before the test; first, as a hand at rest fails them).
     tw = t_all[win]
     rest = win[tw <= now - c.sequential_onset_span]
     last = win[tw >= now - 0.5 * c.sequential_onset_step]
     if rest.size:
-        moved = g[last].mean(axis=0) - g[rest].mean(axis=0)
-        toward = float(moved @ (r[-1] - g[rest].mean(axis=0)))
+        g_rest = g[rest].mean(axis=0)
+        moved = g[last].mean(axis=0) - g_rest
+        toward = float(moved @ (r[-1] - g_rest))
         if vector_norm(moved) < 0.5 * c.fidget_amplitude or toward <= 0.0:
             return None
-    noise = noise_floor(g[idx[tv <= now - c.sequential_window]])
+    # A dropout only matters where the gap's closing is fitted (the last predict_window): the
+    # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
+    # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
+    steps = np.diff(tw)
+    recent = tw[1:] >= now - c.predict_window
+    step = median(steps)
+    if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
+        return None
     # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted
     # sideways at arm's length, closes it slower than the hand moves): a constant-acceleration
     # model of the gap closes faster than predict_sigmas of its standard error ...
-    w0 = min(now - c.predict_window, float(t_all[win[-c.predict_min_samples]]))
-    fit = win[t_all[win] >= w0]
-    gap_fit = _fit(t_all[fit] - now, -np.linalg.norm(r[fit] - g[fit], axis=1), noise)
-    if gap_fit is None:
+    w0 = min(now - c.predict_window, float(tw[-c.predict_min_samples]))
+    fit = win[tw >= w0]
+    q = _Quadratic(t_all[fit] - now)
+    x_gap = -np.linalg.norm(r[fit] - g[fit], axis=1)
+    coef = q.coefficients(x_gap)
+    if coef is None:
         return None
-    (_, v_c, a_c, _), (_, s_v, _, _) = gap_fit
-    if not v_c >= c.predict_sigmas * s_v:
+    _, v_c, a_c, _ = q.state(coef)
+    # (a gap not closing fails that bar whatever its error: the error, the noise floor and the
+    # test are only measured for one that closes)
+    if not v_c >= 0.0:
+        return None
+    noise = noise_floor(g[idx[tv <= now - c.sequential_window]])
+    if not v_c >= c.predict_sigmas * q.errors(x_gap, coef, noise)[1]:
         return None
     ev = reach_evidence(t_all[win], g[win], now, noise, c)
     if ev is None or not ev.statistic >= bar:
