@@ -87,3 +87,12 @@ def test_a_fidget_toward_the_receiver_is_never_a_reach(rate, noise):
     for duration in (0.25, 0.4):
         traj = _recording(rate, noise, FIDGET, duration, 3.5)
         assert _first_confirmation(traj, PhaseConfig()) is None, (rate, noise, duration)
+
+
+def test_a_handover_that_ended_at_the_newest_sample_leaves_nothing_to_test():
+    # `after` (the previous handover's end) at the newest sample: no sample is read, no reach
+    # (this used to index an empty window: an IndexError inside the detector).
+    traj = _recording(120.0, 0.002, REACH, 1.0, 2.8)
+    c = PhaseConfig()
+    assert sequential_reach(traj, c, float(traj.t[-1])) is None
+    assert sequential_reach(traj, c, float(traj.t[-1]) + 1.0) is None

@@ -204,8 +204,10 @@ def sequential_reach(
     now = float(t_all[-1])
     lo = int(t_all.searchsorted(max(now - c.sequential_window - c.predict_noise_window, after)))
     ok = np.isfinite(g[lo:]).all(axis=1) & np.isfinite(r[lo:]).all(axis=1) & (t_all[lo:] > after)
-    if not ok[-1]:
-        return None  # both hands seen now: the model is not extrapolated across a dropout
+    if ok.size == 0 or not ok[-1]:
+        # Both hands seen now, after ``after``: the model is not extrapolated across a
+        # dropout (none at all: ``after`` is the newest sample, a handover just ended).
+        return None
     idx = lo + ok.nonzero()[0]
     tv = t_all[idx]
     win = idx[tv > now - c.sequential_window]
