@@ -187,7 +187,11 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
         share = _seen_share(sigma)
         den = np.empty((rows, hands))
         den.fill(share)  # (np.full's work without its argument handling)
-        out = correlate1d(x, w, axis=0, mode="nearest") / max(share, 1e-12)
+        # (an output array given: scipy allocates none, skipping its dtype-name lookup, a
+        # few microseconds a call)
+        out = np.empty((rows, x.shape[1]))
+        correlate1d(x, w, axis=0, output=out, mode="nearest")
+        np.divide(out, max(share, 1e-12), out=out)
         if share < 0.5:
             out[:] = np.nan
         return out, den
@@ -195,7 +199,8 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     stack = np.empty((rows, hands, 4))
     stack[:, :, :3] = np.where(m[:, :, None], x.reshape(rows, hands, 3), 0.0)
     stack[:, :, 3] = m
-    both = correlate1d(stack, w, axis=0, mode="nearest")
+    both = np.empty_like(stack)
+    correlate1d(stack, w, axis=0, output=both, mode="nearest")
     den = both[:, :, 3]
     out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
     out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
