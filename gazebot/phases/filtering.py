@@ -673,8 +673,11 @@ class SignalCache:
         # arithmetic, written in place where _derived_into reads them (giver, receiver)
         x, q = b["x"], b["q"][:, a - 1 : rows]
         vq = q[2:4]
-        np.subtract(_by_hand(x[a:rows]), _by_hand(x[a - 2 : rows - 2]), out=vq[:, :-1])
-        np.divide(vq[:, :-1], 2.0 * dt, out=vq[:, :-1])
+        # (differenced and scaled on contiguous rows, then copied into the hands' blocks:
+        # half the time of the same arithmetic on the blocks' strided views)
+        diff = x[a:rows] - x[a - 2 : rows - 2]
+        diff /= 2.0 * dt
+        vq[:, :-1] = _by_hand(diff)
         vq[:, -1] = ((x[rows - 1] - x[rows - 2]) / dt).reshape(2, 3)
         shares = b["full"][a - 1 : rows]
         if shares.min() < FULL_WINDOW:  # (away from tracking gaps, none is)
