@@ -189,7 +189,7 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
         den.fill(share)  # (np.full's work without its argument handling)
         # (an output array given: scipy allocates none, skipping its dtype-name lookup, a
         # few microseconds a call)
-        out = np.empty((rows, x.shape[1]))
+        out = np.empty_like(x)
         correlate1d(x, w, axis=0, output=out, mode="nearest")
         np.divide(out, max(share, 1e-12), out=out)
         if share < 0.5:
