@@ -54,6 +54,8 @@ from gazebot.types import (
 _TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
 # Robot events whose phase change the phase detector adopts (it cannot see a grasp).
 _DETECTOR_ADOPTS = frozenset({EventKind.ROBOT_GRASPED, EventKind.ROBOT_RELEASED})
+# NumPy's float64 dtype: one object, so an ``is`` test settles the usual array's dtype.
+_F64 = np.dtype(np.float64)
 
 
 class PhaseDetectorLike(Protocol):
@@ -187,7 +189,12 @@ class GazeEngine:
         for what a sample or an event holds (see the module docstring).
         """
         faults: list[Event] = []
-        t = self._time(frame)
+        t = frame.t
+        # The usual frame's time (a float after the last one) without _time's checks.
+        if type(t) is float and self._last_t < t < math.inf:
+            self._last_t = t
+        else:
+            t = self._time(frame)
         frame = self._plausible(frame)
         try:
             # Every event this sample reveals (a gripper closing can reveal a reach and a
@@ -210,7 +217,9 @@ class GazeEngine:
         tracking_end = (
             detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
-        ctx = filled(GazeContext, t=t, points=self._points(frame), tracking_end=tracking_end)
+        ctx = filled(
+            GazeContext, {"t": t, "points": self._points(frame), "tracking_end": tracking_end}
+        )
         try:
             target = self.behavior.target(ctx)
             kind, point = target.kind, target.point
@@ -281,9 +290,18 @@ class GazeEngine:
         """``frame`` with every point beyond the workspace (or not a numeric 3-vector) missing."""
         changed = {}
         rr = self._radius_sq
-        for name in ("giver_hand", "receiver_hand", "giver_face"):
-            p = getattr(frame, name)
-            if type(p) is np.ndarray and p.shape == (3,) and p.dtype.kind == "f":
+        f64 = _F64
+        for name, p in (
+            ("giver_hand", frame.giver_hand),
+            ("receiver_hand", frame.receiver_hand),
+            ("giver_face", frame.giver_face),
+        ):
+            # ``is`` first: the usual array's dtype is the float64 singleton (cheaper than .kind)
+            if (
+                type(p) is np.ndarray
+                and (p.dtype is f64 or p.dtype.kind == "f")
+                and p.shape == (3,)
+            ):
                 x, y, z = p.tolist()  # plain floats: numpy per-call overhead is microseconds
             else:
                 try:
@@ -379,7 +397,8 @@ class GazeEngine:
         self._last_target = (kind, point)
         status: Status = "degraded" if faults or not ok else "ok"
         handover = self.handover
-        if type(point) is not np.ndarray or point.dtype != np.float64:
+        # ``is`` first: comparing a dtype with the np.float64 type converts it on every call
+        if type(point) is not np.ndarray or (point.dtype is not _F64 and point.dtype != _F64):
             point = np.asarray(point, float)  # (the behavior's points already are)
         cmd = filled(
             GazeCommand,
