@@ -353,14 +353,15 @@ class GazeEngine:
         return out
 
     def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
+        """The behavior's points this tick: the robot's fixed ones and the tracked ones."""
         hand = frame.giver_hand
-        return {
-            **self._fixed_points,
-            "face": frame.giver_face,
-            "hand": hand,
-            "object": hand,
-            "receiver_hand": frame.receiver_hand,
-        }
+        # A copy then item sets: cheaper than a ``{**fixed, ...}`` merge, with the same key order.
+        points = self._fixed_points.copy()
+        points["face"] = frame.giver_face
+        points["hand"] = hand
+        points["object"] = hand
+        points["receiver_hand"] = frame.receiver_hand
+        return points
 
     def _fault(self, t: float, stage: str, err: BaseException) -> Event:
         self.stats.faults += 1
