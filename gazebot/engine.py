@@ -384,7 +384,11 @@ class GazeEngine:
             # One float sum instead of a check per value: finite values of these sizes (angles,
             # rad) cannot overflow, so the sum is finite exactly when every value is.
             ok = math.isfinite(yaw + pitch + residual + shift + sum(q))
-            head = dict(zip(self._head_names, q, strict=True))
+            names = self._head_names
+            # A goal for every head joint, checked by length (zip's strict mode costs more).
+            if len(q) != len(names):
+                raise ValueError(f"{len(q)} head joint goals for {len(names)} head joints")
+            head = dict(zip(names, q))  # noqa: B905 - lengths checked above
         except Exception as err:  # noqa: BLE001 - e.g. a joint reading that is no number
             faults.append(self._fault(t, "kinematics", err))
             events = (*events, faults[-1])

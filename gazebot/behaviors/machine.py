@@ -720,7 +720,8 @@ class BehaviorMachine:
         if type(t) is not float or not math.isfinite(t):
             t = float(t) if _finite(t) else self.handover.phase_start
         if type(end) is not float or not math.isfinite(end):
-            end = end if _finite(end) else math.nan
+            # (a float NaN, the usual unknown end, needs no _finite call)
+            end = end if type(end) is not float and _finite(end) else math.nan
         self.advance(t, end)
         gaze, tracking = self._model.state
         lost_kind = self._lost_kind
