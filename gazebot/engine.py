@@ -226,7 +226,9 @@ class GazeEngine:
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
-        return self._command(t, kind, point, arm, (*stream, *faults), faults)
+        # (the usual tick has no event: no tuple to build)
+        published = (*stream, *faults) if stream or faults else ()
+        return self._command(t, kind, point, arm, published, faults)
 
     def look_at(
         self,
