@@ -290,14 +290,28 @@ class GazeEngine:
 
     def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
         """``frame`` with every point beyond the workspace (or not a numeric 3-vector) missing."""
-        changed = {}
         rr = self._radius_sq
         f64 = _F64
-        for name, p in (
-            ("giver_hand", frame.giver_hand),
-            ("receiver_hand", frame.receiver_hand),
-            ("giver_face", frame.giver_face),
+        hand, receiver, face = frame.giver_hand, frame.receiver_hand, frame.giver_face
+        # The usual frame (three float64 3-vectors, each inside the workspace or all-NaN) in
+        # one test: a fifth cheaper than the loop below, which decides every other frame.
+        if (
+            type(hand) is np.ndarray
+            and type(receiver) is np.ndarray
+            and type(face) is np.ndarray
+            and hand.dtype is f64
+            and receiver.dtype is f64
+            and face.dtype is f64
+            and hand.shape == receiver.shape == face.shape == (3,)
         ):
+            x, y, z = hand.tolist()
+            a, b, c = receiver.tolist()
+            u, v, w = face.tolist()
+            s1, s2, s3 = x * x + y * y + z * z, a * a + b * b + c * c, u * u + v * v + w * w
+            if (s1 <= rr or s1 != s1) and (s2 <= rr or s2 != s2) and (s3 <= rr or s3 != s3):
+                return frame
+        changed = {}
+        for name, p in (("giver_hand", hand), ("receiver_hand", receiver), ("giver_face", face)):
             # ``is`` first: the usual array's dtype is the float64 singleton (cheaper than .kind)
             if (
                 type(p) is np.ndarray
