@@ -18,6 +18,10 @@ NAN3 = np.full(3, np.nan)
 
 _T = TypeVar("_T")
 
+# object's own constructor and setter, looked up once: filled() runs several times per tick.
+_new_object = object.__new__
+_set_attribute = object.__setattr__
+
 
 def filled(cls: type[_T], fields: dict[str, Any] | None = None, /, **values: Any) -> _T:
     """An instance of the frozen dataclass ``cls`` with its fields set straight from
@@ -29,9 +33,9 @@ def filled(cls: type[_T], fields: dict[str, Any] | None = None, /, **values: Any
     keywords (Python's keyword-argument handling costs about 50 ns a name)."""
     if fields is not None and values:
         raise TypeError("filled() takes a fields dict or keywords, not both")
-    obj = object.__new__(cls)
+    obj = _new_object(cls)
     # The dict becomes the instance's attributes, uncopied: a keywords dict is always new.
-    object.__setattr__(obj, "__dict__", values if fields is None else fields)
+    _set_attribute(obj, "__dict__", values if fields is None else fields)
     return obj
 
 

@@ -47,6 +47,23 @@ def test_points_beyond_the_workspace_are_missing_samples_and_counted(loop):
     assert engine.stats.implausible == 60 and cmd.status == "ok"
 
 
+def test_each_point_is_judged_on_its_own_whatever_its_float_type(loop):
+    """A frame off the usual path (a float32 point beside a far one) keeps its plausible
+    points as they are and drops only the far one."""
+    engine = loop.engine
+    engine.reset()
+    radius = engine.robot.config.workspace_radius_m
+    grip32 = np.array(GRIP, dtype=np.float32)
+    frame = TrackingFrame(t=0.0, giver_hand=np.array(HAND), receiver_hand=grip32,
+                          giver_face=np.array([0.0, radius + 1.0, 0.0]))
+    kept = engine._plausible(frame)
+    assert kept.giver_hand is frame.giver_hand and kept.receiver_hand is grip32
+    assert np.all(np.isnan(kept.giver_face)) and engine.stats.implausible == 1
+    usual = TrackingFrame(t=0.0, giver_hand=np.array(HAND), receiver_hand=np.array(GRIP),
+                          giver_face=np.full(3, np.nan))
+    assert engine._plausible(usual) is usual and engine.stats.implausible == 1
+
+
 @pytest.mark.parametrize("huge", [1e155, -1e308, 1e20])
 def test_a_sample_with_huge_finite_values_does_not_kill_the_loop(loop, huge):
     loop.reset()

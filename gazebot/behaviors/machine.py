@@ -720,7 +720,8 @@ class BehaviorMachine:
         if type(t) is not float or not math.isfinite(t):
             t = float(t) if _finite(t) else self.handover.phase_start
         if type(end) is not float or not math.isfinite(end):
-            end = end if _finite(end) else math.nan
+            # (a float NaN, the usual unknown end, needs no _finite call)
+            end = end if type(end) is not float and _finite(end) else math.nan
         self.advance(t, end)
         gaze, tracking = self._model.state
         lost_kind = self._lost_kind
@@ -729,7 +730,7 @@ class BehaviorMachine:
                 return self._held
             return GazeTarget(lost_kind, self._point(lost_kind, ctx))
         kind = self._kind_of_state[gaze]
-        target = filled(GazeTarget, kind=kind, point=self._point(kind, ctx))
+        target = filled(GazeTarget, {"kind": kind, "point": self._point(kind, ctx)})
         if kind != lost_kind:
             self._point(lost_kind, ctx)  # keeps the last known face fresh for a tracking loss
         self._last_target = target
@@ -745,7 +746,14 @@ class BehaviorMachine:
 
     def _point(self, kind: str, ctx: GazeContext) -> np.ndarray:
         points = ctx.points if isinstance(ctx.points, dict) else {}
-        arr = self._valid(points.get(kind))
+        arr = points.get(kind)
+        # The usual point (a finite float64 3-vector) checked here: a _valid call costs more.
+        if type(arr) is np.ndarray and arr.dtype is _F64 and arr.shape == (3,):
+            x, y, z = arr.tolist()
+            if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+                arr = None
+        else:
+            arr = self._valid(arr)
         if arr is not None:
             self._known[kind] = arr
             return arr
