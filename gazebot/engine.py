@@ -36,6 +36,7 @@ from gazebot.kinematics import (
 from gazebot.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.types import (
     EVENT_OF_PHASE,
+    F64,
     NAN3,
     PHASE_OF_EVENT,
     Event,
@@ -54,8 +55,6 @@ from gazebot.types import (
 _TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
 # Robot events whose phase change the phase detector adopts (it cannot see a grasp).
 _DETECTOR_ADOPTS = frozenset({EventKind.ROBOT_GRASPED, EventKind.ROBOT_RELEASED})
-# NumPy's float64 dtype: one object, so an ``is`` test settles the usual array's dtype.
-_F64 = np.dtype(np.float64)
 
 
 class PhaseDetectorLike(Protocol):
@@ -291,7 +290,7 @@ class GazeEngine:
     def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
         """``frame`` with every point beyond the workspace (or not a numeric 3-vector) missing."""
         rr = self._radius_sq
-        f64 = _F64
+        f64 = F64
         hand, receiver, face = frame.giver_hand, frame.receiver_hand, frame.giver_face
         # The usual frame (three float64 3-vectors, each inside the workspace or all-NaN) in
         # one test: a fifth cheaper than the loop below, which decides every other frame.
@@ -419,7 +418,7 @@ class GazeEngine:
         status: Status = "degraded" if faults or not ok else "ok"
         handover = self.handover
         # ``is`` first: comparing a dtype with the np.float64 type converts it on every call
-        if type(point) is not np.ndarray or (point.dtype is not _F64 and point.dtype != _F64):
+        if type(point) is not np.ndarray or (point.dtype is not F64 and point.dtype != F64):
             point = np.asarray(point, float)  # (the behavior's points already are)
         cmd = filled(
             GazeCommand,

@@ -15,6 +15,9 @@ from typing import Any, Literal, TypeVar
 import numpy as np
 
 NAN3 = np.full(3, np.nan)
+# NumPy's float64 dtype: one object, so an ``is`` test settles the usual array's dtype on the
+# per-tick paths (cheaper than comparing dtypes).
+F64 = np.dtype(np.float64)
 
 _T = TypeVar("_T")
 

@@ -83,6 +83,7 @@ from gazebot.behaviors.spec import (
 )
 from gazebot.handover import HandoverState, PhaseChange
 from gazebot.types import (
+    F64,
     Event,
     EventKind,
     GazeContext,
@@ -99,7 +100,6 @@ _RESTORED = "after the loss"
 _STAYS = "due, but before the followed segment's start: the latest start wins, the gaze stays"
 
 
-_F64 = np.dtype(np.float64)
 
 
 def _finite(x: object) -> bool:
@@ -748,7 +748,7 @@ class BehaviorMachine:
         points = ctx.points if isinstance(ctx.points, dict) else {}
         arr = points.get(kind)
         # The usual point (a finite float64 3-vector) checked here: a _valid call costs more.
-        if type(arr) is np.ndarray and arr.dtype is _F64 and arr.shape == (3,):
+        if type(arr) is np.ndarray and arr.dtype is F64 and arr.shape == (3,):
             x, y, z = arr.tolist()
             if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
                 arr = None
@@ -778,7 +778,7 @@ class BehaviorMachine:
         if p is None:
             return None
         # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more
-        arr = p if type(p) is np.ndarray and (p.dtype is _F64 or p.dtype == _F64) else _as3(p)
+        arr = p if type(p) is np.ndarray and (p.dtype is F64 or p.dtype == F64) else _as3(p)
         if arr is None or arr.shape != (3,):
             return None
         # Scalar checks on one list: much cheaper than np.isfinite(...).all() on a 3-vector,

@@ -42,11 +42,10 @@ from gazebot.kinematics.shifts import (
     MinJerkTrajectory,
     min_jerk,
 )
-from gazebot.types import filled
+from gazebot.types import F64, filled
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
 _REPLAN_EPS = 1e-6
-_F64 = np.dtype(np.float64)
 
 
 @dataclass(frozen=True)
@@ -322,7 +321,7 @@ class GazeController:
             return None
         p = target_point
         # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more.
-        if type(p) is not np.ndarray or (p.dtype is not _F64 and p.dtype != _F64):
+        if type(p) is not np.ndarray or (p.dtype is not F64 and p.dtype != F64):
             p = np.asarray(target_point, dtype=float)
         if p.shape != (3,):
             p = p.reshape(-1)

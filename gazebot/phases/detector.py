@@ -56,15 +56,13 @@ from gazebot.phases.prediction import predict_end
 from gazebot.phases.segment import Segment, segments_from_events
 from gazebot.phases.trajectory import Trajectory
 from gazebot.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
+from gazebot.types import F64, Event, EventKind, Phase, TrackingFrame, filled
 from gazebot.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
-from gazebot.types import Event, EventKind, Phase, TrackingFrame, filled
-
-_F64 = np.dtype(np.float64)
 
 
 def _point(p: object) -> np.ndarray:
     """A point as a float 3-vector (NaNs if it is not a numeric 3-vector)."""
-    if type(p) is np.ndarray and p.dtype is _F64 and p.shape == (3,):
+    if type(p) is np.ndarray and p.dtype is F64 and p.shape == (3,):
         return p  # the usual case (the engine's frames): no conversion (an identity check)
     try:
         v = np.asarray(p, dtype=float).reshape(-1)
