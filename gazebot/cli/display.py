@@ -134,7 +134,7 @@ def run_display(
             if delay > 0:
                 time.sleep(delay)
     except KeyboardInterrupt:
-        pass
+        pass  # Ctrl-C is how a display without --duration is stopped: not an error
     if writer is not None and duration is not None and slots and now >= end:
         # Ended by --duration: the video is exactly that long. The last slots may have begun
         # while the loop was late (a busy machine); they repeat the last image like any other

@@ -57,7 +57,7 @@ def handle(args: argparse.Namespace) -> int:
         try:
             threading.Event().wait(args.duration)
         except KeyboardInterrupt:
-            pass
+            pass  # Ctrl-C ends the run early, as --duration would; the router closes below
     finally:
         session.close()
     return 0

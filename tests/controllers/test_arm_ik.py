@@ -5,8 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-pytest.importorskip("pinocchio")
-
 
 def _ik(robot="jaco2", speed=2.0):  # rad/s
     from gazebot.controllers.arm_ik import ArmIK

@@ -137,7 +137,7 @@ def test_kl_weight_nu_pulls_the_local_controller_to_the_policy_and_lambda_shifts
 
 
 def test_policy_network_imitates_a_linear_controller_and_its_jacobian_is_exact():
-    pytest.importorskip("jax")
+    pytest.importorskip("jax", reason="the policy network needs the optional extra gazebot[gps]")
     rng = np.random.default_rng(3)
     dx, du = 6, 3
     K = rng.standard_normal((du, dx))
