@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gazebot.kinematics.eyes import angle_of, eye_angles
+from gazebot.kinematics.eyes import angle_of, eye_angles_of, residual_of
 from gazebot.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.kinematics.robot import RobotModel
 from gazebot.kinematics.shifts import (
@@ -111,7 +111,7 @@ class GazeController:
         self._eyes_model = eyes
         self._eye_vlim = robot.eye_velocity_limit
         self._min_distance = self.ik.min_distance
-        # Finite even if max_distance is not (see _parse).
+        # Finite even if max_distance is not (see _tick).
         self._max_abs = min(self.ik.max_distance, sys.float_info.max)
         self._saccade_threshold = self.shifts.saccade_threshold
         self.reset()
@@ -216,9 +216,28 @@ class GazeController:
     ) -> tuple[float, bool, bool]:
         """The work of :meth:`update`; returns the shift amplitude, whether the target was
         valid and whether the eyes are at their range."""
-        dt = self._advance(t)
+        last = self._t
+        # The usual tick (a float time after the last one, a float64 3-vector) without the
+        # general path's calls: _advance gives the same for it.
+        if type(t) is float and last is not None and last < t < math.inf:
+            dt = t - last  # > 0: the difference of two ordered floats
+            self._t = t
+            self._clock += dt
+        else:
+            dt = self._advance(t)
         arm_moved = self.robot.set_arm(arm) if arm is not None else False
-        target = self._parse(target_point)
+        p = target_point
+        if p is None:
+            target = None
+        else:
+            # ``is`` first: NumPy's float64 dtype is one object (the usual point needs no call).
+            if type(p) is not np.ndarray or p.dtype is not F64 or p.shape != (3,):
+                p = _vector(p)
+            x, y, z = p.tolist()
+            # Finite and not absurdly far (a corrupted sample is held like a missing one); a
+            # NaN fails every comparison, and the bound is finite even if max_distance is not.
+            m = self._max_abs
+            target = (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
         valid = target is not None
         shift = 0.0
         if valid and not (target == self._target and not arm_moved and self._goal_final):
@@ -270,13 +289,17 @@ class GazeController:
     def _aim_eyes(self, dt: float) -> bool:
         """Aim the eyes at the target from the head command (saccade profile, speed limit,
         range); returns whether they are at their range."""
-        x, y, z = self._to_local(self._target)  # type: ignore[arg-type]
+        # _to_local written out (the same arithmetic, a call and a tuple less per tick)
+        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = self._gaze_frame()
+        tx, ty, tz = self._target  # type: ignore[misc]
+        dx, dy, dz = tx - px, ty - py, tz - pz
+        x = r00 * dx + r10 * dy + r20 * dz
+        y = r01 * dx + r11 * dy + r21 * dz
+        z = r02 * dx + r12 * dy + r22 * dz
         if not math.sqrt(x * x + y * y + z * z) >= self._min_distance:
             return False  # too close for a direction (or not a number): the eyes stay
         eyes = self._eyes_model
-        v = (x, y, z)
-        yaw, pitch = eye_angles(v)
-        yaw, pitch, saturated = eyes.clip(yaw, pitch)  # eyes.look(v), one call less
+        yaw, pitch, saturated = eyes.clip(*eye_angles_of(x, y, z))  # eyes.look((x, y, z))
         if self._saccade is not None:
             t0, dur, (y0, p0) = self._saccade
             s = min_jerk((self._clock - t0) / dur)
@@ -298,7 +321,7 @@ class GazeController:
             pitch = hi
         yaw, pitch, _ = eyes.clip(yaw, pitch)
         self._eyes = (yaw, pitch)
-        self._residual = eyes.residual(yaw, pitch, v)
+        self._residual = residual_of(yaw, pitch, x, y, z)  # eyes.residual, floats already
         return saturated
 
     def _advance(self, t: float) -> float:
@@ -315,23 +338,6 @@ class GazeController:
             return 0.0
         self._clock += dt
         return dt
-
-    def _parse(self, target_point: np.ndarray | None) -> tuple[float, float, float] | None:
-        if target_point is None:
-            return None
-        p = target_point
-        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more.
-        if type(p) is not np.ndarray or (p.dtype is not F64 and p.dtype != F64):
-            p = np.asarray(target_point, dtype=float)
-        if p.shape != (3,):
-            p = p.reshape(-1)
-            if p.shape != (3,):
-                raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
-        x, y, z = p.tolist()
-        # Finite and not absurdly far (a corrupted sample is held like a missing one); a NaN
-        # fails every comparison, and the bound is finite even if max_distance is not.
-        m = self._max_abs
-        return (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
 
     def _gaze_frame(self) -> list[list[float]]:
         """Gaze frame rows at the head command (cached: the eyes of one tick and the re-plan of
@@ -466,3 +472,17 @@ class GazeController:
             self._saccade = (t_start, dur, self._eyes)
             return float(amplitude)
         return 0.0
+
+
+def _vector(point: object) -> np.ndarray:
+    """``point`` as a float64 (3,) array.
+
+    Raises:
+        ValueError: it is not a 3D point.
+    """
+    p = np.asarray(point, dtype=float)
+    if p.shape != (3,):
+        p = p.reshape(-1)
+        if p.shape != (3,):
+            raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
+    return p
