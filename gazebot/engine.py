@@ -48,7 +48,7 @@ from gazebot.types import (
     Status,
     TrackingFrame,
     TrackingState,
-    filled,
+    from_fields,
 )
 
 # Targets the engine fills from tracking each tick; all others come from the robot config.
@@ -216,7 +216,7 @@ class GazeEngine:
         tracking_end = (
             detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
-        ctx = filled(
+        ctx = from_fields(
             GazeContext, {"t": t, "points": self._points(frame), "tracking_end": tracking_end}
         )
         try:
@@ -395,7 +395,7 @@ class GazeEngine:
         """The command for ``kind`` at ``point``; the last safe one (or rest) if the kinematics
         fail or give a non-finite value."""
         try:
-            q, yaw, pitch, residual, shift = self.gaze.update_raw(t, point, arm=arm)
+            q, yaw, pitch, residual, shift = self.gaze.update_raw(t, point, arm)
             # One float sum instead of a check per value: finite values of these sizes (angles,
             # rad) cannot overflow, so the sum is finite exactly when every value is.
             ok = math.isfinite(yaw + pitch + residual + shift + sum(q))
@@ -420,7 +420,7 @@ class GazeEngine:
         # ``is`` first: comparing a dtype with the np.float64 type converts it on every call
         if type(point) is not np.ndarray or (point.dtype is not F64 and point.dtype != F64):
             point = np.asarray(point, float)  # (the behavior's points already are)
-        cmd = filled(
+        cmd = from_fields(
             GazeCommand,
             {  # every field, in field order (GazeCommand's dataclass fields)
                 "t": t,

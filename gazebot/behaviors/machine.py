@@ -89,7 +89,7 @@ from gazebot.types import (
     GazeContext,
     GazeTarget,
     Phase,
-    filled,
+    from_fields,
 )
 
 _ROOT, _GAZE, _TRACKING = "behavior", "behavior_gaze", "behavior_tracking"
@@ -730,7 +730,7 @@ class BehaviorMachine:
                 return self._held
             return GazeTarget(lost_kind, self._point(lost_kind, ctx))
         kind = self._kind_of_state[gaze]
-        target = filled(GazeTarget, {"kind": kind, "point": self._point(kind, ctx)})
+        target = from_fields(GazeTarget, {"kind": kind, "point": self._point(kind, ctx)})
         if kind != lost_kind:
             self._point(lost_kind, ctx)  # keeps the last known face fresh for a tracking loss
         self._last_target = target

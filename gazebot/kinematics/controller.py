@@ -390,7 +390,7 @@ class GazeController:
             new_shift = amplitude > self._saccade_threshold
 
         robot = self.robot
-        revision = robot.arm_revision
+        revision = self._frame[1]  # type: ignore[index] # (the _gaze_frame call above set it)
         # A target that moved without a gaze shift is followed at the tracking tolerance; a new
         # or unchanged one (e.g. after the arm moved, or to finish a tracked goal) in full.
         tracking = not new_shift and target != self._target
