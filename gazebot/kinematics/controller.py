@@ -360,19 +360,6 @@ class GazeController:
             r02 * dx + r12 * dy + r22 * dz,
         )
 
-    def _in_deadband(self, target: tuple[float, float, float]) -> bool:
-        """Whether ``target`` is within ``ik.goal_deadband`` of the target the head goal was
-        solved for, seen from the goal's gaze origin, with no saccade under way. The eyes take
-        the difference as far as their range allows: where the target is beyond their reach
-        anyway, the gaze misses by at most the deadband's angle more than with the goal
-        re-solved. Never with fixed eyes (``head-only`` mode)."""
-        ref = self._solved_for
-        deadband = self._deadband
-        if ref is None or deadband <= 0.0 or self._saccade is not None:
-            return False
-        ox, oy, oz, ux, uy, uz = ref
-        return angle_of(ux, uy, uz, target[0] - ox, target[1] - oy, target[2] - oz) <= deadband
-
     def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
@@ -396,7 +383,23 @@ class GazeController:
         tracking = not new_shift and target != self._target
         last = self._solution
         if last is not None and last[1] == revision and last[0].q is self._goal:
-            if tracking and self._in_deadband(target):
+            # The goal deadband: the target is within ``ik.goal_deadband`` of the one the goal
+            # was solved for, seen from the goal's gaze origin, with no saccade under way. The
+            # eyes take the difference as far as their range allows: where the target is
+            # beyond their reach anyway, the gaze misses by at most the deadband's angle more
+            # than with the goal re-solved. (``_solved_for`` is None without a deadband, as in
+            # ``head-only`` mode.)
+            ref = self._solved_for
+            if (
+                tracking
+                and ref is not None
+                and self._saccade is None
+                and angle_of(
+                    ref[3], ref[4], ref[5], target[0] - ref[0], target[1] - ref[1],
+                    target[2] - ref[2],
+                )
+                <= self._deadband
+            ):
                 # The head goal stays; the eyes, aimed from the head's pose, take the rest. It
                 # is solved in full once the target stands still.
                 self._target = target
