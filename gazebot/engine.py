@@ -42,7 +42,6 @@ from gazebot.types import (
     Event,
     EventKind,
     GazeCommand,
-    GazeContext,
     Phase,
     PhaseSource,
     Status,
@@ -216,12 +215,9 @@ class GazeEngine:
         tracking_end = (
             detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
-        ctx = from_fields(
-            GazeContext, {"t": t, "points": self._points(frame), "tracking_end": tracking_end}
-        )
         try:
-            target = self.behavior.target(ctx)
-            kind, point = target.kind, target.point
+            # behavior.target(GazeContext(...)) without the two values it would build
+            kind, point = self.behavior.aim(t, self._points(frame), tracking_end)
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
