@@ -111,7 +111,7 @@ class GazeController:
         self._eyes_model = eyes
         self._eye_vlim = robot.eye_velocity_limit
         self._min_distance = self.ik.min_distance
-        # Finite even if max_distance is not (see _tick).
+        # Finite even if max_distance is not (see update_raw).
         self._max_abs = min(self.ik.max_distance, sys.float_info.max)
         self._saccade_threshold = self.shifts.saccade_threshold
         self.reset()
@@ -145,6 +145,9 @@ class GazeController:
         # The goal's gaze origin and the unit direction from it to the target the goal was
         # solved for (the deadband's reference), or None.
         self._solved_for: tuple[float, float, float, float, float, float] | None = None
+        # The last update's target was a finite point; the eyes were at their range.
+        self._target_valid = True
+        self._eyes_saturated = False
 
     @property
     def head(self) -> dict[str, float]:
@@ -177,7 +180,8 @@ class GazeController:
             ValueError: ``target_point`` is not a 3D point or ``t`` not a number (programming
                 errors, unlike NaN values, which are held).
         """
-        shift, valid, eyes_saturated = self._tick(t, target_point, arm)
+        shift = self.update_raw(t, target_point, arm)[4]
+        valid, eyes_saturated = self._target_valid, self._eyes_saturated
         names = self._names
         state = filled(
             HeadEyeState,
@@ -204,18 +208,6 @@ class GazeController:
         order; a list the controller replaces, never changes), eye yaw, eye pitch, residual and
         shift amplitude, the same floats as the :class:`HeadEyeState` fields (building that
         value and its three dicts costs microseconds the engine does not need)."""
-        shift = self._tick(t, target_point, arm)[0]
-        yaw, pitch = self._eyes
-        return self._q, yaw, pitch, self._residual, shift
-
-    def _tick(
-        self,
-        t: float,
-        target_point: np.ndarray | None,
-        arm: Mapping[str, float] | None,
-    ) -> tuple[float, bool, bool]:
-        """The work of :meth:`update`; returns the shift amplitude, whether the target was
-        valid and whether the eyes are at their range."""
         last = self._t
         # The usual tick (a float time after the last one, a float64 3-vector) without the
         # general path's calls: _advance gives the same for it.
@@ -250,10 +242,11 @@ class GazeController:
             else:
                 self._vel = [0.0] * len(self._q)
 
-        eyes_saturated = False
-        if self._target is not None:
-            eyes_saturated = self._aim_eyes(dt)
-        return shift, valid, eyes_saturated
+        # (kept for update(): the engine's tick does not read them)
+        self._target_valid = valid
+        self._eyes_saturated = self._aim_eyes(dt) if self._target is not None else False
+        yaw, pitch = self._eyes
+        return self._q, yaw, pitch, self._residual, shift
 
     def _follow(self, pos: list[float], dt: float) -> None:
         """Move the head command toward the plan's position ``pos`` within the velocity and
