@@ -272,7 +272,7 @@ class GazeController:
                 x = lo
             if x > hi:
                 x = hi
-            finite = finite and math.isfinite(x)
+            finite = finite and x - x == 0.0  # isfinite(x) without a call (inf - inf is NaN)
             q.append(x)
             vel.append((x - a) / dt)
         if finite:
@@ -292,7 +292,8 @@ class GazeController:
         if not math.sqrt(x * x + y * y + z * z) >= self._min_distance:
             return False  # too close for a direction (or not a number): the eyes stay
         eyes = self._eyes_model
-        yaw, pitch, saturated = eyes.clip(*eye_angles_of(x, y, z))  # eyes.look((x, y, z))
+        yaw, pitch = eye_angles_of(x, y, z)
+        yaw, pitch, saturated = eyes.clip(yaw, pitch)  # eyes.look((x, y, z))
         if self._saccade is not None:
             t0, dur, (y0, p0) = self._saccade
             s = min_jerk((self._clock - t0) / dur)
