@@ -282,13 +282,7 @@ class GazeController:
     def _aim_eyes(self, dt: float) -> bool:
         """Aim the eyes at the target from the head command (saccade profile, speed limit,
         range); returns whether they are at their range."""
-        # _to_local written out (the same arithmetic, a call and a tuple less per tick)
-        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = self._gaze_frame()
-        tx, ty, tz = self._target  # type: ignore[misc]
-        dx, dy, dz = tx - px, ty - py, tz - pz
-        x = r00 * dx + r10 * dy + r20 * dz
-        y = r01 * dx + r11 * dy + r21 * dz
-        z = r02 * dx + r12 * dy + r22 * dz
+        x, y, z = self._to_local(self._target)  # type: ignore[arg-type]
         if not math.sqrt(x * x + y * y + z * z) >= self._min_distance:
             return False  # too close for a direction (or not a number): the eyes stay
         eyes = self._eyes_model
