@@ -351,7 +351,6 @@ class GazeController:
     def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
-        cfg = self.shifts
         # The shift's size: from the gaze origin, between the new target and the old one (or
         # the line of sight); floats unpacked once (this runs every tick the target moves).
         (r00, _, _, ox), (r10, _, _, oy), (r20, _, _, oz) = self._gaze_frame()
@@ -364,11 +363,10 @@ class GazeController:
             amplitude = angle_of(nx, ny, nz, old[0] - ox, old[1] - oy, old[2] - oz)
             new_shift = amplitude > self._saccade_threshold
 
-        robot = self.robot
         revision = self._frame[1]  # type: ignore[index] # (the _gaze_frame call above set it)
         # A target that moved without a gaze shift is followed at the tracking tolerance; a new
         # or unchanged one (e.g. after the arm moved, or to finish a tracked goal) in full.
-        tracking = not new_shift and target != self._target
+        tracking = not new_shift and target != old
         last = self._solution
         if last is not None and last[1] == revision and last[0].q is self._goal:
             # The goal deadband: the target is within ``ik.goal_deadband`` of the one the goal
@@ -397,7 +395,7 @@ class GazeController:
         else:
             warm_frame = warm_rows = None
         sol = solve_ik_raw(
-            robot,
+            self.robot,
             target,
             self._goal,
             self.ik,
@@ -421,6 +419,7 @@ class GazeController:
         self._goal_final = sol.converged
 
         # Neck: continue from the current command, its velocity and the plan's acceleration.
+        cfg = self.shifts
         traj = self._traj
         q = self._q
         acc = traj.sample(t_start)[2] if traj is not None else (0.0,) * len(q)
