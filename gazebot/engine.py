@@ -42,13 +42,12 @@ from gazebot.types import (
     Event,
     EventKind,
     GazeCommand,
-    GazeContext,
     Phase,
     PhaseSource,
     Status,
     TrackingFrame,
     TrackingState,
-    filled,
+    from_fields,
 )
 
 # Targets the engine fills from tracking each tick; all others come from the robot config.
@@ -216,12 +215,9 @@ class GazeEngine:
         tracking_end = (
             detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
-        ctx = filled(
-            GazeContext, {"t": t, "points": self._points(frame), "tracking_end": tracking_end}
-        )
         try:
-            target = self.behavior.target(ctx)
-            kind, point = target.kind, target.point
+            # behavior.target(GazeContext(...)) without the two values it would build
+            kind, point = self.behavior.aim(t, self._points(frame), tracking_end)
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
@@ -395,7 +391,7 @@ class GazeEngine:
         """The command for ``kind`` at ``point``; the last safe one (or rest) if the kinematics
         fail or give a non-finite value."""
         try:
-            q, yaw, pitch, residual, shift = self.gaze.update_raw(t, point, arm=arm)
+            q, yaw, pitch, residual, shift = self.gaze.update_raw(t, point, arm)
             # One float sum instead of a check per value: finite values of these sizes (angles,
             # rad) cannot overflow, so the sum is finite exactly when every value is.
             ok = math.isfinite(yaw + pitch + residual + shift + sum(q))
@@ -420,7 +416,7 @@ class GazeEngine:
         # ``is`` first: comparing a dtype with the np.float64 type converts it on every call
         if type(point) is not np.ndarray or (point.dtype is not F64 and point.dtype != F64):
             point = np.asarray(point, float)  # (the behavior's points already are)
-        cmd = filled(
+        cmd = from_fields(
             GazeCommand,
             {  # every field, in field order (GazeCommand's dataclass fields)
                 "t": t,

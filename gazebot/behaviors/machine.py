@@ -89,7 +89,7 @@ from gazebot.types import (
     GazeContext,
     GazeTarget,
     Phase,
-    filled,
+    from_fields,
 )
 
 _ROOT, _GAZE, _TRACKING = "behavior", "behavior_gaze", "behavior_tracking"
@@ -584,8 +584,9 @@ class BehaviorMachine:
         self._tracking_end = math.nan
         self._lost_since = math.nan
         self._hold_until = math.inf
-        self._held: GazeTarget | None = None
-        self._last_target: GazeTarget | None = None
+        # The last (kind, point) aimed at with tracking ok, and the one held while lost.
+        self._held: tuple[str, np.ndarray] | None = None
+        self._last_target: tuple[str, np.ndarray] | None = None
         self._known: dict[str, np.ndarray] = {}
         self._machine.set_state([f"{_GAZE}_{_state_name(self.spec.before)}", _TRACKING_OK])
         self.origin = GazeOrigin(Phase.IDLE, "before", self.gaze)
@@ -715,7 +716,15 @@ class BehaviorMachine:
 
     def target(self, ctx: GazeContext) -> GazeTarget:
         """Where to look at ``ctx.t``: a target kind and its current point."""
-        t, end = ctx.t, ctx.tracking_end
+        kind, point = self.aim(ctx.t, ctx.points, ctx.tracking_end)
+        return from_fields(GazeTarget, {"kind": kind, "point": point})
+
+    def aim(
+        self, t: float, points: dict[str, np.ndarray], tracking_end: float
+    ) -> tuple[str, np.ndarray]:
+        """:meth:`target` from the context's fields, as the kind and the point (the engine's
+        tick: no context or target value to build and read back)."""
+        end = tracking_end
         # (the engine's floats skip the general checks: this runs every tick)
         if type(t) is not float or not math.isfinite(t):
             t = float(t) if _finite(t) else self.handover.phase_start
@@ -723,16 +732,18 @@ class BehaviorMachine:
             # (a float NaN, the usual unknown end, needs no _finite call)
             end = end if type(end) is not float and _finite(end) else math.nan
         self.advance(t, end)
+        if type(points) is not dict and not isinstance(points, dict):  # (``is``: the usual one)
+            points = {}
         gaze, tracking = self._model.state
         lost_kind = self._lost_kind
         if tracking != _TRACKING_OK:
             if tracking == _TRACKING_HOLD and self._held is not None:
                 return self._held
-            return GazeTarget(lost_kind, self._point(lost_kind, ctx))
+            return lost_kind, self._point(lost_kind, points)
         kind = self._kind_of_state[gaze]
-        target = filled(GazeTarget, {"kind": kind, "point": self._point(kind, ctx)})
+        target = (kind, self._point(kind, points))
         if kind != lost_kind:
-            self._point(lost_kind, ctx)  # keeps the last known face fresh for a tracking loss
+            self._point(lost_kind, points)  # keeps the last known face fresh for a tracking loss
         self._last_target = target
         return target
 
@@ -744,13 +755,15 @@ class BehaviorMachine:
                 return float(value)
         return None
 
-    def _point(self, kind: str, ctx: GazeContext) -> np.ndarray:
-        points = ctx.points if isinstance(ctx.points, dict) else {}
+    def _point(self, kind: str, points: dict[str, np.ndarray]) -> np.ndarray:
+        """The point of ``kind`` in ``points`` if valid, else its last known or default one."""
         arr = points.get(kind)
         # The usual point (a finite float64 3-vector) checked here: a _valid call costs more.
         if type(arr) is np.ndarray and arr.dtype is F64 and arr.shape == (3,):
             x, y, z = arr.tolist()
-            if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            # Finite exactly when v - v is 0 for each coordinate (inf - inf and NaN are NaN):
+            # three subtractions cost less than three isfinite calls.
+            if not (x - x == 0.0 and y - y == 0.0 and z - z == 0.0):
                 arr = None
         else:
             arr = self._valid(arr)

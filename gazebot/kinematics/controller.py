@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gazebot.kinematics.eyes import angle_of, eye_angles
+from gazebot.kinematics.eyes import angle_of, eye_angles_of, residual_of
 from gazebot.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.kinematics.robot import RobotModel
 from gazebot.kinematics.shifts import (
@@ -111,7 +111,7 @@ class GazeController:
         self._eyes_model = eyes
         self._eye_vlim = robot.eye_velocity_limit
         self._min_distance = self.ik.min_distance
-        # Finite even if max_distance is not (see _parse).
+        # Finite even if max_distance is not (see update_raw).
         self._max_abs = min(self.ik.max_distance, sys.float_info.max)
         self._saccade_threshold = self.shifts.saccade_threshold
         self.reset()
@@ -145,6 +145,9 @@ class GazeController:
         # The goal's gaze origin and the unit direction from it to the target the goal was
         # solved for (the deadband's reference), or None.
         self._solved_for: tuple[float, float, float, float, float, float] | None = None
+        # The last update's target was a finite point; the eyes were at their range.
+        self._target_valid = True
+        self._eyes_saturated = False
 
     @property
     def head(self) -> dict[str, float]:
@@ -177,7 +180,8 @@ class GazeController:
             ValueError: ``target_point`` is not a 3D point or ``t`` not a number (programming
                 errors, unlike NaN values, which are held).
         """
-        shift, valid, eyes_saturated = self._tick(t, target_point, arm)
+        shift = self.update_raw(t, target_point, arm)[4]
+        valid, eyes_saturated = self._target_valid, self._eyes_saturated
         names = self._names
         state = filled(
             HeadEyeState,
@@ -204,21 +208,28 @@ class GazeController:
         order; a list the controller replaces, never changes), eye yaw, eye pitch, residual and
         shift amplitude, the same floats as the :class:`HeadEyeState` fields (building that
         value and its three dicts costs microseconds the engine does not need)."""
-        shift = self._tick(t, target_point, arm)[0]
-        yaw, pitch = self._eyes
-        return self._q, yaw, pitch, self._residual, shift
-
-    def _tick(
-        self,
-        t: float,
-        target_point: np.ndarray | None,
-        arm: Mapping[str, float] | None,
-    ) -> tuple[float, bool, bool]:
-        """The work of :meth:`update`; returns the shift amplitude, whether the target was
-        valid and whether the eyes are at their range."""
-        dt = self._advance(t)
+        last = self._t
+        # The usual tick (a float time after the last one, a float64 3-vector) without the
+        # general path's calls: _advance gives the same for it.
+        if type(t) is float and last is not None and last < t < math.inf:
+            dt = t - last  # > 0: the difference of two ordered floats
+            self._t = t
+            self._clock += dt
+        else:
+            dt = self._advance(t)
         arm_moved = self.robot.set_arm(arm) if arm is not None else False
-        target = self._parse(target_point)
+        p = target_point
+        if p is None:
+            target = None
+        else:
+            # ``is`` first: NumPy's float64 dtype is one object (the usual point needs no call).
+            if type(p) is not np.ndarray or p.dtype is not F64 or p.shape != (3,):
+                p = _vector(p)
+            x, y, z = p.tolist()
+            # Finite and not absurdly far (a corrupted sample is held like a missing one); a
+            # NaN fails every comparison, and the bound is finite even if max_distance is not.
+            m = self._max_abs
+            target = (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
         valid = target is not None
         shift = 0.0
         if valid and not (target == self._target and not arm_moved and self._goal_final):
@@ -231,10 +242,11 @@ class GazeController:
             else:
                 self._vel = [0.0] * len(self._q)
 
-        eyes_saturated = False
-        if self._target is not None:
-            eyes_saturated = self._aim_eyes(dt)
-        return shift, valid, eyes_saturated
+        # (kept for update(): the engine's tick does not read them)
+        self._target_valid = valid
+        self._eyes_saturated = self._aim_eyes(dt) if self._target is not None else False
+        yaw, pitch = self._eyes
+        return self._q, yaw, pitch, self._residual, shift
 
     def _follow(self, pos: list[float], dt: float) -> None:
         """Move the head command toward the plan's position ``pos`` within the velocity and
@@ -260,7 +272,7 @@ class GazeController:
                 x = lo
             if x > hi:
                 x = hi
-            finite = finite and math.isfinite(x)
+            finite = finite and x - x == 0.0  # isfinite(x) without a call (inf - inf is NaN)
             q.append(x)
             vel.append((x - a) / dt)
         if finite:
@@ -274,9 +286,8 @@ class GazeController:
         if not math.sqrt(x * x + y * y + z * z) >= self._min_distance:
             return False  # too close for a direction (or not a number): the eyes stay
         eyes = self._eyes_model
-        v = (x, y, z)
-        yaw, pitch = eye_angles(v)
-        yaw, pitch, saturated = eyes.clip(yaw, pitch)  # eyes.look(v), one call less
+        yaw, pitch = eye_angles_of(x, y, z)
+        yaw, pitch, saturated = eyes.clip(yaw, pitch)  # eyes.look((x, y, z))
         if self._saccade is not None:
             t0, dur, (y0, p0) = self._saccade
             s = min_jerk((self._clock - t0) / dur)
@@ -298,7 +309,7 @@ class GazeController:
             pitch = hi
         yaw, pitch, _ = eyes.clip(yaw, pitch)
         self._eyes = (yaw, pitch)
-        self._residual = eyes.residual(yaw, pitch, v)
+        self._residual = residual_of(yaw, pitch, x, y, z)  # eyes.residual, floats already
         return saturated
 
     def _advance(self, t: float) -> float:
@@ -315,23 +326,6 @@ class GazeController:
             return 0.0
         self._clock += dt
         return dt
-
-    def _parse(self, target_point: np.ndarray | None) -> tuple[float, float, float] | None:
-        if target_point is None:
-            return None
-        p = target_point
-        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more.
-        if type(p) is not np.ndarray or (p.dtype is not F64 and p.dtype != F64):
-            p = np.asarray(target_point, dtype=float)
-        if p.shape != (3,):
-            p = p.reshape(-1)
-            if p.shape != (3,):
-                raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
-        x, y, z = p.tolist()
-        # Finite and not absurdly far (a corrupted sample is held like a missing one); a NaN
-        # fails every comparison, and the bound is finite even if max_distance is not.
-        m = self._max_abs
-        return (x, y, z) if -m <= x <= m and -m <= y <= m and -m <= z <= m else None
 
     def _gaze_frame(self) -> list[list[float]]:
         """Gaze frame rows at the head command (cached: the eyes of one tick and the re-plan of
@@ -354,23 +348,9 @@ class GazeController:
             r02 * dx + r12 * dy + r22 * dz,
         )
 
-    def _in_deadband(self, target: tuple[float, float, float]) -> bool:
-        """Whether ``target`` is within ``ik.goal_deadband`` of the target the head goal was
-        solved for, seen from the goal's gaze origin, with no saccade under way. The eyes take
-        the difference as far as their range allows: where the target is beyond their reach
-        anyway, the gaze misses by at most the deadband's angle more than with the goal
-        re-solved. Never with fixed eyes (``head-only`` mode)."""
-        ref = self._solved_for
-        deadband = self._deadband
-        if ref is None or deadband <= 0.0 or self._saccade is not None:
-            return False
-        ox, oy, oz, ux, uy, uz = ref
-        return angle_of(ux, uy, uz, target[0] - ox, target[1] - oy, target[2] - oz) <= deadband
-
     def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
-        cfg = self.shifts
         # The shift's size: from the gaze origin, between the new target and the old one (or
         # the line of sight); floats unpacked once (this runs every tick the target moves).
         (r00, _, _, ox), (r10, _, _, oy), (r20, _, _, oz) = self._gaze_frame()
@@ -383,14 +363,29 @@ class GazeController:
             amplitude = angle_of(nx, ny, nz, old[0] - ox, old[1] - oy, old[2] - oz)
             new_shift = amplitude > self._saccade_threshold
 
-        robot = self.robot
-        revision = robot.arm_revision
+        revision = self._frame[1]  # type: ignore[index] # (the _gaze_frame call above set it)
         # A target that moved without a gaze shift is followed at the tracking tolerance; a new
         # or unchanged one (e.g. after the arm moved, or to finish a tracked goal) in full.
-        tracking = not new_shift and target != self._target
+        tracking = not new_shift and target != old
         last = self._solution
         if last is not None and last[1] == revision and last[0].q is self._goal:
-            if tracking and self._in_deadband(target):
+            # The goal deadband: the target is within ``ik.goal_deadband`` of the one the goal
+            # was solved for, seen from the goal's gaze origin, with no saccade under way. The
+            # eyes take the difference as far as their range allows: where the target is
+            # beyond their reach anyway, the gaze misses by at most the deadband's angle more
+            # than with the goal re-solved. (``_solved_for`` is None without a deadband, as in
+            # ``head-only`` mode.)
+            ref = self._solved_for
+            if (
+                tracking
+                and ref is not None
+                and self._saccade is None
+                and angle_of(
+                    ref[3], ref[4], ref[5], target[0] - ref[0], target[1] - ref[1],
+                    target[2] - ref[2],
+                )
+                <= self._deadband
+            ):
                 # The head goal stays; the eyes, aimed from the head's pose, take the rest. It
                 # is solved in full once the target stands still.
                 self._target = target
@@ -400,7 +395,7 @@ class GazeController:
         else:
             warm_frame = warm_rows = None
         sol = solve_ik_raw(
-            robot,
+            self.robot,
             target,
             self._goal,
             self.ik,
@@ -424,6 +419,7 @@ class GazeController:
         self._goal_final = sol.converged
 
         # Neck: continue from the current command, its velocity and the plan's acceleration.
+        cfg = self.shifts
         traj = self._traj
         q = self._q
         acc = traj.sample(t_start)[2] if traj is not None else (0.0,) * len(q)
@@ -466,3 +462,17 @@ class GazeController:
             self._saccade = (t_start, dur, self._eyes)
             return float(amplitude)
         return 0.0
+
+
+def _vector(point: object) -> np.ndarray:
+    """``point`` as a float64 (3,) array.
+
+    Raises:
+        ValueError: it is not a 3D point.
+    """
+    p = np.asarray(point, dtype=float)
+    if p.shape != (3,):
+        p = p.reshape(-1)
+        if p.shape != (3,):
+            raise ValueError(f"target_point must be a 3D point, got shape {p.shape}")
+    return p

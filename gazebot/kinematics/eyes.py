@@ -16,7 +16,11 @@ import numpy as np
 
 def eye_angles(v: np.ndarray | Sequence[float]) -> tuple[float, float]:
     """Yaw and pitch (rad) that point the eyes along ``v`` (gaze frame, any length > 0)."""
-    x, y, z = v[0], v[1], v[2]  # math's functions take them as floats (no float() calls)
+    return eye_angles_of(v[0], v[1], v[2])  # math's functions take them as floats
+
+
+def eye_angles_of(x: float, y: float, z: float) -> tuple[float, float]:
+    """:func:`eye_angles` of ``(x, y, z)`` given as floats (the gaze controller's per-tick form)."""
     return math.atan2(y, x), math.atan2(-z, math.hypot(x, y))
 
 
@@ -66,8 +70,15 @@ class DisplayEyes:
 
     def residual(self, yaw: float, pitch: float, v: np.ndarray | Sequence[float]) -> float:
         """Angle (rad) between the eyes' line of sight and ``v`` (gaze frame)."""
-        # eye_direction() as floats: this runs every controller tick. (float() on v: a float32
-        # or float16 component would otherwise keep the products in its own precision.)
-        cp = math.cos(pitch)
-        return angle_of(cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch),
-                        float(v[0]), float(v[1]), float(v[2]))
+        # (float() on v: a float32 or float16 component would otherwise keep the products in
+        # its own precision.)
+        return residual_of(yaw, pitch, float(v[0]), float(v[1]), float(v[2]))
+
+
+def residual_of(yaw: float, pitch: float, x: float, y: float, z: float) -> float:
+    """Angle (rad) between the line of sight of eyes at ``(yaw, pitch)`` and ``(x, y, z)`` (gaze
+    frame, floats): :meth:`DisplayEyes.residual`'s arithmetic, the gaze controller's per-tick
+    form."""
+    # eye_direction() as floats: numpy's per-call overhead would cost more than the arithmetic.
+    cp = math.cos(pitch)
+    return angle_of(cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch), x, y, z)

@@ -142,6 +142,8 @@ class RobotModel:
         first = int(self.head_idx[0]) if len(self.head_idx) else 0
         contiguous = self.head_idx.tolist() == list(range(first, first + len(self.head_idx)))
         self._head_sel = slice(first, first + len(self.head_idx)) if contiguous else self.head_idx
+        # A one-joint head's index: setting one item costs a quarter of a slice set from a list.
+        self._head_one = first if len(self.head_idx) == 1 else None
         self._arm_revision = 0
         # (head vector, arm revision) whose forward kinematics :attr:`data` holds, or None.
         self._kinematics_of: tuple[tuple[float, ...], int] | None = None
@@ -260,7 +262,11 @@ class RobotModel:
         if last is not None and last[0] == key:
             return last[1]
         q = self._q_work
-        q[self._head_sel] = q_head
+        one = self._head_one
+        if one is not None:
+            (q[one],) = q_head  # (a ValueError for another length, as the slice set gives)
+        else:
+            q[self._head_sel] = q_head
         pin.forwardKinematics(self.model, self.data, q)
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
         self._kinematics_of = key

@@ -219,8 +219,15 @@ class MinJerkTrajectory(Trajectory):
     def sample_position(self, t: float) -> list[float]:
         """The position of :meth:`sample` alone, as a list of floats (the gaze controller's
         command each tick; velocity and acceleration are needed only to re-plan)."""
-        s = min(max(t - self.t0, 0.0), self.duration)
-        if s >= self.duration:
+        # min(max(t - t0, 0), duration) as comparisons (the same float, NaN and -0.0
+        # included): this runs every tick the neck moves.
+        s = t - self.t0
+        if 0.0 > s:
+            s = 0.0
+        duration = self.duration
+        if duration < s:
+            s = duration
+        if s >= duration:
             return list(self._goal)
         return [
             c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))))

@@ -44,7 +44,7 @@ from gazebot.types import (
     Phase,
     TrackingFrame,
     TrackingState,
-    filled,
+    from_fields,
     is_valid_point,
 )
 
@@ -236,7 +236,7 @@ class GazeLoop:
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
         # cmd.replaced(...) without its field-name check (these are GazeCommand's fields).
         fields = dict(cmd.__dict__, blink=blink, distance=distance, answers_sample=answers)
-        return filled(GazeCommand, fields)
+        return from_fields(GazeCommand, fields)
 
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor

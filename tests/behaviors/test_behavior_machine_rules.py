@@ -7,8 +7,9 @@ from __future__ import annotations
 import math
 from collections import Counter
 
+import numpy as np
 import pytest
-from behavior_helpers import ctx, ev
+from behavior_helpers import ctx, ev, hand_at
 
 from gazebot.behaviors import BehaviorMachine, list_behaviors, load_behavior
 from gazebot.behaviors.machine import diagram
@@ -110,3 +111,38 @@ def test_the_handover_phase_the_machine_reads_is_its_handover_machines_state():
     m.handle(ev("retreat_started", 0.5))  # stale: the handover machine's rule refuses it
     assert m.phase is R and m.handover._model.state == "reach" and m.ignored == 1
     assert math.isfinite(m.handover.phase_start)
+
+
+def _script(m: BehaviorMachine, tick) -> list:
+    """What ``tick(m, t)`` gives over a handover with a tracking loss (hold, then lost) and a
+    hand sample that goes missing."""
+    out = []
+    for i in range(0, 400):
+        t = i / 100
+        if i == 30:
+            m.handle(ev("reach_started", 0.3))
+        if i == 150:
+            m.handle(ev("tracking_lost", 1.5))
+        if i == 250:
+            m.handle(ev("tracking_restored", 2.5))
+        out.append(tick(m, t))
+    return out
+
+
+@pytest.mark.parametrize("name", ["face-hand-face", "hand"])
+def test_aim_gives_the_kind_and_point_target_gives(name):
+    spec = load_behavior(name)
+
+    def by_target(m: BehaviorMachine, t: float):
+        c = ctx(t, Phase.IDLE, 0.0, hand=hand_at(t) if t < 1.0 else np.full(3, np.nan))
+        got = m.target(c)
+        return got.kind, got.point.tolist(), m.state
+
+    def by_aim(m: BehaviorMachine, t: float):
+        c = ctx(t, Phase.IDLE, 0.0, hand=hand_at(t) if t < 1.0 else np.full(3, np.nan))
+        kind, point = m.aim(c.t, c.points, c.tracking_end)
+        return kind, point.tolist(), m.state
+
+    expected = _script(BehaviorMachine(spec, seed=1), by_target)
+    assert {"reach_hand_hold", "reach_hand_lost"} <= {s for _, _, s in expected}  # both paths
+    assert _script(BehaviorMachine(spec, seed=1), by_aim) == expected

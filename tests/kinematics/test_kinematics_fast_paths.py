@@ -108,3 +108,11 @@ def test_update_raw_gives_the_floats_of_update(name):
 def test_eye_residual_of_a_narrow_float_vector_is_computed_in_double(sawyer, dtype):
     v = np.array([1.0, 0.3, -0.2], dtype)
     assert sawyer.eyes.residual(0.1, 0.05, v) == sawyer.eyes.residual(0.1, 0.05, v.astype(float))
+
+
+@pytest.mark.parametrize("name", ["sawyer", "jaco2"])
+def test_a_head_vector_of_the_wrong_length_is_refused_not_truncated(name):
+    robot = RobotModel.load(name)
+    n = len(robot.head_joints)
+    with pytest.raises(ValueError):
+        robot.gaze_frame_lists([0.1] * (n + 1))

@@ -12,7 +12,7 @@ import pytest
 
 from gazebot import GazeEngine
 from gazebot.runtime import GazeLoop
-from gazebot.types import GazeCommand, Phase, TrackingFrame, filled
+from gazebot.types import GazeCommand, GazeTarget, Phase, TrackingFrame, filled, from_fields
 
 
 def _frames(n: int = 60):
@@ -71,3 +71,12 @@ def test_filled_refuses_a_fields_dict_and_keywords_together():
     # (one of them would be dropped silently)
     with pytest.raises(TypeError, match="not both"):
         filled(GazeCommand, {"t": 0.0}, t=1.0)
+
+
+def test_from_fields_builds_the_value_the_constructor_builds():
+    point = np.array([1.0, 0.0, 1.5])
+    made = from_fields(GazeTarget, {"kind": "face", "point": point})
+    assert type(made) is GazeTarget
+    assert vars(made) == vars(GazeTarget("face", point))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        made.kind = "hand"  # type: ignore[misc]
