@@ -86,10 +86,14 @@ class _Samples:
     def __len__(self) -> int:
         return self._s1 - self._s0 + len(self._new)
 
-    def append(self, row: tuple[float, ...]) -> None:
+    def append(self, row: tuple[float, ...], keep_from: float = -math.inf) -> None:
+        """Queue a sample (times increasing), then forget those older than ``keep_from`` (one
+        call per sample: :meth:`drop_before` runs only when there is one to forget)."""
         if self._s1 == self._s0 and not self._new:
             self._first_t = row[0]
         self._new.append(row)
+        if self._first_t < keep_from:
+            self.drop_before(keep_from)
 
     def drop_before(self, t0: float) -> None:
         """Forget the samples older than ``t0``."""
@@ -310,8 +314,7 @@ class PhaseDetector:
         g_ok = finite(gx) and finite(gy) and finite(gz)
         r_ok = finite(rx) and finite(ry) and finite(rz)
         samples = self._samples
-        samples.append((t, gx, gy, gz, rx, ry, rz))
-        samples.drop_before(t - c.online_window)
+        samples.append((t, gx, gy, gz, rx, ry, rz), t - c.online_window)
         if g_ok:
             self._seen_g = t
         if r_ok:
