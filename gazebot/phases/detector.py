@@ -71,27 +71,32 @@ def _point(p: object) -> np.ndarray:
     return v if v.shape == (3,) else np.full(3, np.nan)
 
 
+_ROW = 7  # values of a kept sample: t, giver xyz, receiver xyz
+
+
 class _Samples:
     """The samples kept (rows ``[t, giver xyz, receiver xyz]``) in one array that grows and is
     compacted in place: the analysis reads them as views, with no per-sample conversion. A new
-    sample waits in a list until the rows are read (a list append per sample; one conversion
-    of the few new rows per analysis)."""
+    sample waits in a flat list until the rows are read (a list extend per sample; one copy of
+    the few new rows' values per analysis, in order into the rows' block: cheaper than numpy
+    converting a list of rows)."""
 
     def __init__(self) -> None:
-        self._buf = np.empty((256, 7))
+        self._buf = np.empty((256, _ROW))
         self._s0 = self._s1 = 0
-        self._new: list[tuple[float, ...]] = []  # the newest rows, not yet in _buf
+        self._new: list[float] = []  # the newest rows' values, _ROW a row, not yet in _buf
         self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
 
     def __len__(self) -> int:
-        return self._s1 - self._s0 + len(self._new)
+        return self._s1 - self._s0 + len(self._new) // _ROW
 
     def append(self, row: tuple[float, ...], keep_from: float = -math.inf) -> None:
-        """Queue a sample (times increasing), then forget those older than ``keep_from`` (one
-        call per sample: :meth:`drop_before` runs only when there is one to forget)."""
+        """Queue a sample (``_ROW`` values; times increasing), then forget those older than
+        ``keep_from`` (one call per sample: :meth:`drop_before` runs only when there is one to
+        forget)."""
         if self._s1 == self._s0 and not self._new:
             self._first_t = row[0]
-        self._new.append(row)
+        self._new.extend(row)
         if self._first_t < keep_from:
             self.drop_before(keep_from)
 
@@ -108,31 +113,31 @@ class _Samples:
             return
         new = self._new  # (every row in the array is gone: the new rows next)
         k = 0
-        while k < len(new) and new[k][0] < t0:
-            k += 1
+        while k < len(new) and new[k] < t0:
+            k += _ROW
         del new[:k]
-        self._first_t = new[0][0] if new else math.inf
+        self._first_t = new[0] if new else math.inf
 
     def time(self, i: int) -> float:
         """Time of the ``i``-th sample kept."""
         m = self._s1 - self._s0
-        return float(self._buf[self._s0 + i, 0]) if i < m else self._new[i - m][0]
+        return float(self._buf[self._s0 + i, 0]) if i < m else self._new[(i - m) * _ROW]
 
     def rows(self) -> np.ndarray:
         """The samples kept (a view of the buffer: valid until the next call that grows or
         compacts it; :meth:`append` only queues)."""
         new = self._new
         if new:
-            k, buf = len(new), self._buf
+            k, buf = len(new) // _ROW, self._buf
             if self._s1 + k > buf.shape[0]:
                 m = self._s1 - self._s0
                 cap = buf.shape[0]
                 while 2 * (m + k) > cap:
                     cap *= 2
-                self._buf = np.empty((cap, 7)) if cap != buf.shape[0] else buf
+                self._buf = np.empty((cap, _ROW)) if cap != buf.shape[0] else buf
                 self._buf[:m] = buf[self._s0 : self._s1]
                 self._s0, self._s1 = 0, m
-            self._buf[self._s1 : self._s1 + k] = new
+            self._buf[self._s1 : self._s1 + k].flat = new  # (a contiguous block, row by row)
             self._s1 += k
             new.clear()
         return self._buf[self._s0 : self._s1]

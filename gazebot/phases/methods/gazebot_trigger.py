@@ -44,6 +44,19 @@ def _nanmean2(a: Sequence[float], b: Sequence[float]) -> list[float]:
     return out
 
 
+def _mean3(points: list[Sequence[float]]) -> tuple[float, float, float]:
+    """The mean of 3-vectors (summed in order from 0.0, over their count), NaNs if none."""
+    n = len(points)
+    if not n:
+        return math.nan, math.nan, math.nan
+    sx = sy = sz = 0.0
+    for x, y, z in points:
+        sx += x
+        sy += y
+        sz += z
+    return sx / n, sy / n, sz / n
+
+
 def _norm_at_least(v: Sequence[float], bar: float) -> bool:
     """``vector_norm(np.array(v)) >= bar`` (a 3-vector, ``bar`` >= 0), decided in plain floats
     unless the squares' sum is within rounding of ``bar``'s square: numpy's dot may sum the
@@ -156,10 +169,10 @@ class GazebotTrigger:
         self._speed_rows = int((c.smoothing + c.edge_guard + c.trigger_speed_baseline) / period)
         self._step_time = self._k * period  # s a giver step spans
         self._onset_bar = c.trigger_distance_factor * c.reach_onset_speed
-        # Sums of the positions seen this period (giver xyz, receiver xyz) and their counts, in
-        # plain floats: a sample costs a few additions, not numpy calls.
-        self._acc = [0.0] * 6
-        self._acc_n = [0, 0]
+        # The positions seen this period, per hand (summed in plain floats when it closes: a
+        # sample costs an append, not numpy calls).
+        self._seen_g: list[Sequence[float]] = []
+        self._seen_r: list[Sequence[float]] = []
         # The rows kept are items _s0.. of each column (times, giver means, receiver means,
         # relative positions, distances, giver steps: |giver - giver trigger_speed_baseline
         # earlier|); the relative position, distance and step are computed once per row. Item
@@ -179,20 +192,12 @@ class GazebotTrigger:
         self._held: tuple[int, int, list[float], int] = (-1, -1, [], 0)
 
     def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
-        """Accumulate one sample's hand positions (``*_ok``: that hand was seen)."""
-        acc = self._acc
+        """Keep one sample's hand positions (``*_ok``: that hand was seen) until the period
+        closes (the sequences are kept, not copied: the caller does not change them)."""
         if g_ok:
-            x, y, z = g
-            acc[0] += x
-            acc[1] += y
-            acc[2] += z
-            self._acc_n[0] += 1
+            self._seen_g.append(g)
         if r_ok:
-            x, y, z = r
-            acc[3] += x
-            acc[4] += y
-            acc[5] += z
-            self._acc_n[1] += 1
+            self._seen_r.append(r)
 
     def decide(self, now: float, state: OnlineState) -> TriggerMode:
         """Close the period: ``full`` if the next boundary may have passed, ``refresh`` if not
@@ -222,11 +227,11 @@ class GazebotTrigger:
             self._base += s0
             s0, end = 0, end - s0
         self._s0 = s0
-        a = self._acc
-        ng, nr = self._acc_n
         nan = math.nan
-        gx, gy, gz = (a[0] / ng, a[1] / ng, a[2] / ng) if ng else (nan, nan, nan)
-        rx, ry, rz = (a[3] / nr, a[4] / nr, a[5] / nr) if nr else (nan, nan, nan)
+        gx, gy, gz = _mean3(self._seen_g)
+        rx, ry, rz = _mean3(self._seen_r)
+        self._seen_g.clear()
+        self._seen_r.clear()
         dx, dy, dz = rx - gx, ry - gy, rz - gz
         # (the sum in this order is what np.linalg.norm(rel, axis=1) computes; a test pins it)
         d = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -241,8 +246,6 @@ class GazebotTrigger:
         self._rel.append((dx, dy, dz))
         self._d.append(d)
         self._step.append(step)
-        self._acc = [0.0] * 6
-        self._acc_n = [0, 0]
 
     def rows(self) -> np.ndarray:
         """The per-period rows kept: ``[t, giver xyz, receiver xyz, relative xyz, distance,
