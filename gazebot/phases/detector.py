@@ -195,6 +195,7 @@ class PhaseDetector:
         # longer) computes only the rows the new samples change. (append_only: the windows
         # are cut from the samples kept, which only grow at their end.)
         self._signal_cache = SignalCache(append_only=True)
+        self._unknown = np.empty((0, 5))  # (see _unknown_block)
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()
@@ -439,7 +440,9 @@ class PhaseDetector:
         window = rows[i0:]
         # (the rows are float64 of known shapes: no conversion or check needed; views, not
         # copies: only this analysis reads them, and nothing writes to a trajectory's arrays)
-        traj = Trajectory.of_hands(window[:, 0], window[:, 1:4], window[:, 4:])
+        traj = Trajectory.of_hands(
+            window[:, 0], window[:, 1:4], window[:, 4:], self._unknown_block(window.shape[0])
+        )
         s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
@@ -462,6 +465,16 @@ class PhaseDetector:
                 self._advance(segs, now, True)
                 self._rules_after_contact(s, now)
         self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
+
+    def _unknown_block(self, n: int) -> np.ndarray:
+        """An all-NaN ``(n, 5)`` block (read-only) for an analysis window's face, gripper and
+        load share (unknown online): one kept and grown, not one allocated per analysis."""
+        block = self._unknown
+        if block.shape[0] < n:
+            block = np.full((max(2 * n, 256), 5), np.nan)
+            block.flags.writeable = False
+            self._unknown = block
+        return block[:n]
 
     def _rules_after_contact(self, s: Signals, now: float) -> bool:
         """In a transfer or retreat, apply the method's
