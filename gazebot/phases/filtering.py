@@ -180,21 +180,9 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     if sigma <= 0 or x.shape[0] < 2:
         return x, m.astype(float)
     rows = x.shape[0]
-    w = gaussian_weights(sigma)
     if m.all():
-        # Every row seen (the usual case): only the positions need smoothing; the seen share
-        # is the same at every row.
-        share = _seen_share(sigma)
-        den = np.empty((rows, hands))
-        den.fill(share)  # (np.full's work without its argument handling)
-        # (an output array given: scipy allocates none, skipping its dtype-name lookup, a
-        # few microseconds a call)
-        out = np.empty_like(x)
-        correlate1d(x, w, axis=0, output=out, mode="nearest")
-        np.divide(out, max(share, 1e-12), out=out)
-        if share < 0.5:
-            out[:] = np.nan
-        return out, den
+        return _smooth_all_seen(x, hands, sigma)
+    w = gaussian_weights(sigma)
     # per row and hand: x, y, z (0 where unseen) and whether seen; smoothed in one call
     stack = np.empty((rows, hands, 4))
     stack[:, :, :3] = np.where(m[:, :, None], x.reshape(rows, hands, 3), 0.0)
@@ -207,12 +195,30 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     return out.reshape(rows, 3 * hands), den
 
 
+def _smooth_all_seen(x: np.ndarray, hands: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`smooth` of at least two rows, every one seen (the usual case: only the positions
+    need smoothing; the seen share is the same at every row), ``sigma`` > 0."""
+    share = _seen_share(sigma)
+    den = np.empty((x.shape[0], hands))
+    den.fill(share)  # (np.full's work without its argument handling)
+    # (an output array given: scipy allocates none, skipping its dtype-name lookup, a few
+    # microseconds a call)
+    out = np.empty_like(x)
+    correlate1d(x, gaussian_weights(sigma), axis=0, output=out, mode="nearest")
+    np.divide(out, max(share, 1e-12), out=out)
+    if share < 0.5:
+        out[:] = np.nan
+    return out, den
+
+
 def smooth_seen_prefix(x: np.ndarray, seen: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
     """:func:`smooth` of rows ``x`` (N, 6: both hands) whose first ``seen`` rows are seen for
     both hands and the rest for neither (NaN, as written here where :func:`smooth` returns
     ``x`` itself; else not read): the same result, bit for bit, without finding that mask (the
     online cache knows it: its rows past the newest sample are the only unknown ones)."""
     rows = x.shape[0]
+    if seen >= rows and sigma > 0 and rows >= 2:
+        return _smooth_all_seen(x, 2, sigma)
     if seen >= rows or sigma <= 0 or rows < 2:
         m = np.zeros((rows, 2), dtype=bool)
         m[:seen] = True
