@@ -71,25 +71,34 @@ def _point(p: object) -> np.ndarray:
     return v if v.shape == (3,) else np.full(3, np.nan)
 
 
+_ROW = 7  # values of a kept sample: t, giver xyz, receiver xyz
+
+
 class _Samples:
     """The samples kept (rows ``[t, giver xyz, receiver xyz]``) in one array that grows and is
     compacted in place: the analysis reads them as views, with no per-sample conversion. A new
-    sample waits in a list until the rows are read (a list append per sample; one conversion
-    of the few new rows per analysis)."""
+    sample waits in a flat list until the rows are read (a list extend per sample; one copy of
+    the few new rows' values per analysis, in order into the rows' block: cheaper than numpy
+    converting a list of rows)."""
 
     def __init__(self) -> None:
-        self._buf = np.empty((256, 7))
+        self._buf = np.empty((256, _ROW))
         self._s0 = self._s1 = 0
-        self._new: list[tuple[float, ...]] = []  # the newest rows, not yet in _buf
+        self._new: list[float] = []  # the newest rows' values, _ROW a row, not yet in _buf
         self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
 
     def __len__(self) -> int:
-        return self._s1 - self._s0 + len(self._new)
+        return self._s1 - self._s0 + len(self._new) // _ROW
 
-    def append(self, row: tuple[float, ...]) -> None:
+    def append(self, row: tuple[float, ...], keep_from: float = -math.inf) -> None:
+        """Queue a sample (``_ROW`` values; times increasing), then forget those older than
+        ``keep_from`` (one call per sample: :meth:`drop_before` runs only when there is one to
+        forget)."""
         if self._s1 == self._s0 and not self._new:
             self._first_t = row[0]
-        self._new.append(row)
+        self._new.extend(row)
+        if self._first_t < keep_from:
+            self.drop_before(keep_from)
 
     def drop_before(self, t0: float) -> None:
         """Forget the samples older than ``t0``."""
@@ -104,31 +113,31 @@ class _Samples:
             return
         new = self._new  # (every row in the array is gone: the new rows next)
         k = 0
-        while k < len(new) and new[k][0] < t0:
-            k += 1
+        while k < len(new) and new[k] < t0:
+            k += _ROW
         del new[:k]
-        self._first_t = new[0][0] if new else math.inf
+        self._first_t = new[0] if new else math.inf
 
     def time(self, i: int) -> float:
         """Time of the ``i``-th sample kept."""
         m = self._s1 - self._s0
-        return float(self._buf[self._s0 + i, 0]) if i < m else self._new[i - m][0]
+        return float(self._buf[self._s0 + i, 0]) if i < m else self._new[(i - m) * _ROW]
 
     def rows(self) -> np.ndarray:
         """The samples kept (a view of the buffer: valid until the next call that grows or
         compacts it; :meth:`append` only queues)."""
         new = self._new
         if new:
-            k, buf = len(new), self._buf
+            k, buf = len(new) // _ROW, self._buf
             if self._s1 + k > buf.shape[0]:
                 m = self._s1 - self._s0
                 cap = buf.shape[0]
                 while 2 * (m + k) > cap:
                     cap *= 2
-                self._buf = np.empty((cap, 7)) if cap != buf.shape[0] else buf
+                self._buf = np.empty((cap, _ROW)) if cap != buf.shape[0] else buf
                 self._buf[:m] = buf[self._s0 : self._s1]
                 self._s0, self._s1 = 0, m
-            self._buf[self._s1 : self._s1 + k] = new
+            self._buf[self._s1 : self._s1 + k].flat = new  # (a contiguous block, row by row)
             self._s1 += k
             new.clear()
         return self._buf[self._s0 : self._s1]
@@ -186,6 +195,7 @@ class PhaseDetector:
         # longer) computes only the rows the new samples change. (append_only: the windows
         # are cut from the samples kept, which only grow at their end.)
         self._signal_cache = SignalCache(append_only=True)
+        self._unknown = np.empty((0, 5))  # (see _unknown_block)
         # The method's cheap trigger, if it has one: the full analysis runs only when the next
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()
@@ -310,8 +320,7 @@ class PhaseDetector:
         g_ok = finite(gx) and finite(gy) and finite(gz)
         r_ok = finite(rx) and finite(ry) and finite(rz)
         samples = self._samples
-        samples.append((t, gx, gy, gz, rx, ry, rz))
-        samples.drop_before(t - c.online_window)
+        samples.append((t, gx, gy, gz, rx, ry, rz), t - c.online_window)
         if g_ok:
             self._seen_g = t
         if r_ok:
@@ -431,7 +440,9 @@ class PhaseDetector:
         window = rows[i0:]
         # (the rows are float64 of known shapes: no conversion or check needed; views, not
         # copies: only this analysis reads them, and nothing writes to a trajectory's arrays)
-        traj = Trajectory.of_hands(window[:, 0], window[:, 1:4], window[:, 4:])
+        traj = Trajectory.of_hands(
+            window[:, 0], window[:, 1:4], window[:, 4:], self._unknown_block(window.shape[0])
+        )
         s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
         if s is not None and self.phase is Phase.REACH:
@@ -454,6 +465,16 @@ class PhaseDetector:
                 self._advance(segs, now, True)
                 self._rules_after_contact(s, now)
         self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
+
+    def _unknown_block(self, n: int) -> np.ndarray:
+        """An all-NaN ``(n, 5)`` block (read-only) for an analysis window's face, gripper and
+        load share (unknown online): one kept and grown, not one allocated per analysis."""
+        block = self._unknown
+        if block.shape[0] < n:
+            block = np.full((max(2 * n, 256), 5), np.nan)
+            block.flags.writeable = False
+            self._unknown = block
+        return block[:n]
 
     def _rules_after_contact(self, s: Signals, now: float) -> bool:
         """In a transfer or retreat, apply the method's

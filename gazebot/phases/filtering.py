@@ -180,21 +180,9 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     if sigma <= 0 or x.shape[0] < 2:
         return x, m.astype(float)
     rows = x.shape[0]
-    w = gaussian_weights(sigma)
     if m.all():
-        # Every row seen (the usual case): only the positions need smoothing; the seen share
-        # is the same at every row.
-        share = _seen_share(sigma)
-        den = np.empty((rows, hands))
-        den.fill(share)  # (np.full's work without its argument handling)
-        # (an output array given: scipy allocates none, skipping its dtype-name lookup, a
-        # few microseconds a call)
-        out = np.empty_like(x)
-        correlate1d(x, w, axis=0, output=out, mode="nearest")
-        np.divide(out, max(share, 1e-12), out=out)
-        if share < 0.5:
-            out[:] = np.nan
-        return out, den
+        return _smooth_all_seen(x, hands, sigma)
+    w = gaussian_weights(sigma)
     # per row and hand: x, y, z (0 where unseen) and whether seen; smoothed in one call
     stack = np.empty((rows, hands, 4))
     stack[:, :, :3] = np.where(m[:, :, None], x.reshape(rows, hands, 3), 0.0)
@@ -205,6 +193,51 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
     out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
     out[(den < 0.5) | ~m] = np.nan  # do not invent samples inside long gaps
     return out.reshape(rows, 3 * hands), den
+
+
+def _smooth_all_seen(x: np.ndarray, hands: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`smooth` of at least two rows, every one seen (the usual case: only the positions
+    need smoothing; the seen share is the same at every row), ``sigma`` > 0."""
+    share = _seen_share(sigma)
+    den = np.empty((x.shape[0], hands))
+    den.fill(share)  # (np.full's work without its argument handling)
+    # (an output array given: scipy allocates none, skipping its dtype-name lookup, a few
+    # microseconds a call)
+    out = np.empty_like(x)
+    correlate1d(x, gaussian_weights(sigma), axis=0, output=out, mode="nearest")
+    np.divide(out, max(share, 1e-12), out=out)
+    if share < 0.5:
+        out[:] = np.nan
+    return out, den
+
+
+def smooth_seen_prefix(x: np.ndarray, seen: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`smooth` of rows ``x`` (N, 6: both hands) whose first ``seen`` rows are seen for
+    both hands and the rest for neither (NaN, as written here where :func:`smooth` returns
+    ``x`` itself; else not read): the same result, bit for bit, without finding that mask (the
+    online cache knows it: its rows past the newest sample are the only unknown ones)."""
+    rows = x.shape[0]
+    if seen >= rows and sigma > 0 and rows >= 2:
+        return _smooth_all_seen(x, 2, sigma)
+    if seen >= rows or sigma <= 0 or rows < 2:
+        m = np.zeros((rows, 2), dtype=bool)
+        m[:seen] = True
+        x[seen:] = np.nan
+        return smooth(x, m, sigma)
+    # smooth's masked path with that mask: a seen row keeps its values and counts 1, an
+    # unseen one counts 0 with zeros (np.where's), and unseen rows come out NaN
+    w = gaussian_weights(sigma)
+    stack = np.empty((rows, 2, 4))
+    stack[:seen, :, :3] = x[:seen].reshape(seen, 2, 3)
+    stack[:seen, :, 3] = 1.0
+    stack[seen:] = 0.0
+    both = np.empty_like(stack)
+    correlate1d(stack, w, axis=0, output=both, mode="nearest")
+    den = both[:, :, 3]
+    out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
+    out[den < 0.5] = np.nan  # do not invent samples inside long gaps
+    out[seen:] = np.nan
+    return out.reshape(rows, 6), den
 
 
 # What np.nanmax (np.nanmin) computes for a float array: the largest (smallest) value that is
@@ -634,6 +667,7 @@ class SignalCache:
         gs = grid[a - lead :]
         xr = np.empty((gs.shape[0], 6))
         bar = config.max_gap_hold + 1e-9
+        seen_rows = -1  # (>= 0: the rows before it are seen for both hands, none after)
         if clean:
             i_s = max(int(t.searchsorted(gs[0], side="right")) - 1, 0)
             ts = t[i_s:]
@@ -644,7 +678,8 @@ class SignalCache:
             if max_dt > bar and ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
                 xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
             else:
-                xr[int(gs.searchsorted(t[-1], side="right")) :] = np.nan
+                # (only the rows past the newest sample are unknown: smoothed as such)
+                seen_rows = int(gs.searchsorted(t[-1], side="right"))
         else:
             i_t = int(t.searchsorted(gs[0], side="right")) - 1  # the sample at or before
             ok_old = self._masks()[1]
@@ -664,9 +699,12 @@ class SignalCache:
                 xr[_far_from_samples(tv, gs, bar), cols] = np.nan
         self._reserve(rows, a)
         b = self._buf
-        fin = np.isfinite(xr)
-        m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]
-        xs, full = smooth(xr, m, self._sigma)
+        if seen_rows >= 0:
+            xs, full = smooth_seen_prefix(xr, seen_rows, self._sigma)
+        else:
+            fin = np.isfinite(xr)
+            m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]
+            xs, full = smooth(xr, m, self._sigma)
         b["x"][a:rows] = xs[lead:]
         b["full"][a:rows] = full[lead:]
         # velocities from row a - 1 (its central difference reads row a): _velocities'

@@ -31,18 +31,23 @@ def _mirrored(
     # happened to run). (t is sorted: the samples read are a prefix.)
     k = int(t.searchsorted(now - c.smoothing, side="right"))
     t, v = t[:k], v[:k]
-    ok = np.isfinite(v)
-    if v.shape[0] and ok.all():  # every speed known (the usual case): no NaN to pass over
-        i = int(v.argmax())
+    if not k:
+        return onset + nominal
+    # argmax stops at the first NaN or inf: a finite largest value means every speed is known
+    # (speeds are never -inf), the usual case, with no NaN to pass over and no mask to build
+    i = int(v.argmax())
+    peak = float(v[i])
+    if math.isfinite(peak):
         last = float(v[-1])
     else:
+        ok = np.isfinite(v)
         if not ok.any():
             return onset + nominal
         # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its
         # copies and checks)
         i = int(np.where(np.isnan(v), -np.inf, v).argmax())
         last = float(v[ok.shape[0] - 1 - int(ok[::-1].argmax())])  # the last known
-    peak = float(v[i])
+        peak = float(v[i])
     if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
         return onset + 2.0 * max(float(t[i]) - onset, 0.0)
     return onset + nominal

@@ -67,18 +67,21 @@ class Trajectory:
             setattr(self, name, arr)
 
     @classmethod
-    def of_hands(cls, t: np.ndarray, giver_hand: np.ndarray, receiver_hand: np.ndarray
-                 ) -> Trajectory:
+    def of_hands(cls, t: np.ndarray, giver_hand: np.ndarray, receiver_hand: np.ndarray,
+                 unknown: np.ndarray | None = None) -> Trajectory:
         """``Trajectory(t, giver_hand, receiver_hand)`` from float64 arrays already shaped
         ``(N,)``, ``(N, 3)``, ``(N, 3)`` (the samples the online detector keeps), without the
         constructor's conversions and checks: it builds one per analysis. Face, gripper and
-        load share are unknown (NaN), as the constructor makes them (views of one array)."""
+        load share are unknown (NaN), as the constructor makes them: views of one all-NaN
+        ``(N, 5)`` block, ``unknown`` if given (the caller's, reused between calls), else a new
+        one."""
         traj = cls.__new__(cls)
         traj.t = t
         traj.giver_hand = giver_hand
         traj.receiver_hand = receiver_hand
-        unknown = np.empty((t.shape[0], 5))  # (one block for the three: one allocation)
-        unknown.fill(np.nan)
+        if unknown is None:
+            unknown = np.empty((t.shape[0], 5))  # (one block for the three: one allocation)
+            unknown.fill(np.nan)
         traj.giver_face = unknown[:, :3]
         traj.gripper_closed = unknown[:, 3]
         traj.load_share = unknown[:, 4]

@@ -126,11 +126,14 @@ def test_of_hands_builds_the_trajectory_the_constructor_builds():
     t, g, r = np.sort(rng.random(40)), rng.random((40, 3)), rng.random((40, 3))
     g[5] = np.nan
     ref, fast = Trajectory(t, g, r), Trajectory.of_hands(t, g, r)
+    # (and from a caller's all-NaN block, as the detector passes one)
+    given = Trajectory.of_hands(t, g, r, np.full((40, 5), np.nan))
     for name in ("t", "giver_hand", "receiver_hand", "giver_face", "gripper_closed",
                  "load_share"):
-        a, b = getattr(ref, name), getattr(fast, name)
-        assert a.shape == b.shape and a.dtype == b.dtype
+        a, b, c = getattr(ref, name), getattr(fast, name), getattr(given, name)
+        assert a.shape == b.shape == c.shape and a.dtype == b.dtype == c.dtype
         np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(a, c)
 
 
 

@@ -31,12 +31,30 @@ def _nanmean2(a: Sequence[float], b: Sequence[float]) -> list[float]:
     """``np.nanmean([a, b], axis=0)`` of two 3-vectors: per coordinate the sum of the values
     that are not NaN (NaN counted as 0) over their count, NaN if none (numpy's arithmetic,
     without its generic machinery and warning)."""
+    a0, a1, a2 = a
+    b0, b1, b2 = b
+    if a0 == a0 and a1 == a1 and a2 == a2 and b0 == b0 and b1 == b1 and b2 == b2:
+        # (no NaN, the usual case: each mean is the sum over 2, without the per-value tests)
+        return [(a0 + b0) / 2, (a1 + b1) / 2, (a2 + b2) / 2]
     out = []
     for u, w in zip(map(float, a), map(float, b), strict=True):  # (bools that add to 2)
         u_ok, w_ok = u == u, w == w
         n = u_ok + w_ok
         out.append(((u if u_ok else 0.0) + (w if w_ok else 0.0)) / n if n else math.nan)
     return out
+
+
+def _mean3(points: list[Sequence[float]]) -> tuple[float, float, float]:
+    """The mean of 3-vectors (summed in order from 0.0, over their count), NaNs if none."""
+    n = len(points)
+    if not n:
+        return math.nan, math.nan, math.nan
+    sx = sy = sz = 0.0
+    for x, y, z in points:
+        sx += x
+        sy += y
+        sz += z
+    return sx / n, sy / n, sz / n
 
 
 def _norm_at_least(v: Sequence[float], bar: float) -> bool:
@@ -132,12 +150,29 @@ class GazebotTrigger:
     def __init__(self, config: PhaseConfig) -> None:
         self.config = config
         # Rows apart of the speed baseline (the giver's step column reads this far back).
-        baseline = config.trigger_speed_baseline / max(config.online_period, 1e-3)
+        c = config
+        period = max(c.online_period, 1e-3)
+        baseline = c.trigger_speed_baseline / period
         self._k = max(1, int(round(baseline)))
-        # Sums of the positions seen this period (giver xyz, receiver xyz) and their counts, in
-        # plain floats: a sample costs a few additions, not numpy calls.
-        self._acc = [0.0] * 6
-        self._acc_n = [0, 0]
+        # The rules' bars and spans, which depend on the (frozen) settings alone: computed
+        # once, by the same expressions the rules would evaluate each period.
+        self._reach_recent = c.min_transfer + c.edge_guard + c.online_period  # s
+        self._still_bar = c.trigger_still_factor * c.still_closing
+        self._release_bar = c.trigger_distance_factor * c.release_distance
+        self._far_bar = c.trigger_far_fraction * c.retreat_far_distance
+        self._closed_bar = c.trigger_distance_factor * min(
+            c.reach_confirm_distance, c.predict_distance
+        )
+        self._deep_bar = c.trigger_deep_fraction * c.min_approach
+        self._own_bar = c.trigger_own_fraction * c.reach_confirm_distance
+        # rows back to the start of the span the reach rule reads the speed over
+        self._speed_rows = int((c.smoothing + c.edge_guard + c.trigger_speed_baseline) / period)
+        self._step_time = self._k * period  # s a giver step spans
+        self._onset_bar = c.trigger_distance_factor * c.reach_onset_speed
+        # The positions seen this period, per hand (summed in plain floats when it closes: a
+        # sample costs an append, not numpy calls).
+        self._seen_g: list[Sequence[float]] = []
+        self._seen_r: list[Sequence[float]] = []
         # The rows kept are items _s0.. of each column (times, giver means, receiver means,
         # relative positions, distances, giver steps: |giver - giver trigger_speed_baseline
         # earlier|); the relative position, distance and step are computed once per row. Item
@@ -157,20 +192,12 @@ class GazebotTrigger:
         self._held: tuple[int, int, list[float], int] = (-1, -1, [], 0)
 
     def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
-        """Accumulate one sample's hand positions (``*_ok``: that hand was seen)."""
-        acc = self._acc
+        """Keep one sample's hand positions (``*_ok``: that hand was seen) until the period
+        closes (the sequences are kept, not copied: the caller does not change them)."""
         if g_ok:
-            x, y, z = g
-            acc[0] += x
-            acc[1] += y
-            acc[2] += z
-            self._acc_n[0] += 1
+            self._seen_g.append(g)
         if r_ok:
-            x, y, z = r
-            acc[3] += x
-            acc[4] += y
-            acc[5] += z
-            self._acc_n[1] += 1
+            self._seen_r.append(r)
 
     def decide(self, now: float, state: OnlineState) -> TriggerMode:
         """Close the period: ``full`` if the next boundary may have passed, ``refresh`` if not
@@ -200,11 +227,11 @@ class GazebotTrigger:
             self._base += s0
             s0, end = 0, end - s0
         self._s0 = s0
-        a = self._acc
-        ng, nr = self._acc_n
         nan = math.nan
-        gx, gy, gz = (a[0] / ng, a[1] / ng, a[2] / ng) if ng else (nan, nan, nan)
-        rx, ry, rz = (a[3] / nr, a[4] / nr, a[5] / nr) if nr else (nan, nan, nan)
+        gx, gy, gz = _mean3(self._seen_g)
+        rx, ry, rz = _mean3(self._seen_r)
+        self._seen_g.clear()
+        self._seen_r.clear()
         dx, dy, dz = rx - gx, ry - gy, rz - gz
         # (the sum in this order is what np.linalg.norm(rel, axis=1) computes; a test pins it)
         d = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -219,8 +246,6 @@ class GazebotTrigger:
         self._rel.append((dx, dy, dz))
         self._d.append(d)
         self._step.append(step)
-        self._acc = [0.0] * 6
-        self._acc_n = [0, 0]
 
     def rows(self) -> np.ndarray:
         """The per-period rows kept: ``[t, giver xyz, receiver xyz, relative xyz, distance,
@@ -240,7 +265,6 @@ class GazebotTrigger:
         """A necessary condition of the rule that ends the current phase, on the per-period
         means (loose: ``trigger_distance_factor`` x its distances, so it fires before the rule
         can)."""
-        c = self.config
         ph = state.phase
         times = self._t
         s0, s1 = self._s0, len(times)
@@ -254,9 +278,9 @@ class GazebotTrigger:
         if ph is Phase.REACH:
             # A transfer needs the approach to have stopped, an aborted reach the hands apart:
             # either way the hands are no longer closing fast.
-            since = times[-1] - (c.min_transfer + c.edge_guard + c.online_period)
+            since = times[-1] - self._reach_recent
             recent = _fmax(self._d[_search(times, since, s0, s1) : s1])
-            return recent - d_last <= c.trigger_still_factor * c.still_closing
+            return recent - d_last <= self._still_bar
         first = _search(times, state.phase_start, s0, s1)
         if ph is Phase.TRANSFER:
             # A release moves the hands' relative position off the held pose.
@@ -264,9 +288,9 @@ class GazebotTrigger:
             if mean is None:
                 return True
             # (the last two periods' mean: the analysis trusts nothing newer than edge_guard)
-            now_rel = _nanmean2(self._rel[-2], self._rel[-1])
-            off = [u - m for u, m in zip(now_rel, mean, strict=True)]
-            return _norm_at_least(off, c.trigger_distance_factor * c.release_distance)
+            n0, n1, n2 = _nanmean2(self._rel[-2], self._rel[-1])
+            m0, m1, m2 = mean
+            return _norm_at_least((n0 - m0, n1 - m1, n2 - m2), self._release_bar)
         if ph is Phase.RETREAT:
             if state.joined_late:
                 return True
@@ -274,17 +298,18 @@ class GazebotTrigger:
             k = self._k
             if s1 - first <= k:
                 return True
-            g0, g1 = self._g[first], self._g[-1]
-            if not all(map(math.isfinite, g0 + g1)):
+            x0, y0, z0 = self._g[first]
+            x1, y1, z1 = self._g[-1]
+            fin = math.isfinite
+            if not (fin(x0) and fin(y0) and fin(z0) and fin(x1) and fin(y1) and fin(z1)):
                 return True
-            far = c.trigger_far_fraction * c.retreat_far_distance
-            if _norm_at_least([u - v for u, v in zip(g1, g0, strict=True)], far):
+            if _norm_at_least((x1 - x0, y1 - y0, z1 - z0), self._far_bar):
                 return True
             last = self._step[-1]
             if not math.isfinite(last):
                 return True
             # (the steps within the retreat: rows at least k after its first)
-            return last <= c.trigger_landing_fraction * self._smax.update(
+            return last <= self.config.trigger_landing_fraction * self._smax.update(
                 self._step, self._base, first + k, s1
             )
         return True
@@ -313,12 +338,10 @@ class GazebotTrigger:
     def _reach_possible(self, d_last: float, floor: float) -> bool:
         """A reach (or a transfer) needs the hands closer than they were since the last phase
         began and the giver's hand moving since they were farthest."""
-        c = self.config
         k = self._k
-        loose = c.trigger_distance_factor
         times = self._t
         s0, end = self._s0, len(times)
-        first = _search(times, floor - c.online_period, s0, end)
+        first = _search(times, floor - self.config.online_period, s0, end)
         if end - first <= k:
             return False
         d_max = self._dmax.update(self._d, self._base, first, end)
@@ -326,26 +349,25 @@ class GazebotTrigger:
         # (the predictive rule confirms a reach from predict_distance of the giver's own travel;
         # the sequential one, in practice, past 1.2 cm: every fidget fits a cubic start up to
         # its midpoint, so it waits for more than half the largest fidget)
-        if not closed >= loose * min(c.reach_confirm_distance, c.predict_distance):
+        if not closed >= self._closed_bar:
             return False
         i_max = self._d.index(d_max, first)  # np.nanargmax: the first largest
-        deep = closed >= c.trigger_deep_fraction * c.min_approach
+        deep = closed >= self._deep_bar
         if not deep:
             # (the giver's own share of the closing, read only when the dip is not deep)
-            g1, g0 = self._g[-1], self._g[i_max]
-            moved = [u - v for u, v in zip(g1, g0, strict=True)]
-            own_bar = c.trigger_own_fraction * c.reach_confirm_distance
-            if not _dot_over_at_least(moved, self._rel[-1], max(d_last, 1e-9), own_bar):
+            x1, y1, z1 = self._g[-1]
+            x0, y0, z0 = self._g[i_max]
+            moved = (x1 - x0, y1 - y0, z1 - z0)
+            if not _dot_over_at_least(moved, self._rel[-1], max(d_last, 1e-9), self._own_bar):
                 return False  # only the receiver came closer: no reach of the giver's yet
         # The giver's hand moving fast: since the hands were farthest for a deep dip, else
         # within the window the rule reads (smoothing, before the edge guard).
-        span = (c.smoothing + c.edge_guard + c.trigger_speed_baseline) / max(c.online_period, 1e-3)
-        recent = end - 1 - int(span)
+        recent = end - 1 - self._speed_rows
         g_first = max(i_max - k, s0 if deep else recent, s0)
         if end - g_first <= k:
             return True
         # The speeds over k rows from g_first on are the steps of the rows k after it (each
         # row's step is from the row k before it, there when the row arrived), divided by the
         # same positive number: the largest speed is the largest step's.
-        v_max = _fmax(self._step[g_first + k : end]) / (k * max(c.online_period, 1e-3))
-        return bool(max(0.0, v_max) >= loose * c.reach_onset_speed)
+        v_max = _fmax(self._step[g_first + k : end]) / self._step_time
+        return bool(max(0.0, v_max) >= self._onset_bar)

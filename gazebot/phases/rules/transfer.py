@@ -66,39 +66,56 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
-    """Dips of ``d`` at least ``depth`` deep on both sides, as ``(left, minimum, right)`` index
-    triples (left/right: the highest points between neighbouring dips). The recording's ends
-    count as high ground, so a recording that starts or ends mid-handover keeps its dip.
-    NaN samples are skipped."""
+    """Dips of ``d`` at least ``depth`` (> 0) deep on both sides, as ``(left, minimum, right)``
+    index triples (left/right: the highest points between neighbouring dips). The recording's
+    ends count as high ground, so a recording that starts or ends mid-handover keeps its dip.
+    NaN samples are skipped.
+
+    A zigzag with hysteresis ``depth``: going down, the lowest sample so far (the first of
+    equal ones) is the minimum until a sample rises ``depth`` above it; going up, the highest
+    so far until one falls ``depth`` below it. Each leg is found with running extrema over the
+    samples left (a few numpy calls a leg, not a Python step per sample: the online analysis
+    reads the dips of hundreds of samples every period); ``tests/phases`` pins it to the
+    sample-by-sample form."""
+    if not depth > 0:
+        raise ValueError(f"dips: depth must be > 0, got {depth}")
     out: list[tuple[int, int, int]] = []
-    idx = np.isfinite(d).nonzero()[0]
-    if idx.size == 0:
+    if d.shape[0] == 0:
         return out
-    left = int(idx[0])
-    going_down = True
-    lo_v, lo_i = math.inf, -1
-    hi_v, hi_i = -math.inf, -1
-    for i, v in zip(idx.tolist(), d[idx].tolist(), strict=True):
-        if going_down:
-            if v < lo_v:
-                lo_v, lo_i = v, i
-            elif v >= lo_v + depth:
-                going_down = False
-                hi_v, hi_i = v, i
-        else:
-            if v > hi_v:
-                hi_v, hi_i = v, i
-            elif v <= hi_v - depth:
-                out.append((left, lo_i, hi_i))
-                left = hi_i
-                going_down = True
-                lo_v, lo_i = v, i
-    if going_down:
-        if lo_i >= 0:
-            out.append((left, lo_i, int(idx[-1])))
+    ok = np.isfinite(d)
+    if ok.all():
+        v, idx = d, None
     else:
-        out.append((left, lo_i, hi_i if hi_i >= 0 else int(idx[-1])))
-    return out
+        idx = ok.nonzero()[0]
+        if idx.size == 0:
+            return out
+        v = d[idx]
+
+    def at(i: int) -> int:  # index into d of the i-th finite sample
+        return i if idx is None else int(idx[i])
+
+    m = v.shape[0]
+    left = at(0)
+    s = 0  # the down leg starts here
+    while True:
+        # down: the first sample at least depth above the lowest before it (in that leg).
+        # (depth > 0: such a sample is never below that lowest, so it is no new minimum)
+        rise = v[s + 1 :] >= np.minimum.accumulate(v[s : m - 1]) + depth
+        j = int(rise.argmax()) if rise.shape[0] else 0
+        if not (rise.shape[0] and rise[j]):
+            out.append((left, at(s + int(v[s:].argmin())), at(m - 1)))
+            return out
+        u = s + 1 + j  # the up leg starts here
+        lo_i = s + int(v[s:u].argmin())
+        fall = v[u + 1 :] <= np.maximum.accumulate(v[u : m - 1]) - depth
+        j = int(fall.argmax()) if fall.shape[0] else 0
+        if not (fall.shape[0] and fall[j]):
+            out.append((left, at(lo_i), at(u + int(v[u:].argmax()))))
+            return out
+        s = u + 1 + j
+        hi = at(u + int(v[u:s].argmax()))
+        out.append((left, at(lo_i), hi))
+        left = hi
 
 
 def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:

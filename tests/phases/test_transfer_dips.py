@@ -1,0 +1,70 @@
+"""``rules.transfer.dips`` (leg by leg, with running extrema) finds the dips the sample-by-sample
+zigzag finds, index for index."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gazebot.phases.rules.transfer import dips
+
+
+def _dips_by_sample(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
+    """The zigzag one sample at a time (the rule's definition, as it was written first)."""
+    out: list[tuple[int, int, int]] = []
+    idx = np.isfinite(d).nonzero()[0]
+    if idx.size == 0:
+        return out
+    left = int(idx[0])
+    going_down = True
+    lo_v, lo_i = math.inf, -1
+    hi_v, hi_i = -math.inf, -1
+    for i, v in zip(idx.tolist(), d[idx].tolist(), strict=True):
+        if going_down:
+            if v < lo_v:
+                lo_v, lo_i = v, i
+            elif v >= lo_v + depth:
+                going_down = False
+                hi_v, hi_i = v, i
+        else:
+            if v > hi_v:
+                hi_v, hi_i = v, i
+            elif v <= hi_v - depth:
+                out.append((left, lo_i, hi_i))
+                left = hi_i
+                going_down = True
+                lo_v, lo_i = v, i
+    if going_down:
+        if lo_i >= 0:
+            out.append((left, lo_i, int(idx[-1])))
+    else:
+        out.append((left, lo_i, hi_i if hi_i >= 0 else int(idx[-1])))
+    return out
+
+
+def test_dips_match_the_sample_by_sample_zigzag_on_walks_with_gaps_ties_and_plateaus() -> None:
+    rng = np.random.default_rng(19)
+    for trial in range(600):
+        n = int(rng.integers(0, 120))
+        step = rng.normal(0.0, 0.05, n)
+        if trial % 3 == 0:
+            step = np.round(step, 1)  # (plateaus and equal values: ties for the extrema)
+        d = 1.0 + np.cumsum(step)
+        if trial % 4 == 0 and n:
+            d[rng.random(n) < 0.2] = np.nan  # tracking gaps
+        if trial % 7 == 0 and n:
+            d[:] = np.nan if trial % 14 == 0 else d[0]  # all unknown / all equal
+        depth = float(rng.choice([0.05, 0.1, 0.2, 1e-12]))
+        assert dips(d, depth) == _dips_by_sample(d, depth), (trial, d.tolist(), depth)
+
+
+def test_dips_of_one_or_no_sample() -> None:
+    assert dips(np.array([0.4]), 0.1) == [(0, 0, 0)] == _dips_by_sample(np.array([0.4]), 0.1)
+    assert dips(np.empty(0), 0.1) == [] == _dips_by_sample(np.empty(0), 0.1)
+
+
+def test_dips_need_a_positive_depth() -> None:
+    with pytest.raises(ValueError, match="depth must be > 0"):
+        dips(np.array([1.0, 0.5, 1.0]), 0.0)
