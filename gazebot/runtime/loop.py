@@ -39,6 +39,7 @@ import numpy as np
 
 from gazebot.render.blink import BlinkModel
 from gazebot.types import (
+    F64,
     Event,
     GazeCommand,
     Phase,
@@ -191,7 +192,7 @@ class GazeLoop:
                 raise ValueError(f"tick: t={t} disagrees with the frame's t={ft}")
         self.ticks += 1
         try:
-            cmd = self.engine.step(frame, arm=joints)
+            cmd = self.engine.step(frame, joints)  # (arm: positional, a cheaper call)
         except Exception:  # noqa: BLE001 - a node never dies on input; the tick sends nothing
             self.faults += 1
             return None
@@ -229,9 +230,12 @@ class GazeLoop:
             return None
         distance = None
         point = cmd.target_point
-        if type(point) is np.ndarray and point.shape == (3,) and point.dtype.kind == "f":
-            # The engine's points are such arrays. No finiteness check: a NaN or infinite
-            # coordinate makes the distance NaN or infinite, which the range test below refuses.
+        if type(point) is np.ndarray and (point.dtype is F64 or point.dtype.kind == "f") and (
+            point.shape == (3,)
+        ):
+            # The engine's points are such arrays (float64: ``is`` first, NumPy's dtype is one
+            # object). No finiteness check: a NaN or infinite coordinate makes the distance NaN
+            # or infinite, which the range test below refuses.
             x, y, z = point.tolist()
             valid = True
         elif is_valid_point(point):
