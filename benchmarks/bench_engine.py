@@ -7,11 +7,10 @@ step: what the one loop costs on top."""
 from __future__ import annotations
 
 import math
-import statistics
 
 import numpy as np
 
-from benchmarks.common import Result, best_cpu_time, median_time
+from benchmarks.common import Result, alternating
 from gazebot import GazeEngine
 from gazebot.phases.synthetic import SyntheticOptions, generate
 from gazebot.runtime import GazeLoop
@@ -49,12 +48,12 @@ def run() -> list[Result]:
             state["i"] = i + 1
 
         n = len(frames)
-        ours = median_time(step, repeat=7, number=n) * 1e6
         peer_step = _hand_written_peer(frames)
-        peer = median_time(peer_step, repeat=7, number=n) * 1e6
-        # CPU time over whole recordings (the step at frame 0 resets the engine).
-        cpu_ours = best_cpu_time(step, repeat=9, number=n, warmup=0) * 1e6
-        cpu_peer = best_cpu_time(peer_step, repeat=9, number=n, warmup=0) * 1e6
+        # Whole recordings (the step at frame 0 resets the engine), ours and the peer's in
+        # alternating rounds: wall medians and the least CPU time of each.
+        ours, peer, cpu_ours, cpu_peer = (
+            x * 1e6 for x in alternating(step, peer_step, rounds=15, number=n)
+        )
         results.append(
             Result(
                 f"engine.step, {robot}, face-hand-face, 120 Hz handover",
@@ -86,16 +85,9 @@ def run() -> list[Result]:
             engine.step(frames[i % len(frames)])
             state["i"] = i + 1
 
-        # Alternating rounds: load from other processes hits both alike.
-        t_ours, t_peer, c_ours, c_peer = [], [], [], []
-        for _ in range(9):
-            t_ours.append(median_time(tick, repeat=1, number=n, warmup=0))
-            t_peer.append(median_time(bare_step, repeat=1, number=n, warmup=0))
-            c_ours.append(best_cpu_time(tick, repeat=1, number=n, warmup=0))
-            c_peer.append(best_cpu_time(bare_step, repeat=1, number=n, warmup=0))
-        ours = statistics.median(t_ours) * 1e6
-        peer = statistics.median(t_peer) * 1e6
-        cpu_ours, cpu_peer = min(c_ours) * 1e6, min(c_peer) * 1e6
+        ours, peer, cpu_ours, cpu_peer = (
+            x * 1e6 for x in alternating(tick, bare_step, rounds=15, number=n)
+        )
         results.append(
             Result(
                 f"GazeLoop.tick, {robot}: engine + safety + blink + vergence",

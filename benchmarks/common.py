@@ -65,6 +65,35 @@ def best_cpu_time(
     return best
 
 
+def alternating(
+    ours: Callable[[], object], peer: Callable[[], object], rounds: int = 15, number: int = 1
+) -> tuple[float, float, float, float]:
+    """Wall median and least CPU time (``time.thread_time``) per call of ``ours`` and
+    ``peer``, timed in alternating rounds of ``number`` calls each (one warm-up round first):
+    load from other processes, which comes in bursts longer than a round, then hits both
+    alike instead of whichever ran during a burst. Returns ``(ours_wall, peer_wall, ours_cpu,
+    peer_cpu)`` in seconds."""
+    ours()
+    peer()
+    wall: dict[int, list[float]] = {0: [], 1: []}
+    cpu: dict[int, list[float]] = {0: [], 1: []}
+    for i in range(rounds):
+        # (the order flips every round: neither always runs right after the other)
+        for k in (0, 1) if i % 2 == 0 else (1, 0):
+            fn = ours if k == 0 else peer
+            w0, c0 = time.perf_counter(), time.thread_time()
+            for _ in range(number):
+                fn()
+            cpu[k].append((time.thread_time() - c0) / number)
+            wall[k].append((time.perf_counter() - w0) / number)
+    return (
+        statistics.median(wall[0]),
+        statistics.median(wall[1]),
+        min(cpu[0]),
+        min(cpu[1]),
+    )
+
+
 def print_results(results: list[Result]) -> None:
     for r in results:
         peer = f"{r.peer:.4g} {r.unit} ({r.peer_name})" if r.peer is not None else "-"
