@@ -39,6 +39,7 @@ import numpy as np
 
 from gazebot.render.blink import BlinkModel
 from gazebot.types import (
+    F64,
     Event,
     GazeCommand,
     Phase,
@@ -112,15 +113,15 @@ class GazeLoop:
         self.faults = 0  # ticks the engine raised on (answered with None)
         self.ticks = 0
         self._t = -math.inf
-        self._frame_key: tuple | None = None
+        # (the last gaze frame: its head pose, arm revision and rows)
+        self._frame_pose: list[float] | None = None
+        self._frame_revision: object = None
         self._frame_rows: list[list[float]] = []
         robot = self._robot = engine.robot  # (the engine's robot never changes)
-        self._limits = [(str(n), float(lo), float(hi))
-                        for n, lo, hi in zip(robot.head_joints, robot.lower, robot.upper,
-                                             strict=True)]
-        self._rest = [float(r) for r in robot.rest]
-        # (per tick: the command pose's joints with their rest values, and the eyes' range)
-        self._rest_of = [(n, r) for (n, _, _), r in zip(self._limits, self._rest, strict=True)]
+        # (per tick: each head joint's name, limits and rest value, and the eyes' range)
+        self._joints = [(str(n), float(lo), float(hi), float(r))
+                        for n, lo, hi, r in zip(robot.head_joints, robot.lower, robot.upper,
+                                                robot.rest, strict=True)]
         self._eyes = robot.eyes
 
     @classmethod
@@ -191,7 +192,7 @@ class GazeLoop:
                 raise ValueError(f"tick: t={t} disagrees with the frame's t={ft}")
         self.ticks += 1
         try:
-            cmd = self.engine.step(frame, arm=joints)
+            cmd = self.engine.step(frame, joints)  # (arm: positional, a cheaper call)
         except Exception:  # noqa: BLE001 - a node never dies on input; the tick sends nothing
             self.faults += 1
             return None
@@ -201,23 +202,40 @@ class GazeLoop:
         self, cmd: GazeCommand, answers: bool, joints: Mapping[str, float] | None
     ) -> GazeCommand | None:
         # What GazeCommand.is_finite() checks, in one pass with the limits: a NaN or infinite
-        # head goal fails its limit comparison and non-finite eyes are clipped.
+        # head goal fails its limit comparison and non-finite eyes are clipped. The checks and
+        # the rest below are written out in this one function (no helper calls, no key tuple):
+        # they run every tick and their calls were most of the loop's cost.
         isfinite = math.isfinite
         head = cmd.head
-        if not (
-            isfinite(cmd.t)
-            and isfinite(cmd.blink)
-            and isfinite(cmd.gaze_shift)
-            and self._within_limits(head)
-            and not self._eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]
-        ):
+        if not (isfinite(cmd.t) and isfinite(cmd.blink) and isfinite(cmd.gaze_shift)):
+            self.unsafe += 1
+            return None
+        # Every head goal is for a joint of the robot and within its limits (a check, not a
+        # clip: the gaze controller clips); on the way, the commanded head vector (rest for a
+        # joint the command lacks).
+        pose = []
+        known = 0
+        for name, lo, hi, rest in self._joints:
+            if name in head:
+                v = head[name]
+                if not lo <= v <= hi:
+                    self.unsafe += 1
+                    return None
+                known += 1
+                pose.append(v)
+            else:
+                pose.append(rest)
+        if known != len(head) or self._eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]:
             self.unsafe += 1
             return None
         distance = None
         point = cmd.target_point
-        if type(point) is np.ndarray and point.shape == (3,) and point.dtype.kind == "f":
-            # The engine's points are such arrays. No finiteness check: a NaN or infinite
-            # coordinate makes the distance NaN or infinite, which the range test below refuses.
+        if type(point) is np.ndarray and (point.dtype is F64 or point.dtype.kind == "f") and (
+            point.shape == (3,)
+        ):
+            # The engine's points are such arrays (float64: ``is`` first, NumPy's dtype is one
+            # object). No finiteness check: a NaN or infinite coordinate makes the distance NaN
+            # or infinite, which the range test below refuses.
             x, y, z = point.tolist()
             valid = True
         elif is_valid_point(point):
@@ -226,47 +244,52 @@ class GazeLoop:
         else:
             valid = False
         if valid:
-            rows = self._gaze_frame(self._display_pose(head, joints))
+            if joints:
+                # The display is where the measured head is, when all its joints are known.
+                pose = self._measured_pose(joints) or pose
+            rows = self._gaze_frame(pose)
             dx, dy, dz = x - rows[0][3], y - rows[1][3], z - rows[2][3]
             d = math.sqrt(dx * dx + dy * dy + dz * dz)
             # A target at the display itself (or beyond any float) has no defined vergence.
             distance = d if 1e-3 < d < math.inf else None
-        # Blink times never go back (the engine's t never does either).
-        t = self._t = max(cmd.t, self._t)
-        blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
-        # cmd.replaced(...) without its field-name check (these are GazeCommand's fields).
-        fields = dict(cmd.__dict__, blink=blink, distance=distance, answers_sample=answers)
+        # Blink times never go back (the engine's t never does either): max(cmd.t, self._t)
+        # as a comparison.
+        t = cmd.t
+        if self._t > t:
+            t = self._t
+        self._t = t
+        # min(max(b, 0), 1) as comparisons (the same result, NaN and -0.0 included)
+        blink = float(self.blinks.update(t, cmd.gaze_shift))
+        if blink < 0.0:
+            blink = 0.0
+        if blink > 1.0:
+            blink = 1.0
+        # cmd.replaced(...) without its field-name check (these are GazeCommand's fields); a
+        # copy, then the three fields (their places in the dict are kept).
+        fields = cmd.__dict__.copy()
+        fields["blink"] = blink
+        fields["distance"] = distance
+        fields["answers_sample"] = answers
         return from_fields(GazeCommand, fields)
 
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
         the arm carrying the head moved (a head at rest: no forward kinematics)."""
         robot = self._robot
-        key = (*pose, getattr(robot, "arm_revision", None))
-        if key != self._frame_key:
-            self._frame_key = key
+        revision = getattr(robot, "arm_revision", None)
+        # (pose and revision compared apart: equal to comparing them as one tuple, without
+        # building it)
+        if pose != self._frame_pose or revision != self._frame_revision:
+            self._frame_pose = pose
+            self._frame_revision = revision
             self._frame_rows = robot.gaze_frame_lists(pose)
         return self._frame_rows
 
-    def _display_pose(
-        self, head: dict[str, float], joints: Mapping[str, float] | None
-    ) -> list[float]:
-        """Head vector where the display is: the measured head joints when all are known and
-        finite, else the commanded (safe) ones."""
-        if joints:
-            measured = [joints.get(n, math.nan) for n, _, _ in self._limits]
-            if all(isinstance(v, (int, float)) and math.isfinite(v) for v in measured):
-                return [min(max(v, lo), hi)
-                        for v, (_, lo, hi) in zip(measured, self._limits, strict=True)]
-        return [head.get(n, r) for n, r in self._rest_of]
-
-    def _within_limits(self, head: Mapping[str, float]) -> bool:
-        """Every head goal is for a joint of the robot and within its limits (a check, not a
-        clip: the gaze controller clips)."""
-        known = 0
-        for name, lo, hi in self._limits:
-            if name in head:
-                known += 1
-                if not lo <= head[name] <= hi:
-                    return False
-        return known == len(head)
+    def _measured_pose(self, joints: Mapping[str, float]) -> list[float] | None:
+        """The measured head vector clipped into the limits, or ``None`` unless every head
+        joint is in ``joints`` and finite."""
+        measured = [joints.get(n, math.nan) for n, _, _, _ in self._joints]
+        if all(isinstance(v, (int, float)) and math.isfinite(v) for v in measured):
+            return [min(max(v, lo), hi)
+                    for v, (_, lo, hi, _) in zip(measured, self._joints, strict=True)]
+        return None

@@ -147,3 +147,33 @@ def test_the_loop_fills_the_engines_command_without_copying_its_fields_by_hand(s
     assert cmd.replaced(blink=0.5).blink == 0.5
     with pytest.raises(TypeError, match="no fields"):
         cmd.replaced(blinks=0.5)
+
+
+def test_distance_follows_the_measured_head_and_the_arm_carrying_it():
+    # The display is where the measured head is (when every head joint is measured) and moves
+    # with the arm joint that carries the head, even while the commanded pose stays the same.
+    from gazebot.kinematics import RobotModel
+
+    robot = RobotModel.load("sawyer")
+    engine = _Engine(robot)
+    loop = GazeLoop(engine)
+    point = np.array([1.2, 0.4, 1.3])
+
+    def expected(arm: float, pan: float) -> float:
+        probe = RobotModel.load("sawyer")
+        probe.set_arm({"right_j0": arm})
+        origin = probe.gaze_pose(probe.head_vector({"head_pan": pan})).position
+        return float(np.linalg.norm(point - origin))
+
+    cases = [
+        ({"right_j0": 0.0, "head_pan": 0.5}, 0.0, 0.5),  # measured head: its pose
+        ({"right_j0": 0.6, "head_pan": 0.5}, 0.6, 0.5),  # the arm moved, the head did not
+        ({"right_j0": 0.6}, 0.6, 0.3),  # head not measured: the commanded pose
+        ({"right_j0": 0.6, "head_pan": math.nan}, 0.6, 0.3),  # nor when not a number
+        ({"right_j0": -0.4, "head_pan": 99.0}, -0.4, float(robot.upper[0])),  # clipped
+    ]
+    for i, (joints, arm, pan) in enumerate(cases):
+        robot.set_arm({"right_j0": arm})  # (the engine does this with the tick's joints)
+        engine.next = _cmd({"head_pan": 0.3}, point=point, t=float(i))
+        cmd = loop.tick(TrackingFrame(t=float(i)), joints=joints)
+        assert cmd.distance == pytest.approx(expected(arm, pan), abs=1e-12), joints
