@@ -211,11 +211,33 @@ def _smooth_all_seen(x: np.ndarray, hands: int, sigma: float) -> tuple[np.ndarra
     return out, den
 
 
+@lru_cache(maxsize=64)
+def _prefix_shares(rows: int, seen: int, sigma: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What :func:`smooth`'s masked path derives from a mask of ``rows`` rows whose first
+    ``seen`` are seen (both hands), which depends on those three numbers alone (computed once
+    per triple: the online cache asks for the same few again and again): the window's seen
+    share per row and hand (rows, 2; smooth's ``den``, the same correlation of the same
+    line), its divisor ``max(share, 1e-12)`` per column (rows, 6) and which columns come out
+    unknown (rows, 6: a share under 0.5, or an unseen row). Read-only."""
+    line = np.zeros((rows, 2))
+    line[:seen] = 1.0
+    share = np.empty_like(line)
+    correlate1d(line, gaussian_weights(sigma), axis=0, output=share, mode="nearest")
+    # (hand h's three columns are 3h..3h+2, as smooth's (rows, hands, 3) reshape lays them)
+    divisor = np.repeat(np.maximum(share, 1e-12), 3, axis=1)
+    unknown = np.repeat(share < 0.5, 3, axis=1)
+    unknown[seen:] = True
+    for a in (share, divisor, unknown):
+        a.flags.writeable = False
+    return share, divisor, unknown
+
+
 def smooth_seen_prefix(x: np.ndarray, seen: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`smooth` of rows ``x`` (N, 6: both hands) whose first ``seen`` rows are seen for
-    both hands and the rest for neither (NaN, as written here where :func:`smooth` returns
-    ``x`` itself; else not read): the same result, bit for bit, without finding that mask (the
-    online cache knows it: its rows past the newest sample are the only unknown ones)."""
+    """:func:`smooth` of rows ``x`` (N, 6: both hands, contiguous) whose first ``seen`` rows
+    are seen for both hands and the rest for neither (overwritten here: NaN where
+    :func:`smooth` returns ``x`` itself, else zeros; not read): the same result, bit for bit,
+    without finding that mask (the online cache knows it: its rows past the newest sample are
+    the only unknown ones). The seen share returned may be read-only."""
     rows = x.shape[0]
     if seen >= rows and sigma > 0 and rows >= 2:
         return _smooth_all_seen(x, 2, sigma)
@@ -225,19 +247,17 @@ def smooth_seen_prefix(x: np.ndarray, seen: int, sigma: float) -> tuple[np.ndarr
         x[seen:] = np.nan
         return smooth(x, m, sigma)
     # smooth's masked path with that mask: a seen row keeps its values and counts 1, an
-    # unseen one counts 0 with zeros (np.where's), and unseen rows come out NaN
-    w = gaussian_weights(sigma)
-    stack = np.empty((rows, 2, 4))
-    stack[:seen, :, :3] = x[:seen].reshape(seen, 2, 3)
-    stack[:seen, :, 3] = 1.0
-    stack[seen:] = 0.0
-    both = np.empty_like(stack)
-    correlate1d(stack, w, axis=0, output=both, mode="nearest")
-    den = both[:, :, 3]
-    out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
-    out[den < 0.5] = np.nan  # do not invent samples inside long gaps
-    out[seen:] = np.nan
-    return out.reshape(rows, 6), den
+    # unseen one counts 0 with zeros (np.where's), and unseen rows come out NaN. Each column
+    # is correlated on its own (the same line, the same sums, whatever the array's shape), so
+    # the positions take one correlation of x with zeros past the seen rows, and the mask's
+    # correlation and what follows from it are the cached ones.
+    share, divisor, unknown = _prefix_shares(rows, seen, sigma)
+    x[seen:] = 0.0
+    out = np.empty_like(x)
+    correlate1d(x, gaussian_weights(sigma), axis=0, output=out, mode="nearest")
+    np.divide(out, divisor, out=out)
+    out[unknown] = np.nan  # do not invent samples inside long gaps, nor past the newest
+    return out, share
 
 
 # What np.nanmax (np.nanmin) computes for a float array: the largest (smallest) value that is
