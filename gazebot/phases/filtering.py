@@ -25,6 +25,7 @@ dispatch, which costs more than the work on these short arrays.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -37,6 +38,15 @@ from gazebot.types import filled
 
 # Share of the smoothing window that must hold data for a velocity to be known.
 FULL_WINDOW = 0.6
+
+try:
+    # The compiled routine np.interp(x, xp, fp) of real values ends in (called with left and
+    # right None: its defaults): the same arithmetic without the public function's dispatch
+    # and argument checks, a few microseconds a call (the cache interpolates six columns per
+    # analysis). tests/phases/test_signals_fused.py pins it to np.interp.
+    from numpy._core.multiarray import interp as _interp
+except ImportError:  # pragma: no cover (another numpy layout: the public function itself)
+    _interp = np.interp
 
 
 @dataclass(frozen=True)
@@ -137,7 +147,7 @@ def resample(
     if tv.shape[0] < 2:
         return out
     for k in range(p.shape[1]):
-        out[:, k] = np.interp(grid, tv, pv[:, k])
+        out[:, k] = _interp(grid, tv, pv[:, k], None, None)
     bar = max_gap + 1e-9
     if float(np.max(np.diff(tv))) <= bar:
         # No gap between the samples is that long (the usual case): only the grid points
@@ -651,9 +661,9 @@ class SignalCache:
             sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
             sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
             seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
-        # (few new samples: their largest step in plain floats)
+        # (few new samples: their largest step in plain floats, each later minus earlier)
         new_t = t[n0 - 1 :].tolist()
-        max_dt = max(self._max_dt, max(b - a for a, b in zip(new_t, new_t[1:], strict=False)))
+        max_dt = max(self._max_dt, max(map(operator.sub, new_t[1:], new_t)))
         dt = 1.0 / config.analysis_rate
         # The smoothing width: half the median sample interval only counts when it exceeds
         # half the smoothing, which needs an interval that long.
@@ -692,8 +702,8 @@ class SignalCache:
             i_s = max(int(t.searchsorted(gs[0], side="right")) - 1, 0)
             ts = t[i_s:]
             for k in range(3):
-                xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
-                xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
+                xr[:, k] = _interp(gs, ts, g_in[i_s:, k], None, None)
+                xr[:, 3 + k] = _interp(gs, ts, r_in[i_s:, k], None, None)
             # (no step of the window is longer than bar: none of ts's is)
             if max_dt > bar and ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
                 xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
@@ -714,7 +724,7 @@ class SignalCache:
                 tv, pv = t[i_s:][valid], p_in[i_s:][valid]
                 cols = slice(3 * hand, 3 * hand + 3)
                 for k in range(3):
-                    xr[:, 3 * hand + k] = np.interp(gs, tv, pv[:, k])
+                    xr[:, 3 * hand + k] = _interp(gs, tv, pv[:, k], None, None)
                 # (what resample's two ways of marking far grid points both give here)
                 xr[_far_from_samples(tv, gs, bar), cols] = np.nan
         self._reserve(rows, a)
