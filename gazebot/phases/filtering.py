@@ -18,8 +18,9 @@ samples longer computes only the rows those samples change (the same result, bit
 
 Here and in the rules, the arrays' own methods (``a.searchsorted(x)``, ``m.nonzero()[0]``,
 ``a.argmax()``) stand for numpy's functions of the same name (``np.searchsorted``,
-``np.flatnonzero``, ``np.argmax``): the same computation without the functions' Python-level
-dispatch, which costs more than the work on these short arrays.
+``np.flatnonzero``, ``np.argmax``), and ``x[1:] - x[:-1]`` for ``np.diff(x)`` (the subtraction
+it makes), stand for numpy's functions: the same computation without the functions'
+Python-level dispatch, which costs more than the work on these short arrays.
 """
 
 from __future__ import annotations
@@ -142,14 +143,15 @@ def resample(
 ) -> np.ndarray:
     """Linear interpolation of the valid rows (``ok``; ``None``: all) of ``p`` (N, 3 or 6: two
     hands that share ``ok``) onto ``grid``; NaN inside gaps longer than ``max_gap``."""
-    out = np.full((grid.shape[0], p.shape[1]), np.nan)
+    out = np.empty((grid.shape[0], p.shape[1]))  # (every column is written below)
     tv, pv = (t, p) if ok is None else (t[ok], p[ok])
     if tv.shape[0] < 2:
+        out.fill(np.nan)
         return out
     for k in range(p.shape[1]):
         out[:, k] = _interp(grid, tv, pv[:, k], None, None)
     bar = max_gap + 1e-9
-    if float(np.max(np.diff(tv))) <= bar:
+    if float((tv[1:] - tv[:-1]).max()) <= bar:
         # No gap between the samples is that long (the usual case): only the grid points
         # before the first sample or after the last one are far from them.
         out[: int(grid.searchsorted(tv[0], side="left"))] = np.nan
@@ -452,7 +454,7 @@ def compute_signals(
         )
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
     # corners at every sample that would otherwise show up as speed spikes.
-    med_dt = median(np.diff(t)) if n > 1 else dt
+    med_dt = median(t[1:] - t[:-1]) if n > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
     fin = np.isfinite(x)
     m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands)
@@ -574,7 +576,7 @@ class SignalCache:
         self._clean = bool(ok.all())
         self._seen, self._ok = (None, None) if self._clean else (seen, ok)
         self._last_seen = [self._last_of(seen[:, h]) for h in (0, 1)]
-        self._max_dt = float(np.max(np.diff(t)))
+        self._max_dt = float((t[1:] - t[:-1]).max())
         self._sigma = sigma
         self._grid = s.t
         self._rows = s.t.shape[0]
@@ -669,7 +671,7 @@ class SignalCache:
         # half the smoothing, which needs an interval that long.
         sigma_s = 0.5 * config.smoothing
         if max_dt > config.smoothing:
-            sigma_s = max(sigma_s, 0.5 * median(np.diff(t)))
+            sigma_s = max(sigma_s, 0.5 * median(t[1:] - t[:-1]))
         if sigma_s / dt != self._sigma:
             return None
         grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)

@@ -86,7 +86,8 @@ def noise_floor(x: np.ndarray) -> float:
     little at tracking rates, and the median ignores a fidget)."""
     if x.shape[0] < 4:
         return 0.0
-    d2 = np.diff(x, n=2, axis=0).reshape(-1)
+    d1 = x[1:] - x[:-1]  # (np.diff(x, n=2, axis=0): the difference of the differences)
+    d2 = (d1[1:] - d1[:-1]).reshape(-1)
     mad = median(np.abs(d2 - median(d2)))
     return 1.4826 * mad / math.sqrt(6.0)
 
@@ -139,7 +140,8 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     rest = idx[(tv < w0 - 1e-9) & (tv >= w0 - c.predict_rest_window)]
     if fit.size < c.predict_min_samples or rest.size == 0:
         return None
-    steps = np.diff(t_all[fit])
+    t_fit = t_all[fit]
+    steps = t_fit[1:] - t_fit[:-1]  # (np.diff's subtraction)
     if float(steps.max()) > c.predict_gap_factor * median(steps):
         return None  # a dropout inside the window leaves the model unconstrained there
     # The line from the giver's resting hand to the receiver's hand now.
@@ -149,7 +151,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if gap <= 1e-6:
         return None
     u = line / gap
-    tf = t_all[fit] - now
+    tf = t_fit - now
     q = _Quadratic(tf)
     x_along = (g[fit] - g_rest) @ u
     coef = q.coefficients(x_along)
