@@ -47,7 +47,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import median, vector_norm
-from gazebot.phases.rules.directed import _Quadratic, noise_floor
+from gazebot.phases.rules.directed import _quadratic_at, noise_floor
 from gazebot.phases.trajectory import Trajectory
 
 
@@ -238,7 +238,7 @@ def sequential_reach(
     # model of the gap closes faster than predict_sigmas of its standard error ...
     w0 = min(now - c.predict_window, float(tw[-c.predict_min_samples]))
     fit = win[tw >= w0]
-    q = _Quadratic(t_all[fit] - now)
+    q = _quadratic_at(t_all[fit] - now)
     x_gap = -np.linalg.norm(r[fit] - g[fit], axis=1)
     coef = q.coefficients(x_gap)
     if coef is None:
