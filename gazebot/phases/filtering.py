@@ -19,8 +19,8 @@ samples longer computes only the rows those samples change (the same result, bit
 Here and in the rules, the arrays' own methods (``a.searchsorted(x)``, ``m.nonzero()[0]``,
 ``a.argmax()``) stand for numpy's functions of the same name (``np.searchsorted``,
 ``np.flatnonzero``, ``np.argmax``), and ``x[1:] - x[:-1]`` for ``np.diff(x)`` (the subtraction
-it makes), stand for numpy's functions: the same computation without the functions'
-Python-level dispatch, which costs more than the work on these short arrays.
+it makes): the same computation without the functions' Python-level dispatch, which costs
+more than the work on these short arrays.
 """
 
 from __future__ import annotations
