@@ -18,13 +18,15 @@ samples longer computes only the rows those samples change (the same result, bit
 
 Here and in the rules, the arrays' own methods (``a.searchsorted(x)``, ``m.nonzero()[0]``,
 ``a.argmax()``) stand for numpy's functions of the same name (``np.searchsorted``,
-``np.flatnonzero``, ``np.argmax``): the same computation without the functions' Python-level
-dispatch, which costs more than the work on these short arrays.
+``np.flatnonzero``, ``np.argmax``), and ``x[1:] - x[:-1]`` for ``np.diff(x)`` (the subtraction
+it makes): the same computation without the functions' Python-level dispatch, which costs
+more than the work on these short arrays.
 """
 
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -37,6 +39,15 @@ from gazebot.types import filled
 
 # Share of the smoothing window that must hold data for a velocity to be known.
 FULL_WINDOW = 0.6
+
+try:
+    # The compiled routine np.interp(x, xp, fp) of real values ends in (called with left and
+    # right None: its defaults): the same arithmetic without the public function's dispatch
+    # and argument checks, a few microseconds a call (the cache interpolates six columns per
+    # analysis). tests/phases/test_signals_fused.py pins it to np.interp.
+    from numpy._core.multiarray import interp as _interp
+except ImportError:  # pragma: no cover (another numpy layout: the public function itself)
+    _interp = np.interp
 
 
 @dataclass(frozen=True)
@@ -132,14 +143,15 @@ def resample(
 ) -> np.ndarray:
     """Linear interpolation of the valid rows (``ok``; ``None``: all) of ``p`` (N, 3 or 6: two
     hands that share ``ok``) onto ``grid``; NaN inside gaps longer than ``max_gap``."""
-    out = np.full((grid.shape[0], p.shape[1]), np.nan)
+    out = np.empty((grid.shape[0], p.shape[1]))  # (every column is written below)
     tv, pv = (t, p) if ok is None else (t[ok], p[ok])
     if tv.shape[0] < 2:
+        out.fill(np.nan)
         return out
     for k in range(p.shape[1]):
-        out[:, k] = np.interp(grid, tv, pv[:, k])
+        out[:, k] = _interp(grid, tv, pv[:, k], None, None)
     bar = max_gap + 1e-9
-    if float(np.max(np.diff(tv))) <= bar:
+    if float((tv[1:] - tv[:-1]).max()) <= bar:
         # No gap between the samples is that long (the usual case): only the grid points
         # before the first sample or after the last one are far from them.
         out[: int(grid.searchsorted(tv[0], side="left"))] = np.nan
@@ -211,11 +223,33 @@ def _smooth_all_seen(x: np.ndarray, hands: int, sigma: float) -> tuple[np.ndarra
     return out, den
 
 
+@lru_cache(maxsize=64)
+def _prefix_shares(rows: int, seen: int, sigma: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What :func:`smooth`'s masked path derives from a mask of ``rows`` rows whose first
+    ``seen`` are seen (both hands), which depends on those three numbers alone (computed once
+    per triple: the online cache asks for the same few again and again): the window's seen
+    share per row and hand (rows, 2; smooth's ``den``, the same correlation of the same
+    line), its divisor ``max(share, 1e-12)`` per column (rows, 6) and which columns come out
+    unknown (rows, 6: a share under 0.5, or an unseen row). Read-only."""
+    line = np.zeros((rows, 2))
+    line[:seen] = 1.0
+    share = np.empty_like(line)
+    correlate1d(line, gaussian_weights(sigma), axis=0, output=share, mode="nearest")
+    # (hand h's three columns are 3h..3h+2, as smooth's (rows, hands, 3) reshape lays them)
+    divisor = np.repeat(np.maximum(share, 1e-12), 3, axis=1)
+    unknown = np.repeat(share < 0.5, 3, axis=1)
+    unknown[seen:] = True
+    for a in (share, divisor, unknown):
+        a.flags.writeable = False
+    return share, divisor, unknown
+
+
 def smooth_seen_prefix(x: np.ndarray, seen: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`smooth` of rows ``x`` (N, 6: both hands) whose first ``seen`` rows are seen for
-    both hands and the rest for neither (NaN, as written here where :func:`smooth` returns
-    ``x`` itself; else not read): the same result, bit for bit, without finding that mask (the
-    online cache knows it: its rows past the newest sample are the only unknown ones)."""
+    """:func:`smooth` of rows ``x`` (N, 6: both hands, contiguous) whose first ``seen`` rows
+    are seen for both hands and the rest for neither (overwritten here: NaN where
+    :func:`smooth` returns ``x`` itself, else zeros; not read): the same result, bit for bit,
+    without finding that mask (the online cache knows it: its rows past the newest sample are
+    the only unknown ones). The seen share returned may be read-only."""
     rows = x.shape[0]
     if seen >= rows and sigma > 0 and rows >= 2:
         return _smooth_all_seen(x, 2, sigma)
@@ -225,19 +259,17 @@ def smooth_seen_prefix(x: np.ndarray, seen: int, sigma: float) -> tuple[np.ndarr
         x[seen:] = np.nan
         return smooth(x, m, sigma)
     # smooth's masked path with that mask: a seen row keeps its values and counts 1, an
-    # unseen one counts 0 with zeros (np.where's), and unseen rows come out NaN
-    w = gaussian_weights(sigma)
-    stack = np.empty((rows, 2, 4))
-    stack[:seen, :, :3] = x[:seen].reshape(seen, 2, 3)
-    stack[:seen, :, 3] = 1.0
-    stack[seen:] = 0.0
-    both = np.empty_like(stack)
-    correlate1d(stack, w, axis=0, output=both, mode="nearest")
-    den = both[:, :, 3]
-    out = both[:, :, :3] / np.maximum(den, 1e-12)[:, :, None]
-    out[den < 0.5] = np.nan  # do not invent samples inside long gaps
-    out[seen:] = np.nan
-    return out.reshape(rows, 6), den
+    # unseen one counts 0 with zeros (np.where's), and unseen rows come out NaN. Each column
+    # is correlated on its own (the same line, the same sums, whatever the array's shape), so
+    # the positions take one correlation of x with zeros past the seen rows, and the mask's
+    # correlation and what follows from it are the cached ones.
+    share, divisor, unknown = _prefix_shares(rows, seen, sigma)
+    x[seen:] = 0.0
+    out = np.empty_like(x)
+    correlate1d(x, gaussian_weights(sigma), axis=0, output=out, mode="nearest")
+    np.divide(out, divisor, out=out)
+    out[unknown] = np.nan  # do not invent samples inside long gaps, nor past the newest
+    return out, share
 
 
 # What np.nanmax (np.nanmin) computes for a float array: the largest (smallest) value that is
@@ -422,7 +454,7 @@ def compute_signals(
         )
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
     # corners at every sample that would otherwise show up as speed spikes.
-    med_dt = median(np.diff(t)) if n > 1 else dt
+    med_dt = median(t[1:] - t[:-1]) if n > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
     fin = np.isfinite(x)
     m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands)
@@ -544,7 +576,7 @@ class SignalCache:
         self._clean = bool(ok.all())
         self._seen, self._ok = (None, None) if self._clean else (seen, ok)
         self._last_seen = [self._last_of(seen[:, h]) for h in (0, 1)]
-        self._max_dt = float(np.max(np.diff(t)))
+        self._max_dt = float((t[1:] - t[:-1]).max())
         self._sigma = sigma
         self._grid = s.t
         self._rows = s.t.shape[0]
@@ -631,15 +663,15 @@ class SignalCache:
             sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
             sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
             seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
-        # (few new samples: their largest step in plain floats)
+        # (few new samples: their largest step in plain floats, each later minus earlier)
         new_t = t[n0 - 1 :].tolist()
-        max_dt = max(self._max_dt, max(b - a for a, b in zip(new_t, new_t[1:], strict=False)))
+        max_dt = max(self._max_dt, max(map(operator.sub, new_t[1:], new_t)))
         dt = 1.0 / config.analysis_rate
         # The smoothing width: half the median sample interval only counts when it exceeds
         # half the smoothing, which needs an interval that long.
         sigma_s = 0.5 * config.smoothing
         if max_dt > config.smoothing:
-            sigma_s = max(sigma_s, 0.5 * median(np.diff(t)))
+            sigma_s = max(sigma_s, 0.5 * median(t[1:] - t[:-1]))
         if sigma_s / dt != self._sigma:
             return None
         grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
@@ -672,8 +704,8 @@ class SignalCache:
             i_s = max(int(t.searchsorted(gs[0], side="right")) - 1, 0)
             ts = t[i_s:]
             for k in range(3):
-                xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
-                xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
+                xr[:, k] = _interp(gs, ts, g_in[i_s:, k], None, None)
+                xr[:, 3 + k] = _interp(gs, ts, r_in[i_s:, k], None, None)
             # (no step of the window is longer than bar: none of ts's is)
             if max_dt > bar and ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
                 xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
@@ -694,7 +726,7 @@ class SignalCache:
                 tv, pv = t[i_s:][valid], p_in[i_s:][valid]
                 cols = slice(3 * hand, 3 * hand + 3)
                 for k in range(3):
-                    xr[:, 3 * hand + k] = np.interp(gs, tv, pv[:, k])
+                    xr[:, 3 * hand + k] = _interp(gs, tv, pv[:, k], None, None)
                 # (what resample's two ways of marking far grid points both give here)
                 xr[_far_from_samples(tv, gs, bar), cols] = np.nan
         self._reserve(rows, a)
@@ -711,12 +743,15 @@ class SignalCache:
         # arithmetic, written in place where _derived_into reads them (giver, receiver)
         x, q = b["x"], b["q"][:, a - 1 : rows]
         vq = q[2:4]
-        # (differenced and scaled on contiguous rows, then copied into the hands' blocks:
-        # half the time of the same arithmetic on the blocks' strided views)
-        diff = x[a:rows] - x[a - 2 : rows - 2]
-        diff /= 2.0 * dt
-        vq[:, :-1] = _by_hand(diff)
-        vq[:, -1] = ((x[rows - 1] - x[rows - 2]) / dt).reshape(2, 3)
+        # (differenced and scaled on contiguous rows, the last one-sided, then copied into
+        # the hands' blocks in one go: half the time of the same arithmetic on the blocks'
+        # strided views)
+        diff = np.empty((rows - a + 1, 6))
+        np.subtract(x[a:rows], x[a - 2 : rows - 2], out=diff[:-1])
+        np.subtract(x[rows - 1], x[rows - 2], out=diff[-1])
+        diff[:-1] /= 2.0 * dt
+        diff[-1] /= dt
+        vq[:] = _by_hand(diff)
         shares = b["full"][a - 1 : rows]
         if shares.min() < FULL_WINDOW:  # (away from tracking gaps, none is)
             vq[shares.T < FULL_WINDOW] = np.nan

@@ -9,7 +9,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.prediction import predict_end
-from gazebot.phases.rules.directed import _Quadratic
+from gazebot.phases.rules.directed import _Quadratic, _quadratic_at
 from gazebot.phases.rules.sequential import _grids, min_jerk_profile, reach_evidence
 from gazebot.types import Phase
 
@@ -48,6 +48,38 @@ def test_a_shared_quadratic_design_fits_each_signal_as_its_own_fit_would():
                 continue
             assert q.state(coef).tobytes() == ref[0].tobytes()
             assert q.errors(x, coef, noise).tobytes() == ref[1].tobytes()
+
+
+def test_a_design_shared_between_calls_fits_each_signal_as_its_own_fit_would():
+    """_quadratic_at hands the same design to windows with the same times (bit for bit), and
+    its remembered fits (a signal fitted again, as the directed and sequential rules fit the
+    gap) and inverse give each fit's own values: against the plain reference, with windows
+    whose times repeat and signals that repeat, in any order."""
+    rng = np.random.default_rng(13)
+    times = [np.sort(-rng.uniform(0.0, 0.3, int(rng.integers(3, 30)))) for _ in range(5)]
+    for t in times:
+        t[-1] = 0.0
+    times.append(np.zeros(4))  # a singular design: no fit, remembered as none
+    signals = {id(t): [np.cumsum(rng.normal(0.0, 0.01, t.shape[0])) for _ in range(3)]
+               for t in times}
+    for _ in range(200):
+        t = times[int(rng.integers(len(times)))]
+        q = _quadratic_at(t.copy())  # (equal times in a new array: the same design)
+        assert q is _quadratic_at(t)
+        assert not q.m.flags.writeable
+        x = signals[id(t)][int(rng.integers(3))].copy()
+        noise = float(rng.choice([0.0, 1e-3]))
+        ref = _fit_reference(t, x, noise)
+        coef = q.coefficients(x)
+        assert (coef is None) == (ref is None)
+        if ref is None:
+            continue
+        assert not coef.flags.writeable
+        assert q.state(coef).tobytes() == ref[0].tobytes()
+        assert q.errors(x, coef, noise).tobytes() == ref[1].tobytes()
+    # (a negative zero is other bits: another design, the same values)
+    t0 = np.array([-0.2, -0.1, 0.0])
+    assert _quadratic_at(t0) is not _quadratic_at(np.array([-0.2, -0.1, -0.0]))
 
 
 def test_the_in_place_min_jerk_profile_equals_the_plain_one():

@@ -287,3 +287,47 @@ def test_trigger_dot_bar_decides_as_numpys_dot() -> None:
             if np.isfinite(bar):
                 got = _dot_over_at_least(a.tolist(), b.tolist(), float(d), float(bar))
                 assert got == (own >= bar), (a, b, d, bar)
+
+
+def test_the_compiled_interpolation_is_np_interp_bit_for_bit() -> None:
+    """filtering._interp (np.interp's compiled routine, called directly) gives np.interp's
+    values: points before, between, on and after the samples, NaN and strided values."""
+    from gazebot.phases.filtering import _interp
+
+    rng = np.random.default_rng(5)
+    for n in (1, 2, 7, 60):
+        xp = np.cumsum(rng.uniform(0.001, 0.02, n))
+        fp2 = rng.normal(size=(n, 3))
+        fp2[rng.random((n, 3)) < 0.05] = np.nan
+        x = np.concatenate((rng.uniform(xp[0] - 0.05, xp[-1] + 0.05, 40), xp[::2]))
+        for k in range(3):
+            fp = fp2[:, k]  # (a strided column, as the cache passes)
+            got = _interp(x, xp, fp, None, None)
+            np.testing.assert_array_equal(got.view(np.int64), np.interp(x, xp, fp).view(np.int64))
+
+
+def test_the_subtractions_standing_for_np_diff_give_its_bits() -> None:
+    """``x[1:] - x[:-1]`` (filtering, the reach rules' steps) and the difference of the
+    differences (the noise floor's) are np.diff's values, n=1 and n=2, on a strided column,
+    NaN and inf included; the max and median read from them are then the same too."""
+    from gazebot.phases.filtering import median
+    from gazebot.phases.rules.directed import noise_floor
+
+    rng = np.random.default_rng(8)
+    rows = rng.normal(size=(50, 7))
+    rows[rng.random((50, 7)) < 0.04] = np.nan
+    rows[3, 2] = np.inf
+    t = rows[:, 0]  # (strided, as the detector's window columns are)
+    np.testing.assert_array_equal((t[1:] - t[:-1]).view(np.int64), np.diff(t).view(np.int64))
+    x = rows[:, 1:4]
+    d1 = x[1:] - x[:-1]
+    np.testing.assert_array_equal(
+        (d1[1:] - d1[:-1]).view(np.int64), np.diff(x, n=2, axis=0).view(np.int64)
+    )
+    clean = np.cumsum(rng.uniform(0.005, 0.01, 60))
+    assert float((clean[1:] - clean[:-1]).max()) == float(np.max(np.diff(clean)))
+    assert median(clean[1:] - clean[:-1]) == float(np.median(np.diff(clean)))
+    hand = rng.normal(size=(40, 3)) * 0.002
+    d2 = np.diff(hand, n=2, axis=0).reshape(-1)
+    want = 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0)
+    assert noise_floor(hand) == want

@@ -29,6 +29,7 @@ with the one minimum-jerk helper (:func:`~gazebot.phases.rules.onset.min_jerk_sp
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -42,7 +43,8 @@ from gazebot.phases.trajectory import Trajectory
 class _Quadratic:
     """The least-squares design of ``x ~ c0 + c1 t + c2 t^2`` at times ``t`` (relative to the
     newest sample), shared by every fit at those times: the rule fits several signals at the
-    same times, and the design matrix and its normal matrix's inverse are the same for all."""
+    same times, and the design matrix and its normal matrix's inverse are the same for all.
+    The rules take theirs from :func:`_quadratic_at`, which also shares it between calls."""
 
     def __init__(self, t: np.ndarray) -> None:
         n = t.shape[0]
@@ -55,12 +57,27 @@ class _Quadratic:
         self.lin = np.array(
             [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0], [0.0, -t[0], -(t[0] ** 2)]]
         )
+        m.flags.writeable = False
+        self.lin.flags.writeable = False
         self._inverse: np.ndarray | None = None
+        # The last fits: the signal's bytes -> its coefficients (read-only), or None. The
+        # directed and the sequential rule fit the same gap signal at the same times in one
+        # analysis; an identical lstsq call gives identical values, so it is made once.
+        self._fits: dict[bytes, np.ndarray | None] = {}
 
     def coefficients(self, x: np.ndarray) -> np.ndarray | None:
-        """``(c0, c1, c2)`` fitted to ``x``; ``None`` if the design is singular."""
+        """``(c0, c1, c2)`` fitted to ``x`` (read-only); ``None`` if the design is singular."""
+        key = x.tobytes()
+        if key in self._fits:
+            return self._fits[key]
         coef, _, rank, _ = np.linalg.lstsq(self.m, x, rcond=None)
-        return None if rank < 3 else coef
+        out = None if rank < 3 else coef
+        if out is not None:
+            out.flags.writeable = False
+        if len(self._fits) >= _FITS_KEPT:
+            self._fits.clear()
+        self._fits[key] = out
+        return out
 
     def state(self, coef: np.ndarray) -> np.ndarray:
         """``(x, v, a)`` at ``t = 0`` and the travel ``x(0) - x(t[0])`` of the fit ``coef``."""
@@ -74,10 +91,31 @@ class _Quadratic:
         res = x - m @ coef
         var = max(noise * noise, float(res @ res) / max(n - 3, 1))
         if self._inverse is None:
-            self._inverse = np.linalg.inv(m.T @ m)
+            inverse = np.linalg.inv(m.T @ m)
+            inverse.flags.writeable = False
+            self._inverse = inverse
         cov = var * self._inverse
         lin = self.lin
         return np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", lin, cov, lin), 0.0))
+
+
+# Fits a shared design remembers (a few analyses' worth: each fits at most six signals).
+_FITS_KEPT = 16
+
+
+@functools.lru_cache(maxsize=16)
+def _quadratic_of(t_bits: bytes) -> _Quadratic:
+    """The design at the float64 times whose bytes are ``t_bits`` (see :func:`_quadratic_at`)."""
+    return _Quadratic(np.frombuffer(t_bits))
+
+
+def _quadratic_at(t: np.ndarray) -> _Quadratic:
+    """The shared :class:`_Quadratic` of the float64 times ``t``: at a regular sample rate the
+    fit windows of successive analyses hold the same relative times, bit for bit, so their
+    design, its inverse (a LAPACK call that costs tens of microseconds with its code out of
+    the caches) and identical fits are made once. Keyed by the times' bytes: the same bits,
+    the same design, so the same values as a fresh one."""
+    return _quadratic_of(np.ascontiguousarray(t, dtype=float).tobytes())
 
 
 def noise_floor(x: np.ndarray) -> float:
@@ -86,7 +124,8 @@ def noise_floor(x: np.ndarray) -> float:
     little at tracking rates, and the median ignores a fidget)."""
     if x.shape[0] < 4:
         return 0.0
-    d2 = np.diff(x, n=2, axis=0).reshape(-1)
+    d1 = x[1:] - x[:-1]  # (np.diff(x, n=2, axis=0): the difference of the differences)
+    d2 = (d1[1:] - d1[:-1]).reshape(-1)
     mad = median(np.abs(d2 - median(d2)))
     return 1.4826 * mad / math.sqrt(6.0)
 
@@ -139,7 +178,8 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     rest = idx[(tv < w0 - 1e-9) & (tv >= w0 - c.predict_rest_window)]
     if fit.size < c.predict_min_samples or rest.size == 0:
         return None
-    steps = np.diff(t_all[fit])
+    t_fit = t_all[fit]
+    steps = t_fit[1:] - t_fit[:-1]  # (np.diff's subtraction)
     if float(steps.max()) > c.predict_gap_factor * median(steps):
         return None  # a dropout inside the window leaves the model unconstrained there
     # The line from the giver's resting hand to the receiver's hand now.
@@ -149,8 +189,8 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if gap <= 1e-6:
         return None
     u = line / gap
-    tf = t_all[fit] - now
-    q = _Quadratic(tf)
+    tf = t_fit - now
+    q = _quadratic_at(tf)
     x_along = (g[fit] - g_rest) @ u
     coef = q.coefficients(x_along)
     if coef is None:

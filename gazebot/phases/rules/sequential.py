@@ -47,7 +47,7 @@ import numpy as np
 
 from gazebot.phases.config import PhaseConfig
 from gazebot.phases.filtering import median, vector_norm
-from gazebot.phases.rules.directed import _Quadratic, noise_floor
+from gazebot.phases.rules.directed import _quadratic_at, noise_floor
 from gazebot.phases.trajectory import Trajectory
 
 
@@ -228,7 +228,7 @@ def sequential_reach(
     # A dropout only matters where the gap's closing is fitted (the last predict_window): the
     # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
     # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
-    steps = np.diff(tw)
+    steps = tw[1:] - tw[:-1]  # (np.diff's subtraction)
     recent = tw[1:] >= now - c.predict_window
     step = median(steps)
     if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
@@ -238,7 +238,7 @@ def sequential_reach(
     # model of the gap closes faster than predict_sigmas of its standard error ...
     w0 = min(now - c.predict_window, float(tw[-c.predict_min_samples]))
     fit = win[tw >= w0]
-    q = _Quadratic(t_all[fit] - now)
+    q = _quadratic_at(t_all[fit] - now)
     x_gap = -np.linalg.norm(r[fit] - g[fit], axis=1)
     coef = q.coefficients(x_gap)
     if coef is None:
