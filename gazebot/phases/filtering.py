@@ -40,15 +40,6 @@ from gazebot.types import filled
 # Share of the smoothing window that must hold data for a velocity to be known.
 FULL_WINDOW = 0.6
 
-try:
-    # The compiled routine np.interp(x, xp, fp) of real values ends in (called with left and
-    # right None: its defaults): the same arithmetic without the public function's dispatch
-    # and argument checks, a few microseconds a call (the cache interpolates six columns per
-    # analysis). tests/phases/test_signals_fused.py pins it to np.interp.
-    from numpy._core.multiarray import interp as _interp
-except ImportError:  # pragma: no cover (another numpy layout: the public function itself)
-    _interp = np.interp
-
 
 @dataclass(frozen=True)
 class Signals:
@@ -149,7 +140,7 @@ def resample(
         out.fill(np.nan)
         return out
     for k in range(p.shape[1]):
-        out[:, k] = _interp(grid, tv, pv[:, k], None, None)
+        out[:, k] = np.interp(grid, tv, pv[:, k])
     bar = max_gap + 1e-9
     if float((tv[1:] - tv[:-1]).max()) <= bar:
         # No gap between the samples is that long (the usual case): only the grid points
@@ -704,8 +695,8 @@ class SignalCache:
             i_s = max(int(t.searchsorted(gs[0], side="right")) - 1, 0)
             ts = t[i_s:]
             for k in range(3):
-                xr[:, k] = _interp(gs, ts, g_in[i_s:, k], None, None)
-                xr[:, 3 + k] = _interp(gs, ts, r_in[i_s:, k], None, None)
+                xr[:, k] = np.interp(gs, ts, g_in[i_s:, k])
+                xr[:, 3 + k] = np.interp(gs, ts, r_in[i_s:, k])
             # (no step of the window is longer than bar: none of ts's is)
             if max_dt > bar and ts.shape[0] > 1 and float((ts[1:] - ts[:-1]).max()) > bar:
                 xr[_far_from_samples(ts, gs, bar)] = np.nan  # (resample's long-gap path)
@@ -726,7 +717,7 @@ class SignalCache:
                 tv, pv = t[i_s:][valid], p_in[i_s:][valid]
                 cols = slice(3 * hand, 3 * hand + 3)
                 for k in range(3):
-                    xr[:, 3 * hand + k] = _interp(gs, tv, pv[:, k], None, None)
+                    xr[:, 3 * hand + k] = np.interp(gs, tv, pv[:, k])
                 # (what resample's two ways of marking far grid points both give here)
                 xr[_far_from_samples(tv, gs, bar), cols] = np.nan
         self._reserve(rows, a)

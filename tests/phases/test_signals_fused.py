@@ -289,23 +289,6 @@ def test_trigger_dot_bar_decides_as_numpys_dot() -> None:
                 assert got == (own >= bar), (a, b, d, bar)
 
 
-def test_the_compiled_interpolation_is_np_interp_bit_for_bit() -> None:
-    """filtering._interp (np.interp's compiled routine, called directly) gives np.interp's
-    values: points before, between, on and after the samples, NaN and strided values."""
-    from gazebot.phases.filtering import _interp
-
-    rng = np.random.default_rng(5)
-    for n in (1, 2, 7, 60):
-        xp = np.cumsum(rng.uniform(0.001, 0.02, n))
-        fp2 = rng.normal(size=(n, 3))
-        fp2[rng.random((n, 3)) < 0.05] = np.nan
-        x = np.concatenate((rng.uniform(xp[0] - 0.05, xp[-1] + 0.05, 40), xp[::2]))
-        for k in range(3):
-            fp = fp2[:, k]  # (a strided column, as the cache passes)
-            got = _interp(x, xp, fp, None, None)
-            np.testing.assert_array_equal(got.view(np.int64), np.interp(x, xp, fp).view(np.int64))
-
-
 def test_the_subtractions_standing_for_np_diff_give_its_bits() -> None:
     """``x[1:] - x[:-1]`` (filtering, the reach rules' steps) and the difference of the
     differences (the noise floor's) are np.diff's values, n=1 and n=2, on a strided column,

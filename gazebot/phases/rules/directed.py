@@ -68,8 +68,10 @@ class _Quadratic:
     def coefficients(self, x: np.ndarray) -> np.ndarray | None:
         """``(c0, c1, c2)`` fitted to ``x`` (read-only); ``None`` if the design is singular."""
         key = x.tobytes()
-        if key in self._fits:
-            return self._fits[key]
+        # (one dict read, never a test then a read: another thread's clear() may run between)
+        known = self._fits.get(key, _UNFITTED)
+        if known is not _UNFITTED:
+            return known  # type: ignore[return-value]
         coef, _, rank, _ = np.linalg.lstsq(self.m, x, rcond=None)
         out = None if rank < 3 else coef
         if out is not None:
@@ -101,6 +103,7 @@ class _Quadratic:
 
 # Fits a shared design remembers (a few analyses' worth: each fits at most six signals).
 _FITS_KEPT = 16
+_UNFITTED = object()  # (a fit can be None: singular design)
 
 
 @functools.lru_cache(maxsize=16)
