@@ -69,9 +69,9 @@ def alternating(
     ours: Callable[[], object], peer: Callable[[], object], rounds: int = 15, number: int = 1
 ) -> tuple[float, float, float, float]:
     """Wall median and least CPU time (``time.thread_time``) per call of ``ours`` and
-    ``peer``, timed in alternating rounds of ``number`` calls each (one warm-up round first):
-    load from other processes, which comes in bursts longer than a round, then hits both
-    alike instead of whichever ran during a burst. Returns ``(ours_wall, peer_wall, ours_cpu,
+    ``peer``, timed in alternating rounds of ``number`` calls each (after one warm-up call
+    of each): load from other processes, which comes in bursts longer than a round, then hits
+    both alike instead of whichever ran during a burst. Returns ``(ours_wall, peer_wall, ours_cpu,
     peer_cpu)`` in seconds."""
     ours()
     peer()

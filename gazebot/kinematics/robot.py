@@ -264,7 +264,9 @@ class RobotModel:
         q = self._q_work
         one = self._head_one
         if one is not None:
-            (q[one],) = q_head  # (a ValueError for another length, as the slice set gives)
+            if len(key[0]) != 1:
+                raise ValueError(f"expected 1 head joint value, got {len(key[0])}")
+            q[one] = key[0][0]  # (an item set: a quarter of the slice set's cost)
         else:
             q[self._head_sel] = q_head
         pin.forwardKinematics(self.model, self.data, q)

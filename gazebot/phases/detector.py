@@ -438,8 +438,9 @@ class PhaseDetector:
             if n - i0 < 3:
                 i0 = 0
         window = rows[i0:]
-        # (the rows are float64 of known shapes: no conversion or check needed; views, not
-        # copies: only this analysis reads them, and nothing writes to a trajectory's arrays)
+        window.flags.writeable = False  # (a method writing into it would change the samples kept)
+        # (the rows are float64 of known shapes: no conversion or check needed; read-only
+        # views, not copies: only this analysis reads them)
         traj = Trajectory.of_hands(
             window[:, 0], window[:, 1:4], window[:, 4:], self._unknown_block(window.shape[0])
         )

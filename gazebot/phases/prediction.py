@@ -33,13 +33,13 @@ def _mirrored(
     t, v = t[:k], v[:k]
     if not k:
         return onset + nominal
-    # argmax stops at the first NaN or inf: a finite largest value means every speed is known
-    # (speeds are never -inf), the usual case, with no NaN to pass over and no mask to build
+    # argmax returns the first NaN if there is one, and +inf is the largest value: with a
+    # finite largest value and a finite last one, the peak and the last known speed are what
+    # the NaN-aware reads below give (the usual case: no mask to build)
     i = int(v.argmax())
     peak = float(v[i])
-    if math.isfinite(peak):
-        last = float(v[-1])
-    else:
+    last = float(v[-1])
+    if not (math.isfinite(peak) and math.isfinite(last)):
         ok = np.isfinite(v)
         if not ok.any():
             return onset + nominal

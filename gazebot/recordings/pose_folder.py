@@ -5,6 +5,7 @@ Names are the file names without ``_pose_saved.csv`` / ``.csv``; rows are sample
 
 from __future__ import annotations
 
+import math
 import re
 import warnings
 from pathlib import Path
@@ -81,7 +82,12 @@ def read_pose_folder(
     counts = {len(v) for v in points.values()}
     n = min(counts)
     points = {k: v[:n] for k, v in points.items()}
-    t = np.arange(n) / float(rate)
+    with np.errstate(over="ignore"):  # (checked below: a rate so small the times overflow)
+        t = np.arange(n) / float(rate)
+    if n and not math.isfinite(float(t[-1])):
+        raise RecordingError(
+            path, f"--rate {rate!r} Hz puts the samples beyond any time (expected a rate in Hz)"
+        )
     return build(
         path,
         "pose-folder",

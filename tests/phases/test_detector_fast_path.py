@@ -159,6 +159,7 @@ def test_the_predicted_end_reads_the_peak_np_nanargmax_finds():
         v = np.round(rng.random(n), 1)  # ties: the first largest wins
         v[rng.random(n) < 0.3] = np.nan
         v[rng.random(n) < 0.05] = np.inf
+        v[rng.random(n) < 0.05] = -np.inf  # (no speed is, but the rule reads it as numpy would)
         if np.isnan(v).all():
             continue
         now = float(t[-1]) + float(rng.uniform(0.0, 0.2))
@@ -187,3 +188,40 @@ def test_kept_samples_are_the_window_of_the_samples_appended():
         assert kept.time(0) == rows[0][0] and kept.time(len(rows) - 1) == rows[-1][0]
         if i % int(rng.integers(1, 40)) == 0:
             np.testing.assert_array_equal(kept.rows(), np.array(rows))
+
+
+def test_a_long_one_hand_loss_keeps_the_detector_bounded():
+    """While one hand stays lost (tracking lost: the trigger's periods do not close), the
+    detector keeps nothing per sample beyond its window: a minute more of the loss leaves its
+    memory where it was, and the tick that restores tracking stays an ordinary one."""
+    import tracemalloc
+
+    from gazebot.phases.detector import PhaseDetector
+    from gazebot.types import TrackingFrame
+
+    det = PhaseDetector(PhaseConfig())
+    rate, t = 120.0, 0.0
+    lost = np.array([np.nan, np.nan, np.nan])
+
+    def feed(seconds: float, receiver_seen: bool) -> None:
+        nonlocal t
+        for _ in range(int(seconds * rate)):
+            t += 1.0 / rate
+            receiver = np.array([0.6, 0.0, 1.0]) if receiver_seen else lost
+            det.update_all(TrackingFrame.make(t, giver_hand=np.array([0.0, 0.3, 1.0]),
+                                              receiver_hand=receiver))
+
+    feed(2.0, True)
+    feed(20.0, False)
+    assert not det.tracking
+    tracemalloc.start()
+    try:
+        feed(5.0, False)
+        before = tracemalloc.get_traced_memory()[0]
+        feed(60.0, False)
+        grown = tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+    assert grown < 50_000, f"{grown} bytes more after a minute of one-hand loss"
+    feed(1.0, True)
+    assert det.tracking

@@ -68,3 +68,26 @@ def test_dips_of_one_or_no_sample() -> None:
 def test_dips_need_a_positive_depth() -> None:
     with pytest.raises(ValueError, match="depth must be > 0"):
         dips(np.array([1.0, 0.5, 1.0]), 0.0)
+
+
+def test_dips_match_the_zigzag_on_long_recordings_with_many_legs() -> None:
+    """Legs shorter and much longer than the first search window, hundreds of them: the same
+    dips (the windows double from each leg's start, so a leg's search never reads past what
+    it needs by more than its own length)."""
+    rng = np.random.default_rng(23)
+    t = np.arange(6000) / 120.0
+    for freq, noise in ((3.0, 0.002), (0.05, 0.01), (0.7, 0.0)):
+        d = 0.5 + 0.3 * np.sin(2 * np.pi * freq * t) + rng.normal(0.0, noise, t.shape[0])
+        d[rng.random(t.shape[0]) < 0.01] = np.nan
+        for depth in (0.05, 0.2, 0.7):
+            assert dips(d, depth) == _dips_by_sample(d, depth), (freq, depth)
+
+
+def test_dips_of_float32_distances_are_decided_in_float64() -> None:
+    """A float32 signal is compared in float64, as the zigzag's plain floats compare it."""
+    rng = np.random.default_rng(29)
+    for _ in range(300):
+        d = (1.0 + np.cumsum(rng.normal(0.0, 0.1, 40))).astype(np.float32)
+        assert dips(d, 0.2) == _dips_by_sample(d, 0.2)
+    d = np.array([0.7, 0.9, 0.2], np.float32)
+    assert dips(d, 0.2) == _dips_by_sample(d, 0.2)

@@ -132,6 +132,11 @@ def test_pose_folder_bounds_coordinates_and_refuses_a_rate_with_huge_steps(tmp_p
     assert rec.out_of_workspace == 3
     with pytest.raises(RecordingError, match="row 3: .*gaps over 60 s"):
         load_recording(d, NAMES, rate=1e-6)
+    # a rate so small that the sample times overflow (found by the pose-folder fuzz test)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(RecordingError, match=r"--rate 2\.2250738585e-313 Hz"):
+            load_recording(d, NAMES, rate=2.2250738585e-313)
 
 
 def test_bag_outlier_stamp_is_an_error_naming_the_topic(tmp_path):

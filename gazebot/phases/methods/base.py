@@ -86,7 +86,10 @@ class Segmenter(ABC):
     ) -> Signals | None:
         """The signals of the samples seen so far (for the end-of-phase prediction);
         ``cache``: the detector's, so a window that only grew is computed only where it
-        changed (see :func:`~gazebot.phases.filtering.compute_signals`)."""
+        changed (see :func:`~gazebot.phases.filtering.compute_signals`).
+
+        The online detector's trajectories are read-only views of the samples it keeps (a
+        method copies what it wants to change)."""
         return compute_signals(trajectory, self.config, cache) if len(trajectory) else None
 
     def online_segments(

@@ -44,19 +44,6 @@ def _nanmean2(a: Sequence[float], b: Sequence[float]) -> list[float]:
     return out
 
 
-def _mean3(points: list[Sequence[float]]) -> tuple[float, float, float]:
-    """The mean of 3-vectors (summed in order from 0.0, over their count), NaNs if none."""
-    n = len(points)
-    if not n:
-        return math.nan, math.nan, math.nan
-    sx = sy = sz = 0.0
-    for x, y, z in points:
-        sx += x
-        sy += y
-        sz += z
-    return sx / n, sy / n, sz / n
-
-
 def _norm_at_least(v: Sequence[float], bar: float) -> bool:
     """``vector_norm(np.array(v)) >= bar`` (a 3-vector, ``bar`` >= 0), decided in plain floats
     unless the squares' sum is within rounding of ``bar``'s square: numpy's dot may sum the
@@ -169,10 +156,11 @@ class GazebotTrigger:
         self._speed_rows = int((c.smoothing + c.edge_guard + c.trigger_speed_baseline) / period)
         self._step_time = self._k * period  # s a giver step spans
         self._onset_bar = c.trigger_distance_factor * c.reach_onset_speed
-        # The positions seen this period, per hand (summed in plain floats when it closes: a
-        # sample costs an append, not numpy calls).
-        self._seen_g: list[Sequence[float]] = []
-        self._seen_r: list[Sequence[float]] = []
+        # Sums of the positions seen this period and their counts, per hand, in plain floats:
+        # a sample costs a few additions, not numpy calls, and nothing is kept per sample
+        # (tracking lost for long skips the periods' close, not the samples).
+        self._sums = [0.0] * 6  # giver xyz, receiver xyz
+        self._ng = self._nr = 0
         # The rows kept are items _s0.. of each column (times, giver means, receiver means,
         # relative positions, distances, giver steps: |giver - giver trigger_speed_baseline
         # earlier|); the relative position, distance and step are computed once per row. Item
@@ -192,12 +180,20 @@ class GazebotTrigger:
         self._held: tuple[int, int, list[float], int] = (-1, -1, [], 0)
 
     def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
-        """Keep one sample's hand positions (``*_ok``: that hand was seen) until the period
-        closes (the sequences are kept, not copied: the caller does not change them)."""
+        """Add one sample's hand positions (``*_ok``: that hand was seen) to the period's sums."""
+        a = self._sums
         if g_ok:
-            self._seen_g.append(g)
+            x, y, z = g
+            a[0] += x
+            a[1] += y
+            a[2] += z
+            self._ng += 1
         if r_ok:
-            self._seen_r.append(r)
+            x, y, z = r
+            a[3] += x
+            a[4] += y
+            a[5] += z
+            self._nr += 1
 
     def decide(self, now: float, state: OnlineState) -> TriggerMode:
         """Close the period: ``full`` if the next boundary may have passed, ``refresh`` if not
@@ -228,10 +224,11 @@ class GazebotTrigger:
             s0, end = 0, end - s0
         self._s0 = s0
         nan = math.nan
-        gx, gy, gz = _mean3(self._seen_g)
-        rx, ry, rz = _mean3(self._seen_r)
-        self._seen_g.clear()
-        self._seen_r.clear()
+        a, ng, nr = self._sums, self._ng, self._nr
+        gx, gy, gz = (a[0] / ng, a[1] / ng, a[2] / ng) if ng else (nan, nan, nan)
+        rx, ry, rz = (a[3] / nr, a[4] / nr, a[5] / nr) if nr else (nan, nan, nan)
+        self._sums = [0.0] * 6
+        self._ng = self._nr = 0
         dx, dy, dz = rx - gx, ry - gy, rz - gz
         # (the sum in this order is what np.linalg.norm(rel, axis=1) computes; a test pins it)
         d = math.sqrt(dx * dx + dy * dy + dz * dz)

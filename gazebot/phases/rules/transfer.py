@@ -65,6 +65,28 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
 
 
+def _leg_end(v: np.ndarray, s: int, depth: float, down: bool) -> int:
+    """The end of the leg of ``v`` starting at ``s``: going down, the first index after ``s``
+    at least ``depth`` above the lowest sample from ``s`` before it (going up: ``depth``
+    below the highest); -1 if none. Searched in windows from ``s`` that double in length, so
+    a leg costs a few numpy calls and work proportional to its own length, whatever follows
+    it (a whole recording's distance has hundreds of legs)."""
+    m = v.shape[0]
+    w = 64
+    while True:
+        e = min(s + w, m)
+        if down:
+            hit = v[s + 1 : e] >= np.minimum.accumulate(v[s : e - 1]) + depth
+        else:
+            hit = v[s + 1 : e] <= np.maximum.accumulate(v[s : e - 1]) - depth
+        j = int(hit.argmax()) if hit.shape[0] else 0
+        if hit.shape[0] and hit[j]:
+            return s + 1 + j
+        if e == m:
+            return -1
+        w *= 2
+
+
 def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
     """Dips of ``d`` at least ``depth`` (> 0) deep on both sides, as ``(left, minimum, right)``
     index triples (left/right: the highest points between neighbouring dips). The recording's
@@ -73,15 +95,17 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
 
     A zigzag with hysteresis ``depth``: going down, the lowest sample so far (the first of
     equal ones) is the minimum until a sample rises ``depth`` above it; going up, the highest
-    so far until one falls ``depth`` below it. Each leg is found with running extrema over the
-    samples left (a few numpy calls a leg, not a Python step per sample: the online analysis
-    reads the dips of hundreds of samples every period); ``tests/phases`` pins it to the
-    sample-by-sample form."""
+    so far until one falls ``depth`` below it. Each leg is found with running extrema
+    (:func:`_leg_end`: a few numpy calls a leg, not a Python step per sample: the online
+    analysis reads the dips of hundreds of samples every period); ``tests/phases`` pins it to
+    the sample-by-sample form."""
     if not depth > 0:
         raise ValueError(f"dips: depth must be > 0, got {depth}")
     out: list[tuple[int, int, int]] = []
     if d.shape[0] == 0:
         return out
+    if d.dtype != np.float64:
+        d = d.astype(float)  # (compared in float64, as the plain floats of the zigzag are)
     ok = np.isfinite(d)
     if ok.all():
         v, idx = d, None
@@ -94,25 +118,19 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
     def at(i: int) -> int:  # index into d of the i-th finite sample
         return i if idx is None else int(idx[i])
 
-    m = v.shape[0]
     left = at(0)
     s = 0  # the down leg starts here
     while True:
-        # down: the first sample at least depth above the lowest before it (in that leg).
-        # (depth > 0: such a sample is never below that lowest, so it is no new minimum)
-        rise = v[s + 1 :] >= np.minimum.accumulate(v[s : m - 1]) + depth
-        j = int(rise.argmax()) if rise.shape[0] else 0
-        if not (rise.shape[0] and rise[j]):
-            out.append((left, at(s + int(v[s:].argmin())), at(m - 1)))
+        # (depth > 0: the sample ending a leg is never a new extreme of that leg)
+        u = _leg_end(v, s, depth, down=True)  # the up leg starts here
+        if u < 0:
+            out.append((left, at(s + int(v[s:].argmin())), at(v.shape[0] - 1)))
             return out
-        u = s + 1 + j  # the up leg starts here
         lo_i = s + int(v[s:u].argmin())
-        fall = v[u + 1 :] <= np.maximum.accumulate(v[u : m - 1]) - depth
-        j = int(fall.argmax()) if fall.shape[0] else 0
-        if not (fall.shape[0] and fall[j]):
+        s = _leg_end(v, u, depth, down=False)  # the next down leg starts here
+        if s < 0:
             out.append((left, at(lo_i), at(u + int(v[u:].argmax()))))
             return out
-        s = u + 1 + j
         hi = at(u + int(v[u:s].argmax()))
         out.append((left, at(lo_i), hi))
         left = hi
