@@ -215,9 +215,15 @@ class GazeEngine:
         tracking_end = (
             detector.expected_phase_end if detector.phase is state.phase else math.nan
         )
+        # The behavior's points: the robot's fixed ones and the tracked ones (a copy then item
+        # sets: cheaper than a ``{**fixed, ...}`` merge, with the same key order).
+        points = self._fixed_points.copy()
+        points["face"] = frame.giver_face
+        points["hand"] = points["object"] = frame.giver_hand
+        points["receiver_hand"] = frame.receiver_hand
         try:
             # behavior.target(GazeContext(...)) without the two values it would build
-            kind, point = self.behavior.aim(t, self._points(frame), tracking_end)
+            kind, point = self.behavior.aim(t, points, tracking_end)
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
@@ -362,17 +368,6 @@ class GazeEngine:
             detected = getattr(event, "detected_at", change.t)
             out.append(Event(EVENT_OF_PHASE[change.phase], change.t, detected, info))
         return out
-
-    def _points(self, frame: TrackingFrame) -> dict[str, np.ndarray]:
-        """The behavior's points this tick: the robot's fixed ones and the tracked ones."""
-        hand = frame.giver_hand
-        # A copy then item sets: cheaper than a ``{**fixed, ...}`` merge, with the same key order.
-        points = self._fixed_points.copy()
-        points["face"] = frame.giver_face
-        points["hand"] = hand
-        points["object"] = hand
-        points["receiver_hand"] = frame.receiver_hand
-        return points
 
     def _fault(self, t: float, stage: str, err: BaseException) -> Event:
         self.stats.faults += 1
