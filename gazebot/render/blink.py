@@ -115,25 +115,38 @@ class BlinkModel:
         Raises ``ValueError`` for a non-finite ``t`` or shift, or a ``t`` earlier than the last one
         (call :meth:`reset` to start over).
         """
-        t = float(t)
-        shift = float(gaze_shift_rad)
+        # (the loop's values already are floats: no conversion calls; this runs every tick)
+        if type(t) is not float:
+            t = float(t)
+        shift = gaze_shift_rad if type(gaze_shift_rad) is float else float(gaze_shift_rad)
         if not math.isfinite(t):
             raise ValueError(f"t must be finite, got {t}")
         if not math.isfinite(shift):
             raise ValueError(f"gaze_shift_rad must be finite, got {shift}")
         c = self.config
-        if self._t is None:
-            self._t = t
+        last = self._t
+        if last is None:
+            self._t = last = t
             self._next = t + self._interval()
-        if t < self._t - 1e-9:
-            raise ValueError(f"t went backwards ({t} < {self._t}); call reset() to restart")
-        dt = max(t - self._t, 0.0)
+        if t < last - 1e-9:
+            raise ValueError(f"t went backwards ({t} < {last}); call reset() to restart")
+        dt = t - last
+        if dt < 0.0:  # max(dt, 0.0) as a comparison
+            dt = 0.0
         self._t = t
-        self._acc = self._acc * math.exp(-dt / c.shift_window_s) + abs(shift)
-        if self._acc < 0.5 * c.shift_threshold_rad:
+        # The decayed sum of shifts. Nothing built up (0.0, never -0.0) decays to 0.0 (the
+        # factor is in [0, 1], never NaN: dt >= 0 and the window a finite > 0), and the usual
+        # tick adds no shift (acc + 0.0 is acc): those calls are skipped.
+        acc = self._acc
+        if acc != 0.0:
+            acc *= math.exp(-dt / c.shift_window_s)
+        if shift != 0.0:
+            acc += abs(shift)
+        self._acc = acc
+        if acc < 0.5 * c.shift_threshold_rad:
             self._armed = True
         in_blink = t - self._start < c.duration_s
-        if self._armed and self._acc >= c.shift_threshold_rad:
+        if self._armed and acc >= c.shift_threshold_rad:
             self._armed = False  # one decision per shift
             if self._rng.random() < c.shift_probability and not in_blink:
                 self._begin(t)
