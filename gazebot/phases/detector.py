@@ -94,9 +94,10 @@ class _Samples:
         """Queue a sample (``_ROW`` values; times increasing), then forget those older than
         ``keep_from`` (one call per sample: :meth:`drop_before` runs only when there is one to
         forget)."""
-        if self._s1 == self._s0 and not self._new:
-            self._first_t = row[0]
-        self._new.extend(row)
+        t = row[0]
+        if t < self._first_t:  # (only when none is kept, _first_t inf: the times increase)
+            self._first_t = t
+        self._new += row
         if self._first_t < keep_from:
             self.drop_before(keep_from)
 
@@ -297,11 +298,13 @@ class PhaseDetector:
 
     def _step(self, frame: TrackingFrame) -> None:
         st = self.stats
-        try:
-            t = float(frame.t)
-        except (TypeError, ValueError):
-            t = math.nan
-        if not math.isfinite(t):
+        t = frame.t
+        if type(t) is not float:  # (the usual frame's time is a float already)
+            try:
+                t = float(t)
+            except (TypeError, ValueError):
+                t = math.nan
+        if t - t != 0.0:  # (not finite: inf - inf and NaN - NaN are NaN)
             st.bad_time += 1
             return
         if t <= self._last_t:
@@ -313,12 +316,18 @@ class PhaseDetector:
         self._last_t = t
         st.samples += 1
         c = self.config
-        g, r = _point(frame.giver_hand).tolist(), _point(frame.receiver_hand).tolist()
+        g, r = frame.giver_hand, frame.receiver_hand
+        # (the usual frame's points are float 3-vectors: _point's test inline, no call)
+        g = (g if type(g) is np.ndarray and g.dtype is F64 and g.shape == (3,)
+             else _point(g)).tolist()
+        r = (r if type(r) is np.ndarray and r.dtype is F64 and r.shape == (3,)
+             else _point(r)).tolist()
         gx, gy, gz = g
         rx, ry, rz = r
-        finite = math.isfinite
-        g_ok = finite(gx) and finite(gy) and finite(gz)
-        r_ok = finite(rx) and finite(ry) and finite(rz)
+        # Finite: x * 0.0 is 0 for a finite x, NaN for inf or NaN (and the zeros never
+        # overflow): math.isfinite's answer without three calls a point.
+        g_ok = gx * 0.0 + gy * 0.0 + gz * 0.0 == 0.0
+        r_ok = rx * 0.0 + ry * 0.0 + rz * 0.0 == 0.0
         samples = self._samples
         samples.append((t, gx, gy, gz, rx, ry, rz), t - c.online_window)
         if g_ok:
