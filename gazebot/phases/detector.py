@@ -381,8 +381,9 @@ class PhaseDetector:
             self.stats.skipped += 1
             if self.phase is Phase.RETREAT and t - self.phase_start > c.max_retreat:
                 self._done(t, t, "timeout")
-        if math.isfinite(self.expected_phase_end):
-            self.expected_phase_end = max(self.expected_phase_end, t)
+        end = self.expected_phase_end
+        if end - end == 0.0 and t > end:  # (finite and passed: max(end, t) without calls)
+            self.expected_phase_end = t
 
     def _online_state(self) -> OnlineState:
         """What the trigger reads of the detector: the last one while it holds (these change a
