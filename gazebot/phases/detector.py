@@ -79,10 +79,12 @@ class _Samples:
     compacted in place: the analysis reads them as views, with no per-sample conversion. A new
     sample waits in a flat list until the rows are read (a list extend per sample; one copy of
     the few new rows' values per analysis, in order into the rows' block: cheaper than numpy
-    converting a list of rows)."""
+    converting a list of rows). The rows are read through a read-only view of the block
+    (made once per block, not per read: an analysis cannot write into the samples kept)."""
 
     def __init__(self) -> None:
         self._buf = np.empty((256, _ROW))
+        self._flat, self._ro = self._views(self._buf)
         self._s0 = self._s1 = 0
         self._new: list[float] = []  # the newest rows' values, _ROW a row, not yet in _buf
         self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
@@ -124,9 +126,16 @@ class _Samples:
         m = self._s1 - self._s0
         return float(self._buf[self._s0 + i, 0]) if i < m else self._new[(i - m) * _ROW]
 
+    @staticmethod
+    def _views(buf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The block's values as one flat writable view, and the block as a read-only view."""
+        ro = buf.view()
+        ro.flags.writeable = False
+        return buf.reshape(-1), ro
+
     def rows(self) -> np.ndarray:
-        """The samples kept (a view of the buffer: valid until the next call that grows or
-        compacts it; :meth:`append` only queues)."""
+        """The samples kept (a read-only view of the buffer: valid until the next call that
+        grows or compacts it; :meth:`append` only queues)."""
         new = self._new
         if new:
             k, buf = len(new) // _ROW, self._buf
@@ -135,13 +144,18 @@ class _Samples:
                 cap = buf.shape[0]
                 while 2 * (m + k) > cap:
                     cap *= 2
-                self._buf = np.empty((cap, _ROW)) if cap != buf.shape[0] else buf
+                if cap != buf.shape[0]:
+                    self._buf = np.empty((cap, _ROW))
+                    self._flat, self._ro = self._views(self._buf)
                 self._buf[:m] = buf[self._s0 : self._s1]
                 self._s0, self._s1 = 0, m
-            self._buf[self._s1 : self._s1 + k].flat = new  # (a contiguous block, row by row)
-            self._s1 += k
+            s1 = self._s1
+            # (the new rows' block, row by row, through the flat view: a slice assignment
+            # converts the list in one go, cheaper than .flat's item by item)
+            self._flat[s1 * _ROW : (s1 + k) * _ROW] = new
+            self._s1 = s1 + k
             new.clear()
-        return self._buf[self._s0 : self._s1]
+        return self._ro[self._s0 : self._s1]
 
 
 @dataclass
@@ -447,8 +461,7 @@ class PhaseDetector:
             i0 = int(t.searchsorted(self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
-        window = rows[i0:]
-        window.flags.writeable = False  # (a method writing into it would change the samples kept)
+        window = rows[i0:]  # (read-only: a method writing into it would change the samples kept)
         # (the rows are float64 of known shapes: no conversion or check needed; read-only
         # views, not copies: only this analysis reads them)
         traj = Trajectory.of_hands(
