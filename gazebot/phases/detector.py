@@ -79,10 +79,12 @@ class _Samples:
     compacted in place: the analysis reads them as views, with no per-sample conversion. A new
     sample waits in a flat list until the rows are read (a list extend per sample; one copy of
     the few new rows' values per analysis, in order into the rows' block: cheaper than numpy
-    converting a list of rows)."""
+    converting a list of rows). The rows are read through a read-only view of the block
+    (made once per block, not per read: an analysis cannot write into the samples kept)."""
 
     def __init__(self) -> None:
         self._buf = np.empty((256, _ROW))
+        self._flat, self._ro = self._views(self._buf)
         self._s0 = self._s1 = 0
         self._new: list[float] = []  # the newest rows' values, _ROW a row, not yet in _buf
         self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
@@ -94,9 +96,10 @@ class _Samples:
         """Queue a sample (``_ROW`` values; times increasing), then forget those older than
         ``keep_from`` (one call per sample: :meth:`drop_before` runs only when there is one to
         forget)."""
-        if self._s1 == self._s0 and not self._new:
-            self._first_t = row[0]
-        self._new.extend(row)
+        t = row[0]
+        if t < self._first_t:  # (only when none is kept, _first_t inf: the times increase)
+            self._first_t = t
+        self._new += row
         if self._first_t < keep_from:
             self.drop_before(keep_from)
 
@@ -123,9 +126,16 @@ class _Samples:
         m = self._s1 - self._s0
         return float(self._buf[self._s0 + i, 0]) if i < m else self._new[(i - m) * _ROW]
 
+    @staticmethod
+    def _views(buf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The block's values as one flat writable view, and the block as a read-only view."""
+        ro = buf.view()
+        ro.flags.writeable = False
+        return buf.reshape(-1), ro
+
     def rows(self) -> np.ndarray:
-        """The samples kept (a view of the buffer: valid until the next call that grows or
-        compacts it; :meth:`append` only queues)."""
+        """The samples kept (a read-only view of the buffer: valid until the next call that
+        grows or compacts it; :meth:`append` only queues)."""
         new = self._new
         if new:
             k, buf = len(new) // _ROW, self._buf
@@ -134,13 +144,18 @@ class _Samples:
                 cap = buf.shape[0]
                 while 2 * (m + k) > cap:
                     cap *= 2
-                self._buf = np.empty((cap, _ROW)) if cap != buf.shape[0] else buf
+                if cap != buf.shape[0]:
+                    self._buf = np.empty((cap, _ROW))
+                    self._flat, self._ro = self._views(self._buf)
                 self._buf[:m] = buf[self._s0 : self._s1]
                 self._s0, self._s1 = 0, m
-            self._buf[self._s1 : self._s1 + k].flat = new  # (a contiguous block, row by row)
-            self._s1 += k
+            s1 = self._s1
+            # (the new rows' block, row by row, through the flat view: a slice assignment
+            # converts the list in one go, cheaper than .flat's item by item)
+            self._flat[s1 * _ROW : (s1 + k) * _ROW] = new
+            self._s1 = s1 + k
             new.clear()
-        return self._buf[self._s0 : self._s1]
+        return self._ro[self._s0 : self._s1]
 
 
 @dataclass
@@ -297,11 +312,13 @@ class PhaseDetector:
 
     def _step(self, frame: TrackingFrame) -> None:
         st = self.stats
-        try:
-            t = float(frame.t)
-        except (TypeError, ValueError):
-            t = math.nan
-        if not math.isfinite(t):
+        t = frame.t
+        if type(t) is not float:  # (the usual frame's time is a float already)
+            try:
+                t = float(t)
+            except (TypeError, ValueError):
+                t = math.nan
+        if t - t != 0.0:  # (not finite: inf - inf and NaN - NaN are NaN)
             st.bad_time += 1
             return
         if t <= self._last_t:
@@ -313,12 +330,18 @@ class PhaseDetector:
         self._last_t = t
         st.samples += 1
         c = self.config
-        g, r = _point(frame.giver_hand).tolist(), _point(frame.receiver_hand).tolist()
+        g, r = frame.giver_hand, frame.receiver_hand
+        # (the usual frame's points are float 3-vectors: _point's test inline, no call)
+        g = (g if type(g) is np.ndarray and g.dtype is F64 and g.shape == (3,)
+             else _point(g)).tolist()
+        r = (r if type(r) is np.ndarray and r.dtype is F64 and r.shape == (3,)
+             else _point(r)).tolist()
         gx, gy, gz = g
         rx, ry, rz = r
-        finite = math.isfinite
-        g_ok = finite(gx) and finite(gy) and finite(gz)
-        r_ok = finite(rx) and finite(ry) and finite(rz)
+        # Finite: x * 0.0 is 0 for a finite x, NaN for inf or NaN (and the zeros never
+        # overflow): math.isfinite's answer without three calls a point.
+        g_ok = gx * 0.0 + gy * 0.0 + gz * 0.0 == 0.0
+        r_ok = rx * 0.0 + ry * 0.0 + rz * 0.0 == 0.0
         samples = self._samples
         samples.append((t, gx, gy, gz, rx, ry, rz), t - c.online_window)
         if g_ok:
@@ -372,8 +395,9 @@ class PhaseDetector:
             self.stats.skipped += 1
             if self.phase is Phase.RETREAT and t - self.phase_start > c.max_retreat:
                 self._done(t, t, "timeout")
-        if math.isfinite(self.expected_phase_end):
-            self.expected_phase_end = max(self.expected_phase_end, t)
+        end = self.expected_phase_end
+        if end - end == 0.0 and t > end:  # (finite and passed: max(end, t) without calls)
+            self.expected_phase_end = t
 
     def _online_state(self) -> OnlineState:
         """What the trigger reads of the detector: the last one while it holds (these change a
@@ -437,8 +461,7 @@ class PhaseDetector:
             i0 = int(t.searchsorted(self.phase_start - back))
             if n - i0 < 3:
                 i0 = 0
-        window = rows[i0:]
-        window.flags.writeable = False  # (a method writing into it would change the samples kept)
+        window = rows[i0:]  # (read-only: a method writing into it would change the samples kept)
         # (the rows are float64 of known shapes: no conversion or check needed; read-only
         # views, not copies: only this analysis reads them)
         traj = Trajectory.of_hands(

@@ -645,10 +645,12 @@ class SignalCache:
         # repeating a coordinate of the one before, needs no per-hand search.
         tail = np.concatenate((g_in[n0 - 1 :], r_in[n0 - 1 :]), axis=1)
         # (a sum is finite only if every term is; one that overflows only costs the search)
+        # (the ufuncs' reductions and count_nonzero: what .sum() and .any() compute, without
+        # their Python-level wrappers; a microsecond or two an analysis)
         clean = (
             self._clean
-            and math.isfinite(float(tail.sum()))
-            and not (tail[1:] == tail[:-1]).any()
+            and math.isfinite(float(np.add.reduce(tail, axis=None)))
+            and not np.count_nonzero(tail[1:] == tail[:-1])
         )
         if not clean:
             sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
@@ -744,7 +746,7 @@ class SignalCache:
         diff[-1] /= dt
         vq[:] = _by_hand(diff)
         shares = b["full"][a - 1 : rows]
-        if shares.min() < FULL_WINDOW:  # (away from tracking gaps, none is)
+        if np.minimum.reduce(shares, axis=None) < FULL_WINDOW:  # (.min(); away from gaps, none is)
             vq[shares.T < FULL_WINDOW] = np.nan
         sp = b["speeds"][:, a - 1 : rows]
         _derived_into(x[a - 1 : rows], q, b["norms"][:, a - 1 : rows], sp[0], sp[1], sp[2])

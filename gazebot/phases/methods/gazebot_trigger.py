@@ -182,6 +182,18 @@ class GazebotTrigger:
     def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
         """Add one sample's hand positions (``*_ok``: that hand was seen) to the period's sums."""
         a = self._sums
+        if g_ok and r_ok:  # (the usual sample: both hands, in one step)
+            x, y, z = g
+            a[0] += x
+            a[1] += y
+            a[2] += z
+            x, y, z = r
+            a[3] += x
+            a[4] += y
+            a[5] += z
+            self._ng += 1
+            self._nr += 1
+            return
         if g_ok:
             x, y, z = g
             a[0] += x
@@ -224,9 +236,9 @@ class GazebotTrigger:
             s0, end = 0, end - s0
         self._s0 = s0
         nan = math.nan
-        a, ng, nr = self._sums, self._ng, self._nr
-        gx, gy, gz = (a[0] / ng, a[1] / ng, a[2] / ng) if ng else (nan, nan, nan)
-        rx, ry, rz = (a[3] / nr, a[4] / nr, a[5] / nr) if nr else (nan, nan, nan)
+        (gx, gy, gz, rx, ry, rz), ng, nr = self._sums, self._ng, self._nr
+        gx, gy, gz = (gx / ng, gy / ng, gz / ng) if ng else (nan, nan, nan)
+        rx, ry, rz = (rx / nr, ry / nr, rz / nr) if nr else (nan, nan, nan)
         self._sums = [0.0] * 6
         self._ng = self._nr = 0
         dx, dy, dz = rx - gx, ry - gy, rz - gz
