@@ -61,9 +61,8 @@ from gazebot.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
 
 
 def _point(p: object) -> np.ndarray:
-    """A point as a float 3-vector (NaNs if it is not a numeric 3-vector)."""
-    if type(p) is np.ndarray and p.dtype is F64 and p.shape == (3,):
-        return p  # the usual case (the engine's frames): no conversion (an identity check)
+    """A point as a float 3-vector (NaNs if it is not a numeric 3-vector): the conversion
+    for anything but the usual float64 3-vector, which the per-sample path takes as it is."""
     try:
         v = np.asarray(p, dtype=float).reshape(-1)
     except (TypeError, ValueError):

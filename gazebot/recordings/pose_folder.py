@@ -44,8 +44,15 @@ def read_pose_folder(
             count, or a name the folder lacks.
     """
     path = Path(path)
-    if rate is None or not rate > 0:
+    if rate is None:
         raise RecordingError(path, "a pose folder has no time column: pass --rate HZ")
+    given = rate
+    try:
+        rate = float(rate)
+    except (TypeError, ValueError):
+        rate = math.nan
+    if not 0.0 < rate < math.inf:
+        raise RecordingError(path, f"--rate {given!r}: expected a finite rate > 0 in Hz")
     files = sorted(p for p in path.glob("*.csv"))
     points: dict[str, np.ndarray] = {}
     for f in files:

@@ -91,3 +91,9 @@ def test_dips_of_float32_distances_are_decided_in_float64() -> None:
         assert dips(d, 0.2) == _dips_by_sample(d, 0.2)
     d = np.array([0.7, 0.9, 0.2], np.float32)
     assert dips(d, 0.2) == _dips_by_sample(d, 0.2)
+
+
+def test_dips_of_long_double_distances_keep_their_precision() -> None:
+    """A wider float signal is compared in its own precision, as the zigzag compares it."""
+    d = np.array([0.9, 0.8, 0.9, 1, 1, 1, 0.9, 1], dtype=np.longdouble)
+    assert dips(d, 0.1) == _dips_by_sample(d, 0.1)

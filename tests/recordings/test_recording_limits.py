@@ -4,6 +4,7 @@ a C3D cut short as an error, and no numpy warning leaking from 1e308."""
 
 from __future__ import annotations
 
+import math
 import tracemalloc
 import warnings
 
@@ -137,6 +138,10 @@ def test_pose_folder_bounds_coordinates_and_refuses_a_rate_with_huge_steps(tmp_p
         warnings.simplefilter("error")
         with pytest.raises(RecordingError, match=r"--rate 2\.2250738585e-313 Hz"):
             load_recording(d, NAMES, rate=2.2250738585e-313)
+    # a rate that is no finite positive number is named as the fault, not the data
+    for bad in (math.inf, -50.0, 0.0, math.nan, "fast"):
+        with pytest.raises(RecordingError, match="expected a finite rate > 0 in Hz"):
+            load_recording(d, NAMES, rate=bad)
 
 
 def test_bag_outlier_stamp_is_an_error_naming_the_topic(tmp_path):

@@ -182,18 +182,6 @@ class GazebotTrigger:
     def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
         """Add one sample's hand positions (``*_ok``: that hand was seen) to the period's sums."""
         a = self._sums
-        if g_ok and r_ok:  # (the usual sample: both hands, in one step)
-            x, y, z = g
-            a[0] += x
-            a[1] += y
-            a[2] += z
-            x, y, z = r
-            a[3] += x
-            a[4] += y
-            a[5] += z
-            self._ng += 1
-            self._nr += 1
-            return
         if g_ok:
             x, y, z = g
             a[0] += x

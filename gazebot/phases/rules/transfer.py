@@ -104,8 +104,10 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
     out: list[tuple[int, int, int]] = []
     if d.shape[0] == 0:
         return out
-    if d.dtype != np.float64:
-        d = d.astype(float)  # (compared in float64, as the plain floats of the zigzag are)
+    if d.dtype.kind != "f" or d.dtype.itemsize < 8:
+        # (a narrower or integer signal compared in float64, as the zigzag's plain floats
+        # compare it; a wider one keeps its precision, as its tolist() does)
+        d = d.astype(float)
     ok = np.isfinite(d)
     if ok.all():
         v, idx = d, None
