@@ -110,7 +110,8 @@ class BlinkModel:
         return 1.0 - _smoothstep((tau - c.close_s - c.closed_s) / c.open_s)
 
     def update(self, t: float, gaze_shift_rad: float = 0.0) -> float:
-        """Advance to time ``t`` (s) after the gaze moved by ``gaze_shift_rad``; return the blink.
+        """Advance to time ``t`` (s) after the gaze moved by ``gaze_shift_rad`` (a shift beyond
+        pi counts as pi); return the blink.
 
         Raises ``ValueError`` for a non-finite ``t`` or shift, or a ``t`` earlier than the last one
         (call :meth:`reset` to start over).
@@ -141,7 +142,9 @@ class BlinkModel:
         if acc != 0.0:
             acc *= math.exp(-dt / c.shift_window_s)
         if shift != 0.0:
-            acc += abs(shift)
+            # (no gaze shift is more than a half turn: a larger value counts as one, so the
+            # sum stays finite and decays, where inf would decay to NaN and disarm for good)
+            acc += abs(shift) if -math.pi <= shift <= math.pi else math.pi
         self._acc = acc
         if acc < 0.5 * c.shift_threshold_rad:
             self._armed = True

@@ -111,3 +111,17 @@ def test_time_going_backwards_raises_value_error():
 def test_bad_config_raises_value_error(kwargs):
     with pytest.raises(ValueError, match="BlinkConfig"):
         BlinkConfig(**kwargs)
+
+
+def test_absurd_shifts_count_as_a_half_turn_and_shift_blinks_come_back():
+    """Finite but absurd shifts (1e308 rad: a corrupted command) count as pi: the decayed sum
+    stays finite, so after a long still stretch a large shift evokes blinks again (an
+    overflowing sum would decay to NaN and disarm the shift rule for good)."""
+    cfg = BlinkConfig(rate_per_min=2.0, shift_probability=1.0)
+    m = BlinkModel(seed=0, config=cfg)
+    m.update(0.0, 1e308)
+    m.update(0.01, -1e308)
+    m.update(1e6, 0.0)  # a very long gap: the sum decays to nothing
+    before = m.blinks
+    m.update(1e6 + 5.0, math.radians(40))
+    assert m.blinks == before + 1 and m.blink_times[-1] == 1e6 + 5.0
