@@ -111,7 +111,7 @@ def handle(args: argparse.Namespace) -> int:
                       f"{cfg.names.namespace} ({endpoints})", file=sys.stderr, flush=True)
                 node.run(duration=args.duration, stop=stop)
         except KeyboardInterrupt:
-            pass
+            pass  # Ctrl-C is how a user stops the node: the closing below runs as for SIGTERM
         except EngineRefused as exc:
             print(f"gazebot run: error: {exc}", file=sys.stderr, flush=True)
             return 3
