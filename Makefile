@@ -53,7 +53,7 @@ lock lock-upgrade:
 	rm -rf .venv-lock
 
 check-gl: $(STAMP)
-	$(PY) -m gazebot.sim.gl_check
+	$(PY) -m gazebot.apps.render.gl_check
 
 # The browser tests (pytest -m browser) drive Debian's Chromium through its chromedriver. As root
 # on Debian, install both when missing; elsewhere say so, and those tests skip with that reason.
@@ -75,7 +75,7 @@ test: $(TEST_STAMP) check-gl browser-deps
 	$(PY) -m pytest
 
 test-lowest: $(LOW_STAMP) browser-deps
-	$(LOW_VENV)/bin/python -m gazebot.sim.gl_check
+	$(LOW_VENV)/bin/python -m gazebot.apps.render.gl_check
 	$(LOW_VENV)/bin/python -m pytest
 
 bench: $(TEST_STAMP)

@@ -4,7 +4,7 @@
   ``face-hand-face``, against a hand-written if/else implementation of the same timing;
 - annotation loading: ``load_annotations`` (validating, reporting oddities) on the first 64 real
   files against a raw openpyxl read of the same cells (read-only, stop at the first empty frame);
-- replay: ``gazebot.annotations.replay`` of ``hand-face`` over all annotated receivers (events,
+- replay: ``gazebot.apps.annotations.replay`` of ``hand-face`` over all annotated receivers (events,
   contexts and the behavior machine frame by frame) against an independent plain-NumPy
   vectorised scoring of the same behavior (hand in reach and transfer, face from 0.375 s after
   each retreat start; ``Own Hand`` as hand, ``Other`` ignored); both must give the same matched
@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.common import Result, median_time
-from gazebot.behaviors import BehaviorMachine, load_behavior
-from gazebot.types import Event, EventKind, GazeContext, GazeTarget, Phase
+from gazebot.core.behaviors import BehaviorMachine, load_behavior
+from gazebot.core.types import Event, EventKind, GazeContext, GazeTarget, Phase
 
 _REPO = Path(__file__).resolve().parents[1]
 _DATA = Path(os.environ.get("GAZEBOT_SHARED_DATA", _REPO.parent / "shared" / "data"))
@@ -157,8 +157,8 @@ def _raw_openpyxl(files: list[Path]) -> list[list[tuple]]:
 def _annotation_results() -> list[Result]:
     if not _ANNOTATIONS.is_dir():
         return []
-    from gazebot.annotations import load_annotations, replay
-    from gazebot.annotations.loader import annotation_files, load_handover
+    from gazebot.apps.annotations import load_annotations, replay
+    from gazebot.apps.annotations.loader import annotation_files, load_handover
 
     files = annotation_files(_ANNOTATIONS)[:64]
 

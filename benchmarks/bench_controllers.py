@@ -20,7 +20,7 @@ HAND = np.array([1.5, 0.0, 0.0])
 
 
 def _config(horizon: int | None = None, reach_time: float = 3.0):
-    from gazebot.controllers import load_controllers_config
+    from gazebot.apps.controllers import load_controllers_config
 
     cfg = load_controllers_config()
     update: dict = {"reach_time_s": reach_time, "u_max_m_s": 1.0, "dt_s": 0.2}
@@ -31,8 +31,8 @@ def _config(horizon: int | None = None, reach_time: float = 3.0):
 
 def _solve_ms(name: str, horizon: int | None = None, reach_time: float = 3.0):
     """Median and max solve ms per step, and the STL step problems of the last run."""
-    from gazebot.controllers import make_controller
-    from gazebot.controllers.rollout import run_reach
+    from gazebot.apps.controllers import make_controller
+    from gazebot.apps.controllers.rollout import run_reach
 
     controller = make_controller(name, _config(horizon, reach_time))
     problems = []
@@ -65,7 +65,7 @@ def _median_ms(fn, problems) -> float:
 
 
 def run() -> list[Result]:
-    from gazebot.controllers.stl_milp import solve_reach_milp, solve_reach_milp_cvxpy
+    from gazebot.apps.controllers.stl_milp import solve_reach_milp, solve_reach_milp_cvxpy
 
     period_ms = 200.0
     out = []

@@ -41,7 +41,7 @@ def _percentile(xs: list[float], q: float) -> float:
 
 
 def _record_frames(seconds: float) -> list:
-    from gazebot.sim import HandoverSimulation
+    from gazebot.apps.sim import HandoverSimulation
 
     with HandoverSimulation("sawyer", "default", seed=0) as sim:
         frames = []
@@ -52,14 +52,14 @@ def _record_frames(seconds: float) -> list:
 
 
 def _latency() -> list[Result]:
-    from gazebot.drivers.engine_node import EngineNode, EngineNodeConfig
-    from gazebot.drivers.rmw.names import Names
-    from gazebot.drivers.session import EPHEMERAL_ENDPOINT, BusConfig, open_session
-    from gazebot.drivers.zenoh_driver import ZenohRobotDriver
-    from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
-    from gazebot.engine import GazeEngine
-    from gazebot.ros2 import convert, topics
-    from gazebot.runtime import GazeLoop
+    from gazebot.core.engine import GazeEngine
+    from gazebot.core.runtime import GazeLoop
+    from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig
+    from gazebot.io.drivers.rmw.names import Names
+    from gazebot.io.drivers.session import EPHEMERAL_ENDPOINT, BusConfig, open_session
+    from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
+    from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
+    from gazebot.io.ros2 import convert, topics
 
     frames = _record_frames(N_SAMPLES / 120)
     names = Names("/bench")
@@ -179,10 +179,10 @@ def _latency() -> list[Result]:
 
 
 def _real_time_factor(repeat: int = 3) -> list[Result]:
-    from gazebot.drivers.session import BusConfig
-    from gazebot.drivers.sim_node import SimNode, SimNodeConfig
-    from gazebot.drivers.zenoh_robot import ZenohRobotEndpoint
-    from gazebot.sim import HandoverSimulation
+    from gazebot.apps.sim import HandoverSimulation
+    from gazebot.io.drivers.session import BusConfig
+    from gazebot.io.drivers.sim_node import SimNode, SimNodeConfig
+    from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 
     def bare() -> float:
         with HandoverSimulation("sawyer", "default", seed=0) as sim:
@@ -197,7 +197,7 @@ def _real_time_factor(repeat: int = 3) -> list[Result]:
         with HandoverSimulation("sawyer", "default", seed=0) as sim:
             return SimNode(sim, endpoint, SimNodeConfig(speed=float("inf"))).run(SIM_SECONDS)
 
-    from gazebot.drivers.rmw.names import Names
+    from gazebot.io.drivers.rmw.names import Names
 
     endpoint = ZenohRobotEndpoint.open(
         BusConfig(Names("/benchrtf"), listen=(f"tcp/127.0.0.1:{_free_port()}",)), "sim")

@@ -12,8 +12,8 @@ import numpy as np
 
 from benchmarks.common import Result, alternating
 from gazebot import GazeEngine
-from gazebot.phases.synthetic import SyntheticOptions, generate
-from gazebot.runtime import GazeLoop
+from gazebot.core.phases.synthetic import SyntheticOptions, generate
+from gazebot.core.runtime import GazeLoop
 
 
 def _hand_written_peer(frames):

@@ -1,4 +1,4 @@
-"""Eye drawing: OpenCV (``gazebot.render.EyeRenderer``, what gazebot draws with everywhere)
+"""Eye drawing: OpenCV (``gazebot.apps.render.EyeRenderer``, what gazebot draws with everywhere)
 against the same eyes drawn with pygame-ce (``benchmarks/eyes_pygame_peer.py``: same geometry,
 style and precomputed static layers, per-frame drawing with SDL primitives), in one run:
 
@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 
 from benchmarks.common import Result, median_time
-from gazebot.render import EyeRenderer
+from gazebot.apps.render import EyeRenderer
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
@@ -110,7 +110,7 @@ def _head_screen(poses) -> Result:
     from types import SimpleNamespace
 
     from benchmarks.eyes_pygame_peer import PygameEyeRenderer
-    from gazebot.render.head_display import EyeAnimator, HeadScreen, status_text
+    from gazebot.apps.render.head_display import EyeAnimator, HeadScreen, status_text
 
     screen = HeadScreen(EyeRenderer.for_robot("sawyer"))
     pg = PygameEyeRenderer.for_robot("sawyer")

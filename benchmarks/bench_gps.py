@@ -33,11 +33,11 @@ def run() -> list[Result]:
                        note="skipped: takes tens of minutes")]
     import jax
 
-    from gazebot.gps.badmm import train
-    from gazebot.gps.config import load_gps_config
-    from gazebot.gps.evaluate import evaluate
-    from gazebot.gps.state import StateKind
-    from gazebot.gps.store import load, save
+    from gazebot.apps.gps.badmm import train
+    from gazebot.apps.gps.config import load_gps_config
+    from gazebot.apps.gps.evaluate import evaluate
+    from gazebot.apps.gps.state import StateKind
+    from gazebot.apps.gps.store import load, save
 
     cfg = load_gps_config()
     out: list[Result] = []
@@ -81,10 +81,10 @@ def run() -> list[Result]:
 def scene_transitions(trained, repeats: int = 3, samples: int = 5, seed: int = 0) -> np.ndarray:
     """Transitions (x_t, u_t, x_t+1) of the trained policy with its Gaussian action noise on each
     training target: ``repeats`` x ``samples`` trials per target, as the prior sees in training."""
-    from gazebot.gps.dynamics import transitions
-    from gazebot.gps.rollout import run_trial
-    from gazebot.gps.scene import HandoverScene
-    from gazebot.gps.tester import motion_to
+    from gazebot.apps.gps.dynamics import transitions
+    from gazebot.apps.gps.rollout import run_trial
+    from gazebot.apps.gps.scene import HandoverScene
+    from gazebot.apps.gps.tester import motion_to
 
     rng = np.random.default_rng(seed)
     scene = HandoverScene(trained.cfg.scene)
@@ -105,7 +105,7 @@ def gmm_result(trained, clusters: int) -> Result:
     from sklearn.exceptions import ConvergenceWarning
     from sklearn.mixture import GaussianMixture
 
-    from gazebot.gps.dynamics import GMMPrior
+    from gazebot.apps.gps.dynamics import GMMPrior
 
     pts = scene_transitions(trained)
     prior = GMMPrior(clusters)

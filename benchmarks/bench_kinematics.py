@@ -50,7 +50,7 @@ class ClosedFormPanTilt:
 
 
 def _peer_error_deg(robot, peer: ClosedFormPanTilt, targets) -> float:
-    from gazebot.kinematics.eyes import angle_between
+    from gazebot.core.kinematics.eyes import angle_between
 
     errs = []
     for t in targets:
@@ -60,7 +60,7 @@ def _peer_error_deg(robot, peer: ClosedFormPanTilt, targets) -> float:
 
 
 def run() -> list[Result]:
-    from gazebot.kinematics import GazeController, RobotModel, solve_ik
+    from gazebot.core.kinematics import GazeController, RobotModel, solve_ik
 
     results: list[Result] = []
     for name in ("jaco2", "sawyer"):

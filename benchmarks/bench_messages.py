@@ -1,4 +1,4 @@
-"""Message encode + decode: ROS 2 CDR (``gazebot.ros2``: rosbags' serializer, what the ROS 2 wire
+"""Message encode + decode: ROS 2 CDR (``gazebot.io.ros2``: rosbags' serializer, what the ROS 2 wire
 sends) against the JSON payloads it replaced (``benchmarks/json_payload_peer.py``: strict pydantic
 models), per message, in one run.
 
@@ -22,9 +22,9 @@ import numpy as np
 
 from benchmarks import json_payload_peer as js
 from benchmarks.common import Result, median_time
-from gazebot.ros2 import Codec, typestore
-from gazebot.ros2 import convert as cv
-from gazebot.types import Event, EventKind, Phase, TrackingFrame
+from gazebot.core.types import Event, EventKind, Phase, TrackingFrame
+from gazebot.io.ros2 import Codec, typestore
+from gazebot.io.ros2 import convert as cv
 
 N = 50  # messages per timed round (short rounds, interleaved: load hits both alike)
 ROUNDS = 21
@@ -136,7 +136,7 @@ def _event() -> tuple[Callable[[], object], Callable[[], object], int, int]:
 
 
 def _eye_frame() -> tuple[Callable[[], object], Callable[[], object], int, int]:
-    from gazebot.render import EyeRenderer
+    from gazebot.apps.render import EyeRenderer
 
     img = EyeRenderer.for_robot("sawyer").render(0.1, -0.05)
     ok, buf = cv2.imencode(".jpg", img[:, :, ::-1])

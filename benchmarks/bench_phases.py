@@ -25,10 +25,10 @@ import numpy as np
 from benchmarks.common import Result
 from benchmarks.kth_data import RATE, force_truth, kth_dir
 from benchmarks.reach_bound import bound_latencies
-from gazebot.phases import PhaseConfig, PhaseDetector, Trajectory, run_online, segment
-from gazebot.phases.methods import PHASE_METHODS
-from gazebot.phases.synthetic import CASE_KINDS, case_set, rest_recording, synthetic_set
-from gazebot.types import EventKind, Phase
+from gazebot.core.phases import PhaseConfig, PhaseDetector, Trajectory, run_online, segment
+from gazebot.core.phases.methods import PHASE_METHODS
+from gazebot.core.phases.synthetic import CASE_KINDS, case_set, rest_recording, synthetic_set
+from gazebot.core.types import EventKind, Phase
 
 SEED = "seed-7.2.5"
 RATES_HZ = (8.0, 15.0, 30.0, 60.0, 100.0, 120.0, 240.0)  # the synthetic set's rates
@@ -49,7 +49,7 @@ def _interleaved(a, b, repeat: int) -> tuple[float, float]:
 
 
 def _kth_trajectory() -> tuple[Trajectory, float, float] | None:
-    from gazebot.recordings import PointNames, load_recording
+    from gazebot.io.recordings import PointNames, load_recording
 
     folder = kth_dir()
     if folder is None:

@@ -17,7 +17,7 @@ W, H = 640, 480
 
 
 def _real_time_factor() -> Result:
-    from gazebot.sim.simulation import HandoverSimulation
+    from gazebot.apps.sim.simulation import HandoverSimulation
 
     n_ticks = int(SIM_SECONDS / CONTROL_DT)
 
@@ -54,7 +54,7 @@ def _real_time_factor() -> Result:
 
 
 def _render_fps() -> Result:
-    from gazebot.sim.simulation import HandoverSimulation
+    from gazebot.apps.sim.simulation import HandoverSimulation
 
     sim = HandoverSimulation("sawyer", "default", seed=0)
     for _ in range(int(3.0 / CONTROL_DT)):  # mid-handover: arm out, object in hand
@@ -67,7 +67,7 @@ def _render_fps() -> Result:
         sim.apply_eyes(float(yaws[state["i"] % len(yaws)]), 0.2)  # new eyes every frame
         sim.render(width=W, height=H)
 
-    from gazebot.sim.scene import OBSERVER
+    from gazebot.apps.sim.scene import OBSERVER
 
     # The same handover model and state, seen by the same camera, with whatever the display
     # texture holds (no eyes drawn, no texture upload).
@@ -95,8 +95,8 @@ def _render_fps() -> Result:
 def _cartesian_reach_rtf(controller: str) -> Result:
     """The simulation with one of the seed's reach controllers (planning every 0.2 s, arm
     differential IK every tick) against the joint-space reach of the same handover."""
-    from gazebot.sim.scene_config import SceneConfig, load_scene
-    from gazebot.sim.simulation import HandoverSimulation
+    from gazebot.apps.sim.scene_config import SceneConfig, load_scene
+    from gazebot.apps.sim.simulation import HandoverSimulation
 
     data = load_scene("default").model_dump()
     data["controller"].update(reach_controller=controller, reach_time_s=2.5)

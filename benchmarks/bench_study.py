@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.common import Result, median_time
-from gazebot.study.web.app import VISITOR_COOKIE
+from gazebot.apps.study.web.app import VISITOR_COOKIE
 
 # Seed Table 6.1, likability (video study; rows Face, Hand, L-FH, S-FH; averaged, fractional).
 TABLE_6_1_LIKABILITY = np.array(
@@ -195,10 +195,10 @@ def _web_results() -> list[Result]:
     import functools
     import statistics
 
-    from gazebot.study.folder import load_study
-    from gazebot.study.plan import make_plan
-    from gazebot.study.render import render_study
-    from gazebot.study.synthetic import render_synthetic_video
+    from gazebot.apps.study.folder import load_study
+    from gazebot.apps.study.plan import make_plan
+    from gazebot.apps.study.render import render_study
+    from gazebot.apps.study.synthetic import render_synthetic_video
 
     results = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -284,7 +284,7 @@ def _web_results() -> list[Result]:
 def run() -> list[Result]:
     import choix
 
-    from gazebot.study.bradley_terry import fit_bradley_terry
+    from gazebot.apps.study.bradley_terry import fit_bradley_terry
 
     def probs(theta: np.ndarray) -> np.ndarray:
         e = np.exp(theta - theta.max())

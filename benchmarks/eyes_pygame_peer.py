@@ -1,9 +1,10 @@
 """The benchmark peer of gazebot's eye drawing: the robot's eyes drawn with pygame-ce (SDL)
 straight onto a surface. ``benchmarks/bench_eyes.py`` times it against the OpenCV drawing of
-:class:`gazebot.render.EyeRenderer` (which won, so it draws everywhere; this one is kept only as
+:class:`gazebot.apps.render.EyeRenderer` (which won, so it draws everywhere; this one is kept only
+as
 the measured alternative).
 
-Same geometry, style and static layers as :class:`gazebot.render.eyes.EyeRenderer` (the
+Same geometry, style and static layers as :class:`gazebot.apps.render.eyes.EyeRenderer` (the
 background, the sclera coverage and the brows are computed once by it); per frame the eye boxes
 are filled with the sclera color, iris and pupil are drawn as filled polygons with antialiased
 outlines, highlights as antialiased circles, the lids as polygons, and a precomputed overlay
@@ -17,7 +18,7 @@ import os
 
 import numpy as np
 
-from gazebot.render.eyes import EyeRenderer, _check_finite, _stroke
+from gazebot.apps.render.eyes import EyeRenderer, _check_finite, _stroke
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pygame  # noqa: E402

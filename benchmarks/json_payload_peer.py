@@ -1,4 +1,4 @@
-"""The JSON wire gazebot spoke before issue 18 (``gazebot/drivers/payloads.py`` at commit
+"""The JSON wire gazebot spoke before issue 18 (``gazebot/io/drivers/payloads.py`` at commit
 039ef9b, the messages the benchmark compares; unchanged but for the models it does not use):
 strict, frozen, versioned pydantic models serialized as JSON with ``"v": 1``. Kept here as the
 peer of ``bench_messages``: the ROS 2 CDR messages replaced it on the bus.
@@ -19,7 +19,7 @@ from pydantic import (
     ValidationError,
 )
 
-from gazebot.types import Event, EventKind, TrackingFrame, is_valid_point
+from gazebot.core.types import Event, EventKind, TrackingFrame, is_valid_point
 
 VERSION = 1
 
@@ -286,7 +286,7 @@ EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]
 
 
 def category_of(kind: str) -> EventCategory:
-    """``phase`` or ``robot`` for :class:`~gazebot.types.EventKind` values; ``fault`` else."""
+    """``phase`` or ``robot`` for :class:`~gazebot.core.types.EventKind` values; ``fault`` else."""
     try:
         ek = EventKind(kind)
     except ValueError:
@@ -334,7 +334,7 @@ class EventMsg(Msg):
         )
 
     def to_event(self) -> Event | None:
-        """The :class:`~gazebot.types.Event` for phase and robot events, ``None`` otherwise."""
+        """The :class:`~gazebot.core.types.Event` for phase and robot events, ``None`` otherwise."""
         try:
             kind = EventKind(self.kind)
         except ValueError:

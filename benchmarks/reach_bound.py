@@ -6,8 +6,9 @@ synthetic robot is scripted to set off 50-400 ms after the giver's true onset, s
 reading its gripper would measure that script, and on a robot that waits for the reported reach,
 its own output.)
 
-A fidget of the generator's class (:data:`~gazebot.phases.synthetic.FIDGET_AMPLITUDE`,
-:data:`~gazebot.phases.synthetic.FIDGET_DURATION`: a minimum-jerk move of at most 2 cm in 0.25-0.6
+A fidget of the generator's class (:data:`~gazebot.core.phases.synthetic.FIDGET_AMPLITUDE`,
+:data:`~gazebot.core.phases.synthetic.FIDGET_DURATION`: a minimum-jerk move of at most 2 cm in
+0.25-0.6
 s, in any direction, toward the receiver too) starts exactly like a reach: both grow as ``k (t -
 t0)^3``. An ideal observer is given far more than a detector has: the giver's hand *as the
 generator moved it* (no marker noise, no sway, no dropouts, the reach known), the recording's
@@ -32,8 +33,8 @@ import math
 import numpy as np
 from scipy.optimize import minimize
 
-from gazebot.phases.rules.sequential import min_jerk_profile
-from gazebot.phases.synthetic import FIDGET_AMPLITUDE, FIDGET_DURATION, SyntheticHandover
+from gazebot.core.phases.rules.sequential import min_jerk_profile
+from gazebot.core.phases.synthetic import FIDGET_AMPLITUDE, FIDGET_DURATION, SyntheticHandover
 
 ONSET_STEP = 0.005  # s between the fidget onsets tried
 DURATION_STEPS = 12  # fidget durations tried, geometric over FIDGET_DURATION

@@ -17,9 +17,9 @@ import argparse
 import math
 
 from gazebot import Event, EventKind, GazeEngine
-from gazebot.phases import load_phase_config
-from gazebot.phases.synthetic import SyntheticOptions, generate
-from gazebot.recordings import PointNames, load_recording
+from gazebot.core.phases import load_phase_config
+from gazebot.core.phases.synthetic import SyntheticOptions, generate
+from gazebot.io.recordings import PointNames, load_recording
 
 
 def main(argv: list[str] | None = None) -> list[str]:

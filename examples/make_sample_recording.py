@@ -1,5 +1,5 @@
 """Write ``examples/sample-handover.csv``: one human-to-robot handover made by gazebot's own
-generator (``gazebot.phases.synthetic``), so ``gazebot phases`` has something to run on in a
+generator (``gazebot.core.phases.synthetic``), so ``gazebot phases`` has something to run on in a
 fresh clone. Its ground truth is printed (and in ``sample-handover.truth.json``).
 
     python examples/make_sample_recording.py     # rewrites both files (reproducible)
@@ -13,7 +13,7 @@ import math
 import sys
 from pathlib import Path
 
-from gazebot.phases.synthetic import SyntheticOptions, generate
+from gazebot.core.phases.synthetic import SyntheticOptions, generate
 
 HERE = Path(__file__).resolve().parent
 SEED = 7

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from gazebot.controllers import CONTROLLERS, ReachController, ReachObservation, VelocityPlan
-from gazebot.controllers.base import integrate
-from gazebot.phases import PhaseConfig, Segment, Trajectory, segment
-from gazebot.phases.methods import PHASE_METHODS, Segmenter
-from gazebot.types import Phase
+from gazebot.apps.controllers import CONTROLLERS, ReachController, ReachObservation, VelocityPlan
+from gazebot.apps.controllers.base import integrate
+from gazebot.core.phases import PhaseConfig, Segment, Trajectory, segment
+from gazebot.core.phases.methods import PHASE_METHODS, Segmenter
+from gazebot.core.types import Phase
 
 HOLD_M = 0.03  # the hands are "together" within this of their closest approach (m)
 SETTLE_S = 0.2  # online: the closest approach is this old before it counts (s)
@@ -77,8 +77,8 @@ def register() -> None:
 
 def main() -> list[str]:
     from gazebot import GazeEngine
-    from gazebot.controllers import make_controller
-    from gazebot.phases.synthetic import SyntheticOptions, generate
+    from gazebot.apps.controllers import make_controller
+    from gazebot.core.phases.synthetic import SyntheticOptions, generate
 
     register()
     lines = []

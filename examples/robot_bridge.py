@@ -17,8 +17,8 @@ from __future__ import annotations
 import argparse
 import time
 
-from gazebot.drivers import BusConfig, Names, ZenohRobotEndpoint
-from gazebot.phases.synthetic import SyntheticOptions, generate
+from gazebot.core.phases.synthetic import SyntheticOptions, generate
+from gazebot.io.drivers import BusConfig, Names, ZenohRobotEndpoint
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from gazebot.types import (
+from gazebot.core.types import (
     Event,
     EventKind,
     GazeCommand,
@@ -19,7 +19,7 @@ from gazebot.types import (
 )
 
 if TYPE_CHECKING:
-    from gazebot.engine import GazeEngine
+    from gazebot.core.engine import GazeEngine
 
 __all__ = [
     "Event",
@@ -37,7 +37,7 @@ __version__ = "0.1.0"
 def __getattr__(name: str):
     # The engine pulls in Pinocchio; import it only when asked for.
     if name == "GazeEngine":
-        from gazebot.engine import GazeEngine
+        from gazebot.core.engine import GazeEngine
 
         return GazeEngine
     raise AttributeError(f"module 'gazebot' has no attribute {name!r}")

@@ -1,5 +1,5 @@
 import sys
 
-from gazebot.cli import main
+from gazebot.apps.cli import main
 
 sys.exit(main())

@@ -49,7 +49,7 @@ def test_robot_bridge_example_is_driven_by_the_engine_node_over_zenoh(capsys):
 
     thread = threading.Thread(target=robot)
     thread.start()
-    from gazebot.cli import main
+    from gazebot.apps.cli import main
 
     rc = main(["run", "--robot", "sawyer", "--behavior", "face-hand-face",
                  "--namespace", "/example",
@@ -70,7 +70,7 @@ def test_shipped_sample_recording_is_what_the_generator_writes():
 
 
 def test_gazebot_phases_runs_on_the_sample_recording_and_finds_its_handover(capsys):
-    from gazebot.cli import main
+    from gazebot.apps.cli import main
 
     assert main(["phases", str(EXAMPLES / "sample-handover.csv"), "--json"]) == 0
     segments = json.loads(capsys.readouterr().out)["segments"]
@@ -83,9 +83,9 @@ def test_gazebot_phases_runs_on_the_sample_recording_and_finds_its_handover(caps
 
 
 def test_register_extensions_example_adds_a_phase_method_and_a_controller_from_outside():
-    from gazebot.controllers import CONTROLLERS
-    from gazebot.phases.methods import PHASE_METHODS
-    from gazebot.sim.scene_config import SceneConfig
+    from gazebot.apps.controllers import CONTROLLERS
+    from gazebot.apps.sim.scene_config import SceneConfig
+    from gazebot.core.phases.methods import PHASE_METHODS
 
     example = _load("register_extensions")
     try:
@@ -100,7 +100,7 @@ def test_register_extensions_example_adds_a_phase_method_and_a_controller_from_o
         # Registered names are accepted wherever the built-ins are: configs and the CLI.
         scene = SceneConfig.model_validate({"controller": {"reach_controller": "straight"}})
         assert scene.controller.reach_controller == "straight"
-        from gazebot.cli import build_parser
+        from gazebot.apps.cli import build_parser
 
         args = build_parser().parse_args(["phases", "x.csv", "--method", "closest-approach"])
         assert args.method == "closest-approach"
@@ -113,21 +113,21 @@ def test_an_installed_extension_reaches_the_real_gazebot_cli_through_its_entry_p
     monkeypatch, capsys
 ):
     """A package that declares the example's classes as entry points (groups
-    ``gazebot.phase_methods`` and ``gazebot.controllers``) is usable by name in the real
+    ``gazebot.phase_methods`` and ``gazebot.apps.controllers``) is usable by name in the real
     ``gazebot`` command, with no code of its own run first."""
     import importlib.metadata as md
 
-    from gazebot.cli import build_parser, main
-    from gazebot.controllers import CONTROLLERS
-    from gazebot.phases.methods import PHASE_METHODS
+    from gazebot.apps.cli import build_parser, main
+    from gazebot.apps.controllers import CONTROLLERS
+    from gazebot.core.phases.methods import PHASE_METHODS
 
     installed = [
         md.EntryPoint("closest-approach", "register_extensions:ClosestApproach",
                       "gazebot.phase_methods"),
-        md.EntryPoint("straight", "register_extensions:Straight", "gazebot.controllers"),
+        md.EntryPoint("straight", "register_extensions:Straight", "gazebot.apps.controllers"),
     ]
     monkeypatch.syspath_prepend(str(EXAMPLES))
-    monkeypatch.setattr("gazebot.registry.importlib.metadata.entry_points",
+    monkeypatch.setattr("gazebot.core.registry.importlib.metadata.entry_points",
                         lambda group=None: [ep for ep in installed if ep.group == group])
     PHASE_METHODS.reload_entry_points()
     CONTROLLERS.reload_entry_points()

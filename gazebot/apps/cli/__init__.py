@@ -1,0 +1,100 @@
+"""The ``gazebot`` command line: one module per command group, each with ``register(subparsers)``.
+
+Angles on the command line are in degrees unless an option says otherwise; everything inside is SI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+
+from gazebot.apps.cli.errors import UsageError
+from gazebot.core.config import ConfigError
+from gazebot.core.phases.trajectory import TrajectoryFormatError
+from gazebot.io.recordings import RecordingError
+
+# Command groups, in the order ``gazebot --help`` lists them.
+COMMAND_MODULES = (
+    "demo",
+    "phases",
+    "behaviors",
+    "annotations",
+    "ik",
+    "render",
+    "sim",
+    "reach_plan",
+    "run",
+    "display",
+    "router",
+    "study",
+    "gps",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="gazebot",
+        description="Robot gaze behavior engine for human-to-robot handovers.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for name in COMMAND_MODULES:
+        module = importlib.import_module(f"gazebot.apps.cli.{name}")
+        module.register(sub)
+    _plain_help(parser)
+    return parser
+
+
+def _plain_help(parser: argparse.ArgumentParser) -> None:
+    """Strip the reST literal markup (````x````) that module docstrings used as descriptions
+    carry: ``--help`` is read in a terminal. In place, for every sub-command."""
+    parser.description = _plain(parser.description)
+    for action in parser._actions:
+        action.help = _plain(action.help)
+        if isinstance(action, argparse._SubParsersAction):
+            for choice in action._choices_actions:
+                choice.help = _plain(choice.help)
+            for sub in set(action.choices.values()):
+                _plain_help(sub)
+
+
+def _plain(text: str | None) -> str | None:
+    return None if text is None else text.replace("``", "")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        result = args.func(args)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # The reader went away (e.g. `| head`): not an error of ours. Point stdout at devnull so
+        # the interpreter's final flush does not complain again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except (ConfigError, TrajectoryFormatError, RecordingError, UsageError, OSError) as exc:
+        # Input errors only: a malformed file, a wrong option, a missing file, a directory where
+        # a file was expected, permissions. Any other exception is a bug: it keeps its traceback.
+        # A file name that is not UTF-8 is kept as surrogates: shown escaped, not a crash.
+        text = str(exc).encode("utf-8", "backslashreplace").decode("utf-8")
+        print(f"gazebot: error: {text}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    except Exception as exc:
+        # A node that cannot join the bus (its port taken, a bad endpoint) is not a bug.
+        from gazebot.apps.cli.bus import bus_failure
+
+        message = bus_failure(exc)
+        if message is None:
+            raise
+        print(f"gazebot: error: {message}", file=sys.stderr)
+        return 2
+    return int(result or 0)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

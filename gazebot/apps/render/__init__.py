@@ -1,0 +1,30 @@
+"""Off-screen eye images for the robots' head screens.
+
+``EyeRenderer.for_robot("sawyer").render(eye_yaw, eye_pitch, blink, distance)`` returns an RGB
+image.
+The blink that closes the lids comes from the runtime loop's
+:class:`~gazebot.core.runtime.blink.BlinkModel`.
+The eye state travels on the bus as :class:`gazebot.io.drivers.payloads.EyeStateMsg` (tens of
+bytes); ``gazebot display`` draws it on the robot's head screen with the same renderer.
+
+``gazebot.apps.render.video`` (the H.264 MP4 writer) and ``gazebot.apps.render.timeline`` (the
+timeline CSV
+and plot) are imported on their own; the handover recording loop that drives the simulation is
+``gazebot.apps.sim.record`` (render draws things, it does not run them).
+"""
+
+from __future__ import annotations
+
+from gazebot.apps.render.eye_style import EyeStyle, available_eye_styles, load_eye_style
+from gazebot.apps.render.eyes import EyeRenderer, LazyEyeRenderer
+from gazebot.apps.render.eyes_display import RobotDisplay, robot_display
+
+__all__ = [
+    "EyeRenderer",
+    "LazyEyeRenderer",
+    "EyeStyle",
+    "RobotDisplay",
+    "available_eye_styles",
+    "load_eye_style",
+    "robot_display",
+]

@@ -1,0 +1,15 @@
+"""The one handover state (:class:`HandoverState`): the phase stream merged from the phase
+detector's evidence and the robot's events, which the engine reports and the behavior runs."""
+
+from __future__ import annotations
+
+from gazebot.core.handover.state import (
+    RULES,
+    HandoverState,
+    PhaseChange,
+    Rule,
+    event_source,
+    machine_definition,
+)
+
+__all__ = ["RULES", "HandoverState", "PhaseChange", "Rule", "event_source", "machine_definition"]

@@ -1,0 +1,709 @@
+"""Online (causal) phase detection, one tracking frame at a time.
+
+The detector keeps the last ``online_window`` seconds of samples and, at most every
+``online_period``, runs the configured method (:mod:`gazebot.core.phases.methods`) on the samples
+seen so far (``partial``: a boundary the data do not show yet stays open, and the last
+``edge_guard`` is not trusted). A method may offer a cheap trigger (the
+:meth:`~gazebot.core.phases.methods.base.Segmenter.trigger` hook; ``gazebot``'s is
+:mod:`~gazebot.core.phases.methods.gazebot_trigger`) that says per period whether its analysis
+needs to run, and its own rules for when a transfer or retreat ends once the hands are in
+contact (``rules_after_contact`` / ``phase_end``); the detector has no method-specific branch.
+Each phase start the analysis shows beyond the current phase is emitted once, in order
+(reach -> transfer -> retreat -> done), back-dated to where the analysis puts it (never before
+the current phase's start). So online and offline share every rule; the online latency is what
+the data need to show a boundary.
+
+Robot evidence (seed section 4.3) comes first: a rising edge of "gripper closed" or of a load
+share above ``load_share_shared`` starts the transfer at once (and reports the reach if it was
+missed); a load share above ``load_share_robot`` starts the retreat. Once frames carry that
+evidence, hand motion alone no longer starts a transfer (hands resting close together while the
+robot has not grasped are a giver waiting).
+
+A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
+back about as far apart as when it started (taken back before any transfer), ends as
+``handover_done`` with ``source = "aborted"`` (a reach adopted by :meth:`PhaseDetector.resync`
+that began before the first sample: once the hands are ``transfer_distance_margin`` farther
+apart than the closest seen). A reach that was an earlier movement (the giver
+lifted the object, rested ``reach_stall``, then set off toward the receiver) ends with
+``source = "stalled"`` when the final approach shows, and that approach is the reach (a new
+``reach_started``); a retreat longer
+than ``max_retreat`` ends with ``source = "timeout"``.
+
+Bad samples: a frame with a non-finite time, or a time not after the last accepted one
+(duplicate or out of order), is ignored and counted (``stats``). Missing points (NaN) and
+frozen repeats are bridged for up to ``max_gap_hold``; after that ``tracking_lost`` fires
+(``t`` = last valid sample, ``info["missing"]`` names the points) and phase detection pauses
+until both hands are seen again (``tracking_restored``).
+
+One :meth:`PhaseDetector.update` call returns at most one event; the rest are queued and
+returned by the next calls, oldest first (:meth:`PhaseDetector.update_all` returns all).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from gazebot.core.phases.config import PhaseConfig
+from gazebot.core.phases.durations import REACH_S
+from gazebot.core.phases.filtering import SignalCache, Signals, nanmax, nanmin, vector_norm
+from gazebot.core.phases.methods import make_segmenter
+from gazebot.core.phases.methods.base import OnlineState
+from gazebot.core.phases.prediction import predict_end
+from gazebot.core.phases.segment import Segment, segments_from_events
+from gazebot.core.phases.trajectory import Trajectory
+from gazebot.core.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
+from gazebot.core.types import F64, Event, EventKind, Phase, TrackingFrame, filled
+from gazebot.core.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
+
+
+def _point(p: object) -> np.ndarray:
+    """A point as a float 3-vector (NaNs if it is not a numeric 3-vector): the conversion
+    for anything but the usual float64 3-vector, which the per-sample path takes as it is."""
+    try:
+        v = np.asarray(p, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        return np.full(3, np.nan)
+    return v if v.shape == (3,) else np.full(3, np.nan)
+
+
+_ROW = 7  # values of a kept sample: t, giver xyz, receiver xyz
+
+
+class _Samples:
+    """The samples kept (rows ``[t, giver xyz, receiver xyz]``) in one array that grows and is
+    compacted in place: the analysis reads them as views, with no per-sample conversion. A new
+    sample waits in a flat list until the rows are read (a list extend per sample; one copy of
+    the few new rows' values per analysis, in order into the rows' block: cheaper than numpy
+    converting a list of rows). The rows are read through a read-only view of the block
+    (made once per block, not per read: an analysis cannot write into the samples kept)."""
+
+    def __init__(self) -> None:
+        self._buf = np.empty((256, _ROW))
+        self._flat, self._ro = self._views(self._buf)
+        self._s0 = self._s1 = 0
+        self._new: list[float] = []  # the newest rows' values, _ROW a row, not yet in _buf
+        self._first_t = math.inf  # time of the first sample kept (a float: read every sample)
+
+    def __len__(self) -> int:
+        return self._s1 - self._s0 + len(self._new) // _ROW
+
+    def append(self, row: tuple[float, ...], keep_from: float = -math.inf) -> None:
+        """Queue a sample (``_ROW`` values; times increasing), then forget those older than
+        ``keep_from`` (one call per sample: :meth:`drop_before` runs only when there is one to
+        forget)."""
+        t = row[0]
+        if t < self._first_t:  # (only when none is kept, _first_t inf: the times increase)
+            self._first_t = t
+        self._new += row
+        if self._first_t < keep_from:
+            self.drop_before(keep_from)
+
+    def drop_before(self, t0: float) -> None:
+        """Forget the samples older than ``t0``."""
+        if self._first_t >= t0:
+            return
+        buf, i, end = self._buf, self._s0, self._s1
+        while i < end and buf[i, 0] < t0:
+            i += 1
+        self._s0 = i
+        if i < end:
+            self._first_t = float(buf[i, 0])
+            return
+        new = self._new  # (every row in the array is gone: the new rows next)
+        k = 0
+        while k < len(new) and new[k] < t0:
+            k += _ROW
+        del new[:k]
+        self._first_t = new[0] if new else math.inf
+
+    def time(self, i: int) -> float:
+        """Time of the ``i``-th sample kept."""
+        m = self._s1 - self._s0
+        return float(self._buf[self._s0 + i, 0]) if i < m else self._new[(i - m) * _ROW]
+
+    @staticmethod
+    def _views(buf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The block's values as one flat writable view, and the block as a read-only view."""
+        ro = buf.view()
+        ro.flags.writeable = False
+        return buf.reshape(-1), ro
+
+    def rows(self) -> np.ndarray:
+        """The samples kept (a read-only view of the buffer: valid until the next call that
+        grows or compacts it; :meth:`append` only queues)."""
+        new = self._new
+        if new:
+            k, buf = len(new) // _ROW, self._buf
+            if self._s1 + k > buf.shape[0]:
+                m = self._s1 - self._s0
+                cap = buf.shape[0]
+                while 2 * (m + k) > cap:
+                    cap *= 2
+                if cap != buf.shape[0]:
+                    self._buf = np.empty((cap, _ROW))
+                    self._flat, self._ro = self._views(self._buf)
+                self._buf[:m] = buf[self._s0 : self._s1]
+                self._s0, self._s1 = 0, m
+            s1 = self._s1
+            # (the new rows' block, row by row, through the flat view: a slice assignment
+            # converts the list in one go, cheaper than .flat's item by item)
+            self._flat[s1 * _ROW : (s1 + k) * _ROW] = new
+            self._s1 = s1 + k
+            new.clear()
+        return self._ro[self._s0 : self._s1]
+
+
+@dataclass
+class DetectorStats:
+    """Counts of samples the detector ignored or bridged, and analyses it ran."""
+
+    samples: int = 0
+    out_of_order: int = 0
+    duplicates: int = 0
+    bad_time: int = 0
+    held: int = 0
+    analyses: int = 0
+    skipped: int = 0
+
+
+class PhaseDetector:
+    """Causal handover phase detector running ``config.method`` (see the module docstring).
+
+    Attributes:
+        config: The settings.
+        phase: Current phase (``idle`` -> ``reach`` -> ``transfer`` -> ``retreat`` -> ``done``,
+            then ``reach`` again for a following handover).
+        phase_start: Estimated start of the current phase (s; NaN in ``idle``).
+        expected_phase_end: Predicted end of the current phase (s; NaN when unknown).
+        handover: Index of the current (or last) handover, -1 before the first.
+        tracking: False between ``tracking_lost`` and ``tracking_restored``.
+        stats: Counts of ignored and bridged samples.
+    """
+
+    def __init__(self, config: PhaseConfig | None = None) -> None:
+        self.config = config if config is not None else PhaseConfig()
+        self.segmenter = make_segmenter(self.config)
+        self.phase = Phase.IDLE
+        self.phase_start = math.nan
+        self.expected_phase_end = math.nan
+        self.handover = -1
+        self.tracking = True
+        self.stats = DetectorStats()
+        self._queue: deque[Event] = deque()
+        self._samples = _Samples()
+        self._last_t = -math.inf
+        self._last_analysis = -math.inf
+        self._seen_g = self._seen_r = math.nan  # last valid sample of each hand
+        # Robot evidence at the previous frame; None: not known (after a resync the first frame
+        # sets it, so a gripper already closed is no rising edge).
+        self._prev_evidence: bool | None = False
+        self._robot_reports = False
+        self._signals: Signals | None = None
+        self._finite_of: Signals | None = None  # the signals self._finite indexes
+        self._finite = np.empty(0, dtype=np.intp)
+        # The last analysis's signals, so the next one (on the same window, a few samples
+        # longer) computes only the rows the new samples change. (append_only: the windows
+        # are cut from the samples kept, which only grow at their end.)
+        self._signal_cache = SignalCache(append_only=True)
+        self._unknown = np.empty((0, 5))  # (see _unknown_block)
+        # The method's cheap trigger, if it has one: the full analysis runs only when the next
+        # boundary may have passed.
+        self._trigger = self.segmenter.trigger()
+        self._last_full = -math.inf
+        self._state_key: tuple[object, ...] = ()  # the values self._state was made of
+        self._state: OnlineState | None = None
+        self._reach_missing_since = math.nan
+        self._floor = -math.inf  # the next phase never starts before this
+        # The current phase began before this detector saw the hands move (resync, restart).
+        self._joined_late = False
+        # The hands' distance when the current reach began, as last read while the analysis
+        # window still held that moment (a reach can outlast the window); NaN: never read.
+        self._reach_d0 = math.nan
+
+    # ----------------------------------------------------------------- public API
+    @property
+    def pending(self) -> int:
+        """Number of queued events the next calls will return."""
+        return len(self._queue)
+
+    def update(self, frame: TrackingFrame) -> Event | None:
+        """Feed one frame; return the oldest new (or queued) event, else ``None``."""
+        self._step(frame)
+        return self._queue.popleft() if self._queue else None
+
+    def update_all(self, frame: TrackingFrame) -> list[Event]:
+        """Feed one frame; return every new and queued event, oldest first."""
+        self._step(frame)
+        if not self._queue:
+            return []
+        out = list(self._queue)
+        self._queue.clear()
+        return out
+
+    def resync(self, event: Event) -> None:
+        """Adopt a phase known from elsewhere (e.g. published before an engine restart).
+
+        Phase events set the phase and its start to ``event.t``; ``robot_grasped`` counts as a
+        transfer start when the detector is idle, done or in a reach. Tracking and other robot
+        events are ignored. No event is emitted, and queued events are dropped. A new handover
+        is counted when a reach (or a transfer without a reach) follows ``idle``, ``done`` or
+        ``retreat``. The robot evidence of the next frame is a baseline, not an edge (a gripper
+        still closed after a finished handover starts no new one).
+        """
+        kind = event.kind
+        if kind is EventKind.ROBOT_GRASPED:
+            if self.phase not in (Phase.IDLE, Phase.REACH, Phase.DONE):
+                return
+            phase = Phase.TRANSFER
+        else:
+            phase = _PHASE_OF_EVENT.get(kind)
+            if phase is None:
+                return
+        between = self.phase in (Phase.IDLE, Phase.DONE, Phase.RETREAT)
+        if between and phase in (Phase.REACH, Phase.TRANSFER):
+            self.handover += 1
+        self._enter(phase, event.t)
+        self._joined_late = True
+        self._prev_evidence = None
+        self._queue.clear()
+
+    def adopt(self, phase: Phase, t0: float) -> None:
+        """Enter ``phase`` at ``t0`` because other evidence showed it (the handover state's:
+        the robot grasped or released), live: no event is emitted, queued events stay, and the
+        handover is counted as if the detector had started the phase itself. A phase that does
+        not move forward (or a time before the current phase's start) is ignored."""
+        order = (Phase.IDLE, Phase.REACH, Phase.TRANSFER, Phase.RETREAT, Phase.DONE)
+        current = Phase.IDLE if self.phase is Phase.DONE else self.phase
+        if order.index(phase) <= order.index(current) or not math.isfinite(t0):
+            return
+        if math.isfinite(self.phase_start) and t0 < self.phase_start:
+            return
+        if self.phase in (Phase.IDLE, Phase.DONE) and phase is not Phase.DONE:
+            self.handover += 1
+        self._enter(phase, t0)
+
+    # ----------------------------------------------------------------- internals
+    def _enter(self, phase: Phase, t0: float) -> None:
+        # Joined late: fewer than two samples seen before the phase's start.
+        self._joined_late = len(self._samples) < 3 or self._samples.time(1) >= t0
+        self.phase = phase
+        self.phase_start = t0
+        self._floor = t0
+        self._reach_missing_since = math.nan
+        self._reach_d0 = math.nan
+        self.expected_phase_end = predict_end(phase, t0, self._signals, t0, self.config)
+
+    def _start(self, phase: Phase, t0: float, now: float, source: str) -> None:
+        t0 = min(t0, now)
+        if math.isfinite(self.phase_start):
+            t0 = max(t0, self.phase_start)  # phases never go back in time
+        if phase is Phase.REACH or (
+            phase is Phase.TRANSFER and self.phase in (Phase.IDLE, Phase.DONE)
+        ):
+            self.handover += 1
+        info = {"handover": max(self.handover, 0), "source": source}
+        self._queue.append(Event(_EVENT_OF_PHASE[phase], t0, now, info))
+        self._enter(phase, t0)
+
+    def _step(self, frame: TrackingFrame) -> None:
+        st = self.stats
+        t = frame.t
+        if type(t) is not float:  # (the usual frame's time is a float already)
+            try:
+                t = float(t)
+            except (TypeError, ValueError):
+                t = math.nan
+        if t - t != 0.0:  # (not finite: inf - inf and NaN - NaN are NaN)
+            st.bad_time += 1
+            return
+        if t <= self._last_t:
+            if t == self._last_t:
+                st.duplicates += 1
+            else:
+                st.out_of_order += 1
+            return
+        self._last_t = t
+        st.samples += 1
+        c = self.config
+        g, r = frame.giver_hand, frame.receiver_hand
+        # (the usual frame's points are float 3-vectors: _point's test inline, no call)
+        g = (g if type(g) is np.ndarray and g.dtype is F64 and g.shape == (3,)
+             else _point(g)).tolist()
+        r = (r if type(r) is np.ndarray and r.dtype is F64 and r.shape == (3,)
+             else _point(r)).tolist()
+        gx, gy, gz = g
+        rx, ry, rz = r
+        # Finite: x * 0.0 is 0 for a finite x, NaN for inf or NaN (and the zeros never
+        # overflow): math.isfinite's answer without three calls a point.
+        g_ok = gx * 0.0 + gy * 0.0 + gz * 0.0 == 0.0
+        r_ok = rx * 0.0 + ry * 0.0 + rz * 0.0 == 0.0
+        samples = self._samples
+        samples.append((t, gx, gy, gz, rx, ry, rz), t - c.online_window)
+        if g_ok:
+            self._seen_g = t
+        if r_ok:
+            self._seen_r = t
+        if self._trigger is not None:
+            self._trigger.add(g, g_ok, r, r_ok)
+        if not (g_ok and r_ok):
+            st.held += 1
+            if self.tracking:
+                first = samples.time(0)
+                last_g = self._seen_g if self._seen_g == self._seen_g else first
+                last_r = self._seen_r if self._seen_r == self._seen_r else first
+                last = min(last_g, last_r)
+                if t - last > c.max_gap_hold:
+                    self.tracking = False
+                    missing = [
+                        n for n, ok in (("giver_hand", g_ok), ("receiver_hand", r_ok)) if not ok
+                    ]
+                    info = {"handover": max(self.handover, 0), "missing": missing}
+                    self._queue.append(Event(EventKind.TRACKING_LOST, last, t, info))
+            if not self.tracking:
+                return
+        elif not self.tracking:
+            self.tracking = True
+            info = {"handover": max(self.handover, 0)}
+            self._queue.append(Event(EventKind.TRACKING_RESTORED, t, t, info))
+
+        if frame.gripper_closed is None and frame.load_share is None:
+            self._prev_evidence = False  # no robot evidence (tracking alone, the usual frame)
+        elif self._robot_evidence(frame, t):
+            return
+        if t - self._last_analysis >= c.online_period - 1e-9:
+            # On a fixed grid of online_period (the first sample at or after each tick), not
+            # online_period after the last analysed sample: that waits up to twice the period
+            # when samples come just faster than it (60 Hz: 33 ms, 100 Hz: 30 ms by rounding),
+            # so more samples would confirm later.
+            since = t - self._last_analysis
+            if c.online_period > 0 and since < 4.0 * c.online_period:
+                self._last_analysis += c.online_period * math.floor(since / c.online_period + 1e-6)
+            else:
+                self._last_analysis = t  # the first sample, or after a pause: a new grid
+            mode = "full"
+            if self._trigger is not None:
+                mode = self._trigger.decide(t, self._online_state())
+            if mode != "skip":
+                self._last_full = t
+                self._analyse(t, predict_only=mode == "refresh")
+                return
+            self.stats.skipped += 1
+            if self.phase is Phase.RETREAT and t - self.phase_start > c.max_retreat:
+                self._done(t, t, "timeout")
+        end = self.expected_phase_end
+        if end - end == 0.0 and t > end:  # (finite and passed: max(end, t) without calls)
+            self.expected_phase_end = t
+
+    def _online_state(self) -> OnlineState:
+        """What the trigger reads of the detector: the last one while it holds (these change a
+        few times per handover; a new value costs more than comparing them)."""
+        key = (self.phase, self.phase_start, self._floor, self.tracking, self._joined_late,
+               self._last_full)
+        state = self._state
+        if state is None or key != self._state_key:  # (a NaN not the same object: rebuilt)
+            self._state_key = key
+            self._state = state = filled(
+                OnlineState,
+                phase=self.phase,
+                phase_start=self.phase_start,
+                floor=self._floor,
+                tracking=self.tracking,
+                joined_late=self._joined_late,
+                last_full=self._last_full,
+            )
+        return state
+
+    def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
+        """Gripper / load-share evidence of a frame that carries some (the caller handles a
+        frame with neither, the usual one); True if it started a phase on this frame."""
+        c = self.config
+        grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
+        load = frame.load_share
+        load_ok = load is not None and math.isfinite(load)
+        if frame.gripper_closed is not None or load_ok:
+            self._robot_reports = True
+        evidence = grip or (load_ok and load > c.load_share_shared)  # type: ignore[operator]
+        rising = evidence and self._prev_evidence is False
+        self._prev_evidence = evidence
+        source = "gripper" if grip else "load_share"
+        if rising and self.phase in (Phase.IDLE, Phase.DONE, Phase.REACH):
+            if self.phase is not Phase.REACH:
+                self._start(Phase.REACH, t, t, source)
+            self._start(Phase.TRANSFER, t, t, source)
+            return True
+        if self.phase is Phase.TRANSFER and load_ok and load > c.load_share_robot:  # type: ignore[operator]
+            self._start(Phase.RETREAT, t, t, "load_share")
+            return True
+        return False
+
+    def _analyse(self, now: float, predict_only: bool = False) -> None:
+        """Run the method on the samples kept (``predict_only``: only refresh the end-of-phase
+        prediction from the signals)."""
+        c = self.config
+        self.stats.analyses += 1
+        n = len(self._samples)
+        if n < 3:
+            return
+        rows = self._samples.rows()
+        t = rows[:, 0]
+        i0 = 0
+        if self.phase is not Phase.IDLE and math.isfinite(self.phase_start):
+            # After contact the rules need the hold and what follows, a reach (or, once done,
+            # the next reach) its rest before and what follows, not the whole window (the cost
+            # grows with the samples; after a handover, re-analysing it is wasted).
+            look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
+            back = REACH_S * look
+            i0 = int(t.searchsorted(self.phase_start - back))
+            if n - i0 < 3:
+                i0 = 0
+        window = rows[i0:]  # (read-only: a method writing into it would change the samples kept)
+        # (the rows are float64 of known shapes: no conversion or check needed; read-only
+        # views, not copies: only this analysis reads them)
+        traj = Trajectory.of_hands(
+            window[:, 0], window[:, 1:4], window[:, 4:], self._unknown_block(window.shape[0])
+        )
+        s = self.segmenter.online_signals(traj, cache=self._signal_cache)
+        self._signals = s
+        if s is not None and self.phase is Phase.REACH:
+            # Keep the reach's start distance while the window holds it (a reach can outlast
+            # the window; the taken-back checks compare with it).
+            self._reach_start_distance(s, self._finite_distances(s))
+            restart = self._reach_restart()
+            if restart is not None:
+                # The reach was an earlier movement (the giver lifted the object, waited, and
+                # only now approaches): it ends, and the approach is the reach.
+                self._done(restart, now, "stalled")
+                self._start(Phase.REACH, restart, now, "motion")
+        if s is not None and not predict_only:
+            if not self.segmenter.rules_after_contact:
+                self._advance(self.segmenter.online_segments(traj, s, now, self.phase), now)
+            elif not self._rules_after_contact(s, now):
+                # Once the hands are in contact the method's own end rules run from the
+                # phase's start; before, the whole method finds the next handover.
+                segs = self.segmenter.online_segments(traj, s, now, self.phase)
+                self._advance(segs, now, True)
+                self._rules_after_contact(s, now)
+        self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
+
+    def _unknown_block(self, n: int) -> np.ndarray:
+        """An all-NaN ``(n, 5)`` block (read-only) for an analysis window's face, gripper and
+        load share (unknown online): one kept and grown, not one allocated per analysis."""
+        block = self._unknown
+        if block.shape[0] < n:
+            block = np.full((max(2 * n, 256), 5), np.nan)
+            block.flags.writeable = False
+            self._unknown = block
+        return block[:n]
+
+    def _rules_after_contact(self, s: Signals, now: float) -> bool:
+        """In a transfer or retreat, apply the method's
+        :meth:`~gazebot.core.phases.methods.base.Segmenter.phase_end` rule from the current
+        phase's start. True if the phase is one of these two."""
+        c = self.config
+        for _ in range(2):
+            if self.phase not in (Phase.TRANSFER, Phase.RETREAT):
+                return False
+            end = self.segmenter.phase_end(s, self.phase, self.phase_start, self._joined_late)
+            if end is None:
+                if self.phase is Phase.RETREAT and now - self.phase_start > c.max_retreat:
+                    self._done(now, now, "timeout")
+                return True
+            t_end, source = end
+            if self.phase is Phase.TRANSFER:
+                self._start(Phase.RETREAT, t_end, now, source)
+                continue
+            self._done(t_end, now, source)
+            return True
+        return True
+
+    def _find(self, segs: list[Segment], phase: Phase, after: float) -> Segment | None:
+        for seg in segs:
+            if seg.phase is phase and seg.start >= after - self.config.online_slack:
+                return seg
+        return None
+
+    def _advance(self, segs: list[Segment], now: float, stop_at_contact: bool = False) -> None:
+        """Emit the phase starts ``segs`` show after the current phase (at most one handover);
+        ``stop_at_contact``: stop once in a transfer (the caller's rules take over)."""
+        c = self.config
+        for _ in range(4):  # at most one full handover per analysis
+            ph = self.phase
+            if ph in (Phase.IDLE, Phase.DONE):
+                reach = self._find(segs, Phase.REACH, self._floor)
+                if reach is not None:
+                    self._start(Phase.REACH, reach.start, now, "motion")
+                    continue
+                if not self._robot_reports:
+                    tr = self._find(segs, Phase.TRANSFER, self._floor)
+                    if tr is not None:
+                        self._start(Phase.REACH, tr.start, now, "motion")
+                        continue
+                return
+            if ph is Phase.REACH:
+                tr = None if self._robot_reports else self._find(segs, Phase.TRANSFER, self._floor)
+                if tr is not None:
+                    self._start(Phase.TRANSFER, tr.start, now, "motion")
+                    continue
+                if self._taken_back():
+                    # The hands are farther apart than when the reach began: whatever moved
+                    # was not the approach (the receiver stepped back); the next one is.
+                    self._done(now, now, "aborted")
+                    return
+                alive = any(
+                    sg.phase in (Phase.REACH, Phase.TRANSFER)
+                    and sg.end >= self._floor - c.online_slack
+                    for sg in segs
+                )
+                if alive:
+                    self._reach_missing_since = math.nan
+                elif self._reach_missing_since != self._reach_missing_since:
+                    self._reach_missing_since = now
+                elif (
+                    now - self._reach_missing_since > c.online_period + c.max_refine
+                    and self._hands_back_apart()
+                ):
+                    self._done(now, now, "aborted")
+                return
+            if ph is Phase.TRANSFER:
+                if stop_at_contact:
+                    return
+                ret = self._find(segs, Phase.RETREAT, self._floor)
+                if ret is not None:
+                    self._start(Phase.RETREAT, ret.start, now, "motion")
+                    continue
+                return
+            # Retreat: done when its end is seen, or a next reach began.
+            ret = self._find(segs, Phase.RETREAT, self._floor)
+            nxt = self._find(segs, Phase.REACH, self._floor + c.online_slack * 2)
+            if ret is not None and not ret.open:
+                self._done(ret.end, now, "motion")
+                continue
+            if nxt is not None:
+                self._done(nxt.start, now, "next_reach")
+                continue
+            if now - self.phase_start > c.max_retreat:
+                self._done(now, now, "timeout")
+            return
+
+    def _reach_restart(self) -> float | None:
+        """When the final approach began, if the reach under way was an earlier movement: the
+        giver's hand, less than ``stall_travel`` from where the reach started, rested (under
+        ``rest_speed``) for ``reach_stall``, then moved again (``reach_onset_speed``) and the
+        hands have closed ``reach_confirm_distance`` since. ``None`` otherwise (a giver holding
+        the object out for a slow robot rests too, but does not set off again)."""
+        c = self.config
+        s = self._signals
+        if s is None or s.t.shape[0] < 3:
+            return None
+        i_start = int(s.t.searchsorted(self.phase_start))
+        v = s.giver_speed[i_start:]
+        need = int(round(c.reach_stall / max(s.dt, 1e-9)))
+        if need < 1 or v.shape[0] <= need:
+            return None  # (a reach younger than reach_stall: no rest that long in it)
+        rest = np.isfinite(v) & (v < c.rest_speed)
+        if np.count_nonzero(rest) < need:
+            return None  # (no run of need rest samples without need of them in all)
+        # the last sample of the last rest at least reach_stall long
+        edges = np.diff(np.concatenate([[0], rest.astype(int), [0]])).nonzero()[0]
+        bounds = edges.tolist()  # (plain ints: iterating the array would box each element)
+        runs = [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
+        runs = [(a, b) for a, b in runs if b - a + 1 >= need and b < rest.size - 1]
+        if not runs:
+            return None
+        a, b = runs[-1]
+        i_a, i_b = i_start + a, i_start + b
+        if not np.isfinite(s.giver[[i_start, i_a]]).all():
+            return None
+        if vector_norm(s.giver[i_a] - s.giver[i_start]) >= c.stall_travel:
+            return None  # the hand was held out at the handover place: the reach goes on
+        after = s.giver_speed[i_b + 1 :]
+        d = s.distance[i_b:]
+        if not nanmax(after, initial=0.0) >= c.reach_onset_speed:
+            return None
+        if not float(d[0]) - float(nanmin(d)) >= c.reach_confirm_distance:
+            return None
+        return float(s.t[i_b])
+
+    def _finite_distances(self, s: Signals) -> np.ndarray:
+        """Grid indices of the finite distances of ``s`` (found once per analysis's signals:
+        the reach's checks read them several times)."""
+        if self._finite_of is not s:
+            self._finite_of, self._finite = s, np.isfinite(s.distance).nonzero()[0]
+        return self._finite
+
+    def _reach_start_distance(self, s: Signals, ok: np.ndarray) -> float:
+        """The hands' distance when the current reach began (``ok``: the finite samples of
+        ``s.distance``): read from ``s`` while its window still holds that moment (and kept),
+        else the value kept from the last window that held it; NaN if none did."""
+        if s.t.shape[0] and s.t[0] <= self.phase_start:
+            i0 = int(s.t.searchsorted(self.phase_start))
+            k = int(ok.searchsorted(i0, side="right"))  # (ok increases: those <= i0)
+            self._reach_d0 = float(s.distance[ok[k - 1]]) if k else math.nan
+        return self._reach_d0
+
+    def _taken_back(self) -> bool:
+        """The hands are ``reach_confirm_distance`` farther apart than when the current reach
+        started (known only if this detector saw that start)."""
+        s = self._signals
+        if s is None or self._joined_late:
+            return False
+        ok = self._finite_distances(s)
+        d0 = self._reach_start_distance(s, ok)
+        if not ok.size or d0 != d0:
+            return False
+        return float(s.distance[ok[-1]]) >= d0 + self.config.reach_confirm_distance
+
+    def _hands_back_apart(self) -> bool:
+        """The hands are (almost) as far apart as when the current reach started: the reach
+        was taken back, not merely paused (a reach that pauses is still a reach)."""
+        s = self._signals
+        if s is None or s.t.shape[0] == 0:
+            return True
+        d = s.distance
+        ok = self._finite_distances(s)
+        if ok.size == 0:
+            return True
+        if self._joined_late and not (ok.size and s.t[ok[0]] < self.phase_start):
+            # The reach began before the first sample seen (a resync): its start distance is
+            # unknown, so taken back means the hands left the region around the closest seen.
+            near = float(np.min(d[ok]))
+            return float(d[ok[-1]]) >= near + self.config.transfer_distance_margin
+        d0 = self._reach_start_distance(s, ok)
+        if d0 != d0:  # the start was never seen with a finite distance: the first one seen
+            d0 = float(d[ok[0]])
+        return float(d[ok[-1]]) >= d0 - self.config.reach_confirm_distance
+
+    def _done(self, t0: float, now: float, source: str) -> None:
+        t0 = max(min(t0, now), self.phase_start)
+        info = {"handover": max(self.handover, 0), "source": source}
+        self._queue.append(Event(EventKind.HANDOVER_DONE, t0, now, info))
+        self._enter(Phase.DONE, t0)
+
+
+@dataclass
+class OnlineResult:
+    """What :func:`run_online` saw: every event, the resulting segments and the sample counts."""
+
+    events: list[Event]
+    segments: list[Segment]
+    stats: DetectorStats
+
+
+def run_online(trajectory: Trajectory, config: PhaseConfig | None = None) -> OnlineResult:
+    """Replay a recording through a fresh :class:`PhaseDetector`, sample by sample, in the
+    stored order (out-of-order samples are ignored as they would be live)."""
+    det = PhaseDetector(config)
+    events: list[Event] = []
+    for frame in trajectory.iter_frames():
+        events.extend(det.update_all(frame))
+    t_end = float(np.nanmax(trajectory.t)) if len(trajectory) else math.nan
+    return OnlineResult(events, segments_from_events(events, t_end), det.stats)
+
+
+def make_detector(config: PhaseConfig | None = None) -> PhaseDetector:
+    """The online detector of ``config.method`` (the engine's entry point)."""
+    return PhaseDetector(config)

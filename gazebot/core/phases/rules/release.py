@@ -1,0 +1,92 @@
+"""Transfer -> retreat: when the giver lets go.
+
+The hands are still together while their relative speed *against their common motion*
+(``Signals.hold_speed``) stays within ``settle_floor_factor`` times the hold's floor: hands
+carrying an object together turn with it, so the marker frames behind the hands swing at a
+constant distance (issue 20: 0.02-0.10 m/s of relative motion through a 1 s joint carry), and
+judged against stillness that hold would end at its first turn. The held pose is the median
+relative position (receiver - giver) over the last samples still together; its RMS jitter
+there measures the tracking noise. The release is not before that last still sample. It is seen
+once the relative position has left the held pose by ``release_distance``, or
+``release_noise_factor`` times that jitter if larger, and is back-dated with the minimum-jerk
+start (:func:`~gazebot.core.phases.rules.onset.min_jerk_span`, at most ``max_refine``). A release
+hidden in a tracking gap is dated from the separation seen before the gap, else from the
+giver's own motion onset after it. If the hands never part before the data end, the transfer
+is still open.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gazebot.core.phases.config import PhaseConfig
+from gazebot.core.phases.filtering import Signals, median, row_norms, vector_norm
+from gazebot.core.phases.rules.onset import min_jerk_span
+from gazebot.core.phases.rules.transfer import TransferCore, hold_floor
+
+
+def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np.ndarray) -> float:
+    """Separation from the held pose that marks the release (m)."""
+    dev = row_norms(s.rel[held_idx] - held)
+    dev = dev[np.isfinite(dev)]
+    jitter = float(np.sqrt(np.mean(dev**2))) if dev.size else 0.0
+    return max(c.release_distance, c.release_noise_factor * jitter)
+
+
+def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float, bool]:
+    """``(t_end, open_end)``: the release time, and whether the data end before it.
+
+    The held pose is taken at the end of the hold (the last samples still together, judged by
+    ``hold_speed``): both hands carry the object during a transfer, and may turn with it, so
+    the relative pose drifts, and a pose from the start of the hold would date the release
+    early.
+    """
+    a, b = core.start, core.end
+    t_start = core.t_start if math.isfinite(core.t_start) else float(s.t[a])
+    # The hands were still together (within the hold's own noise) up to i_h: the release is
+    # not before it.
+    v_still = c.settle_floor_factor * hold_floor(s, c, a, b)
+    i0 = min(max(a, int(s.t.searchsorted(t_start))), b)
+    still = (s.hold_speed[i0 : b + 1] <= v_still).nonzero()[0] + i0
+    i_h = int(still[-1]) if still.size else i0
+    window = max(2, int(round(c.smoothing * c.analysis_rate)))
+    idx = np.arange(max(i0, i_h - window), i_h + 1)
+    rows = s.rel[idx]
+    rows = rows[np.isfinite(rows).all(axis=1)]
+    # (np.median(rows, axis=0): each column's median)
+    held = np.array([median(rows[:, k]) for k in range(3)]) if rows.size else np.full(3, np.nan)
+    sep_min = release_threshold(s, c, idx, held)
+    n = s.t.shape[0]
+    j = i_h
+    while j + 1 < n and not vector_norm(s.rel[j] - held) >= sep_min:
+        if not np.isfinite(s.rel_speed[j + 1]):
+            sep = vector_norm(s.rel[j] - held)
+            if sep >= 0.5 * sep_min and s.rel_speed[j] > 1e-6:
+                back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
+                return max(float(s.t[j]) - back, t_start), False
+            onset = giver_onset_after(s, c, j)
+            if onset is None and not np.isfinite(s.rel_speed[j + 1 :]).any():
+                return float(s.t[-1]), True  # tracking lost until the end, nothing moved
+            return max(float(s.t[j]) if onset is None else onset, t_start), False
+        j += 1
+    if j == n - 1 and not vector_norm(s.rel[j] - held) >= sep_min:
+        return float(s.t[-1]), True
+    sep = vector_norm(s.rel[j] - held)
+    back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
+    return max(float(s.t[j]) - back, t_start, float(s.t[i_h])), False
+
+
+def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
+    """Start of the giver's first motion after grid index ``j`` (``None`` if none is seen)."""
+    v = s.giver_speed[j:]
+    fast = (v >= c.reach_onset_speed).nonzero()[0]
+    if fast.size == 0:
+        return None
+    i = j + int(fast[0])
+    x = vector_norm(s.giver[i] - s.giver[j])
+    # Across a tracking gap the motion may have started anywhere in it.
+    unseen = float(np.count_nonzero(~np.isfinite(v[: fast[0]]))) / c.analysis_rate
+    back = min_jerk_span(x, float(v[fast[0]]), c.max_refine + unseen)
+    return max(float(s.t[i]) - back, float(s.t[j]))

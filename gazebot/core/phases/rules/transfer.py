@@ -1,0 +1,318 @@
+"""Reach -> transfer: the handovers in a recording and when each transfer starts.
+
+A handover is a dip of the hands' distance at least ``min_approach`` deep (the recording's ends
+count as high ground) that closes at least ``approach_fraction`` of the distance the hands
+started from (a pause of a slow approach is no handover). Its minimum is the seed's "minimum
+distance" (section 7.2.5), whatever it is: on real motion capture the hand frames sit on the
+back of the hand or at the wrist and the object has size, so they never come closer than
+0.3-0.5 m; no absolute contact distance is assumed. Within the dip, the seed's rule (within
+``transfer_distance_margin`` of the minimum, relative speed under ``transfer_speed_max``)
+gives the transfer's core; runs split by short blips under ``transfer_exit_speed`` or by
+tracking gaps merge. The giver's hand must have moved (``reach_onset_speed``) before the core:
+a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
+more than the giver.
+
+A dip with no such run at least ``min_transfer`` long is a handover on the move when the
+hands pass the object without stopping (:func:`pass_core`): its core is the short stretch
+under ``transfer_exit_speed`` at the closest, slowest point, once the hands are seen parting.
+
+The seed's 15 cm/s is crossed on the tail of the approach, before contact. The transfer starts
+where the approach has stopped: the relative speed falls below ``settle_fraction`` of the
+approach's own peak relative speed (scale-free: fast and slow approaches alike), or below
+``settle_floor_factor`` times the hold's speed floor (marker noise and both hands carrying the
+object keep the relative speed of a real hold at 3-7 cm/s), whichever is higher; a clean
+approach's parabolic tail is then extrapolated down to the floor (:func:`transfer_start`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gazebot.core.phases.config import PhaseConfig
+from gazebot.core.phases.filtering import Signals, nanmax, quantile, vector_norm
+from gazebot.core.phases.rules.onset import min_jerk_span
+
+
+@dataclass(frozen=True)
+class TransferCore:
+    """One handover's transfer core on the analysis grid.
+
+    Attributes:
+        lo: First grid index of the handover's dip.
+        start: First grid index of the seed-rule core.
+        end: Last grid index of the core.
+        hi: Last grid index of the dip.
+        t_start: Transfer start (s), or NaN when the approach has not yet settled in the data.
+    """
+
+    lo: int
+    start: int
+    end: int
+    hi: int
+    t_start: float
+
+
+def runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Inclusive index ranges of the True runs of ``mask``."""
+    if mask.size == 0:
+        return []
+    padded = np.zeros(mask.size + 2, dtype=bool)  # (not a concatenation of converted lists)
+    padded[1:-1] = mask
+    bounds = (padded[1:] != padded[:-1]).nonzero()[0].tolist()
+    return [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
+
+
+def _leg_end(v: np.ndarray, s: int, depth: float, down: bool) -> int:
+    """The end of the leg of ``v`` starting at ``s``: going down, the first index after ``s``
+    at least ``depth`` above the lowest sample from ``s`` before it (going up: ``depth``
+    below the highest); -1 if none. Searched in windows from ``s`` that double in length, so
+    a leg costs a few numpy calls and work proportional to its own length, whatever follows
+    it (a whole recording's distance has hundreds of legs)."""
+    m = v.shape[0]
+    w = 64
+    while True:
+        e = min(s + w, m)
+        if down:
+            hit = v[s + 1 : e] >= np.minimum.accumulate(v[s : e - 1]) + depth
+        else:
+            hit = v[s + 1 : e] <= np.maximum.accumulate(v[s : e - 1]) - depth
+        j = int(hit.argmax()) if hit.shape[0] else 0
+        if hit.shape[0] and hit[j]:
+            return s + 1 + j
+        if e == m:
+            return -1
+        w *= 2
+
+
+def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
+    """Dips of ``d`` at least ``depth`` (> 0) deep on both sides, as ``(left, minimum, right)``
+    index triples (left/right: the highest points between neighbouring dips). The recording's
+    ends count as high ground, so a recording that starts or ends mid-handover keeps its dip.
+    NaN samples are skipped.
+
+    A zigzag with hysteresis ``depth``: going down, the lowest sample so far (the first of
+    equal ones) is the minimum until a sample rises ``depth`` above it; going up, the highest
+    so far until one falls ``depth`` below it. Each leg is found with running extrema
+    (:func:`_leg_end`: a few numpy calls a leg, not a Python step per sample: the online
+    analysis reads the dips of hundreds of samples every period); ``tests/phases`` pins it to
+    the sample-by-sample form."""
+    if not depth > 0:
+        raise ValueError(f"dips: depth must be > 0, got {depth}")
+    out: list[tuple[int, int, int]] = []
+    if d.shape[0] == 0:
+        return out
+    if d.dtype.kind != "f" or d.dtype.itemsize < 8:
+        # (a narrower or integer signal compared in float64, as the zigzag's plain floats
+        # compare it; a wider one keeps its precision, as its tolist() does)
+        d = d.astype(float)
+    ok = np.isfinite(d)
+    if ok.all():
+        v, idx = d, None
+    else:
+        idx = ok.nonzero()[0]
+        if idx.size == 0:
+            return out
+        v = d[idx]
+
+    def at(i: int) -> int:  # index into d of the i-th finite sample
+        return i if idx is None else int(idx[i])
+
+    left = at(0)
+    s = 0  # the down leg starts here
+    while True:
+        # (depth > 0: the sample ending a leg is never a new extreme of that leg)
+        u = _leg_end(v, s, depth, down=True)  # the up leg starts here
+        if u < 0:
+            out.append((left, at(s + int(v[s:].argmin())), at(v.shape[0] - 1)))
+            return out
+        lo_i = s + int(v[s:u].argmin())
+        s = _leg_end(v, u, depth, down=False)  # the next down leg starts here
+        if s < 0:
+            out.append((left, at(lo_i), at(u + int(v[u:].argmax()))))
+            return out
+        hi = at(u + int(v[u:s].argmax()))
+        out.append((left, at(lo_i), hi))
+        left = hi
+
+
+def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
+    """Every handover's transfer core, in time order (see the module docstring)."""
+    d = s.distance
+    n = d.shape[0]
+    if n < 3 or not np.isfinite(d).any():
+        return []
+    out: list[TransferCore] = []
+    unknown = ~np.isfinite(s.rel_speed)
+    rs = np.where(unknown, np.inf, s.rel_speed)
+    min_len = max(1, int(round(c.min_transfer * c.analysis_rate)))
+    for lo, p, hi in dips(d, c.min_approach):
+        near = np.zeros(n, dtype=bool)
+        near[lo : hi + 1] = d[lo : hi + 1] <= d[p] + c.transfer_distance_margin
+        rule_runs = runs(near & (rs < c.transfer_speed_max))
+        if not any(b - a + 1 >= min_len for a, b in rule_runs):
+            passed = pass_core(s, c, near, rs, lo, p, hi)
+            if passed is not None and (not out or passed[0] > out[-1].end):
+                out.append(TransferCore(lo, passed[0], passed[1], hi, float(s.t[passed[0]])))
+            continue
+        soft = near & (rs < c.transfer_exit_speed)
+        merged: list[list[int]] = [list(rule_runs[0])]
+        for a, b in rule_runs[1:]:
+            gap = slice(merged[-1][1] + 1, a)
+            # A short blip under the exit speed, or a tracking gap with nothing but such
+            # samples, does not end a transfer.
+            ok = soft[gap] | unknown[gap]
+            if ok.all() and np.count_nonzero(~unknown[gap]) < min_len:
+                merged[-1][1] = b
+            else:
+                merged.append([a, b])
+        core = next((m for m in merged if m[0] <= p <= m[1]), None)
+        if core is None:
+            core = max(merged, key=lambda m: m[1] - m[0])
+        a, b = core
+        if b - a + 1 < min_len:
+            continue
+        if not is_handover_dip(s, c, lo, p, a):
+            continue  # a pause far apart, or only the receiver moved: not a handover
+        if out and a <= out[-1].end:
+            continue  # the same transfer seen from a neighbouring dip
+        out.append(TransferCore(lo, a, b, hi, transfer_start(s, c, lo, a, b)))
+    return out
+
+
+def is_handover_dip(s: Signals, c: PhaseConfig, lo: int, p: int, a: int) -> bool:
+    """The dip ``[lo .. p]`` closes ``approach_fraction`` of where the hands started and the
+    giver's hand moved (``reach_onset_speed``) before grid index ``a``."""
+    d = s.distance
+    top = float(nanmax(d[lo : p + 1]))
+    if top - d[p] < c.approach_fraction * top:
+        return False  # the hands paused while still far apart (relative to where they started)
+    return bool(nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed)
+
+
+def pass_core(
+    s: Signals, c: PhaseConfig, near: np.ndarray, rs: np.ndarray, lo: int, p: int, hi: int
+) -> tuple[int, int] | None:
+    """A handover without a hold (a quick or on-the-move pass: the hands never slow under the
+    seed's 15 cm/s for ``min_transfer``): the object changes hands where they are closest and
+    slowest. The core is the run under ``transfer_exit_speed`` around the slowest sample of
+    the near run holding the minimum ``p`` (at least ``pass_min_samples`` grid samples), only
+    once the hands are seen parting after it (the dip's far side rises ``min_approach``)."""
+    n = s.t.shape[0]
+    d = s.distance
+    a = p
+    while a > lo and near[a - 1]:
+        a -= 1
+    b = p
+    while b < hi and near[b + 1]:
+        b += 1
+    if b >= n - 1 or not nanmax(d[p:], initial=-np.inf) >= d[p] + c.min_approach:
+        return None  # not yet seen parting
+    k = a + int(rs[a : b + 1].argmin())
+    if not rs[k] < c.transfer_exit_speed:
+        return None
+    i, j = k, k
+    while i > a and rs[i - 1] < c.transfer_exit_speed:
+        i -= 1
+    while j < b and rs[j + 1] < c.transfer_exit_speed:
+        j += 1
+    if j - i + 1 < c.pass_min_samples or not is_handover_dip(s, c, lo, p, i):
+        return None
+    return i, j
+
+
+def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
+    """The relative speed floor of the hold ``[a, b]`` (m/s): marker noise and both hands
+    carrying the object, the ``hold_floor_quantile`` of its relative speed."""
+    hold = s.rel_speed[a : b + 1]
+    hold = hold[np.isfinite(hold)]
+    return quantile(hold, c.hold_floor_quantile) if hold.size else 0.0  # (np.quantile's)
+
+
+def v_settle_fraction(s: Signals, c: PhaseConfig, lo: int, a: int) -> float:
+    """``settle_fraction`` of the approach's peak relative speed (m/s)."""
+    return c.settle_fraction * float(nanmax(s.rel_speed[lo : a + 1], initial=0.0))
+
+
+def settle_speed(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
+    """The relative speed below which the approach of the core ``[a, b]`` has stopped (m/s)."""
+    peak = float(nanmax(s.rel_speed[lo : a + 1], initial=0.0))
+    floor = c.settle_floor_factor * hold_floor(s, c, a, b)
+    return min(max(c.settle_fraction * peak, floor), c.transfer_speed_max)
+
+
+def _crossing(s: Signals, i: int, level: float) -> float:
+    """Time the relative speed fell through ``level`` between grid points ``i - 1`` and ``i``."""
+    if i > 0 and np.isfinite(s.rel_speed[i - 1]):
+        v0, v1 = float(s.rel_speed[i - 1]), float(s.rel_speed[i])
+        if v0 > level >= v1 and v0 > v1:
+            return float(s.t[i - 1]) + (v0 - level) / (v0 - v1) * s.dt
+    return float(s.t[i])
+
+
+def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
+    """When the approach into the core ``[a, b]`` stopped (s); NaN if not yet seen to settle.
+
+    The relative speed's crossing of the settle speed ``v_s``; when that lies above the hold's
+    floor ``v_f`` (``settle_floor_factor`` x floor: a clean approach), the approach's tail,
+    parabolic near its end (``v ~ (t_stop - t)^2``), is extrapolated from the crossings of
+    the seed's ``transfer_speed_max`` (t_a) and ``v_s`` (t_s) to where it meets ``v_f``:
+    ``t_s + stop_extrapolation (t_s - t_a) (sqrt(v_s) - sqrt(v_f)) / (sqrt(v_a) - sqrt(v_s))``
+    (at most ``max_refine``). Only the tail seen before the first tracking gap counts. An
+    approach that stopped inside a tracking gap is dated from the last sample seen before it
+    (:func:`stop_in_gap_before`).
+    """
+    v_settle = settle_speed(s, c, lo, a, b)
+    hidden = stop_in_gap_before(s, a, v_settle)
+    if hidden is not None:
+        return hidden
+    seg = s.rel_speed[a : b + 1]
+    gaps = (~np.isfinite(seg)).nonzero()[0]
+    seen = seg[: int(gaps[0])] if gaps.size else seg
+    below = (seen < v_settle).nonzero()[0]
+    if below.size == 0:
+        if gaps.size:
+            return float(s.t[a + int(seen.argmin())]) if seen.size else float(s.t[a])
+        return math.nan
+    i = a + int(below[0])
+    v_frac = v_settle_fraction(s, c, lo, a)
+    # The core's first part is the approach's tail: once the crossing is known, the hold's
+    # floor is measured on the samples after it (a short, early hold otherwise reads high).
+    for _ in range(2):
+        v_f = c.settle_floor_factor * hold_floor(s, c, i, b)
+        v_new = min(max(v_f, v_frac), c.transfer_speed_max)
+        below = (seen < v_new).nonzero()[0]
+        if v_new >= v_settle or below.size == 0:
+            break
+        v_settle, i = v_new, a + int(below[0])
+    t_s = _crossing(s, i, v_settle)
+    t_a = _crossing(s, a, c.transfer_speed_max)
+    v_a = c.transfer_speed_max
+    if v_f < v_settle < v_a and t_s > t_a:
+        ext = (t_s - t_a) * (math.sqrt(v_settle) - math.sqrt(v_f))
+        ext /= math.sqrt(v_a) - math.sqrt(v_settle)
+        t_s += min(c.stop_extrapolation * ext, c.max_refine)
+    return t_s
+
+
+def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
+    """The approach's stop when it hides in a tracking gap ending at grid index ``a``.
+
+    ``None`` if ``a`` follows a seen sample, or the hands have not settled at ``a``. Else, from
+    the last sample seen before the gap, approaching at speed ``v`` with ``x`` left to go, the
+    minimum-jerk tail (``x ~ (t_stop - t)^3``) stops ``3 x / v`` later; at the latest when the
+    gap ends."""
+    if a == 0 or np.isfinite(s.rel_speed[a - 1]) or not s.rel_speed[a] < v_settle:
+        return None
+    seen = np.isfinite(s.rel_speed[:a]).nonzero()[0]
+    t_a = float(s.t[a])
+    if seen.size == 0:
+        return None
+    i = int(seen[-1])
+    x = vector_norm(s.rel[a] - s.rel[i])
+    v = float(s.rel_speed[i])
+    if not (math.isfinite(x) and v > 1e-6):
+        return t_a
+    return min(float(s.t[i]) + min_jerk_span(x, v), t_a)

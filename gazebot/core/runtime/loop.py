@@ -1,0 +1,295 @@
+"""The one runtime loop: tracking and robot state in, safe head, eye and blink commands out.
+
+Every consumer drives the robot's head and eyes through :class:`GazeLoop`: the in-process
+handover recording (``gazebot demo``, ``gazebot render video``, ``gazebot study render``), the
+engine node on the bus (``gazebot run``, ``gazebot sim --with-engine``) and the in-process
+simulated driver. What it adds to :meth:`gazebot.core.engine.GazeEngine.step`:
+
+* **Blinks**: one :class:`~gazebot.core.runtime.blink.BlinkModel`, fed with the command's
+  ``gaze_shift`` (the size of a gaze shift starting this tick, computed once by the gaze
+  controller).
+* **Vergence distance**: from the same ``gaze`` frame origin to the target point (``None`` when
+  the target is unknown or at the display itself). The ``gaze`` frame is placed at the measured
+  head joints when the tick's ``joints`` has them all (where the display really is), else at
+  the commanded head pose.
+* **Tracking loss**: a tick without a sample (``frame=None``, the transport heard nothing) is a
+  missing sample for the phase detector, which bridges short gaps and reports ``tracking_lost``
+  after ``max_gap_hold``; the behavior then applies its own ``tracking_lost`` policy (hold for
+  ``hold_s``, then look at its target, by default the last known face). There is no other
+  fallback: the behavior's timings are the only ones.
+* **Safety**: the gaze controller is the one place that clips the head goals into the joint
+  limits and the eyes into their range; the loop checks: a command with any non-finite value, a
+  head goal outside the limits (or for a joint the robot lacks) or eyes outside their range is
+  never returned (the tick returns ``None`` and counts it in :attr:`GazeLoop.unsafe`); the blink
+  is kept in 0..1. An engine that raises is answered the same way (counted in
+  :attr:`GazeLoop.faults`): the loop never dies on input.
+
+The loop's output is the engine's :class:`~gazebot.core.types.GazeCommand` with the lids, the
+vergence distance and ``answers_sample`` filled in (one command type from the engine to the
+wire).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+
+from gazebot.core.runtime.blink import BlinkModel
+from gazebot.core.types import (
+    F64,
+    Event,
+    GazeCommand,
+    Phase,
+    TrackingFrame,
+    TrackingState,
+    from_fields,
+    is_valid_point,
+)
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from gazebot.core.kinematics import RobotConfig
+    from gazebot.core.phases import PhaseConfig
+
+#: The loop's command is the engine's (kept as a name for the drivers that import it).
+LoopCommand = GazeCommand
+
+__all__ = ["EngineLike", "GazeLoop", "LoopCommand", "RobotLike", "TrackingState"]
+
+
+class EyesLike(Protocol):
+    def clip(self, yaw: float, pitch: float) -> tuple[float, float, bool]: ...
+
+
+class RobotLike(Protocol):
+    """What the loop reads of the robot (:class:`gazebot.core.kinematics.RobotModel`)."""
+
+    head_joints: Sequence[str]
+    lower: np.ndarray
+    upper: np.ndarray
+    rest: np.ndarray
+    eyes: EyesLike
+
+    def gaze_frame_lists(self, q_head: Sequence[float]) -> list[list[float]]: ...
+
+
+class EngineLike(Protocol):
+    """What the loop drives (:class:`gazebot.core.engine.GazeEngine`)."""
+
+    robot: RobotLike
+
+    @property
+    def phase(self) -> Phase: ...
+
+    def step(
+        self, frame: TrackingFrame, arm: Mapping[str, float] | None = None
+    ) -> GazeCommand: ...
+
+    def notify(self, events: Event | Iterable[Event]) -> None: ...
+
+    def reset(self, head: Mapping[str, float] | None = None) -> None: ...
+
+    def resync(self, events: Iterable[Event]) -> None: ...
+
+
+class GazeLoop:
+    """Turns tracking samples (or their absence) into safe :class:`GazeCommand` s.
+
+    Args:
+        engine: The engine (a :class:`gazebot.core.engine.GazeEngine`, or anything
+            :class:`EngineLike`).
+        blink: The blink model; ``None`` for ``BlinkModel(seed)``.
+        seed: Seed of the default blink model.
+    """
+
+    def __init__(self, engine: EngineLike, blink: BlinkModel | None = None, seed: int = 0) -> None:
+        self.engine = engine
+        self.blinks = blink if blink is not None else BlinkModel(seed)
+        self.unsafe = 0  # commands refused: non-finite, or outside the joint or eye limits
+        self.faults = 0  # ticks the engine raised on (answered with None)
+        self.ticks = 0
+        self._t = -math.inf
+        # (the last gaze frame: its head pose, arm revision and rows)
+        self._frame_pose: list[float] | None = None
+        self._frame_revision: object = None
+        self._frame_rows: list[list[float]] = []
+        robot = self._robot = engine.robot  # (the engine's robot never changes)
+        # (per tick: each head joint's name, limits and rest value, and the eyes' range)
+        self._joints = [(str(n), float(lo), float(hi), float(r))
+                        for n, lo, hi, r in zip(robot.head_joints, robot.lower, robot.upper,
+                                                robot.rest, strict=True)]
+        self._eyes = robot.eyes
+
+    @classmethod
+    def from_config(
+        cls,
+        robot: str | Path | RobotConfig = "sawyer",
+        behavior: str | Path = "face-hand-face",
+        phases: str | Path | PhaseConfig | None = None,
+        seed: int = 0,
+    ) -> GazeLoop:
+        """A loop around ``GazeEngine.from_config(robot, behavior, phases, seed=seed)`` with
+        ``BlinkModel(seed)``."""
+        from gazebot.core.engine import GazeEngine
+
+        return cls(GazeEngine.from_config(robot, behavior, phases, seed=seed), seed=seed)
+
+    @property
+    def robot(self) -> RobotLike:
+        return self.engine.robot
+
+    @property
+    def phase(self) -> Phase:
+        return self.engine.phase
+
+    def notify(self, events: Event | Iterable[Event]) -> None:
+        """Hand one robot event or several (e.g. ``robot_reach_started``) to the engine's next
+        tick."""
+        self.engine.notify(events)
+
+    def reset(self, head: Mapping[str, float] | None = None) -> None:
+        """Forget the handover, the head pose (``head``: the measured one) and the blink line."""
+        self.engine.reset(head)
+        self.blinks.reset()
+        self._t = -math.inf
+
+    def resync(self, events: Iterable[Event]) -> None:
+        """Catch up with a handover under way (see :meth:`GazeEngine.resync`)."""
+        self.engine.resync(events)
+
+    def tick(
+        self,
+        frame: TrackingFrame | None,
+        *,
+        t: float | None = None,
+        joints: Mapping[str, float] | None = None,
+    ) -> GazeCommand | None:
+        """Advance with ``frame``, or, with ``None`` (no sample arrived), to robot time ``t``.
+
+        ``t`` is the tick's robot time (s): required without a frame; with a frame it may be
+        given only if it agrees with ``frame.t``. ``joints`` is the robot's measured joint
+        positions (rad) by name: the arm joints that carry the head (Sawyer's ``right_j0``) and
+        the head joints. Returns the command, or ``None`` when the engine produced an unsafe one
+        (non-finite, or outside the joint or eye limits) or raised (never sent).
+
+        Raises:
+            ValueError: no frame and no ``t``, or a ``t`` that disagrees with ``frame.t``
+                (a caller's mistake, not bad input).
+        """
+        answers = frame is not None
+        if frame is None:
+            if t is None:
+                raise ValueError("tick(None) needs the robot time t")
+            # Silence is a missing sample: the detector bridges it, then reports tracking_lost.
+            frame = TrackingFrame(t=float(t))
+        elif t is not None:
+            ft = frame.t
+            if math.isfinite(t) and math.isfinite(ft) and abs(float(t) - float(ft)) > 1e-9:
+                raise ValueError(f"tick: t={t} disagrees with the frame's t={ft}")
+        self.ticks += 1
+        try:
+            cmd = self.engine.step(frame, joints)  # (arm: positional, a cheaper call)
+        except Exception:  # noqa: BLE001 - a node never dies on input; the tick sends nothing
+            self.faults += 1
+            return None
+        return self._finish(cmd, answers, joints)
+
+    def _finish(
+        self, cmd: GazeCommand, answers: bool, joints: Mapping[str, float] | None
+    ) -> GazeCommand | None:
+        # What GazeCommand.is_finite() checks, in one pass with the limits: a NaN or infinite
+        # head goal fails its limit comparison and non-finite eyes are clipped. The checks and
+        # the rest below are written out in this one function (no helper calls, no key tuple):
+        # they run every tick and their calls were most of the loop's cost.
+        isfinite = math.isfinite
+        head = cmd.head
+        if not (isfinite(cmd.t) and isfinite(cmd.blink) and isfinite(cmd.gaze_shift)):
+            self.unsafe += 1
+            return None
+        # Every head goal is for a joint of the robot and within its limits (a check, not a
+        # clip: the gaze controller clips); on the way, the commanded head vector (rest for a
+        # joint the command lacks).
+        pose = []
+        known = 0
+        for name, lo, hi, rest in self._joints:
+            if name in head:
+                v = head[name]
+                if not lo <= v <= hi:
+                    self.unsafe += 1
+                    return None
+                known += 1
+                pose.append(v)
+            else:
+                pose.append(rest)
+        if known != len(head) or self._eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]:
+            self.unsafe += 1
+            return None
+        distance = None
+        point = cmd.target_point
+        if type(point) is np.ndarray and (point.dtype is F64 or point.dtype.kind == "f") and (
+            point.shape == (3,)
+        ):
+            # The engine's points are such arrays (float64: ``is`` first, NumPy's dtype is one
+            # object). No finiteness check: a NaN or infinite coordinate makes the distance NaN
+            # or infinite, which the range test below refuses.
+            x, y, z = point.tolist()
+            valid = True
+        elif is_valid_point(point):
+            x, y, z = np.asarray(point, dtype=float).tolist()
+            valid = True
+        else:
+            valid = False
+        if valid:
+            if joints:
+                # The display is where the measured head is, when all its joints are known.
+                pose = self._measured_pose(joints) or pose
+            rows = self._gaze_frame(pose)
+            dx, dy, dz = x - rows[0][3], y - rows[1][3], z - rows[2][3]
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            # A target at the display itself (or beyond any float) has no defined vergence.
+            distance = d if 1e-3 < d < math.inf else None
+        # Blink times never go back (the engine's t never does either): max(cmd.t, self._t)
+        # as a comparison.
+        t = cmd.t
+        if self._t > t:
+            t = self._t
+        self._t = t
+        # min(max(b, 0), 1) as comparisons (the same result, NaN and -0.0 included)
+        blink = float(self.blinks.update(t, cmd.gaze_shift))
+        if blink < 0.0:
+            blink = 0.0
+        if blink > 1.0:
+            blink = 1.0
+        # cmd.replaced(...) without its field-name check (these are GazeCommand's fields); a
+        # copy, then the three fields (their places in the dict are kept).
+        fields = cmd.__dict__.copy()
+        fields["blink"] = blink
+        fields["distance"] = distance
+        fields["answers_sample"] = answers
+        return from_fields(GazeCommand, fields)
+
+    def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
+        """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
+        the arm carrying the head moved (a head at rest: no forward kinematics)."""
+        robot = self._robot
+        revision = getattr(robot, "arm_revision", None)
+        # (pose and revision compared apart: equal to comparing them as one tuple, without
+        # building it)
+        if pose != self._frame_pose or revision != self._frame_revision:
+            self._frame_pose = pose
+            self._frame_revision = revision
+            self._frame_rows = robot.gaze_frame_lists(pose)
+        return self._frame_rows
+
+    def _measured_pose(self, joints: Mapping[str, float]) -> list[float] | None:
+        """The measured head vector clipped into the limits, or ``None`` unless every head
+        joint is in ``joints`` and finite."""
+        measured = [joints.get(n, math.nan) for n, _, _, _ in self._joints]
+        if all(isinstance(v, (int, float)) and math.isfinite(v) for v in measured):
+            return [min(max(v, lo), hi)
+                    for v, (_, lo, hi, _) in zip(measured, self._joints, strict=True)]
+        return None

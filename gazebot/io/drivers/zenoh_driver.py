@@ -1,0 +1,314 @@
+"""``ZenohRobotDriver``: drive any robot whose bridge speaks gazebot's ROS 2 topics on the
+rmw_zenoh wire (:mod:`gazebot.io.ros2.topics`), e.g. ``gazebot sim`` or a ROS 2 robot stack."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from gazebot.core.types import Phase
+from gazebot.io.drivers.base import RobotDriver
+from gazebot.io.drivers.ownership import Ownership
+from gazebot.io.drivers.payloads import (
+    ArmCommandMsg,
+    EyeFrameMsg,
+    EyeStateMsg,
+    HeadCommandMsg,
+    JointStateMsg,
+    Point,
+    TrackingMsg,
+)
+from gazebot.io.drivers.rmw.attachment import gid_of
+from gazebot.io.drivers.rmw.graph import Entity
+from gazebot.io.drivers.rmw.names import Names
+from gazebot.io.drivers.rmw.node import Received
+from gazebot.io.drivers.tracking_assembly import IDLE_FLUSH, REORDER, SampleAssembler
+from gazebot.io.drivers.tracking_source import Rival, SourceArbiter, group_of
+from gazebot.io.drivers.zenoh_node import HISTORY_BYTES, ZenohNode
+from gazebot.io.ros2 import convert, topics
+from gazebot.io.ros2.errors import MessageError
+
+if TYPE_CHECKING:
+    import zenoh
+
+#: Frame of the eye state: the head's ``gaze`` site.
+GAZE_FRAME = "gaze"
+
+
+class ZenohRobotDriver(ZenohNode, RobotDriver):
+    """The engine side of the bus: publishes head commands, the gaze target, eye state (and
+    frames while subscribed), the phase, arm goals, events and health; receives tracking (as
+    ``PointStamped``, ``PoseStamped`` or ``/tf`` frames), joint states, the gripper, the load
+    share, the robot's events and the other nodes' health.
+
+    Args:
+        session: An open session (left open by :meth:`close` unless ``owns_session``).
+        names: Namespace, remapping, domain id and frame names.
+        node: This node's name (default ``engine``).
+        owns_session: Close ``session`` in :meth:`close` (set by :meth:`open`).
+        peer_timeout: Heartbeat timeout (s) after which a peer counts as lost.
+        tracking_backlog: Unread tracking samples kept (oldest dropped beyond, counted in
+            ``tracking_skipped``): 12 = 0.1 s at 120 Hz, the most the engine may lag.
+        assemble_idle: Time (s) without any tracking part after which pending samples are
+            complete anyway; completeness is otherwise decided from the stamps (see
+            :mod:`gazebot.io.drivers.tracking_assembly`).
+        assemble_reorder: Newer samples after which a part missing from a sample counts as
+            not tracked at its stamp (how far one tracking topic may run ahead of another).
+        source_timeout: A tracking source silent this long (s) gives way to the next one
+            (see :mod:`gazebot.io.drivers.tracking_source`); until then another source's samples
+            are dropped, counted by topic and reported as rivals.
+    """
+
+    default_node: ClassVar[str] = "engine"
+
+    def __init__(
+        self,
+        session: zenoh.Session,
+        names: Names,
+        node: str = "engine",
+        *,
+        owns_session: bool = False,
+        peer_timeout: float = 2.0,
+        tracking_backlog: int = 12,
+        assemble_idle: float = IDLE_FLUSH,
+        assemble_reorder: int = REORDER,
+        clock: Callable[[], float] = time.monotonic,
+        max_bytes: dict[str, int] | None = None,
+        history_bytes: int = HISTORY_BYTES,
+        source_timeout: float = 1.0,
+    ) -> None:
+        super().__init__(session, names, node, owns_session=owns_session,
+                         peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes,
+                         history_bytes=history_bytes)
+        self._cond = threading.Condition(threading.Lock())
+        self._queue: deque[TrackingMsg] = deque()
+        self.tracking_backlog = tracking_backlog
+        self.tracking_received = 0
+        self.tracking_skipped = 0
+        self._joints: JointStateMsg | None = None
+        self._ownership: Ownership | None = None
+        self._sources = SourceArbiter(source_timeout, clock)
+        self._gid_labels: dict[bytes, str] = {}
+        self._assembler = SampleAssembler(self._expected_parts, assemble_idle,
+                                          assemble_reorder, clock=clock)
+        ros = self.ros
+        self._head_pub = ros.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
+        self._target_pub = ros.publisher(topics.GAZE_TARGET.name, topics.GAZE_TARGET.type)
+        self._eyes_pub = ros.publisher(topics.EYES.name, topics.EYES.type)
+        self._frame_pub = ros.publisher(topics.EYE_IMAGE.name, topics.EYE_IMAGE.type)
+        self._phase_pub = ros.publisher(topics.PHASE.name, topics.PHASE.type)
+        self._arm_pub = ros.publisher(topics.ARM_COMMAND.name, topics.ARM_COMMAND.type)
+        self._arm_mode_pub = ros.publisher(topics.ARM_MODE.name, topics.ARM_MODE.type)
+        self._part_topics: dict[str, str] = {}
+        for body, t in topics.TRACKING.items():
+            sub = ros.subscription(t.name, (t.type, convert.POSE_STAMPED),
+                                   lambda m, rx, b=body: self._on_point(b, m, rx))
+            self._part_topics[body] = sub.topic
+        if names.tf_frames:
+            sub = ros.subscription(topics.TF.name, topics.TF.type, self._on_tf)
+            for body in names.tf_frames:
+                self._part_topics.setdefault(body, sub.topic)
+        for part, t, fn in (("gripper", topics.GRIPPER, self._on_gripper),
+                            ("load_share", topics.LOAD_SHARE, self._on_share)):
+            self._part_topics[part] = ros.subscription(t.name, t.type, fn).topic
+        ros.subscription(topics.JOINT_STATES.name, topics.JOINT_STATES.type, self._on_joints)
+        self.announce()
+
+    # -- tracking in -----------------------------------------------------------------------
+    def _expected_parts(self) -> set[str]:
+        """The sample parts whose topic has a publisher now (of the group's owning source,
+        once there is one)."""
+        owners = self._sources.owners()
+        published = set()
+        for e in self.ros.graph.entities():
+            if e.kind == "MP":
+                published.add((e.topic, source_label(e)))
+        out = set()
+        for part, topic in self._part_topics.items():
+            owner = owners.get(group_of(part))
+            if any(t == topic and (owner is None or owner == src) for t, src in published):
+                out.add(part)
+        return out
+
+    def _source(self, rx: Received) -> str:
+        """The node that published a received part: the publisher whose token hashes to the
+        GID of the attachment (as rmw_zenoh computes GIDs), else the topic's only publisher
+        (implementations with random GIDs), else one unidentified source."""
+        gid = rx.attachment.gid if rx.attachment is not None else None
+        label = self._gid_labels.get(gid) if gid is not None else None
+        if label is not None:
+            return label
+        publishers = self.ros.graph.endpoints(rx.topic, "MP")
+        for e in publishers:
+            if gid is not None and gid_of(e.token()) == gid:
+                if len(self._gid_labels) > 1000:  # publishers come and go: stay bounded
+                    self._gid_labels.clear()
+                label = self._gid_labels[gid] = source_label(e)
+                return label
+        if len({source_label(e) for e in publishers}) == 1:
+            return source_label(publishers[0])
+        return "unidentified publisher"
+
+    def tracking_sources(self) -> dict[str, str]:
+        """Tracking part (``giver_hand``, ``giver_face``, ``gripper``, ...) -> its source now."""
+        return self._sources.owners()
+
+    def tracking_rivals(self, new_only: bool = False) -> list[Rival]:
+        """Sources whose tracking was ignored lately (``new_only``: not returned before)."""
+        return self._sources.new_rivals() if new_only else self._sources.rivals()
+
+    def _point(self, ros: Any) -> tuple[float, Any]:
+        t, p = convert.point_of(ros)
+        frame = str(ros.header.frame_id)
+        if not self.names.is_base_frame(frame):
+            raise MessageError(ros.__msgtype__, f"frame_id {frame!r}, expected the robot base "
+                               f"frame {self.names.base_frame!r}")
+        return t, p
+
+    def _on_point(self, body: str, ros: Any, rx: Received) -> None:
+        t, p = self._point(ros)
+        self._add(body, t, p, rx)
+
+    def _on_tf(self, ros: Any, rx: Received) -> None:
+        by_child = {child.lstrip("/"): body for body, child in self.names.tf_frames.items()}
+        for tf in ros.transforms:
+            body = by_child.get(str(tf.child_frame_id).lstrip("/"))
+            if body is not None and self.names.is_base_frame(str(tf.header.frame_id)):
+                t, p = convert.point_of(tf)
+                self._add(body, t, p, rx)
+
+    def _on_gripper(self, ros: Any, rx: Received) -> None:
+        self._add("gripper", convert.stamp_of(ros), bool(ros.closed), rx)
+
+    def _on_share(self, ros: Any, rx: Received) -> None:
+        t, share = convert.share_of(ros)
+        self._add("load_share", t, share, rx)
+
+    def _add(self, part: str, t: float, value: Any, rx: Received) -> None:
+        if not math.isfinite(t):
+            raise MessageError(part, f"stamp is not finite: {t}")
+        source = self._source(rx)
+        owner = self._sources.admit(part, source)
+        if owner is not None:
+            raise MessageError(rx.type, f"second tracking source {source} ignored: {owner} "
+                               f"publishes the {group_of(part)}")
+        with self._cond:
+            self._enqueue(self._assembler.add(part, t, value))
+
+    def _enqueue(self, samples: list[TrackingMsg]) -> None:
+        for msg in samples:
+            if len(self._queue) >= self.tracking_backlog:
+                self._queue.popleft()
+                self.tracking_skipped += 1
+            self._queue.append(msg)
+            self.tracking_received += 1
+        if samples:
+            self._cond.notify_all()
+
+    def _on_joints(self, ros: Any, rx: Received) -> None:
+        t, position = convert.joint_positions(ros)
+        seq = rx.attachment.sequence_number - 1 if rx.attachment is not None else 0
+        self._joints = JointStateMsg(seq=max(0, seq), t=t, stamp=time.time(), position=position)
+
+    @property
+    def tracking_late(self) -> int:
+        """Tracking parts that arrived after their sample was complete (dropped)."""
+        return self._assembler.late
+
+    # -- ownership -------------------------------------------------------------------------
+    def claim(self, timeout: float = 0.5) -> None:
+        if self._ownership is None and not self.closed:
+            self._ownership = self.ros.declare(Ownership(self.session, self.names, self.node))
+            self._ownership.declare(timeout)
+
+    def owns_robot(self) -> bool:
+        return self._ownership is not None and self._ownership.is_owner()
+
+    def rival_engines(self) -> list[str]:
+        return [] if self._ownership is None else [str(c) for c in self._ownership.rivals()]
+
+    # -- RobotDriver -----------------------------------------------------------------------
+    def wait_tracking(self, timeout: float) -> TrackingMsg | None:
+        end = self.clock() + max(0.0, timeout)
+        with self._cond:
+            while not self._queue and not self.closed:
+                self._enqueue(self._assembler.flush_stale())
+                now = self.clock()
+                if self._queue or now >= end:
+                    break
+                due = self._assembler.next_deadline()
+                wait = end - now if due is None else min(end, max(due, now + 1e-3)) - now
+                self._cond.wait(wait)
+            return self._queue.popleft() if self._queue else None
+
+    def joint_state(self) -> JointStateMsg | None:
+        return self._joints
+
+    def send_head(self, msg: HeadCommandMsg) -> None:
+        self._head_pub.publish(convert.head_trajectory(
+            msg, msg.time_from_start, velocities=msg.velocity))
+
+    def send_gaze_target(self, t: float, point: Point) -> None:
+        self._target_pub.publish(convert.point_stamped(t, point, self.names.base_frame))
+
+    def send_phase(self, t: float, phase: str, phase_start: float) -> None:
+        self._phase_pub.publish(convert.handover_phase(t, Phase(phase), phase_start))
+
+    def send_eyes(self, msg: EyeStateMsg) -> None:
+        self._eyes_pub.publish(convert.eye_state(_EyeCommand(msg), GAZE_FRAME))
+
+    def send_eye_frame(self, msg: EyeFrameMsg) -> None:
+        image = self.ros.store.types[convert.COMPRESSED_IMAGE]
+        self._frame_pub.publish(image(header=convert.header(msg.t, GAZE_FRAME), format=msg.format,
+                                      data=np.frombuffer(msg.data, np.uint8)))
+
+    def wants_eye_frames(self) -> bool:
+        # Rendering and encoding frames is costly: only while someone subscribes to them.
+        return not self.closed and self._frame_pub.subscribed()
+
+    def send_arm(self, msg: ArmCommandMsg) -> None:
+        if msg.positions is not None:
+            goal = dict(msg.positions)
+            if msg.gripper is not None:
+                goal["gripper"] = msg.gripper
+            self._arm_pub.publish(convert.head_trajectory(
+                _Goal(msg.t, goal), 1.0, stamped=False))
+            return
+        mode = "resume" if msg.resume else str(msg.pose)
+        self._arm_mode_pub.publish(self.ros.store.types["std_msgs/msg/String"](data=mode))
+        if msg.gripper is not None:
+            self._arm_pub.publish(convert.head_trajectory(
+                _Goal(msg.t, {"gripper": msg.gripper}), 1.0, stamped=False))
+
+    def close(self) -> None:
+        if self.closed:
+            return
+        super().close()
+        with self._cond:
+            self._cond.notify_all()  # wake a wait_tracking() in progress
+
+
+def source_label(entity: Entity) -> str:
+    """A tracking source's name: its node's name and its session."""
+    return f"{entity.node} (session {entity.zid})"
+
+
+class _EyeCommand:
+    """An :class:`EyeStateMsg` read as the command attributes :func:`convert.eye_state` takes."""
+
+    def __init__(self, msg: EyeStateMsg) -> None:
+        self.t, self.eye_yaw, self.eye_pitch = msg.t, msg.yaw, msg.pitch
+        self.blink, self.distance = msg.blink, msg.distance
+
+
+class _Goal:
+    """Joint goals read as a command (``t``, ``head``) by :func:`convert.head_trajectory`."""
+
+    def __init__(self, t: float, goal: dict[str, float]) -> None:
+        self.t, self.head = t, goal

@@ -1,0 +1,192 @@
+"""MCAP files with ROS 2 messages (``ros2`` profile, CDR, ``ros2msg`` schemas), as
+``ros2 bag record -s mcap``, Foxglove and ``gazebot demo`` write them; read with the ``mcap``
+library and decoded by rosbags from the definitions embedded in the file.
+
+Names are topics carrying ``geometry_msgs/PointStamped``, ``PoseStamped`` or
+``TransformStamped``, and the child frames of ``/tf`` (``tf2_msgs/TFMessage``). Topics ending
+in ``tracking/giver_hand``, ``tracking/receiver_hand`` and ``tracking/giver_face`` (gazebot's
+own) are the default names; ``gazebot_msgs/GripperState`` and ``LoadShare`` become the
+trajectory's gripper and load-share evidence. Times are header stamps (s); points are sampled
+as in :mod:`.rosbag`. A coordinate that is NaN or infinite is a missing sample.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any, BinaryIO
+
+from gazebot.io.recordings.base import (
+    PointNames,
+    Recording,
+    RecordingError,
+    RecordingLimits,
+    bound_streams,
+    build,
+    hold_values,
+    sample_streams,
+)
+from gazebot.io.ros2 import convert as cv
+from gazebot.io.ros2 import topics as ros_topics
+
+_POINT = cv.POINT_STAMPED
+_POSE = cv.POSE_STAMPED
+_TRANSFORM = cv.TRANSFORM_STAMPED
+_TF = cv.TF_MESSAGE
+_GRIPPER = cv.GRIPPER_STATE
+_LOAD = cv.LOAD_SHARE
+_WANTED = (_POINT, _POSE, _TRANSFORM, _TF, _GRIPPER, _LOAD)
+# gazebot's own tracking topics (the bus's names), in the trajectory's order of bodies.
+_DEFAULT_SUFFIX = tuple(ros_topics.TRACKING[body].name for body in cv.BODIES)
+
+
+def _ros2_name(name: str) -> str:
+    pkg, _, short = name.rpartition("/")
+    return name if "/msg/" in name else f"{pkg.split('/')[0]}/msg/{short}"
+
+
+def _stamp(header: object) -> float:
+    st = header.stamp  # type: ignore[attr-defined]
+    return float(st.sec) + 1e-9 * float(st.nanosec)
+
+
+def _default(topics: list[str], suffix: str) -> str | None:
+    hits = [t for t in topics if t.rstrip("/").endswith(suffix)]
+    return hits[0] if len(hits) == 1 else None
+
+
+def read_mcap(
+    path: str | Path,
+    names: PointNames | None = None,
+    max_gap: float = 0.25,
+    limits: RecordingLimits | None = None,
+) -> Recording:
+    """Read the point streams (and gripper / load share) of an MCAP file of ROS 2 messages;
+    ``limits``: see :class:`~gazebot.io.recordings.base.RecordingLimits` (stamps, workspace).
+
+    Raises:
+        RecordingError: Not a readable MCAP file, a message that does not decode as its schema
+            (naming topic and log time), no usable topic, or a name the file lacks.
+    """
+    from rosbags.typesys import Stores, get_typestore
+
+    from gazebot.io.ros2.typestore import definition_types
+
+    path = Path(path)
+    store = get_typestore(Stores.EMPTY)  # the file's own definitions, nothing else
+    known: set[int] = set()
+    series: dict[str, list[tuple[float, float, float, float]]] = {}
+    grip: list[tuple[float, float]] = []
+    load: list[tuple[float, float]] = []
+
+    def add(name: str, t: float, p: object) -> None:
+        # Every row is kept here: bound_streams checks stamps and bounds coordinates (counted).
+        xyz = (float(p.x), float(p.y), float(p.z))  # type: ignore[attr-defined]
+        series.setdefault(name, []).append((t, *xyz))
+
+    notes: list[str] = []
+    try:
+        with open(path, "rb") as raw:
+            f = _CappedReads(raw)
+            for schema, channel, message in _messages(f, notes):  # type: ignore[arg-type]
+                if schema is None or schema.encoding != "ros2msg":
+                    continue
+                if channel.message_encoding != "cdr":
+                    continue
+                typ = _ros2_name(schema.name)
+                if typ not in _WANTED:
+                    continue
+                if schema.id not in known:
+                    types = definition_types(typ, schema.data.decode())
+                    store.register({k: v for k, v in types.items() if k not in store.types})
+                    known.add(schema.id)
+                try:
+                    msg = store.deserialize_cdr(message.data, typ)
+                except Exception as exc:  # rosbags' SerdeError and friends
+                    raise RecordingError(
+                        path, f"topic {channel.topic}: message at log time "
+                        f"{message.log_time * 1e-9:.3f} s is not a {typ} ({exc})",
+                    ) from None
+                if typ == _TF:
+                    for tf in msg.transforms:
+                        add(tf.child_frame_id.lstrip("/"), _stamp(tf.header),
+                            tf.transform.translation)
+                elif typ == _POINT:
+                    add(channel.topic, _stamp(msg.header), msg.point)
+                elif typ == _POSE:
+                    add(channel.topic, _stamp(msg.header), msg.pose.position)
+                elif typ == _TRANSFORM:
+                    add(channel.topic, _stamp(msg.header), msg.transform.translation)
+                elif typ == _GRIPPER:
+                    grip.append((_stamp(msg.header), 1.0 if msg.closed else 0.0))
+                elif 0.0 <= msg.share <= 1.0:  # LoadShare; NaN or out of range: unknown
+                    load.append((_stamp(msg.header), float(msg.share)))
+    except (RecordingError, FileNotFoundError):
+        raise
+    except Exception as exc:  # mcap, its decompressors (zstd, lz4), struct: a damaged file
+        # McapError, MessageError, OSError, ValueError, KeyError, struct.error, ZstdError...
+        raise RecordingError(path, f"not a readable MCAP file of ROS 2 messages ({exc})") from None
+    if not series:
+        raise RecordingError(path, "no PoseStamped, PointStamped, TransformStamped or /tf data")
+    limits = limits or RecordingLimits()
+    series, beyond, namer = bound_streams(path, series, limits)
+    t, points = sample_streams(series, max_gap)
+    topics = sorted(points)
+    defaults = tuple(_default(topics, s) for s in _DEFAULT_SUFFIX)
+    extra = {"gripper_closed": hold_values(t, grip), "load_share": hold_values(t, load)}
+    rec = build(
+        path, "mcap", t, points, names or PointNames(), "m", defaults,  # type: ignore[arg-type]
+        extra, tuple(notes), limits=limits, where=namer(t),
+    )
+    rec.out_of_workspace += sum(beyond[n] for n in set(rec.names) - {None})
+    return rec
+
+
+class _CappedReads:
+    """A binary file whose ``read(n)`` never asks for more than is left in it: the mcap reader
+    reads a record's length field and then that many bytes, so one damaged length in a 1 kB
+    file would otherwise allocate up to gigabytes before finding the file too short."""
+
+    def __init__(self, f: BinaryIO) -> None:
+        self._f = f
+        self._size = os.fstat(f.fileno()).st_size
+
+    def read(self, n: int | None = -1) -> bytes:
+        if n is None or n < 0:
+            return self._f.read()
+        return self._f.read(max(0, min(n, self._size - self._f.tell())))
+
+    def __getattr__(self, name: str) -> Any:  # seek, tell, seekable, ... of the file
+        return getattr(self._f, name)
+
+
+def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
+    """``(schema, channel, message)`` of every message: indexed reading of a finished file, else
+    (a recording cut short, e.g. by a crash) every complete chunk up to the cut, with a note."""
+    from mcap.exceptions import McapError
+    from mcap.reader import NonSeekingReader, make_reader
+
+    try:
+        reader = make_reader(f)
+        reader.get_summary()  # a finished file has its footer
+    except (McapError, struct.error):  # struct.error: shorter than the magic and a record
+        f.seek(0)
+        count, last = 0, None
+        try:
+            # In file order (a time-ordered stream would hold everything back to sort it).
+            for item in NonSeekingReader(f).iter_messages(log_time_order=False):
+                count, last = count + 1, item[2].log_time
+                yield item
+        except (McapError, struct.error) as exc:  # the stream reader meets the cut
+            if not count:
+                raise ValueError(
+                    f"no footer, and cut short before the first complete chunk ({exc!r})"
+                ) from None
+            notes.append(
+                f"the file is cut short ({exc!r}); read the {count} messages before the cut "
+                f"(up to log time {last * 1e-9:.3f} s)"
+            )
+        return
+    yield from reader.iter_messages()

@@ -1,0 +1,149 @@
+"""One control tick of a handover -> the ROS 2 messages of every gazebot topic, into an MCAP
+file: what ``gazebot demo`` records beside its video, on the topics and types a robot running
+gazebot over ROS 2 publishes (:mod:`gazebot.io.ros2.topics`).
+
+Per tick (at the tick's robot time): the tracked bodies (``PointStamped``), gripper state and
+load share, ``/joint_states``, the robot's events, and the engine's answer (``head/command``,
+``gaze_target``, ``eyes/state``, ``handover/events``, ``handover/phase``); ``/diagnostics``
+once per ``diagnostics_period``; the eye display (``CompressedImage``, JPEG) once per
+``eye_image_period`` when an eye renderer is given.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gazebot.core.types import Event, TrackingFrame
+from gazebot.io.ros2 import convert as cv
+from gazebot.io.ros2 import topics as tp
+from gazebot.io.ros2.mcap_writer import McapRecorder
+
+
+@dataclass(frozen=True)
+class LoopStatus:
+    """The health a node reports on ``/diagnostics`` (read by :func:`convert.diagnostics`)."""
+
+    node: str
+    state: str
+    tracking: str
+    phase: str
+    uptime: float
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def _next_slot(t: float, period: float) -> float:
+    """The first multiple of ``period`` after ``t`` (less a nanosecond: tick times are sums
+    of floats), so a periodic topic keeps its rate on any tick grid."""
+    return (math.floor(t / period + 1e-9) + 1) * period - 1e-9
+
+
+class HandoverMcap:
+    """Writes each tick of a handover to ``path`` as ROS 2 messages.
+
+    Args:
+        path: The ``.mcap`` file.
+        base_frame: ROS name of the robot base frame (``RobotConfig.base_frame``).
+        gaze_frame: ROS name of the head's gaze frame (``RobotConfig.gaze_site``).
+        time_from_start: ``head/command``'s time to reach the goal (s): the control period.
+        namespace: The topics' namespace.
+        eye_image: ``(yaw, pitch, blink, distance) -> RGB image`` of the head display, or
+            ``None`` to record no eye images.
+        eye_image_period: Seconds between eye images.
+        diagnostics_period: Seconds between ``/diagnostics`` messages.
+        node: The node name in diagnostics and as the source of events.
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        base_frame: str,
+        gaze_frame: str,
+        time_from_start: float,
+        namespace: str = tp.DEFAULT_NAMESPACE,
+        eye_image: Callable[[float, float, float, float | None], np.ndarray] | None = None,
+        eye_image_period: float = 0.1,
+        diagnostics_period: float = 1.0,
+        node: str = "engine",
+    ) -> None:
+        self.recorder = McapRecorder(path)
+        self.base_frame = base_frame
+        self.gaze_frame = gaze_frame
+        self.time_from_start = time_from_start
+        self.namespace = namespace
+        self.eye_image = eye_image
+        self.eye_image_period = eye_image_period
+        self.diagnostics_period = diagnostics_period
+        self.node = node
+        self._phase: tuple[Any, float] | None = None  # (phase, its start)
+        self._next_image = -math.inf
+        self._next_diag = -math.inf
+        self._t0: float | None = None
+
+    def _write(self, topic: tp.Topic, msg: object, t: float) -> None:
+        self.recorder.write(topic.resolve(self.namespace), msg, t)
+
+    def tick(
+        self,
+        t: float,
+        frame: TrackingFrame | None,
+        joints: Mapping[str, float] | None,
+        robot_events: Sequence[Event],
+        cmd: Any | None,
+    ) -> None:
+        """Record one tick at robot time ``t`` (s): its input (``frame``, measured ``joints``,
+        ``robot_events``) and the engine's command (``None``: none was sent)."""
+        if self._t0 is None:
+            self._t0 = t
+        if frame is not None:
+            for body, p in cv.tracking_points(frame).items():
+                self._write(tp.TRACKING[body], cv.point_stamped(frame.t, p, self.base_frame), t)
+            if frame.gripper_closed is not None:
+                self._write(tp.GRIPPER, cv.gripper_state(frame.t, frame.gripper_closed), t)
+            if frame.load_share is not None:
+                self._write(tp.LOAD_SHARE, cv.load_share(frame.t, frame.load_share), t)
+        if joints:
+            self._write(tp.JOINT_STATES, cv.joint_state(t, joints), t)
+        for event in robot_events:
+            self._write(tp.ROBOT_EVENTS, cv.event_msg(event, "robot", t), t)
+        if cmd is None:
+            return
+        msgs = cv.command_messages(cmd, self.base_frame, self.gaze_frame, self.time_from_start)
+        for role, topic in (("head/command", tp.HEAD_COMMAND), ("gaze_target", tp.GAZE_TARGET),
+                            ("eyes", tp.EYES)):
+            if role in msgs:
+                self._write(topic, msgs[role], t)
+        for msg in msgs["events"]:  # type: ignore[union-attr]
+            self._write(tp.EVENTS, msg, t)
+        phase, source = cv.command_phase(cmd)
+        if self._phase is None or self._phase[0] is not phase:
+            self._phase = (phase, float(cmd.t))
+        self._write(tp.PHASE, cv.handover_phase(float(cmd.t), phase, self._phase[1],
+                                                source=source), t)
+        if self.eye_image is not None and t >= self._next_image:
+            self._next_image = _next_slot(t, self.eye_image_period)
+            img = self.eye_image(cmd.eye_yaw, cmd.eye_pitch, getattr(cmd, "blink", 0.0),
+                                 getattr(cmd, "distance", None))
+            self._write(tp.EYE_IMAGE, cv.compressed_image(img, t, "display"), t)
+        if t >= self._next_diag:
+            self._next_diag = _next_slot(t, self.diagnostics_period)
+            tracking = str(getattr(cmd, "tracking", "ok"))
+            state = getattr(cmd, "status", None) or ("ok" if tracking == "ok" else "degraded")
+            status = LoopStatus(
+                node=self.node, state=str(state),
+                tracking=tracking, phase=phase.value, uptime=t - self._t0,
+            )
+            self._write(tp.DIAGNOSTICS, cv.diagnostics(status, t), t)
+
+    def close(self) -> Path:
+        """Finish the file; returns its path."""
+        return self.recorder.close()
+
+    def abort(self) -> None:
+        """Drop the partial file (a failed run)."""
+        self.recorder.abort()

@@ -1,9 +1,0 @@
-"""The ``gazebot`` method's rules, one per phase boundary, each a pure function of the smoothed
-:class:`~gazebot.phases.filtering.Signals` and the :class:`~gazebot.phases.config.PhaseConfig`:
-
-- :mod:`.transfer`: where handovers are (dips of the hands' distance) and when the transfer
-  starts (reach -> transfer);
-- :mod:`.release`: when the giver lets go (transfer -> retreat);
-- :mod:`.reach`: when the giver's reach starts (idle -> reach);
-- :mod:`.retreat`: when the retreat ends (retreat -> done).
-"""

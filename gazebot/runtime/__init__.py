@@ -1,9 +1,0 @@
-"""The one runtime loop from tracking to the robot's head, eyes and lids (:class:`GazeLoop`),
-shared by the video recordings, the engine node on the bus and the in-process drivers."""
-
-from __future__ import annotations
-
-from gazebot.runtime.loop import EngineLike, GazeLoop, LoopCommand, RobotLike
-from gazebot.types import TrackingState
-
-__all__ = ["EngineLike", "GazeLoop", "LoopCommand", "RobotLike", "TrackingState"]
