@@ -113,7 +113,7 @@ def test_an_installed_extension_reaches_the_real_gazebot_cli_through_its_entry_p
     monkeypatch, capsys
 ):
     """A package that declares the example's classes as entry points (groups
-    ``gazebot.phase_methods`` and ``gazebot.apps.controllers``) is usable by name in the real
+    ``gazebot.phase_methods`` and ``gazebot.controllers``) is usable by name in the real
     ``gazebot`` command, with no code of its own run first."""
     import importlib.metadata as md
 
@@ -124,7 +124,7 @@ def test_an_installed_extension_reaches_the_real_gazebot_cli_through_its_entry_p
     installed = [
         md.EntryPoint("closest-approach", "register_extensions:ClosestApproach",
                       "gazebot.phase_methods"),
-        md.EntryPoint("straight", "register_extensions:Straight", "gazebot.apps.controllers"),
+        md.EntryPoint("straight", "register_extensions:Straight", "gazebot.controllers"),
     ]
     monkeypatch.syspath_prepend(str(EXAMPLES))
     monkeypatch.setattr("gazebot.core.registry.importlib.metadata.entry_points",

@@ -78,7 +78,7 @@ class Registry(Generic[T]):
     Args:
         kind: What an entry is (``controller``), for messages and the table's heading.
         group: The entry-point group installed packages register in (e.g.
-            ``gazebot.apps.controllers``), read when the registry is first read; ``None``: none.
+            ``gazebot.controllers``), read when the registry is first read; ``None``: none.
     """
 
     def __init__(self, kind: str, group: str | None = None) -> None:
