@@ -3,9 +3,8 @@ from it."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
+from conftest import documentation_text
 
 from gazebot.apps.cli.registries import registries
 from gazebot.apps.controllers import CONTROLLERS, make_controller
@@ -13,8 +12,6 @@ from gazebot.core.config import ConfigError
 from gazebot.core.phases import PhaseConfig, load_phase_config
 from gazebot.core.phases.methods import PHASE_METHODS
 from gazebot.core.registry import Registry
-
-README = Path(__file__).resolve().parents[3] / "README.md"
 
 
 def test_every_extension_kind_has_one_registry_with_its_builtins():
@@ -53,8 +50,8 @@ def test_an_unknown_controller_or_phase_method_is_one_clear_error(tmp_path):
 
 
 @pytest.mark.parametrize("registry", [CONTROLLERS, PHASE_METHODS], ids=lambda r: r.kind)
-def test_the_readme_table_is_the_registrys(registry):
-    assert registry.table(builtin_only=True) in README.read_text(encoding="utf-8")
+def test_the_documented_table_is_the_registrys(registry):
+    assert registry.table(builtin_only=True) in documentation_text()
 
 
 def _fake_entry_points(monkeypatch, *eps):

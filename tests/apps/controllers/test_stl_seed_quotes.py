@@ -1,4 +1,4 @@
-"""The README's Table 4.2 section quotes the seed's sentences (4.3.2-4.3.3) word for word."""
+"""The documentation's Table 4.2 section quotes the seed's sentences (4.3.2-4.3.3) word for word."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ REPO = Path(__file__).resolve().parents[3]
 
 
 def _table_4_2_quotes() -> list[str]:
-    rows = [ln for ln in (REPO / "README.md").read_text().splitlines() if ln.startswith("| t_")]
+    rows = [ln for ln in (REPO / "docs" / "seed" / "controllers.md").read_text().splitlines() if ln.startswith("| t_")]
     quotes = [q for ln in rows for q in re.findall(r'"([^"]+)"', ln.split(" | ")[1])]
     return [part.strip() for q in quotes for part in q.split("...")]
 

@@ -125,14 +125,13 @@ def test_a_seed_behaviors_diagram_shows_every_segment_that_decides_its_targets(n
     assert f"timer [held {spec.tracking_lost.hold_s:g} s]" in text
 
 
-def test_the_readmes_diagram_is_the_one_the_machine_draws():
-    from pathlib import Path
+def test_the_documented_diagram_is_the_one_the_machine_draws():
+    from conftest import documentation_text
 
     from gazebot.core.behaviors import load_behavior
     from gazebot.core.behaviors.machine import diagram
 
-    readme = Path(__file__).resolve().parents[3] / "README.md"
-    assert diagram(load_behavior("face-hand-face")).strip() in readme.read_text(encoding="utf-8")
+    assert diagram(load_behavior("face-hand-face")).strip() in documentation_text()
 
 
 @pytest.mark.parametrize("name", SEED_BEHAVIORS)
