@@ -9,7 +9,8 @@ REPO = Path(__file__).resolve().parents[3]
 
 
 def _table_4_2_quotes() -> list[str]:
-    rows = [ln for ln in (REPO / "docs" / "seed" / "controllers.md").read_text().splitlines() if ln.startswith("| t_")]
+    page = (REPO / "docs" / "seed" / "controllers.md").read_text()
+    rows = [ln for ln in page.splitlines() if ln.startswith("| t_")]
     quotes = [q for ln in rows for q in re.findall(r'"([^"]+)"', ln.split(" | ")[1])]
     return [part.strip() for q in quotes for part in q.split("...")]
 
