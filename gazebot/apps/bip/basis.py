@@ -1,0 +1,62 @@
+"""Gaussian radial basis functions on the phase, and a demonstration's weights.
+
+Each degree of freedom ``d`` is approximated as ``y_d(phi) = Phi(phi)^T w_d`` (IntPrim's
+mathematical notes, "Basis Function Decomposition"; Campbell and Amor, CoRL 2017, sec. 3), with
+``Phi(phi)`` the ``B`` Gaussian bumps ``exp(-(phi - c_b)^2 / (2 h^2))`` centred evenly on [0, 1].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class GaussianBasis:
+    """``n`` Gaussian bumps of width ``width`` (in phase units) centred evenly on [0, 1]."""
+
+    n: int = 9
+    width: float = 0.08
+
+    def __post_init__(self) -> None:
+        if self.n < 2:
+            raise ValueError(f"a basis needs at least 2 functions, got {self.n}")
+        if not (np.isfinite(self.width) and self.width > 0.0):
+            raise ValueError(f"basis width must be a positive number, got {self.width}")
+
+    @property
+    def centers(self) -> np.ndarray:
+        return np.linspace(0.0, 1.0, self.n)
+
+    def values(self, phase: np.ndarray | float) -> np.ndarray:
+        """``Phi`` at each phase: shape ``(..., n)`` for phases of shape ``(...)``."""
+        p = np.asarray(phase, float)[..., None]
+        return np.exp(-0.5 * ((p - self.centers) / self.width) ** 2)
+
+    def derivative(self, phase: np.ndarray | float) -> np.ndarray:
+        """``dPhi/dphi`` at each phase, shape ``(..., n)`` (for the EKF Jacobian, eq. 3)."""
+        p = np.asarray(phase, float)[..., None]
+        d = (p - self.centers) / self.width
+        return -d / self.width * np.exp(-0.5 * d**2)
+
+
+def fit_weights(
+    basis: GaussianBasis, phase: np.ndarray, y: np.ndarray, ridge: float = 1e-6
+) -> np.ndarray:
+    """Ridge least squares ``argmin_W |Phi W - Y|^2 + ridge |W|^2`` of one demonstration.
+
+    Args:
+        phase: ``(T,)`` phases of the samples in [0, 1].
+        y: ``(T, D)`` samples.
+    Returns:
+        ``(D, n)`` weights, one row per degree of freedom.
+    """
+    phi = basis.values(phase)
+    lhs = phi.T @ phi + ridge * np.eye(basis.n)
+    return np.linalg.solve(lhs, phi.T @ np.asarray(y, float)).T
+
+
+def reconstruct(basis: GaussianBasis, phase: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """``(T, D)`` trajectory of ``(D, n)`` weights at ``(T,)`` phases."""
+    return basis.values(phase) @ np.asarray(weights, float).T
