@@ -2,7 +2,8 @@
 
 Each degree of freedom ``d`` is approximated as ``y_d(phi) = Phi(phi)^T w_d`` (IntPrim's
 mathematical notes, "Basis Function Decomposition"; Campbell and Amor, CoRL 2017, sec. 3), with
-``Phi(phi)`` the ``B`` Gaussian bumps ``exp(-(phi - c_b)^2 / (2 h^2))`` centred evenly on [0, 1].
+``Phi(phi)`` the ``B`` Gaussian bumps ``exp(-(phi - c_b)^2 / (2 h^2))`` centred evenly on [0, 1],
+normalised to sum 1.
 """
 
 from __future__ import annotations
@@ -25,20 +26,35 @@ class GaussianBasis:
         if not (np.isfinite(self.width) and self.width > 0.0):
             raise ValueError(f"basis width must be a positive number, got {self.width}")
 
+    @classmethod
+    def spaced(cls, n: int) -> GaussianBasis:
+        """``n`` functions whose width is 0.64 of their spacing (the default's ratio: 9 at 0.08)."""
+        if n < 2:
+            raise ValueError(f"a basis needs at least 2 functions, got {n}")
+        return cls(n, 0.64 / (n - 1))
+
     @property
     def centers(self) -> np.ndarray:
         return np.linspace(0.0, 1.0, self.n)
 
+    def _bumps(self, phase: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+        """The unnormalised bumps ``g`` and their derivatives ``dg/dphi``, ``(..., n)`` each."""
+        d = (np.asarray(phase, float)[..., None] - self.centers) / self.width
+        g = np.exp(-0.5 * d**2)
+        return g, -d / self.width * g
+
     def values(self, phase: np.ndarray | float) -> np.ndarray:
-        """``Phi`` at each phase: shape ``(..., n)`` for phases of shape ``(...)``."""
-        p = np.asarray(phase, float)[..., None]
-        return np.exp(-0.5 * ((p - self.centers) / self.width) ** 2)
+        """``Phi`` at each phase: shape ``(..., n)`` for phases of shape ``(...)``; normalised to
+        sum 1 (as ProMPs' basis, Paraschos et al. 2013), so a constant is represented exactly
+        up to the ends of [0, 1]."""
+        g, _ = self._bumps(phase)
+        return g / g.sum(axis=-1, keepdims=True)
 
     def derivative(self, phase: np.ndarray | float) -> np.ndarray:
         """``dPhi/dphi`` at each phase, shape ``(..., n)`` (for the EKF Jacobian, eq. 3)."""
-        p = np.asarray(phase, float)[..., None]
-        d = (p - self.centers) / self.width
-        return -d / self.width * np.exp(-0.5 * d**2)
+        g, dg = self._bumps(phase)
+        total = g.sum(axis=-1, keepdims=True)
+        return (dg * total - g * dg.sum(axis=-1, keepdims=True)) / total**2
 
 
 def fit_weights(

@@ -55,17 +55,15 @@ class FilterConfig:
         human partner the robot sees; the robot's own wrists and the grip width are inferred).
     constraint_sd: ``filter``: the pseudo-observation's noise (m), imposed every update.
     perturb_constraint: ``filter``: perturb the pseudo-observation per member (Burgers et al.).
-    projection_sd: ``projection``: the tolerance (m) the prior is conditioned with; 0 is the
-        exact equality. 2 mm: with 0, the prior's near-singular directions along the constraint
-        (its covariance is the sample covariance of a few demonstrations plus a small jitter)
-        moved the whole prior and raised the wrists' error by a third (docs/bip.md).
+    projection_sd: ``projection``: the tolerance (m) the prior is conditioned with; 0 (the
+        default) is the exact equality.
     """
 
     members: int = 100
     phase_noise: float = 1.0
     observed: tuple[int, ...] = RECEIVER_DOFS
     constraint_sd: float = 0.01
-    projection_sd: float = 0.002
+    projection_sd: float = 0.0
     perturb_constraint: bool = True
 
 

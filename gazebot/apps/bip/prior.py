@@ -38,15 +38,14 @@ class TrainConfig:
             a few demonstrations is singular, and conditioning needs it positive definite.
         noise_floor_m: Least measurement noise standard deviation (m). It stands for the model
             error of a new interaction (the prior cannot reproduce it exactly), not only the
-            tracker's: at 2-10 mm the filter grew overconfident and diverged once the receiver
-            moved (docs/bip.md).
+            tracker's (docs/bip.md).
     """
 
     basis: GaussianBasis = GaussianBasis()
     ridge: float = 1e-6
     phase_sd: float = 0.01
     weight_jitter_m: float = 1e-3
-    noise_floor_m: float = 0.02
+    noise_floor_m: float = 0.01
 
 
 @dataclass(frozen=True)
