@@ -170,10 +170,10 @@ class EnsembleBIP:
         of ``dofs`` (default all): each member at its own phase ``phi_j + tau phi_dot_j``
         (held at 1 once the motion is over)."""
         x = self.members
-        dofs = np.arange(self.prior.n_dof) if dofs is None else np.asarray(dofs)
+        idx = np.arange(self.prior.n_dof) if dofs is None else np.asarray(dofs, dtype=int)
         B = self.prior.n_basis
         phase = np.clip(x[:, 0][:, None] + np.asarray(horizon)[None, :] * x[:, 1][:, None],
                         0.0, 1.0)  # (E, T)
         phi = self.prior.basis.values(phase)  # (E, T, B)
-        w = x[:, 2 + dofs[:, None] * B + np.arange(B)]  # (E, k, B)
+        w = x[:, 2 + idx[:, None] * B + np.arange(B)]  # (E, k, B)
         return np.einsum("etb,ekb->tk", phi, w) / x.shape[0]

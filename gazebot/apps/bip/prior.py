@@ -125,10 +125,11 @@ class BipPrior:
     def load(cls, folder: str | Path) -> BipPrior:
         """Read what :meth:`save` wrote (``folder`` or the ``.npz`` itself)."""
         path = Path(folder)
-        if path.is_dir():
+        if path.suffix != ".npz":
             path = path / "bip_prior.npz"
         if not path.is_file():
-            raise RecordingError(path, "no such file; expected a `gazebot bip train --out` folder")
+            raise RecordingError(path, "no such file; expected the folder a `gazebot bip train "
+                                 "--out` wrote")
         try:
             with np.load(path, allow_pickle=False) as z:
                 n, width = z["basis"]
