@@ -59,6 +59,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         e.add_argument("--members", type=int_at_least(2), default=100,
                        help="ensemble members (default 100)")
         e.add_argument("--seed", type=seed_value, default=0, help="random seed (default 0)")
+        e.add_argument("--observe-width", action="store_true",
+                       help="also observe the grip-width degree of freedom (default: only the "
+                       "receiver's wrists are observed)")
         if name == "evaluate":
             e.add_argument("--constraint", choices=MODES, action="append", default=None,
                            help="constraint mode(s) (repeatable; default: all three)")
@@ -122,7 +125,7 @@ def _train(args: argparse.Namespace) -> int:
 
 
 def _load(args: argparse.Namespace):
-    from gazebot.apps.bip.demos import load_demos
+    from gazebot.apps.bip.demos import RECEIVER_DOFS, WIDTH_DOF, load_demos
     from gazebot.apps.bip.enbip import FilterConfig
     from gazebot.apps.bip.prior import BipPrior
 
@@ -131,7 +134,8 @@ def _load(args: argparse.Namespace):
     short = [d.name for d in tests if d.t.size <= args.observe]
     if short:
         raise UsageError(f"--observe {args.observe}: not shorter than test(s) {', '.join(short)}")
-    return prior, tests, FilterConfig(members=args.members)
+    observed = RECEIVER_DOFS + ((WIDTH_DOF,) if args.observe_width else ())
+    return prior, tests, FilterConfig(members=args.members, observed=observed)
 
 
 def _pick(tests: list, index: int, what: str):
