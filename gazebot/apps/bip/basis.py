@@ -38,9 +38,13 @@ class GaussianBasis:
         return np.linspace(0.0, 1.0, self.n)
 
     def _bumps(self, phase: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
-        """The unnormalised bumps ``g`` and their derivatives ``dg/dphi``, ``(..., n)`` each."""
+        """The unnormalised bumps ``g`` and their derivatives ``dg/dphi``, ``(..., n)`` each,
+        up to a common positive factor per phase."""
         d = (np.asarray(phase, float)[..., None] - self.centers) / self.width
-        g = np.exp(-0.5 * d**2)
+        # Scaled by the largest bump (the ratios do not change): far outside [0, 1] every
+        # bump would underflow to 0 and the normalisation to 0 / 0.
+        e = -0.5 * d**2
+        g = np.exp(e - e.max(axis=-1, keepdims=True))
         return g, -d / self.width * g
 
     def values(self, phase: np.ndarray | float) -> np.ndarray:

@@ -74,3 +74,18 @@ def test_a_non_finite_sample_is_named(training, tmp_path):
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     with pytest.raises(RecordingError, match="non-finite"):
         load_demo(path)
+
+
+def test_basis_is_finite_far_outside_the_phase_range():
+    basis = GaussianBasis()
+    phases = np.array([-50.0, -2.0, 3.0, 80.0])
+    assert np.all(np.isfinite(basis.values(phases)))
+    assert np.all(np.isfinite(basis.derivative(phases)))
+    np.testing.assert_allclose(basis.values(phases).sum(axis=-1), 1.0)
+
+
+def test_basis_derivative_matches_finite_differences():
+    basis = GaussianBasis()
+    phi, h = np.linspace(-0.2, 1.2, 15), 1e-6
+    numeric = (basis.values(phi + h) - basis.values(phi - h)) / (2 * h)
+    np.testing.assert_allclose(basis.derivative(phi), numeric, atol=1e-5)
