@@ -13,11 +13,16 @@ The constraint set, linear in the weights ``w`` (so that both solutions are clos
 
 - the grip-width degree of freedom equals the object's width ``g`` at every basis centre:
   ``Phi(c_k)^T w_width = g``;
-- the giver's wrist separation along the grip axis equals ``g`` at every basis centre ``c_k``:
-  ``u(c_k)^T (Phi(c_k)^T (w_left - w_right)) = g``, where ``u(phi)`` is the unit direction of
-  the prior mean's separation ``left - right`` at ``phi``. This is the wrist-distance constraint
-  ``|left - right| = g`` linearised about the prior's grip axis: it fixes the separation's
-  component along that axis and leaves the rest of the motion free.
+- the giver's wrist separation equals ``g`` times the prior mean's grip axis at every basis
+  centre: ``Phi(c_k)^T (w_left,a - w_right,a) = g u_a(c_k)`` for ``a`` in x, y, z, where
+  ``u(phi)`` is the unit direction of the prior mean's ``left - right``. Then
+  ``|left - right| = g`` along the whole reach, the hands keep the prior's grip axis, and the
+  rest of the motion (where the hands are) is free.
+
+``axis_only=True`` constrains only the separation's component along ``u`` (the distance
+linearised about the prior's axis, 9 rows instead of 27): it leaves the grip axis free, and with
+a prior from 8 demonstrations conditioning on a narrow box turned that axis by up to 30 degrees
+(spurious width-yaw correlations), 3.8 cm off the width (docs/bip.md).
 
 :func:`project_gaussian` is the first solution: the Gaussian ``q`` that minimises ``KL(q || p)``
 among distributions whose samples satisfy ``A s = b`` is ``p`` conditioned on ``A s = b``
@@ -56,8 +61,10 @@ class LinearConstraint:
         return np.asarray(states) @ self.A.T - self.b
 
 
-def grip_constraint(prior: BipPrior, width: float) -> LinearConstraint:
-    """The grip-width constraint for an object ``width`` m wide (see the module docstring)."""
+def grip_constraint(prior: BipPrior, width: float, axis_only: bool = False) -> LinearConstraint:
+    """The grip-width constraint for an object ``width`` m wide (see the module docstring):
+    the separation ``left - right`` equals ``width u(c_k)``, or with ``axis_only`` only its
+    component along ``u(c_k)`` equals ``width``."""
     if not (np.isfinite(width) and width > 0.0):
         raise ValueError(f"grip width must be a positive number of m, got {width}")
     B, D = prior.n_basis, prior.n_dof
@@ -66,25 +73,35 @@ def grip_constraint(prior: BipPrior, width: float) -> LinearConstraint:
     def col(dof: int) -> slice:
         return slice(2 + dof * B, 2 + (dof + 1) * B)
 
-    rows = []
-    for phi_row in prior.basis.values(prior.basis.centers):
+    rows, targets = [], []
+    # (more phases than basis functions would make nearly dependent rows)
+    phases = prior.basis.centers
+    values = prior.basis.values(phases)
+    for phi_row in values:
         row = np.zeros(n)
         row[col(WIDTH_DOF)] = phi_row
         rows.append(row)
-    # (more phases than basis functions would make nearly dependent rows)
-    phases = prior.basis.centers
+        targets.append(width)
     mean = prior.mean_trajectory(phases)
     left, right = GIVER_DOFS[:3], GIVER_DOFS[3:]
     sep = mean[:, list(left)] - mean[:, list(right)]
     axis = sep / np.linalg.norm(sep, axis=1, keepdims=True)
-    for phi_row, u in zip(prior.basis.values(phases), axis, strict=True):
-        row = np.zeros(n)
+    for phi_row, u in zip(values, axis, strict=True):
+        if axis_only:
+            row = np.zeros(n)
+            for a in range(3):
+                row[col(left[a])] = u[a] * phi_row
+                row[col(right[a])] = -u[a] * phi_row
+            rows.append(row)
+            targets.append(width)
+            continue
         for a in range(3):
-            row[col(left[a])] = u[a] * phi_row
-            row[col(right[a])] = -u[a] * phi_row
-        rows.append(row)
-    A = np.array(rows)
-    return LinearConstraint(A=A, b=np.full(len(rows), float(width)))
+            row = np.zeros(n)
+            row[col(left[a])] = phi_row
+            row[col(right[a])] = -phi_row
+            rows.append(row)
+            targets.append(width * u[a])
+    return LinearConstraint(A=np.array(rows), b=np.array(targets, float))
 
 
 def project_gaussian(
