@@ -40,7 +40,7 @@ class Prediction:
 
 
 @dataclass(frozen=True)
-class TestResult:
+class HeldOutResult:
     name: str
     width_m: float
     deviation_m: float
@@ -74,10 +74,10 @@ def predict_test(
                       width=demo.width, observed_until=float(now))
 
 
-def score(prior: BipPrior, demo: Demonstration, pred: Prediction) -> TestResult:
+def score(prior: BipPrior, demo: Demonstration, pred: Prediction) -> HeldOutResult:
     err = np.abs(pred.distance - pred.width)
     pos = np.linalg.norm((pred.predicted - pred.true).reshape(-1, 2, 3), axis=2)
-    return TestResult(
+    return HeldOutResult(
         name=demo.name,
         width_m=pred.width,
         deviation_m=abs(pred.width - prior.width_mean),

@@ -41,3 +41,14 @@ def test_scene_runs_the_gaze_engine_through_the_handover(prior, off_mean_tests):
         assert phase in phases
     assert {"face", "hand"} <= {k.target for k in run.ticks}
     assert run.grip_width_error().mean() < 0.01
+
+
+def test_train_from_a_demos_folder_and_a_bad_csv_is_named(tmp_path, capsys):
+    demos = tmp_path / "demos"
+    assert main(["bip", "demos", "--synthetic", "3", "--out", str(demos)]) == 0
+    assert main(["bip", "train", str(demos), "--out", str(tmp_path / "m")]) == 0
+    (demos / "zz_bad.csv").write_text("t,giver_left_x\n0,1\n", encoding="utf-8")
+    capsys.readouterr()
+    assert main(["bip", "train", str(demos), "--out", str(tmp_path / "m2")]) == 2
+    err = capsys.readouterr().err
+    assert "zz_bad.csv" in err and "missing column" in err
