@@ -63,12 +63,14 @@ def test_constraint_modes_need_a_width(prior):
 
 
 @pytest.mark.parametrize("mode", ["projection", "filter"])
-def test_constraints_hold_with_the_seeds_eight_demonstrations(generator, off_mean_tests, mode):
+def test_constraints_hold_with_the_seeds_eight_demonstrations(generator, mode):
     # A prior from 8 demonstrations has spurious correlations (the grip axis's yaw with the
-    # width); the constraint must hold the whole separation, not only its component on the axis.
+    # width); the constraint must hold the whole separation, not only its component on the axis
+    # (which left the 7th of these tests 3.8 cm off).
     from gazebot.apps.bip.prior import train
 
     prior8 = train(generator.draw_many(8, seed=1))
-    res = evaluate(prior8, off_mean_tests, observe=10, modes=("none", mode))["modes"]
+    tests = generator.draw_many(8, seed=99, widths=[0.20, 0.45, 0.24, 0.40, 0.22, 0.42])
+    res = evaluate(prior8, tests, observe=10, modes=("none", mode))["modes"]
     assert res[mode]["width_error_max_m"] <= 0.01
     assert res[mode]["position_error_m"] <= 1.2 * res["none"]["position_error_m"]
