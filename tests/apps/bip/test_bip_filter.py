@@ -74,3 +74,15 @@ def test_constraints_hold_with_the_seeds_eight_demonstrations(generator, mode):
     res = evaluate(prior8, tests, observe=10, modes=("none", mode))["modes"]
     assert res[mode]["width_error_max_m"] <= 0.01
     assert res[mode]["position_error_m"] <= 1.2 * res["none"]["position_error_m"]
+
+
+def test_ensemble_and_exact_bip_agree_on_the_phase(prior, generator):
+    from gazebot.apps.bip.ekf import ExtendedBIP
+
+    d = generator.draw_many(1, seed=7)[0]
+    ens, ekf = EnsembleBIP(prior, ALL_DOFS, seed=1), ExtendedBIP(prior, ALL_DOFS)
+    for k in range(60):
+        ens.step(d.y[k], 1.0 / 120.0)
+        ekf.step(d.y[k], 1.0 / 120.0)
+    assert ekf.mu[0] == pytest.approx(d.phase[59], abs=0.05)
+    assert ens.phase == pytest.approx(ekf.mu[0], abs=0.05)
