@@ -30,6 +30,7 @@ COMMAND_MODULES = (
     "router",
     "study",
     "gps",
+    "bip",
 )
 
 
