@@ -30,6 +30,8 @@ COMMAND_MODULES = (
     "router",
     "study",
     "gps",
+    "topic",
+    "node",
 )
 
 
