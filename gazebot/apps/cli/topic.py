@@ -13,12 +13,18 @@ import json
 import queue
 import sys
 import time
-from collections.abc import Iterator
-from typing import Any
+from collections.abc import Iterator, Sequence
+from typing import TYPE_CHECKING, Any
 
 from gazebot.apps.cli.argtypes import int_at_least, positive
 from gazebot.apps.cli.bus import add_bus_arguments, bus_config
 from gazebot.apps.cli.errors import UsageError
+from gazebot.io.drivers.session import DEFAULT_ENDPOINT
+
+if TYPE_CHECKING:
+    from gazebot.io.drivers.rmw.graph import Entity
+    from gazebot.io.drivers.rmw.introspect import Inspector, RateStats
+    from gazebot.io.drivers.rmw.node import Handler
 
 #: How long ``list`` and ``info`` wait for the graph by default (s).
 GRAPH_TIMEOUT_S = 5.0
@@ -94,7 +100,7 @@ def _publisher_timeout(p: argparse.ArgumentParser) -> None:
 
 
 @contextlib.contextmanager
-def inspector(args: argparse.Namespace) -> Iterator[Any]:
+def inspector(args: argparse.Namespace) -> Iterator[Inspector]:
     """An :class:`~gazebot.io.drivers.rmw.introspect.Inspector` on a session of the parsed bus
     options, closed (with its session) on exit."""
     from gazebot.io.drivers.rmw.introspect import Inspector
@@ -113,18 +119,24 @@ def inspector(args: argparse.Namespace) -> Iterator[Any]:
         session.close()
 
 
-def settled(insp: Any, args: argparse.Namespace) -> bool:
+def settled(insp: Inspector, args: argparse.Namespace) -> bool:
     """Wait for the graph; say so on stderr when no peer or router answered."""
     if insp.settle(args.timeout):
         return True
-    where = ", ".join(args.connect or ["tcp/127.0.0.1:7447"])
-    print(f"gazebot {args.command}: no peer or router reached at {where} in "
+    print(f"gazebot {args.command}: no peer or router reached at {_where(args)} in "
           f"{args.timeout:g} s (is gazebot sim, gazebot router or a ROS 2 node running? "
           "--connect tcp/HOST:PORT)", file=sys.stderr)
     return False
 
 
-def resolve(insp: Any, name: str) -> str:
+def _where(args: argparse.Namespace) -> str:
+    """The endpoints the session connects to, as the user gave them."""
+    if args.connect:
+        return ", ".join(args.connect)
+    return "the --zenoh-config file's endpoints" if args.zenoh_config else DEFAULT_ENDPOINT
+
+
+def resolve(insp: Inspector, name: str) -> str:
     try:
         return insp.resolve(name)
     except ValueError as exc:
@@ -135,7 +147,7 @@ def _plural(n: int, word: str) -> str:
     return f"{n} {word}{'' if n == 1 else 's'}"
 
 
-def _nodes(entities: Any) -> str:
+def _nodes(entities: Sequence[Entity]) -> str:
     return ", ".join(sorted({e.node_fqn for e in entities}))
 
 
@@ -183,8 +195,9 @@ def topic_info(args: argparse.Namespace) -> int:
     return 0
 
 
-def _endpoints(entities: Any) -> None:
+def _endpoints(entities: Sequence[Entity]) -> None:
     from gazebot.io.drivers.rmw.attachment import gid_of
+    from gazebot.io.drivers.rmw.qos import KEEP_LAST, RELIABLE, TRANSIENT_LOCAL
 
     for e in entities:
         q = e.qos
@@ -196,17 +209,19 @@ def _endpoints(entities: Any) -> None:
         print(f"Endpoint type: {'PUBLISHER' if e.kind == 'MP' else 'SUBSCRIPTION'}")
         print(f"GID: {gid_of(e.token()).hex('.')}")
         if q is not None:
-            print(f"QoS profile: {'reliable' if q.reliability == 1 else 'best effort'}, "
-                  f"{'transient local' if q.durability == 1 else 'volatile'}, "
-                  f"{'keep last ' + str(q.depth) if q.history == 1 else 'keep all'}")
+            print(f"QoS profile: {'reliable' if q.reliability == RELIABLE else 'best effort'}, "
+                  f"{'transient local' if q.durability == TRANSIENT_LOCAL else 'volatile'}, "
+                  f"{f'keep last {q.depth}' if q.history == KEEP_LAST else 'keep all'}")
 
 
-def wait_publishers(insp: Any, topic: str, args: argparse.Namespace) -> list[Any]:
+def wait_publishers(insp: Inspector, topic: str, args: argparse.Namespace) -> list[Entity]:
     """The topic's publishers; waits (saying so on stderr) up to ``--timeout``."""
     pubs = insp.publishers(topic, min(2.0, args.timeout or 2.0))
     if pubs:
         return pubs
     limit = "" if args.timeout is None else f" (at most {args.timeout:g} s)"
+    if not insp.connected():
+        print(f"gazebot topic: no peer or router reached at {_where(args)} yet", file=sys.stderr)
     print(f"gazebot topic: no publisher on {topic} yet; waiting{limit}...", file=sys.stderr,
           flush=True)
     pubs = insp.publishers(topic, None if args.timeout is None else max(0.0, args.timeout - 2.0))
@@ -216,7 +231,8 @@ def wait_publishers(insp: Any, topic: str, args: argparse.Namespace) -> list[Any
     return pubs
 
 
-def _subscribe(insp: Any, topic: str, pubs: list[Any], handler: Any, raw: bool) -> Any:
+def _subscribe(insp: Inspector, topic: str, pubs: list[Entity], handler: Handler,
+               raw: bool) -> None:
     from gazebot.io.ros2.errors import MessageError
 
     types = sorted({p.ros_type or str(p.dds_type) for p in pubs})
@@ -224,18 +240,35 @@ def _subscribe(insp: Any, topic: str, pubs: list[Any], handler: Any, raw: bool) 
         print(f"gazebot topic: {topic} has publishers of {', '.join(types)}; following "
               f"{types[0]} (the others are counted as type mismatches)", file=sys.stderr)
     try:
-        return insp.subscribe(topic, types[0], handler, raw=raw)
+        insp.subscribe(topic, types[0], handler, raw=raw)
     except MessageError as exc:
         raise UsageError(f"{topic}: its type {types[0]} is not one gazebot knows (ROS 2 Jazzy's "
                          f"standard types and gazebot_msgs): {exc.reason}") from None
 
 
-def report_drops(insp: Any, topic: str) -> None:
-    """One line on stderr if messages of ``topic`` did not decode."""
-    n = insp.drops.counts().get(topic, 0)
-    if n:
-        print(f"gazebot topic: {_plural(n, 'message')} on {topic} did not decode "
-              f"(last: {insp.drops.reasons().get(topic, '?')})", file=sys.stderr)
+class DropNotes:
+    """Messages of ``topic`` dropped (they did not decode, or are of another type), on stderr:
+    one line when the first is seen, one with their number at the end, however many."""
+
+    def __init__(self, insp: Inspector, topic: str) -> None:
+        self.insp = insp
+        self.topic = topic
+        self.noted = False
+
+    def poll(self) -> None:
+        if not self.noted and self.insp.drops.counts().get(self.topic):
+            self.noted = True
+            print(f"gazebot topic: dropping messages on {self.topic}: {self._reason()}; "
+                  "counting them", file=sys.stderr, flush=True)
+
+    def summary(self) -> None:
+        n = self.insp.drops.counts().get(self.topic, 0)
+        if n:
+            print(f"gazebot topic: {_plural(n, 'message')} on {self.topic} dropped, the last "
+                  f"one: {self._reason()}", file=sys.stderr)
+
+    def _reason(self) -> str:
+        return self.insp.drops.reasons().get(self.topic, "?")
 
 
 def format_message(msg: Any, as_json: bool, truncate: int | None) -> str:
@@ -274,9 +307,11 @@ def echo_topic(args: argparse.Namespace) -> int:
         if not pubs:
             return 1
         _subscribe(insp, topic, pubs, on_msg, raw=False)
+        drops = DropNotes(insp, topic)
         printed = 0
         try:
             while limit is None or printed < limit:
+                drops.poll()
                 try:
                     msg = inbox.get(timeout=0.5)
                 except queue.Empty:
@@ -286,14 +321,14 @@ def echo_topic(args: argparse.Namespace) -> int:
         except KeyboardInterrupt:
             pass
         finally:
-            report_drops(insp, topic)
+            drops.summary()
             if skipped:
                 print(f"gazebot topic: {_plural(skipped, 'message')} skipped (printing "
                       "could not keep up)", file=sys.stderr)
     return 0
 
 
-def format_rate(stats: Any) -> str:
+def format_rate(stats: RateStats) -> str:
     """Two lines as ``ros2 topic hz`` prints them."""
     return (f"average rate: {stats.rate:.3f}\n"
             f"\tmin: {stats.min_period:.3f}s max: {stats.max_period:.3f}s "
@@ -310,6 +345,7 @@ def topic_hz(args: argparse.Namespace) -> int:
         if not pubs:
             return 1
         _subscribe(insp, topic, pubs, lambda _msg, _rx: window.tick(), raw=True)
+        drops = DropNotes(insp, topic)
         start = time.monotonic()
         shown = 0  # whole seconds reported
         seen = 0  # messages at the last report
@@ -327,9 +363,10 @@ def topic_hz(args: argparse.Namespace) -> int:
                     shown = int(time.monotonic() - start)
                 if done:
                     break
+                drops.poll()
                 time.sleep(0.02)
         except KeyboardInterrupt:
             pass
         finally:
-            report_drops(insp, topic)
+            drops.summary()
     return 0

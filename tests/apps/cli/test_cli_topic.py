@@ -71,7 +71,7 @@ def test_echo_decodes_the_handover_phase_and_the_gaze_target(handover, capsys):
     assert target["header"]["frame_id"] == "world"
     assert set(target["point"]) == {"x", "y", "z"}
     assert all(isinstance(v, float) for v in target["point"].values())
-    assert "did not decode" not in err
+    assert "dropped" not in err
 
 
 def test_list_info_and_node_list_show_gazebots_topics_types_and_nodes(handover, capsys):
@@ -228,15 +228,18 @@ def garbage_bus():
     session.close()
 
 
-def test_echo_counts_messages_that_do_not_decode_in_one_line(garbage_bus, capsys):
+def test_echo_counts_messages_that_do_not_decode_and_says_so_in_two_lines(garbage_bus, capsys):
     rc, out, err = run(capsys, "topic", "echo", "/junk", "--json", "-n", "3", "--timeout",
                        "60", "--connect", garbage_bus)
     assert rc == 0, err
     assert [json.loads(line)["point"] for line in out.splitlines()] == [
         {"x": 1.0, "y": 2.0, "z": 3.0}] * 3
     assert "Traceback" not in err
-    summary = [line for line in err.splitlines() if "did not decode" in line]
-    assert len(summary) == 1 and re.search(r"\d+ messages? on /junk did not decode", summary[0])
+    about = [line for line in err.splitlines() if "/junk" in line]
+    assert len(about) == 2, err  # however many: one line at the first, one at the end
+    assert about[0].startswith("gazebot topic: dropping messages on /junk: does not decode")
+    assert re.fullmatch(r"gazebot topic: \d+ messages? on /junk dropped, the last one: "
+                        r"does not decode .*", about[1])
 
 
 def test_an_unknown_topic_waits_then_says_so(garbage_bus, capsys):

@@ -89,6 +89,8 @@ class Inspector:
         # in a robot's namespace would count as that robot's peer, and as lost once it exits.
         self.node = RosNode(session, Names("/", domain_id=names.domain_id),
                             name or inspector_name(), on_graph=self._on_graph)
+        # Counted, not logged: the caller reports them (a command line, in one line).
+        self.node.drops = DropCounter(logs=False)
 
     @property
     def graph(self) -> Graph:
@@ -96,7 +98,7 @@ class Inspector:
 
     @property
     def drops(self) -> DropCounter:
-        """Messages that did not decode (or of another type), by topic."""
+        """Messages that did not decode (or of another type), by topic; not logged."""
         return self.node.drops
 
     def resolve(self, topic: str) -> str:
