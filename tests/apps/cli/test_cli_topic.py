@@ -22,7 +22,7 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "io" / "drivers"))
 
 import test_drivers_ros2_interop as interop  # noqa: E402
-from drivers_fakes import free_port  # noqa: E402
+from drivers_fakes import free_port, wait_until  # noqa: E402
 
 from gazebot.apps.cli import main  # noqa: E402
 
@@ -146,11 +146,23 @@ class SdkPeer:
 
 
 @needs_sdk
-def test_echo_decodes_a_topic_published_by_zenoh_ros2_sdk(router, msgdir, capsys):
+def test_list_and_echo_show_a_topic_published_by_zenoh_ros2_sdk(router, msgdir, capsys):
     peer = SdkPeer(router, msgdir, "/sdk/points", rate=20, count=60)
+    bus = f"tcp/127.0.0.1:{router}"
     try:
+        # The peer waits for a subscriber before it publishes: its publisher is in the graph.
+        def listed() -> bool:
+            rc, out, _ = run(capsys, "topic", "list", "-t", "--connect", bus)
+            return "/sdk/points [geometry_msgs/msg/PointStamped]" in out.splitlines()
+
+        assert wait_until(listed, timeout=120, poll=0.5)
+        rc, out, _ = run(capsys, "topic", "list", "-v", "--connect", bus)
+        assert (" * /sdk/points [geometry_msgs/msg/PointStamped] 1 publisher: /sdk_talker"
+                in out.split("Subscribed topics:")[0])
+        rc, out, _ = run(capsys, "node", "list", "--connect", bus)
+        assert "/sdk_talker" in out.splitlines()
         rc, out, err = run(capsys, "topic", "echo", "/sdk/points", "--json", "-n", "3",
-                           "--timeout", "180", "--connect", f"tcp/127.0.0.1:{router}")
+                           "--timeout", "180", "--connect", bus)
         assert rc == 0, err
         msgs = [json.loads(line) for line in out.splitlines()]
         assert len(msgs) == 3
