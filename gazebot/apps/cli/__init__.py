@@ -10,6 +10,7 @@ import importlib
 import os
 import sys
 
+from gazebot import __version__
 from gazebot.apps.cli.errors import UsageError
 from gazebot.core.config import ConfigError
 from gazebot.core.phases.trajectory import TrajectoryFormatError
@@ -31,6 +32,8 @@ COMMAND_MODULES = (
     "study",
     "gps",
     "bip",
+    "topic",
+    "node",
 )
 
 
@@ -39,6 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="gazebot",
         description="Robot gaze behavior engine for human-to-robot handovers.",
     )
+    parser.add_argument("--version", action="version", version=f"gazebot {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
