@@ -72,8 +72,10 @@ def read_csv(
         if not row or all(not c.strip() for c in row):
             continue
         if len(row) != len(header):
+            col = header[min(len(row), len(header) - 1)]  # the first cell missing (or extra)
             raise RecordingError(
-                path, f"line {lineno}: expected {len(header)} cells, got {len(row)}"
+                path, f"line {lineno}, column '{col}': expected {len(header)} cells, "
+                f"got {len(row)}"
             )
         out = []
         for col, raw in zip(header, row, strict=True):
