@@ -422,7 +422,8 @@ def test_pose_stamped_and_tf_frames_are_tracking_too_and_remapped_topics_are_use
         return len(got) >= 3
 
     assert wait_until(three_samples)
-    assert got[0].giver_hand == (0.9, 0.0, 1.0) and got[0].giver_face == (1.1, 0.2, 1.6)
+    assert got[0].giver_hand.tolist() == [0.9, 0.0, 1.0]
+    assert got[0].giver_face.tolist() == [1.1, 0.2, 1.6]
     node.on_tracking(got[-1])
     assert wait_until(lambda: targets.msgs)
     assert targets.msgs[-1][1].tolist() == [1.1, 0.2, 1.6]  # the fake engine looks at the face
