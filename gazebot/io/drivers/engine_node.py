@@ -53,7 +53,9 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, Protocol
+
+import numpy as np
 
 from gazebot.core.runtime import GazeLoop, LoopCommand
 from gazebot.core.types import Event, EventKind, TrackingFrame
@@ -75,6 +77,15 @@ log = logging.getLogger("gazebot.io.drivers")
 
 TrackingState = Literal["waiting", "ok", "hold", "lost"]
 Role = Literal["owner", "standby", "refused"]
+
+
+class EyeImages(Protocol):
+    """Renders the display's eyes (:class:`gazebot.apps.render.EyeRenderer`)."""
+
+    def render(self, yaw: float, pitch: float, blink: float = 0.0,
+               distance: float | None = None) -> np.ndarray:
+        """An (H, W, 3) uint8 RGB image of eyes looking at (``yaw``, ``pitch``) rad."""
+        ...
 
 
 class EngineRefused(RuntimeError):
@@ -157,7 +168,7 @@ class EngineNode:
         driver: RobotDriver,
         config: EngineNodeConfig | None = None,
         *,
-        eye_renderer: Any = None,
+        eye_renderer: EyeImages | None = None,
         warn: Callable[[str], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
@@ -577,9 +588,9 @@ class EngineNode:
         self._no_robot_warned = True
         self._warn("no_robot", text, after=after, peers=peers)
 
-    def _warn(self, kind: str, text: str, **info: Any) -> None:
+    def _warn(self, kind: str, text: str, **info: object) -> None:
         self.warnings.append(text)
-        self.emit(kind, **info)
+        self.emit(kind, None, None, **info)
         if self.warn is not None:
             self.warn(text)
         else:

@@ -10,9 +10,12 @@ from __future__ import annotations
 import logging
 import time
 from collections import deque
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import Protocol
 
-from gazebot.core.types import TrackingFrame
+import numpy as np
+
+from gazebot.core.types import Event, TrackingFrame
 from gazebot.io.drivers.base import RobotDriver
 from gazebot.io.ros2 import convert
 from gazebot.io.ros2.convert import RosCompressedImage
@@ -29,7 +32,39 @@ from gazebot.io.ros2.values import (
 log = logging.getLogger("gazebot.io.drivers")
 
 
-def apply_arm_command(sim: Any, cmd: ArmCommand) -> None:
+class SimArm(Protocol):
+    """The simulated robot's arm: its joints and named poses (rad, in ``arm_joints`` order)."""
+
+    @property
+    def arm_joints(self) -> Sequence[str]: ...
+    @property
+    def home(self) -> np.ndarray: ...
+    @property
+    def handover(self) -> np.ndarray: ...
+
+
+class Simulation(Protocol):
+    """What the drivers use of a simulation (:class:`gazebot.apps.sim.HandoverSimulation`)."""
+
+    @property
+    def robot(self) -> SimArm: ...
+    @property
+    def t(self) -> float: ...
+    @property
+    def done(self) -> bool: ...
+    def step(self, dt: float) -> None: ...
+    def tracking(self) -> TrackingFrame: ...
+    def joint_state(self) -> Mapping[str, float]: ...
+    def robot_events(self) -> list[Event]: ...
+    def apply_head(self, joints: Mapping[str, float]) -> None: ...
+    def apply_arm(self, joints: Mapping[str, float]) -> None: ...
+    def release_arm(self) -> None: ...
+    def apply_eyes(self, yaw: float, pitch: float, blink: float = 0.0,
+                   distance: float | None = None) -> None: ...
+    def set_display(self, image: np.ndarray) -> None: ...
+
+
+def apply_arm_command(sim: Simulation, cmd: ArmCommand) -> None:
     """Apply an arm command to a simulation: joint goals or a named pose take the arm over from
     its handover controller; ``resume`` hands it back.
 
@@ -43,8 +78,8 @@ def apply_arm_command(sim: Any, cmd: ArmCommand) -> None:
     goal = dict(cmd.positions or {})
     grip = goal.pop("gripper", cmd.gripper)
     if cmd.pose is not None:
-        goal = dict(zip(robot.arm_joints, (float(q) for q in getattr(robot, cmd.pose)),
-                        strict=True))
+        pose = robot.home if cmd.pose == "home" else robot.handover
+        goal = dict(zip(robot.arm_joints, (float(q) for q in pose), strict=True))
     if grip is not None:
         gripper = getattr(sim, "apply_gripper", None)
         if gripper is None:
@@ -63,7 +98,7 @@ class SimRobotDriver(RobotDriver):
         node: Name used as the source of the engine's events.
     """
 
-    def __init__(self, sim: Any, rate: float = 120.0, node: str = "engine") -> None:
+    def __init__(self, sim: Simulation, rate: float = 120.0, node: str = "engine") -> None:
         if not rate > 0:
             raise ValueError(f"rate must be > 0 Hz, got {rate!r}")
         self.sim = sim
@@ -87,8 +122,7 @@ class SimRobotDriver(RobotDriver):
             self._event_seq += 1
             self._inbox.append(msg)
             self.events.append(msg)
-        frame: TrackingFrame = self.sim.tracking()
-        return frame
+        return self.sim.tracking()
 
     def joint_state(self) -> JointState | None:
         return JointState(float(self.sim.t), dict(self.sim.joint_state()))

@@ -14,9 +14,8 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
-from gazebot.io.drivers.sim_driver import apply_arm_command
+from gazebot.io.drivers.sim_driver import Simulation, apply_arm_command
 from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 from gazebot.io.ros2 import convert
 
@@ -62,11 +61,11 @@ class SimNode:
 
     def __init__(
         self,
-        sim: Any,
+        sim: Simulation,
         endpoint: ZenohRobotEndpoint,
         config: SimNodeConfig | None = None,
         *,
-        view: Callable[[Any], bool] | None = None,
+        view: Callable[[Simulation], bool] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.sim = sim

@@ -110,7 +110,7 @@ class Publisher:
         self._pub = node.session.declare_publisher(self.key)
         self._token = node.session.liveliness().declare_token(self.entity.token())
 
-    def publish(self, msg: Any) -> bool:
+    def publish(self, msg: object) -> bool:
         """Serialize and put ``msg``; ``False`` once the node is closed.
 
         Raises:
