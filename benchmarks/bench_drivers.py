@@ -60,6 +60,7 @@ def _latency() -> list[Result]:
     from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
     from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
     from gazebot.io.ros2 import convert, topics
+    from gazebot.io.ros2.values import JointGoal
 
     frames = _record_frames(N_SAMPLES / 120)
     names = Names("/bench")
@@ -119,8 +120,8 @@ def _latency() -> list[Result]:
         engine_thread.start()
         node.ready.wait(5)
         pong["size"] = len(robot.ros.codec(topics.HEAD_COMMAND.type).encode(
-            convert.head_trajectory(GazeEngine.from_config("sawyer", "face-hand-face")
-                                    .step(frames[0]), 1 / 120)))
+            convert.joint_trajectory(JointGoal.head_of(
+                GazeEngine.from_config("sawyer", "face-hand-face").step(frames[0])))))
 
         ours: list[float] = []
         raw: list[float] = []

@@ -45,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
             robot.publish_joint_state(frame.t, head)
             cmd = robot.head.take()
             if cmd is not None:  # your neck controller goes here
-                head.update(cmd.head)
+                head.update(cmd.positions)
                 applied += 1
             if i % 60 == 0:  # a heartbeat every 0.5 s tells the engine the robot is alive
                 robot.heartbeat()

@@ -118,7 +118,7 @@ PHASE_OF_EVENT: dict[EventKind, Phase] = {
 }
 #: The event that starts each phase (the inverse of :data:`PHASE_OF_EVENT`).
 EVENT_OF_PHASE: dict[Phase, EventKind] = {p: k for k, p in PHASE_OF_EVENT.items()}
-#: Events of the engine's phase stream (category ``phase`` on the bus and in payloads): the
+#: Events of the engine's phase stream (category ``phase`` on the bus): the
 #: phase events and the tracking's loss and return.
 PHASE_STREAM_KINDS: frozenset[EventKind] = frozenset(
     {*PHASE_OF_EVENT, EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED}
@@ -229,8 +229,9 @@ class GazeContext:
 
 @dataclass(frozen=True)
 class GazeCommand:
-    """The one command value, from the engine through the runtime loop to the wire (the bus
-    payloads map it; nothing else copies its fields).
+    """The one command value, from the engine through the runtime loop to the wire
+    (:mod:`gazebot.io.ros2.convert` maps it to the ROS messages; nothing else copies its
+    fields).
 
     The engine fills everything but the lids and the vergence; the runtime loop adds ``blink``,
     ``distance`` and ``answers_sample`` with :meth:`replaced`.

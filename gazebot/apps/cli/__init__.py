@@ -13,7 +13,6 @@ import sys
 from gazebot import __version__
 from gazebot.apps.cli.errors import UsageError
 from gazebot.core.config import ConfigError
-from gazebot.core.phases.trajectory import TrajectoryFormatError
 from gazebot.io.recordings import RecordingError
 
 # Command groups, in the order ``gazebot --help`` lists them.
@@ -80,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
         # the interpreter's final flush does not complain again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except (ConfigError, TrajectoryFormatError, RecordingError, UsageError, OSError) as exc:
+    except (ConfigError, RecordingError, UsageError, OSError) as exc:
         # Input errors only: a malformed file, a wrong option, a missing file, a directory where
         # a file was expected, permissions. Any other exception is a bug: it keeps its traceback.
         # A file name that is not UTF-8 is kept as surrogates: shown escaped, not a crash.

@@ -4,8 +4,9 @@
 image.
 The blink that closes the lids comes from the runtime loop's
 :class:`~gazebot.core.runtime.blink.BlinkModel`.
-The eye state travels on the bus as :class:`gazebot.io.drivers.payloads.EyeStateMsg` (tens of
-bytes); ``gazebot display`` draws it on the robot's head screen with the same renderer.
+The eye state travels on the bus as ``gazebot_msgs/EyeState`` (tens of bytes;
+:class:`gazebot.io.ros2.values.EyeState`); ``gazebot display`` draws it on the robot's head
+screen with the same renderer.
 
 ``gazebot.apps.render.video`` (the H.264 MP4 writer) and ``gazebot.apps.render.timeline`` (the
 timeline CSV

@@ -29,7 +29,7 @@ from gazebot.core.phases.detector import (
 from gazebot.core.phases.filtering import Signals, compute_signals
 from gazebot.core.phases.methods import make_segmenter
 from gazebot.core.phases.segment import Segment, segments_from_events
-from gazebot.core.phases.trajectory import Trajectory, TrajectoryFormatError, load_trajectory_csv
+from gazebot.core.phases.trajectory import Trajectory
 
 
 def segment(trajectory: Trajectory, config: PhaseConfig | None = None) -> list[Segment]:
@@ -48,11 +48,9 @@ __all__ = [
     "Segment",
     "Signals",
     "Trajectory",
-    "TrajectoryFormatError",
     "compute_signals",
     "default_phase_config_path",
     "load_phase_config",
-    "load_trajectory_csv",
     "make_detector",
     "run_online",
     "segment",

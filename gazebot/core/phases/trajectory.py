@@ -1,10 +1,11 @@
-"""Tracked hand trajectories: arrays, the CSV format, and conversion to/from tracking frames.
+"""Tracked hand trajectories: arrays, the CSV they are written as, and conversion to/from
+tracking frames.
 
-CSV header (issue 3): ``t,giver_hand_x,giver_hand_y,giver_hand_z,receiver_hand_x,
-receiver_hand_y,receiver_hand_z`` (s, m), optionally ``giver_face_x,giver_face_y,giver_face_z``,
-``gripper_closed`` (0/1) and ``load_share`` (0..1). An empty cell, ``NaN`` or ``nan`` is a
-missing sample (motion-capture exports write NaN). Other formats and point names:
-:mod:`gazebot.io.recordings`.
+:meth:`Trajectory.to_csv` writes ``t,giver_hand_x,giver_hand_y,giver_hand_z,receiver_hand_x,
+receiver_hand_y,receiver_hand_z`` (s, m), and ``giver_face_x,giver_face_y,giver_face_z``,
+``gripper_closed`` (0/1) and ``load_share`` (0..1) when known; an empty cell is a missing
+sample. Reading it, and every other recording format, is :mod:`gazebot.io.recordings`'
+(:func:`gazebot.io.recordings.csv_table.read_csv`).
 """
 
 from __future__ import annotations
@@ -165,7 +166,8 @@ class Trajectory:
         )
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write the CSV format read by :func:`load_trajectory_csv` (NaN -> empty cell)."""
+        """Write the CSV that :func:`gazebot.io.recordings.csv_table.read_csv` reads (NaN ->
+        empty cell)."""
         path = Path(path)
         cols = list(REQUIRED_COLUMNS)
         has_face = bool(np.isfinite(self.giver_face).any())
@@ -195,97 +197,3 @@ class Trajectory:
                     row.append(cell(self.load_share[i]))
                 w.writerow(row)
         return path
-
-
-class TrajectoryFormatError(ValueError):
-    """A malformed trajectory CSV; the message names the file, line and column."""
-
-    def __init__(self, source: str | Path, line: int, column: str, problem: str):
-        self.source = str(source)
-        self.line = line
-        self.column = column
-        super().__init__(f"{self.source}: line {line}, column '{column}': {problem}")
-
-
-def load_trajectory_csv(path: str | Path) -> Trajectory:
-    """Read a trajectory CSV (see the module docstring).
-
-    Raises:
-        FileNotFoundError: ``path`` does not exist.
-        TrajectoryFormatError: Missing required column, unknown column, wrong number of cells,
-            a non-numeric or infinite value, or a missing time (names line and column).
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"trajectory file not found: {path}")
-    with path.open(newline="", encoding="utf-8-sig") as fh:
-        rows = list(csv.reader(fh))
-    if not rows:
-        raise TrajectoryFormatError(path, 1, "<header>", "empty file, expected a header row")
-    header = [h.strip() for h in rows[0]]
-    for col in REQUIRED_COLUMNS:
-        if col not in header:
-            raise TrajectoryFormatError(path, 1, col, "required column missing from the header")
-    known = set(REQUIRED_COLUMNS) | set(OPTIONAL_COLUMNS)
-    for col in header:
-        if col not in known:
-            raise TrajectoryFormatError(path, 1, col, f"unknown column (known: {sorted(known)})")
-        if header.count(col) > 1:
-            raise TrajectoryFormatError(path, 1, col, "duplicate column")
-    face_cols = [c for c in header if c.startswith("giver_face_")]
-    if face_cols and len(face_cols) != 3:
-        raise TrajectoryFormatError(path, 1, face_cols[0], "giver_face needs _x, _y and _z")
-
-    data: dict[str, list[float]] = {c: [] for c in header}
-    for lineno, row in enumerate(rows[1:], start=2):
-        if not row or all(not c.strip() for c in row):
-            continue  # blank line
-        if len(row) != len(header):
-            col = header[min(len(row), len(header) - 1)]
-            raise TrajectoryFormatError(
-                path, lineno, col, f"expected {len(header)} cells, got {len(row)}"
-            )
-        for col, raw in zip(header, row, strict=True):
-            text = raw.strip()
-            if not text:
-                if col == "t":
-                    raise TrajectoryFormatError(path, lineno, col, "time is empty")
-                data[col].append(math.nan)
-                continue
-            try:
-                value = float(text)
-            except ValueError:
-                raise TrajectoryFormatError(path, lineno, col, f"not a number: {text!r}") from None
-            if math.isnan(value):
-                if col == "t":
-                    raise TrajectoryFormatError(path, lineno, col, "time is missing (NaN)")
-                data[col].append(math.nan)  # a missing sample, as an empty cell
-                continue
-            if math.isinf(value):
-                raise TrajectoryFormatError(
-                    path, lineno, col, f"infinite: {text!r} (NaN or an empty cell = missing)"
-                )
-            if col == "load_share" and not 0.0 <= value <= 1.0:
-                raise TrajectoryFormatError(path, lineno, col, f"expected 0..1, got {value}")
-            if col == "gripper_closed" and value not in (0.0, 1.0):
-                raise TrajectoryFormatError(path, lineno, col, f"expected 0 or 1, got {value}")
-            data[col].append(value)
-
-    def pts(prefix: str) -> np.ndarray:
-        cols = [f"{prefix}_{a}" for a in "xyz"]
-        if cols[0] not in data:
-            return _nan_points(len(data["t"]))
-        arr = np.array([data[c] for c in cols], dtype=float).T.reshape(-1, 3)
-        # A point with only some coordinates is unusable: treat the whole point as missing.
-        arr[np.isnan(arr).any(axis=1)] = np.nan
-        return arr
-
-    n = len(data["t"])
-    return Trajectory(
-        t=np.array(data["t"], dtype=float),
-        giver_hand=pts("giver_hand"),
-        receiver_hand=pts("receiver_hand"),
-        giver_face=pts("giver_face"),
-        gripper_closed=np.array(data.get("gripper_closed", [math.nan] * n), dtype=float),
-        load_share=np.array(data.get("load_share", [math.nan] * n), dtype=float),
-    )

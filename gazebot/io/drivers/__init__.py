@@ -20,17 +20,6 @@ from __future__ import annotations
 
 from gazebot.io.drivers.base import RobotDriver
 from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig, current_handover
-from gazebot.io.drivers.payloads import (
-    ArmCommandMsg,
-    EventMsg,
-    EyeFrameMsg,
-    EyeStateMsg,
-    HeadCommandMsg,
-    JointStateMsg,
-    PayloadError,
-    StatusMsg,
-    TrackingMsg,
-)
 from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.session import DEFAULT_ENDPOINT, EPHEMERAL_ENDPOINT, BusConfig, open_session
 from gazebot.io.drivers.sim_driver import SimRobotDriver, apply_arm_command
@@ -42,23 +31,14 @@ from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 __all__ = [
     "DEFAULT_ENDPOINT",
     "EPHEMERAL_ENDPOINT",
-    "ArmCommandMsg",
     "BusConfig",
     "EngineNode",
     "EngineNodeConfig",
-    "EventMsg",
-    "EyeFrameMsg",
-    "EyeStateMsg",
-    "HeadCommandMsg",
-    "JointStateMsg",
     "Names",
-    "PayloadError",
     "RobotDriver",
     "SimNode",
     "SimNodeConfig",
     "SimRobotDriver",
-    "StatusMsg",
-    "TrackingMsg",
     "ZenohDisplayNode",
     "ZenohRobotDriver",
     "ZenohRobotEndpoint",

@@ -10,19 +10,23 @@ bridge that speaks the ROS 2 topics of :mod:`gazebot.io.ros2.topics`) and
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import Any
+from typing import TYPE_CHECKING
 
-from gazebot.io.drivers.payloads import (
-    ArmCommandMsg,
-    EventMsg,
-    EyeFrameMsg,
-    EyeStateMsg,
-    HeadCommandMsg,
-    JointStateMsg,
+from gazebot.core.types import TrackingFrame
+from gazebot.io.ros2.convert import RosCompressedImage
+from gazebot.io.ros2.values import (
+    ArmCommand,
+    BusEvent,
+    EyeState,
+    JointGoal,
+    JointState,
+    NodeStatus,
     Point,
-    StatusMsg,
-    TrackingMsg,
 )
+
+if TYPE_CHECKING:
+    from gazebot.io.drivers.rmw.node import TypeMismatch
+    from gazebot.io.drivers.tracking_source import Rival
 
 
 class RobotDriver(ABC):
@@ -53,14 +57,14 @@ class RobotDriver(ABC):
         :mod:`gazebot.io.drivers.tracking_source`); empty when the driver has one source."""
         return {}
 
-    def tracking_rivals(self, new_only: bool = False) -> list[Any]:
+    def tracking_rivals(self, new_only: bool = False) -> list[Rival]:
         """Sources whose tracking is ignored (:class:`~gazebot.io.drivers.tracking_source.Rival`;
         ``new_only``: those not returned before)."""
         return []
 
     # -- commands --------------------------------------------------------------------------
     @abstractmethod
-    def send_head(self, msg: HeadCommandMsg) -> None:
+    def send_head(self, goal: JointGoal) -> None:
         """Send head joint goals (rad)."""
 
     def send_gaze_target(self, t: float, point: Point) -> None:  # noqa: B027 - optional
@@ -70,45 +74,45 @@ class RobotDriver(ABC):
         """Send the handover phase (``idle`` ... ``done``), started at ``phase_start`` (s)."""
 
     @abstractmethod
-    def send_eyes(self, msg: EyeStateMsg) -> None:
+    def send_eyes(self, eyes: EyeState) -> None:
         """Send the eye direction and blink for the robot's display to draw."""
 
-    def send_eye_frame(self, msg: EyeFrameMsg) -> None:  # noqa: B027 - optional capability
-        """Send a rendered display image (only when :meth:`wants_eye_frames`)."""
+    def send_eye_frame(self, image: RosCompressedImage) -> None:  # noqa: B027 - optional
+        """Send a rendered display image, encoded (only when :meth:`wants_eye_frames`)."""
 
     def wants_eye_frames(self) -> bool:
         """True when the robot wants rendered display images rather than eye state only."""
         return False
 
     @abstractmethod
-    def send_arm(self, msg: ArmCommandMsg) -> None:
+    def send_arm(self, cmd: ArmCommand) -> None:
         """Send an arm goal (or hand the arm back to the robot's own controller)."""
 
     # -- state -----------------------------------------------------------------------------
     @abstractmethod
-    def wait_tracking(self, timeout: float) -> TrackingMsg | None:
+    def wait_tracking(self, timeout: float) -> TrackingFrame | None:
         """The oldest unread tracking sample, waiting up to ``timeout`` s for one; ``None`` if
         none arrived. A driver keeps a short backlog and drops the oldest beyond it, so a slow
         engine lags by a bounded time."""
 
     @abstractmethod
-    def joint_state(self) -> JointStateMsg | None:
+    def joint_state(self) -> JointState | None:
         """The latest joint state, ``None`` before the first one."""
 
     # -- events and status -----------------------------------------------------------------
     @abstractmethod
-    def poll_events(self) -> list[EventMsg]:
+    def poll_events(self) -> list[BusEvent]:
         """Events other nodes published since the last call (oldest first)."""
 
     @abstractmethod
-    def publish_event(self, msg: EventMsg) -> None:
+    def publish_event(self, event: BusEvent) -> None:
         """Publish one of this node's events."""
 
-    def event_history(self, timeout: float = 1.0) -> list[EventMsg]:
+    def event_history(self, timeout: float = 1.0) -> list[BusEvent]:
         """Events the other nodes have seen (e.g. after a restart), oldest first."""
         return []
 
-    def publish_status(self, msg: StatusMsg) -> None:  # noqa: B027 - optional capability
+    def publish_status(self, status: NodeStatus) -> None:  # noqa: B027 - optional capability
         """Publish this node's heartbeat."""
 
     def peers(self) -> dict[str, bool]:
@@ -119,10 +123,19 @@ class RobotDriver(ABC):
         """Malformed messages dropped so far, by topic."""
         return {}
 
-    def type_mismatches(self) -> dict[str, Any]:
+    def type_mismatches(self) -> dict[str, TypeMismatch]:
         """Topics on which a publisher of another message type (or type version) was heard,
         each with what was expected and received (:class:`~gazebot.io.drivers.rmw.node.
         TypeMismatch`)."""
+        return {}
+
+    def callback_faults(self) -> dict[str, int]:
+        """Subscription callbacks that raised (the message is lost, the driver goes on), by
+        topic."""
+        return {}
+
+    def callback_fault_reasons(self) -> dict[str, str]:
+        """The last exception of each topic's failing callback, one line."""
         return {}
 
     def close(self) -> None:  # noqa: B027 - nothing to release by default

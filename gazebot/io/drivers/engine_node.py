@@ -53,27 +53,39 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, Protocol
+
+import numpy as np
 
 from gazebot.core.runtime import GazeLoop, LoopCommand
-from gazebot.core.types import Event, EventKind
+from gazebot.core.types import Event, EventKind, TrackingFrame
 from gazebot.io.drivers.base import RobotDriver
-from gazebot.io.drivers.payloads import (
-    EventMsg,
-    EyeFrameMsg,
-    EyeStateMsg,
-    HeadCommandMsg,
-    StatusMsg,
-    TrackingMsg,
+from gazebot.io.ros2 import convert
+from gazebot.io.ros2.topics import GAZE_FRAME
+from gazebot.io.ros2.values import (
+    BusEvent,
+    EventCategory,
+    EyeState,
+    JointGoal,
+    NodeStatus,
     category_of,
-    jsonable,
-    point_or_none,
+    finite_point,
+    plain,
 )
 
 log = logging.getLogger("gazebot.io.drivers")
 
 TrackingState = Literal["waiting", "ok", "hold", "lost"]
 Role = Literal["owner", "standby", "refused"]
+
+
+class EyeImages(Protocol):
+    """Renders the display's eyes (:class:`gazebot.apps.render.EyeRenderer`)."""
+
+    def render(self, yaw: float, pitch: float, blink: float = 0.0,
+               distance: float | None = None) -> np.ndarray:
+        """An (H, W, 3) uint8 RGB image of eyes looking at (``yaw``, ``pitch``) rad."""
+        ...
 
 
 class EngineRefused(RuntimeError):
@@ -156,7 +168,7 @@ class EngineNode:
         driver: RobotDriver,
         config: EngineNodeConfig | None = None,
         *,
-        eye_renderer: Any = None,
+        eye_renderer: EyeImages | None = None,
         warn: Callable[[str], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
@@ -174,7 +186,7 @@ class EngineNode:
         self.frames_processed = 0
         self._started = clock()
         self._run_started = self._started
-        self._seq = {"head": 0, "eyes": 0, "frame": 0, "event": 0, "status": 0}
+        self._seq = {"event": 0, "status": 0}
         self._last_frame_wall = math.nan
         self._last_t = math.nan
         self._last_silence_tick = -math.inf
@@ -184,7 +196,7 @@ class EngineNode:
         self._target: str | None = None
         self._mismatch_warned: set[str] = set()
         self._no_robot_warned = False
-        self._last_head: HeadCommandMsg | None = None
+        self._last_head: JointGoal | None = None
         self._phase_sent: tuple[str, float] | None = None
         self._peers: dict[str, bool] = {}
         self._skip_events: set[tuple[str, str, int, int]] = set()
@@ -201,20 +213,20 @@ class EngineNode:
         self._seq[name] += 1
         return self._seq[name] - 1
 
-    def emit(self, kind: str, t: float | None = None, category: str | None = None,
-             **info: Any) -> EventMsg:
+    def emit(self, kind: str, t: float | None = None, category: EventCategory | None = None,
+             **info: object) -> BusEvent:
         """Publish one of the node's own events (fault, behavior, node)."""
         t = self._now_t() if t is None else t
         t = t if math.isfinite(t) else 0.0
-        msg = EventMsg(
-            seq=self._next("event"),
+        msg = BusEvent(
             source=self.driver.node,
             category=category or category_of(kind),
             kind=kind,
             t=t,
             detected_at=t,
             stamp=time.time(),
-            info=jsonable(info),
+            info={k: plain(v) for k, v in info.items()},
+            seq=self._next("event"),
         )
         self.driver.publish_event(msg)
         log.info("event %s %s", kind, msg.info)
@@ -280,11 +292,11 @@ class EngineNode:
                          "refused or waits as standby",
                 "standby": f"another engine ({', '.join(rivals)}) commands this robot: "
                            "standing by until it stops"}
-        info = {"role": self.role, "rivals": list(rivals), "new": new}
         if self.role == "refused":  # the node stops and says why itself
-            self.emit("competing_engine", **info)
+            self.emit("competing_engine", role=self.role, rivals=list(rivals), new=new)
         else:
-            self._warn("competing_engine", text[self.role], **info)
+            self._warn("competing_engine", text[self.role], role=self.role, rivals=list(rivals),
+                       new=new)
 
     def _check_ownership(self) -> None:
         """Report rivals; yield to an earlier engine; take over when the owner went away."""
@@ -424,28 +436,28 @@ class EngineNode:
 
     def _check_callback_faults(self) -> None:
         """Report handler failures in the driver's subscription callbacks (Zenoh's threads)."""
-        counts = getattr(self.driver, "callback_faults", dict)()
+        counts = self.driver.callback_faults()
         for topic, n in sorted(counts.items()):
             new = n - self._callback_faults.get(topic, 0)
             if new > 0:
                 self._callback_faults[topic] = n
-                reason = getattr(self.driver, "callback_fault_reasons", dict)().get(topic, "")
+                reason = self.driver.callback_fault_reasons().get(topic, "")
                 self.fault(f"callback {topic}", f"{new} failed: {reason}")
 
-    def on_tracking(self, msg: TrackingMsg) -> None:
+    def on_tracking(self, frame: TrackingFrame) -> None:
         """Tick the loop with one sample and send the command."""
         now = self.clock()
-        if msg.t < self._last_t - self.config.clock_reset:
+        if frame.t < self._last_t - self.config.clock_reset:
             # The robot's clock went back (e.g. the simulator restarted): the engine would
             # ignore every sample as out of order, so start over from the robot's state.
-            self.emit("tracking_clock_reset", t=msg.t, previous_t=self._last_t)
+            self.emit("tracking_clock_reset", t=frame.t, previous_t=self._last_t)
             self._last_t = math.nan
             self.resync()
         self._last_frame_wall = now
-        self._last_t = msg.t
+        self._last_t = frame.t
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
-        cmd = self._tick_loop("tracking", msg.to_frame(),
+        cmd = self._tick_loop("tracking", frame,
                               joints=joints.position if joints is not None else None)
         self.frames_processed += 1
         if cmd is not None:
@@ -494,7 +506,7 @@ class EngineNode:
             self.emit("tracking_stale", t=cmd.t, silence=silence, last_t=self._last_t)
         if now == "lost":
             self.emit("tracking_timeout", t=cmd.t, silence=silence, target=cmd.target,
-                      face=point_or_none(cmd.target_point))
+                      face=finite_point(cmd.target_point))
 
     def _send(self, cmd: LoopCommand) -> None:
         self._track(cmd)
@@ -504,19 +516,15 @@ class EngineNode:
                 self.fault(f"engine {info.get('stage', '?')}", str(info.get("error", "")))
             elif category_of(event.kind.value) == "phase":
                 self.driver.publish_event(
-                    EventMsg.from_event(event, self.driver.node, self._next("event"), time.time())
+                    BusEvent.of(event, self.driver.node, time.time(), self._next("event"))
                 )
-        stamp = time.time()
-        head = HeadCommandMsg.from_command(cmd, self._next("head"), stamp, self._last_head)
+        head = JointGoal.head_of(cmd, self._last_head)
         self._last_head = head
         self.driver.send_head(head)
-        if (point := point_or_none(cmd.target_point)) is not None:
+        if (point := finite_point(cmd.target_point)) is not None:
             self.driver.send_gaze_target(cmd.t, point)
         self._send_phase(cmd.t)
-        self.driver.send_eyes(
-            EyeStateMsg(seq=self._next("eyes"), t=cmd.t, stamp=stamp, yaw=cmd.eye_yaw,
-                        pitch=cmd.eye_pitch, blink=cmd.blink, distance=cmd.distance)
-        )
+        self.driver.send_eyes(EyeState.of(cmd))
         now = self.clock()
         if (
             self.eye_renderer is not None
@@ -527,17 +535,16 @@ class EngineNode:
             img = self.eye_renderer.render(
                 cmd.eye_yaw, cmd.eye_pitch, blink=cmd.blink, distance=cmd.distance
             )
-            frame = EyeFrameMsg.from_image(img, self._next("frame"), cmd.t, stamp)
-            self.driver.send_eye_frame(frame)
+            self.driver.send_eye_frame(convert.compressed_image(img, cmd.t, GAZE_FRAME))
         self.commands_sent += 1
-        state = str(getattr(self.engine.behavior, "state", ""))
+        state = str(getattr(getattr(self.engine, "behavior", None), "state", ""))
         if state != self._behavior_state:
             self._behavior_state = state
             self.emit("behavior_state", t=cmd.t, category="behavior", state=state)
         if cmd.target != self._target:
             self._target = cmd.target
             self.emit("gaze_target", t=cmd.t, category="behavior", target=cmd.target,
-                      point=point_or_none(cmd.target_point))
+                      point=finite_point(cmd.target_point))
 
     def _send_phase(self, t: float, again: bool = False) -> None:
         """Send the phase when it changed (``again``: also when it did not, for late
@@ -581,9 +588,9 @@ class EngineNode:
         self._no_robot_warned = True
         self._warn("no_robot", text, after=after, peers=peers)
 
-    def _warn(self, kind: str, text: str, **info: Any) -> None:
+    def _warn(self, kind: str, text: str, **info: object) -> None:
         self.warnings.append(text)
-        self.emit(kind, **info)
+        self.emit(kind, None, None, **info)
         if self.warn is not None:
             self.warn(text)
         else:
@@ -599,7 +606,7 @@ class EngineNode:
                 self.emit("peer_restored", peer=node)
         self._peers = peers
 
-    def _heartbeat(self, stopping: bool = False) -> StatusMsg:
+    def _heartbeat(self, stopping: bool = False) -> NodeStatus:
         self._last_beat = self.clock()
         if self._phase_sent is not None:
             self._send_phase(self._now_t(), again=True)
@@ -610,7 +617,7 @@ class EngineNode:
         tracking_rivals = sorted({r.source for r in self.driver.tracking_rivals()})
         degraded = (not all(peers.values()) or self.tracking in ("hold", "lost") or no_robot
                     or faulty or bool(rivals) or self.role != "owner" or bool(tracking_rivals))
-        msg = StatusMsg(
+        msg = NodeStatus(
             node=self.driver.node,
             seq=self._next("status"),
             stamp=time.time(),

@@ -10,13 +10,13 @@ import json
 from collections import deque
 from collections.abc import Iterator
 
-from gazebot.io.drivers.payloads import EventMsg
+from gazebot.io.ros2.values import BusEvent
 
 #: Bytes an event takes besides its text fields (times, sequence number, container).
 _OVERHEAD = 64
 
 
-def event_bytes(msg: EventMsg) -> int:
+def event_bytes(msg: BusEvent) -> int:
     """The size an event is counted with: its text fields and its info as JSON (UTF-8)."""
     text = msg.source + msg.category + msg.kind
     info = json.dumps(msg.info, separators=(",", ":"), default=str)
@@ -31,7 +31,7 @@ class EventLog:
         max_events: Events kept at most.
         max_bytes: Total :func:`event_bytes` kept at most.
         max_event_bytes: An event larger than this is not kept (counted in :attr:`refused`).
-        unique: Keep an event (by :attr:`EventMsg.identity`) only once.
+        unique: Keep an event (by :attr:`BusEvent.identity`) only once.
     """
 
     def __init__(self, max_events: int = 1000, max_bytes: int = 2 * 1024 * 1024,
@@ -46,11 +46,11 @@ class EventLog:
         self.unique = unique
         self.refused = 0
         self.evicted = 0
-        self._events: deque[tuple[EventMsg, int]] = deque()
+        self._events: deque[tuple[BusEvent, int]] = deque()
         self._keys: set[tuple[str, str, int, int]] = set()
         self._bytes = 0
 
-    def append(self, msg: EventMsg) -> bool:
+    def append(self, msg: BusEvent) -> bool:
         """Keep ``msg`` (dropping the oldest as needed); ``False`` when it is not kept (too
         large, or already kept when :attr:`unique`)."""
         if self.unique and msg.identity in self._keys:
@@ -71,7 +71,7 @@ class EventLog:
             self._keys.add(msg.identity)
         return True
 
-    def drain(self) -> list[EventMsg]:
+    def drain(self) -> list[BusEvent]:
         """Every event kept, oldest first; the log is empty afterwards."""
         out = list(self)
         self._events.clear()
@@ -87,5 +87,5 @@ class EventLog:
     def __len__(self) -> int:
         return len(self._events)
 
-    def __iter__(self) -> Iterator[EventMsg]:
+    def __iter__(self) -> Iterator[BusEvent]:
         return (msg for msg, _ in self._events)

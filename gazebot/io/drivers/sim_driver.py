@@ -10,24 +10,61 @@ from __future__ import annotations
 import logging
 import time
 from collections import deque
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import Protocol
 
+import numpy as np
+
+from gazebot.core.types import Event, TrackingFrame
 from gazebot.io.drivers.base import RobotDriver
-from gazebot.io.drivers.payloads import (
-    ArmCommandMsg,
-    EventMsg,
-    EyeFrameMsg,
-    EyeStateMsg,
-    HeadCommandMsg,
-    JointStateMsg,
-    StatusMsg,
-    TrackingMsg,
+from gazebot.io.ros2 import convert
+from gazebot.io.ros2.convert import RosCompressedImage
+from gazebot.io.ros2.errors import MessageError
+from gazebot.io.ros2.values import (
+    ArmCommand,
+    BusEvent,
+    EyeState,
+    JointGoal,
+    JointState,
+    NodeStatus,
 )
 
 log = logging.getLogger("gazebot.io.drivers")
 
 
-def apply_arm_command(sim: Any, msg: ArmCommandMsg) -> None:
+class SimArm(Protocol):
+    """The simulated robot's arm: its joints and named poses (rad, in ``arm_joints`` order)."""
+
+    @property
+    def arm_joints(self) -> Sequence[str]: ...
+    @property
+    def home(self) -> np.ndarray: ...
+    @property
+    def handover(self) -> np.ndarray: ...
+
+
+class Simulation(Protocol):
+    """What the drivers use of a simulation (:class:`gazebot.apps.sim.HandoverSimulation`)."""
+
+    @property
+    def robot(self) -> SimArm: ...
+    @property
+    def t(self) -> float: ...
+    @property
+    def done(self) -> bool: ...
+    def step(self, dt: float) -> None: ...
+    def tracking(self) -> TrackingFrame: ...
+    def joint_state(self) -> Mapping[str, float]: ...
+    def robot_events(self) -> list[Event]: ...
+    def apply_head(self, joints: Mapping[str, float]) -> None: ...
+    def apply_arm(self, joints: Mapping[str, float]) -> None: ...
+    def release_arm(self) -> None: ...
+    def apply_eyes(self, yaw: float, pitch: float, blink: float = 0.0,
+                   distance: float | None = None) -> None: ...
+    def set_display(self, image: np.ndarray) -> None: ...
+
+
+def apply_arm_command(sim: Simulation, cmd: ArmCommand) -> None:
     """Apply an arm command to a simulation: joint goals or a named pose take the arm over from
     its handover controller; ``resume`` hands it back.
 
@@ -35,20 +72,19 @@ def apply_arm_command(sim: Any, msg: ArmCommandMsg) -> None:
         ValueError: unknown joints, or a capability the simulation does not have.
     """
     robot = sim.robot
-    if msg.resume:
+    if cmd.resume:
         sim.release_arm()
         return
-    if msg.pose is not None:
-        goal = dict(zip(robot.arm_joints, (float(q) for q in getattr(robot, msg.pose)),
-                        strict=True))
-    else:
-        goal = dict(msg.positions or {})
-        goal.pop("gripper", None)
-    if msg.gripper is not None or (msg.positions and "gripper" in msg.positions):
+    goal = dict(cmd.positions or {})
+    grip = goal.pop("gripper", cmd.gripper)
+    if cmd.pose is not None:
+        pose = robot.home if cmd.pose == "home" else robot.handover
+        goal = dict(zip(robot.arm_joints, (float(q) for q in pose), strict=True))
+    if grip is not None:
         gripper = getattr(sim, "apply_gripper", None)
         if gripper is None:
             raise ValueError("this simulation's gripper follows its handover controller only")
-        gripper(msg.gripper if msg.gripper is not None else msg.positions["gripper"])
+        gripper(cmd.gripper if cmd.gripper is not None else grip)
     if goal:
         sim.apply_arm(goal)
 
@@ -62,17 +98,16 @@ class SimRobotDriver(RobotDriver):
         node: Name used as the source of the engine's events.
     """
 
-    def __init__(self, sim: Any, rate: float = 120.0, node: str = "engine") -> None:
+    def __init__(self, sim: Simulation, rate: float = 120.0, node: str = "engine") -> None:
         if not rate > 0:
             raise ValueError(f"rate must be > 0 Hz, got {rate!r}")
         self.sim = sim
         self.dt = 1.0 / rate
         self.node = node
-        self._seq = 0
         self._event_seq = 0
-        self._inbox: deque[EventMsg] = deque()
-        self.events: list[EventMsg] = []  # everything published (robot's and the engine's)
-        self.statuses: list[StatusMsg] = []
+        self._inbox: deque[BusEvent] = deque()
+        self.events: list[BusEvent] = []  # everything published (robot's and the engine's)
+        self.statuses: list[NodeStatus] = []
         self.head_commands = 0
         self.rejected: dict[str, int] = {}
 
@@ -80,53 +115,53 @@ class SimRobotDriver(RobotDriver):
         self.rejected[what] = self.rejected.get(what, 0) + 1
         log.warning("simulation rejected a %s command: %s", what, exc)
 
-    def wait_tracking(self, timeout: float) -> TrackingMsg | None:
+    def wait_tracking(self, timeout: float) -> TrackingFrame | None:
         self.sim.step(self.dt)
         for event in self.sim.robot_events():
-            msg = EventMsg.from_event(event, "sim", self._event_seq, time.time())
+            msg = BusEvent.of(event, "sim", time.time(), self._event_seq)
             self._event_seq += 1
             self._inbox.append(msg)
             self.events.append(msg)
-        msg = TrackingMsg.from_frame(self.sim.tracking(), self._seq, time.time())
-        self._seq += 1
-        return msg
+        return self.sim.tracking()
 
-    def joint_state(self) -> JointStateMsg | None:
-        return JointStateMsg(seq=self._seq, t=float(self.sim.t), stamp=time.time(),
-                             position=dict(self.sim.joint_state()))
+    def joint_state(self) -> JointState | None:
+        return JointState(float(self.sim.t), dict(self.sim.joint_state()))
 
-    def send_head(self, msg: HeadCommandMsg) -> None:
+    def send_head(self, goal: JointGoal) -> None:
         try:
-            self.sim.apply_head(msg.head)
+            self.sim.apply_head(goal.positions)
             self.head_commands += 1
         except ValueError as exc:
             self._reject("head", exc)
 
-    def send_eyes(self, msg: EyeStateMsg) -> None:
-        self.sim.apply_eyes(msg.yaw, msg.pitch, msg.blink, distance=msg.distance)
+    def send_eyes(self, eyes: EyeState) -> None:
+        self.sim.apply_eyes(eyes.yaw, eyes.pitch, eyes.blink, distance=eyes.distance)
 
-    def send_eye_frame(self, msg: EyeFrameMsg) -> None:
-        self.sim.set_display(msg.image())
-
-    def send_arm(self, msg: ArmCommandMsg) -> None:
+    def send_eye_frame(self, image: RosCompressedImage) -> None:
         try:
-            apply_arm_command(self.sim, msg)
+            self.sim.set_display(convert.image_of(image))
+        except MessageError as exc:
+            self._reject("eye_frame", exc)
+
+    def send_arm(self, cmd: ArmCommand) -> None:
+        try:
+            apply_arm_command(self.sim, cmd)
         except ValueError as exc:
             self._reject("arm", exc)
 
-    def poll_events(self) -> list[EventMsg]:
+    def poll_events(self) -> list[BusEvent]:
         out = list(self._inbox)
         self._inbox.clear()
         return out
 
-    def publish_event(self, msg: EventMsg) -> None:
-        self.events.append(msg)
+    def publish_event(self, event: BusEvent) -> None:
+        self.events.append(event)
 
-    def event_history(self, timeout: float = 1.0) -> list[EventMsg]:
+    def event_history(self, timeout: float = 1.0) -> list[BusEvent]:
         return list(self.events)
 
-    def publish_status(self, msg: StatusMsg) -> None:
-        self.statuses.append(msg)
+    def publish_status(self, status: NodeStatus) -> None:
+        self.statuses.append(status)
 
     def peers(self) -> dict[str, bool]:
         return {"sim": True}

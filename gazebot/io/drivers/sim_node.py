@@ -14,11 +14,10 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
-from gazebot.io.drivers.payloads import PayloadError
-from gazebot.io.drivers.sim_driver import apply_arm_command
+from gazebot.io.drivers.sim_driver import Simulation, apply_arm_command
 from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
+from gazebot.io.ros2 import convert
 
 log = logging.getLogger("gazebot.io.drivers")
 
@@ -62,11 +61,11 @@ class SimNode:
 
     def __init__(
         self,
-        sim: Any,
+        sim: Simulation,
         endpoint: ZenohRobotEndpoint,
         config: SimNodeConfig | None = None,
         *,
-        view: Callable[[Any], bool] | None = None,
+        view: Callable[[Simulation], bool] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.sim = sim
@@ -92,15 +91,15 @@ class SimNode:
         ep, sim = self.endpoint, self.sim
         if (head := ep.head.take()) is not None:
             try:
-                sim.apply_head(head.head)
+                sim.apply_head(head.positions)
                 self.applied["head"] += 1
             except ValueError as exc:
                 self._reject("head", exc)
         if (frame := ep.eye_frame.take()) is not None:
             try:
-                sim.set_display(frame.image())
+                sim.set_display(convert.image_of(frame))
                 self.applied["eye_frame"] += 1
-            except (PayloadError, ValueError) as exc:
+            except ValueError as exc:  # MessageError among them: not a decodable image
                 self._reject("eye_frame", exc)
         if (eyes := ep.eyes.take()) is not None:
             try:

@@ -1,6 +1,6 @@
 """Tracking samples from their topics: the hands, the face, the gripper and the load share
 arrive as separate messages stamped with the robot time of their sample; this groups them by
-stamp into one :class:`~gazebot.io.drivers.payloads.TrackingMsg`.
+stamp into one :class:`~gazebot.core.types.TrackingFrame`.
 
 Completeness is decided from the stamps, never from how long a sender took between its puts (a
 sender stalled on a busy machine must not split its samples). Zenoh keeps the order within a
@@ -26,16 +26,20 @@ A part that arrives after its sample was complete is too late: counted in ``late
 A part older by more than ``clock_reset`` s than the last one of its own topic means the robot's
 clock restarted (a restarted simulator): the samples start over (the engine node
 resynchronises). Another topic lagging behind, however far, is only late.
-Stamps are compared to the nanosecond, the resolution of ``builtin_interfaces/Time``.
+Stamps are compared to 1 ns, the resolution of ``builtin_interfaces/Time``.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import Any
 
-from gazebot.io.drivers.payloads import TrackingMsg, point_or_none
+import numpy as np
+
+from gazebot.core.types import TrackingFrame
+
+#: One part of a sample: a point (m) for a body, the gripper's closure, the load share (0..1).
+Part = np.ndarray | bool | float
 
 #: Default idle time (s) after which pending samples are complete anyway.
 IDLE_FLUSH = 0.5
@@ -72,20 +76,19 @@ class SampleAssembler:
         self.clock_reset = clock_reset
         self.clock = clock
         self.late = 0
-        self._pending: dict[int, dict[str, Any]] = {}
+        self._pending: dict[int, dict[str, Part]] = {}
         self._newest: dict[str, int] = {}
         self._seen: set[str] = set()
         self._previous: set[str] | None = None  # the parts of the last sample emitted
         self._last_arrival = 0.0
         self._last_ns: int | None = None
-        self._seq = 0
 
-    def add(self, part: str, t: float, value: Any) -> list[TrackingMsg]:
+    def add(self, part: str, t: float, value: Part) -> list[TrackingFrame]:
         """Add one part at robot time ``t`` (s); returns the samples it completed, oldest
         first."""
         ns = round(t * 1e9)
         self._last_arrival = self.clock()
-        restarted: list[TrackingMsg] = []
+        restarted: list[TrackingFrame] = []
         # A restart shows on one topic going back in time (each topic keeps its order); a
         # topic that lags the others, however far, is only late.
         newest = self._newest.get(part)
@@ -125,7 +128,7 @@ class SampleAssembler:
             self._previous = set(parts)
         return done
 
-    def flush_stale(self) -> list[TrackingMsg]:
+    def flush_stale(self) -> list[TrackingFrame]:
         """Every pending sample, oldest first, once nothing arrived for ``idle_flush`` s."""
         if not self._pending or self.clock() - self._last_arrival < self.idle_flush:
             return []
@@ -140,19 +143,16 @@ class SampleAssembler:
             return None
         return self._last_arrival + self.idle_flush
 
-    def _emit(self, ns: int) -> TrackingMsg:
+    def _emit(self, ns: int) -> TrackingFrame:
         parts = self._pending.pop(ns)
         self._last_ns = ns
         sec, nanosec = divmod(ns, 1_000_000_000)
-        msg = TrackingMsg(
-            seq=self._seq,
-            t=float(sec) + 1e-9 * float(nanosec),  # as convert.from_time reads a stamp
-            stamp=time.time(),
-            giver_hand=point_or_none(parts.get("giver_hand")),
-            receiver_hand=point_or_none(parts.get("receiver_hand")),
-            giver_face=point_or_none(parts.get("giver_face")),
-            gripper_closed=parts.get("gripper"),
-            load_share=parts.get("load_share"),
+        gripper, share = parts.get("gripper"), parts.get("load_share")
+        return TrackingFrame.make(
+            float(sec) + 1e-9 * float(nanosec),  # as convert.from_time reads a stamp
+            giver_hand=parts.get("giver_hand"),
+            receiver_hand=parts.get("receiver_hand"),
+            giver_face=parts.get("giver_face"),
+            gripper_closed=None if gripper is None else bool(gripper),
+            load_share=None if share is None else float(share),
         )
-        self._seq += 1
-        return msg

@@ -7,13 +7,14 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
-from gazebot.io.drivers.payloads import EyeStateMsg
 from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.rmw.node import Received
-from gazebot.io.drivers.zenoh_node import ZenohNode, checked, seq_stamp
+from gazebot.io.drivers.zenoh_node import ZenohNode
 from gazebot.io.ros2 import convert, topics
+from gazebot.io.ros2.convert import RosEyeState
+from gazebot.io.ros2.values import EyeState, Json
 
 if TYPE_CHECKING:
     import zenoh
@@ -44,30 +45,27 @@ class ZenohDisplayNode(ZenohNode):
             session, names, node, owns_session=owns_session, peer_timeout=peer_timeout, clock=clock
         )
         self._eyes_lock = threading.Lock()
-        self._latest: EyeStateMsg | None = None
+        self._latest: EyeState | None = None
         self._arrived = -float("inf")
         self.received = 0
         self.ros.subscription(topics.EYES.name, topics.EYES.type, self._on_eyes)
         self.announce()
 
-    def _on_eyes(self, ros: Any, rx: Received) -> None:
-        eyes = convert.eyes_of(ros)
-        seq, stamp = seq_stamp(rx)
-        msg = checked(EyeStateMsg, convert.EYE_STATE, seq=seq, t=eyes.t, stamp=stamp,
-                     yaw=eyes.yaw, pitch=eyes.pitch, blink=eyes.blink, distance=eyes.distance)
+    def _on_eyes(self, ros: RosEyeState, rx: Received) -> None:
+        msg = convert.eyes_of(ros)
         now = self.clock()
         with self._eyes_lock:  # Zenoh keeps one publisher's order: the last one is the newest
             self._latest = msg
             self._arrived = now
             self.received += 1
 
-    def latest(self) -> tuple[EyeStateMsg | None, float]:
+    def latest(self) -> tuple[EyeState | None, float]:
         """The newest eye state and its age (s; ``inf`` when none ever arrived)."""
         with self._eyes_lock:
             msg, arrived = self._latest, self._arrived
         return msg, (self.clock() - arrived) if msg is not None else float("inf")
 
-    def status(self, eyes: str, info: dict[str, Any]) -> None:
+    def status(self, eyes: str, info: dict[str, Json]) -> None:
         """Publish the display's heartbeat; ``eyes`` (``live``, ``silent``, ``waiting``) goes
         to ``info.eyes``."""
         self.heartbeat(tracking="n/a", info={"eyes": eyes, **info})

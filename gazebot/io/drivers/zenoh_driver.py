@@ -8,37 +8,37 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
-from gazebot.core.types import Phase
+from gazebot.core.types import Phase, TrackingFrame
 from gazebot.io.drivers.base import RobotDriver
 from gazebot.io.drivers.ownership import Ownership
-from gazebot.io.drivers.payloads import (
-    ArmCommandMsg,
-    EyeFrameMsg,
-    EyeStateMsg,
-    HeadCommandMsg,
-    JointStateMsg,
-    Point,
-    TrackingMsg,
-)
 from gazebot.io.drivers.rmw.attachment import gid_of
 from gazebot.io.drivers.rmw.graph import Entity
 from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.rmw.node import Received
-from gazebot.io.drivers.tracking_assembly import IDLE_FLUSH, REORDER, SampleAssembler
+from gazebot.io.drivers.tracking_assembly import IDLE_FLUSH, REORDER, Part, SampleAssembler
 from gazebot.io.drivers.tracking_source import Rival, SourceArbiter, group_of
 from gazebot.io.drivers.zenoh_node import HISTORY_BYTES, ZenohNode
 from gazebot.io.ros2 import convert, topics
+from gazebot.io.ros2.convert import (
+    RosCompressedImage,
+    RosGripperState,
+    RosJointState,
+    RosLoadShare,
+    RosPointStamped,
+    RosPoseStamped,
+    RosString,
+    RosTFMessage,
+)
 from gazebot.io.ros2.errors import MessageError
+from gazebot.io.ros2.topics import GAZE_FRAME
+from gazebot.io.ros2.values import ArmCommand, EyeState, JointGoal, JointState, Point
 
 if TYPE_CHECKING:
     import zenoh
-
-#: Frame of the eye state: the head's ``gaze`` site.
-GAZE_FRAME = "gaze"
 
 
 class ZenohRobotDriver(ZenohNode, RobotDriver):
@@ -87,11 +87,11 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                          peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes,
                          history_bytes=history_bytes)
         self._cond = threading.Condition(threading.Lock())
-        self._queue: deque[TrackingMsg] = deque()
+        self._queue: deque[TrackingFrame] = deque()
         self.tracking_backlog = tracking_backlog
         self.tracking_received = 0
         self.tracking_skipped = 0
-        self._joints: JointStateMsg | None = None
+        self._joints: JointState | None = None
         self._ownership: Ownership | None = None
         self._sources = SourceArbiter(source_timeout, clock)
         self._gid_labels: dict[bytes, str] = {}
@@ -108,7 +108,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self._part_topics: dict[str, str] = {}
         for body, t in topics.TRACKING.items():
             sub = ros.subscription(t.name, (t.type, convert.POSE_STAMPED),
-                                   lambda m, rx, b=body: self._on_point(b, m, rx))
+                                   self._point_handler(body))
             self._part_topics[body] = sub.topic
         if names.tf_frames:
             sub = ros.subscription(topics.TF.name, topics.TF.type, self._on_tf)
@@ -163,7 +163,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         """Sources whose tracking was ignored lately (``new_only``: not returned before)."""
         return self._sources.new_rivals() if new_only else self._sources.rivals()
 
-    def _point(self, ros: Any) -> tuple[float, Any]:
+    def _point(self, ros: RosPointStamped | RosPoseStamped) -> tuple[float, np.ndarray]:
         t, p = convert.point_of(ros)
         frame = str(ros.header.frame_id)
         if not self.names.is_base_frame(frame):
@@ -171,11 +171,16 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                                f"frame {self.names.base_frame!r}")
         return t, p
 
-    def _on_point(self, body: str, ros: Any, rx: Received) -> None:
+    def _point_handler(
+        self, body: str
+    ) -> Callable[[RosPointStamped | RosPoseStamped, Received], None]:
+        return lambda ros, rx: self._on_point(body, ros, rx)
+
+    def _on_point(self, body: str, ros: RosPointStamped | RosPoseStamped, rx: Received) -> None:
         t, p = self._point(ros)
         self._add(body, t, p, rx)
 
-    def _on_tf(self, ros: Any, rx: Received) -> None:
+    def _on_tf(self, ros: RosTFMessage, rx: Received) -> None:
         by_child = {child.lstrip("/"): body for body, child in self.names.tf_frames.items()}
         for tf in ros.transforms:
             body = by_child.get(str(tf.child_frame_id).lstrip("/"))
@@ -183,14 +188,14 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                 t, p = convert.point_of(tf)
                 self._add(body, t, p, rx)
 
-    def _on_gripper(self, ros: Any, rx: Received) -> None:
+    def _on_gripper(self, ros: RosGripperState, rx: Received) -> None:
         self._add("gripper", convert.stamp_of(ros), bool(ros.closed), rx)
 
-    def _on_share(self, ros: Any, rx: Received) -> None:
+    def _on_share(self, ros: RosLoadShare, rx: Received) -> None:
         t, share = convert.share_of(ros)
         self._add("load_share", t, share, rx)
 
-    def _add(self, part: str, t: float, value: Any, rx: Received) -> None:
+    def _add(self, part: str, t: float, value: Part, rx: Received) -> None:
         if not math.isfinite(t):
             raise MessageError(part, f"stamp is not finite: {t}")
         source = self._source(rx)
@@ -201,7 +206,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         with self._cond:
             self._enqueue(self._assembler.add(part, t, value))
 
-    def _enqueue(self, samples: list[TrackingMsg]) -> None:
+    def _enqueue(self, samples: list[TrackingFrame]) -> None:
         for msg in samples:
             if len(self._queue) >= self.tracking_backlog:
                 self._queue.popleft()
@@ -211,10 +216,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         if samples:
             self._cond.notify_all()
 
-    def _on_joints(self, ros: Any, rx: Received) -> None:
-        t, position = convert.joint_positions(ros)
-        seq = rx.attachment.sequence_number - 1 if rx.attachment is not None else 0
-        self._joints = JointStateMsg(seq=max(0, seq), t=t, stamp=time.time(), position=position)
+    def _on_joints(self, ros: RosJointState, rx: Received) -> None:
+        self._joints = convert.joint_positions(ros)
 
     @property
     def tracking_late(self) -> int:
@@ -234,7 +237,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         return [] if self._ownership is None else [str(c) for c in self._ownership.rivals()]
 
     # -- RobotDriver -----------------------------------------------------------------------
-    def wait_tracking(self, timeout: float) -> TrackingMsg | None:
+    def wait_tracking(self, timeout: float) -> TrackingFrame | None:
         end = self.clock() + max(0.0, timeout)
         with self._cond:
             while not self._queue and not self.closed:
@@ -247,12 +250,11 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                 self._cond.wait(wait)
             return self._queue.popleft() if self._queue else None
 
-    def joint_state(self) -> JointStateMsg | None:
+    def joint_state(self) -> JointState | None:
         return self._joints
 
-    def send_head(self, msg: HeadCommandMsg) -> None:
-        self._head_pub.publish(convert.head_trajectory(
-            msg, msg.time_from_start, velocities=msg.velocity))
+    def send_head(self, goal: JointGoal) -> None:
+        self._head_pub.publish(convert.joint_trajectory(goal))
 
     def send_gaze_target(self, t: float, point: Point) -> None:
         self._target_pub.publish(convert.point_stamped(t, point, self.names.base_frame))
@@ -260,31 +262,27 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
     def send_phase(self, t: float, phase: str, phase_start: float) -> None:
         self._phase_pub.publish(convert.handover_phase(t, Phase(phase), phase_start))
 
-    def send_eyes(self, msg: EyeStateMsg) -> None:
-        self._eyes_pub.publish(convert.eye_state(_EyeCommand(msg), GAZE_FRAME))
+    def send_eyes(self, eyes: EyeState) -> None:
+        self._eyes_pub.publish(convert.eye_state(eyes, GAZE_FRAME, self.ros.store))
 
-    def send_eye_frame(self, msg: EyeFrameMsg) -> None:
-        image = self.ros.store.types[convert.COMPRESSED_IMAGE]
-        self._frame_pub.publish(image(header=convert.header(msg.t, GAZE_FRAME), format=msg.format,
-                                      data=np.frombuffer(msg.data, np.uint8)))
+    def send_eye_frame(self, image: RosCompressedImage) -> None:
+        self._frame_pub.publish(image)
 
     def wants_eye_frames(self) -> bool:
         # Rendering and encoding frames is costly: only while someone subscribes to them.
         return not self.closed and self._frame_pub.subscribed()
 
-    def send_arm(self, msg: ArmCommandMsg) -> None:
-        if msg.positions is not None:
-            goal = dict(msg.positions)
-            if msg.gripper is not None:
-                goal["gripper"] = msg.gripper
-            self._arm_pub.publish(convert.head_trajectory(
-                _Goal(msg.t, goal), 1.0, stamped=False))
+    def send_arm(self, cmd: ArmCommand) -> None:
+        if cmd.positions is not None:
+            goal = dict(cmd.positions)
+            if cmd.gripper is not None:
+                goal["gripper"] = cmd.gripper
+            self._arm_pub.publish(convert.joint_trajectory(JointGoal(cmd.t, goal, {}, 1.0)))
             return
-        mode = "resume" if msg.resume else str(msg.pose)
-        self._arm_mode_pub.publish(self.ros.store.types["std_msgs/msg/String"](data=mode))
-        if msg.gripper is not None:
-            self._arm_pub.publish(convert.head_trajectory(
-                _Goal(msg.t, {"gripper": msg.gripper}), 1.0, stamped=False))
+        self._arm_mode_pub.publish(RosString("resume" if cmd.resume else str(cmd.pose)))
+        if cmd.gripper is not None:
+            self._arm_pub.publish(convert.joint_trajectory(
+                JointGoal(cmd.t, {"gripper": cmd.gripper}, {}, 1.0)))
 
     def close(self) -> None:
         if self.closed:
@@ -297,18 +295,3 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
 def source_label(entity: Entity) -> str:
     """A tracking source's name: its node's name and its session."""
     return f"{entity.node} (session {entity.zid})"
-
-
-class _EyeCommand:
-    """An :class:`EyeStateMsg` read as the command attributes :func:`convert.eye_state` takes."""
-
-    def __init__(self, msg: EyeStateMsg) -> None:
-        self.t, self.eye_yaw, self.eye_pitch = msg.t, msg.yaw, msg.pitch
-        self.blink, self.distance = msg.blink, msg.distance
-
-
-class _Goal:
-    """Joint goals read as a command (``t``, ``head``) by :func:`convert.head_trajectory`."""
-
-    def __init__(self, t: float, goal: dict[str, float]) -> None:
-        self.t, self.head = t, goal

@@ -21,16 +21,17 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, ClassVar, Literal, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeVar, cast
 
 from gazebot.io.drivers.event_log import EventLog
-from gazebot.io.drivers.payloads import EventMsg, Msg, StatusMsg
 from gazebot.io.drivers.rmw.attachment import Attachment, AttachmentError
 from gazebot.io.drivers.rmw.graph import Entity
 from gazebot.io.drivers.rmw.names import Names, mangle
 from gazebot.io.drivers.rmw.node import DropCounter, Publisher, Received, RosNode, TypeMismatch
 from gazebot.io.ros2 import convert, topics
+from gazebot.io.ros2.convert import RosDiagnosticArray, RosHandoverEvent
 from gazebot.io.ros2.errors import MessageError
+from gazebot.io.ros2.values import BusEvent, Json, NodeStatus, NodeTracking
 
 if TYPE_CHECKING:
     import zenoh
@@ -39,49 +40,20 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("gazebot.io.drivers")
 _Node = TypeVar("_Node", bound="ZenohNode")
-M = TypeVar("M", bound=Msg)
+_V = TypeVar("_V")
 
 HISTORY_SPACE = "@gazebot_history"
 #: Bytes of events a node keeps in its history (and in its inbox) by default.
 HISTORY_BYTES = 2 * 1024 * 1024
 
 
-def event_to_ros(msg: EventMsg) -> Any:
-    """The ``HandoverEvent`` of an :class:`EventMsg`."""
-    return convert.handover_event(msg.source, msg.category, msg.kind, msg.t, msg.detected_at,
-                                  msg.stamp, msg.info)
-
-
-def event_from_ros(ros: Any, seq: int = 0) -> EventMsg:
-    """The :class:`EventMsg` of a ``HandoverEvent`` (``seq``: the publisher's sequence number);
-    :class:`MessageError` for values gazebot cannot use."""
-    v = convert.event_of(ros)
+def checked(what: str, build: Callable[[], _V]) -> _V:
+    """``build()``; a value out of range (:class:`ValueError`) becomes a :class:`MessageError`
+    of message type ``what`` (counted and dropped by the subscription)."""
     try:
-        return EventMsg(seq=max(0, seq), source=v.source, category=v.category, kind=v.kind,
-                        t=v.t, detected_at=v.detected_at, stamp=v.stamp, info=v.info)
+        return build()
     except ValueError as exc:
-        raise MessageError(convert.HANDOVER_EVENT, str(exc).splitlines()[0]) from None
-
-
-def seq_stamp(rx: Received) -> tuple[int, float]:
-    """The publisher's sequence number (from 0) and source time (s) of a received message."""
-    if rx.attachment is None:
-        return 0, time.time()
-    return max(0, rx.attachment.sequence_number - 1), rx.attachment.source_timestamp / 1e9
-
-
-def checked(model: type[M], what: str, **fields: Any) -> M:
-    """``model(**fields)``; a value out of range becomes a :class:`MessageError` (counted and
-    dropped by the subscription) naming the first offending field."""
-    try:
-        return model(**fields)
-    except ValueError as exc:
-        errors = getattr(exc, "errors", None)
-        reason = str(exc).splitlines()[0]
-        if callable(errors) and errors():
-            err = errors()[0]
-            reason = f"{'.'.join(str(p) for p in err['loc'])}: {err['msg']}"
-        raise MessageError(what, reason) from None
+        raise MessageError(what, str(exc)) from None
 
 
 class ZenohNode:
@@ -175,15 +147,15 @@ class ZenohNode:
         return f"{HISTORY_SPACE}/{self.names.domain_id}/{mangle(self.names.namespace)}/{node}"
 
     # -- plumbing --------------------------------------------------------------------------
-    def _on_event(self, ros: Any, rx: Received) -> None:
+    def _on_event(self, ros: RosHandoverEvent, rx: Received) -> None:
         seq = rx.attachment.sequence_number - 1 if rx.attachment is not None else 0
-        msg = event_from_ros(ros, seq)
+        msg = convert.event_of(ros, seq)
         with self._lock:
             self._remember(msg)
             if msg.source != self.node:
                 self._inbox.append(msg)
 
-    def _remember(self, msg: EventMsg) -> None:
+    def _remember(self, msg: BusEvent) -> None:
         self._history.append(msg)
 
     def _on_graph(self, entity: Entity, alive: bool) -> None:
@@ -191,7 +163,7 @@ class ZenohNode:
             with self._lock:  # a new life: wait for its first heartbeat
                 self._last_beat.pop(entity.node, None)
 
-    def _on_status(self, ros: Any, rx: Received) -> None:
+    def _on_status(self, ros: RosDiagnosticArray, rx: Received) -> None:
         now = self.clock()
         with self._lock:
             for health in convert.health_of(ros):
@@ -205,13 +177,14 @@ class ZenohNode:
             for msg in events:
                 pub = self._event_pub(msg)
                 att = Attachment(msg.seq + 1, round(msg.stamp * 1e9), pub.gid)
-                query.reply(self._history_key(self.node), pub.codec.encode(event_to_ros(msg)),
+                query.reply(self._history_key(self.node),
+                            pub.codec.encode(convert.handover_event(msg)),
                             attachment=att.encode())
         except Exception:
             log.exception("could not answer the event history query")
 
     # -- events ----------------------------------------------------------------------------
-    def _event_pub(self, msg: EventMsg) -> Publisher:
+    def _event_pub(self, msg: BusEvent) -> Publisher:
         return self._event_pubs["robot" if msg.category == "robot" else "other"]
 
     def next_event_seq(self) -> int:
@@ -220,24 +193,24 @@ class ZenohNode:
             self._event_seq += 1
             return self._event_seq - 1
 
-    def publish_event(self, msg: EventMsg) -> None:
+    def publish_event(self, event: BusEvent) -> None:
         """Publish one of this node's events (and keep it in the history)."""
         with self._lock:
-            self._remember(msg)
+            self._remember(event)
         if not self._closed:
-            self._event_pub(msg).publish(event_to_ros(msg))
+            self._event_pub(event).publish(convert.handover_event(event))
 
-    def history(self) -> list[EventMsg]:
+    def history(self) -> list[BusEvent]:
         """The events this node has seen (its own and others'), in arrival order."""
         with self._lock:
             return list(self._history)
 
-    def poll_events(self) -> list[EventMsg]:
+    def poll_events(self) -> list[BusEvent]:
         """Events other nodes published since the last call, oldest first."""
         with self._lock:
             return self._inbox.drain()
 
-    def event_history(self, timeout: float = 1.0) -> list[EventMsg]:
+    def event_history(self, timeout: float = 1.0) -> list[BusEvent]:
         """Ask every other node for the events it has seen; merged, de-duplicated, sorted by
         time. Malformed replies are counted and skipped; no answer gives ``[]``. What is
         kept is bounded as the node's own history is (the replies received last are kept)."""
@@ -261,7 +234,8 @@ class ZenohNode:
                 seq = 0
                 if sample.attachment is not None:
                     seq = Attachment.decode(sample.attachment.to_bytes()).sequence_number - 1
-                msg = event_from_ros(codec.decode(sample.payload.to_bytes()), seq)
+                ros = cast(RosHandoverEvent, codec.decode(sample.payload.to_bytes()))
+                msg = convert.event_of(ros, seq)
             except (MessageError, AttachmentError) as exc:
                 self.drops.drop(selector, str(exc))
                 continue
@@ -305,12 +279,12 @@ class ZenohNode:
 
     def heartbeat(
         self,
-        tracking: Literal["ok", "waiting", "hold", "lost", "n/a"] = "n/a",
+        tracking: NodeTracking = "n/a",
         phase: str | None = None,
-        info: dict[str, Any] | None = None,
+        info: dict[str, Json] | None = None,
         stopping: bool = False,
         degraded: bool = False,
-    ) -> StatusMsg:
+    ) -> NodeStatus:
         """Publish and return this node's heartbeat; ``state`` is ``degraded`` when a peer is
         lost, tracking is not flowing or the caller says so."""
         peers = self.peers()
@@ -318,7 +292,7 @@ class ZenohNode:
         with self._lock:
             seq = self._status_seq
             self._status_seq += 1
-        msg = StatusMsg(
+        msg = NodeStatus(
             node=self.node,
             seq=seq,
             stamp=time.time(),
@@ -333,9 +307,9 @@ class ZenohNode:
         self.publish_status(msg)
         return msg
 
-    def publish_status(self, msg: StatusMsg) -> None:
+    def publish_status(self, status: NodeStatus) -> None:
         if not self._closed:
-            self._status_pub.publish(convert.diagnostics(msg, msg.stamp))
+            self._status_pub.publish(convert.diagnostics(status, status.stamp))
 
     # -- lifetime --------------------------------------------------------------------------
     @property

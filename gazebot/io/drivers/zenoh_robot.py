@@ -16,32 +16,32 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
+from typing import TYPE_CHECKING, ClassVar, Generic, TypeVar
 
 from gazebot.core.types import Event, TrackingFrame
 from gazebot.io.drivers.ownership import Claim, OwnershipWatch
-from gazebot.io.drivers.payloads import (
-    ArmCommandMsg,
-    EventMsg,
-    EyeFrameMsg,
-    EyeStateMsg,
-    HeadCommandMsg,
-    JointStateMsg,
-    Msg,
-    StatusMsg,
-    TrackingMsg,
-)
 from gazebot.io.drivers.rmw.attachment import gid_of
 from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.rmw.node import Received
-from gazebot.io.drivers.zenoh_node import HISTORY_BYTES, ZenohNode, checked, seq_stamp
+from gazebot.io.drivers.zenoh_node import HISTORY_BYTES, ZenohNode, checked
 from gazebot.io.ros2 import convert, topics
+from gazebot.io.ros2.convert import RosCompressedImage, RosEyeState, RosJointTrajectory, RosString
 from gazebot.io.ros2.errors import MessageError
+from gazebot.io.ros2.values import (
+    ArmCommand,
+    BusEvent,
+    EyeState,
+    JointGoal,
+    JointState,
+    Json,
+    NodeStatus,
+    NodeTracking,
+)
 
 if TYPE_CHECKING:
     import zenoh
 
-M = TypeVar("M", bound=Msg)
+M = TypeVar("M")
 
 
 class Latest(Generic[M]):
@@ -103,12 +103,10 @@ class ZenohRobotEndpoint(ZenohNode):
         super().__init__(session, names, node, owns_session=owns_session,
                          peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes,
                          history_bytes=history_bytes)
-        self._tracking_seq = 0
-        self._joint_seq = 0
-        self.head: Latest[HeadCommandMsg] = Latest()
-        self.eyes: Latest[EyeStateMsg] = Latest()
-        self.eye_frame: Latest[EyeFrameMsg] = Latest()
-        self.arm: Latest[ArmCommandMsg] = Latest()
+        self.head: Latest[JointGoal] = Latest()
+        self.eyes: Latest[EyeState] = Latest()
+        self.eye_frame: Latest[RosCompressedImage] = Latest()
+        self.arm: Latest[ArmCommand] = Latest()
         self.compete_window = float(compete_window)
         self._compete_lock = threading.Lock()
         self._head_gids: dict[bytes, float] = {}  # publisher GID -> when it last commanded
@@ -131,11 +129,9 @@ class ZenohRobotEndpoint(ZenohNode):
         self.announce()
 
     # -- out -------------------------------------------------------------------------------
-    def publish_tracking(self, frame: TrackingFrame) -> TrackingMsg:
+    def publish_tracking(self, frame: TrackingFrame) -> TrackingFrame:
         """Publish one tracking sample (each tracked body, the gripper and the load share as
-        known, stamped ``frame.t``) and return it (numbered)."""
-        msg = TrackingMsg.from_frame(frame, self._tracking_seq, time.time())
-        self._tracking_seq += 1
+        known, stamped ``frame.t``) and return it."""
         base = self.names.base_frame
         for body, p in convert.tracking_points(frame).items():
             self._point_pubs[body].publish(convert.point_stamped(frame.t, p, base))
@@ -143,23 +139,17 @@ class ZenohRobotEndpoint(ZenohNode):
             self._gripper_pub.publish(convert.gripper_state(frame.t, bool(frame.gripper_closed)))
         if frame.load_share is not None:
             self._share_pub.publish(convert.load_share(frame.t, float(frame.load_share)))
-        return msg
+        return frame
 
-    def publish_joint_state(self, t: float, position: Mapping[str, float]) -> JointStateMsg:
+    def publish_joint_state(self, t: float, position: Mapping[str, float]) -> JointState:
         """Publish the measured joint positions (rad or m, by joint name) on ``/joint_states``."""
-        msg = JointStateMsg(
-            seq=self._joint_seq,
-            t=float(t),
-            stamp=time.time(),
-            position={k: float(v) for k, v in position.items()},
-        )
-        self._joint_seq += 1
-        self._joints_pub.publish(convert.joint_state(msg.t, msg.position))
-        return msg
+        state = JointState(float(t), {k: float(v) for k, v in position.items()})
+        self._joints_pub.publish(convert.joint_state(state.t, state.position))
+        return state
 
-    def publish_robot_event(self, event: Event) -> EventMsg:
+    def publish_robot_event(self, event: Event) -> BusEvent:
         """Publish an event of the robot's own controller (``robot_reach_started``, ...)."""
-        msg = EventMsg.from_event(event, self.node, self.next_event_seq(), time.time())
+        msg = BusEvent.of(event, self.node, time.time(), self.next_event_seq())
         self.publish_event(msg)
         return msg
 
@@ -214,11 +204,11 @@ class ZenohRobotEndpoint(ZenohNode):
             self._publish_fault("competing_engine", publishers=names,
                                 gids=[g.hex() for g in sorted(gids)])
 
-    def _publish_fault(self, kind: str, **info: Any) -> None:
-        t = self.head.peek().t if self.head.peek() is not None else 0.0
-        self.publish_event(EventMsg(seq=self.next_event_seq(), source=self.node,
-                                    category="fault", kind=kind, t=t, detected_at=t,
-                                    stamp=time.time(), info=info))
+    def _publish_fault(self, kind: str, **info: Json) -> None:
+        last = self.head.peek()
+        t = last.t if last is not None else 0.0
+        self.publish_event(BusEvent(self.node, "fault", kind, t, t, time.time(), info,
+                                    self.next_event_seq()))
 
     def head_publishers(self) -> int:
         """Publishers that sent head commands within the last ``compete_window`` s."""
@@ -226,9 +216,9 @@ class ZenohRobotEndpoint(ZenohNode):
         with self._compete_lock:
             return sum(now - seen <= self.compete_window for seen in self._head_gids.values())
 
-    def heartbeat(self, tracking: Any = "n/a", phase: str | None = None,
-                  info: dict[str, Any] | None = None, stopping: bool = False,
-                  degraded: bool = False) -> StatusMsg:
+    def heartbeat(self, tracking: NodeTracking = "n/a", phase: str | None = None,
+                  info: dict[str, Json] | None = None, stopping: bool = False,
+                  degraded: bool = False) -> NodeStatus:
         """The node's heartbeat with ``info.engines`` (claims, the owner first) and
         ``info.head_publishers``; ``degraded`` while engines compete."""
         engines = [str(c) for c in self.owners.claims()]
@@ -238,48 +228,35 @@ class ZenohRobotEndpoint(ZenohNode):
                                  degraded or len(engines) > 1 or publishers > 1)
 
     # -- in --------------------------------------------------------------------------------
-    def _on_head(self, ros: Any, rx: Received) -> None:
+    def _on_head(self, ros: RosJointTrajectory, rx: Received) -> None:
         if rx.attachment is not None:
             self._check_head_publisher(rx.attachment.gid)
-        goal, tfs = convert.trajectory_goal(ros)
-        last = ros.points[-1]
-        names = list(ros.joint_names)
-        vel = [float(v) for v in last.velocities]
-        velocity = dict(zip(names, vel, strict=True)) if len(vel) == len(names) else {}
-        seq, stamp = seq_stamp(rx)
-        self.head.put(checked(
-            HeadCommandMsg, convert.JOINT_TRAJECTORY, seq=seq, t=convert.stamp_of(ros),
-            stamp=stamp, head=goal, velocity=velocity, time_from_start=tfs))
+        goal = convert.trajectory_goal(ros)
+        if not goal.time_from_start > 0.0:
+            raise MessageError(convert.JOINT_TRAJECTORY, "time_from_start must be > 0, got "
+                               f"{goal.time_from_start}")
+        self.head.put(goal)
 
-    def _on_eyes(self, ros: Any, rx: Received) -> None:
-        eyes = convert.eyes_of(ros)
-        seq, stamp = seq_stamp(rx)
-        self.eyes.put(checked(
-            EyeStateMsg, convert.EYE_STATE, seq=seq, t=eyes.t, stamp=stamp, yaw=eyes.yaw,
-            pitch=eyes.pitch, blink=eyes.blink, distance=eyes.distance))
+    def _on_eyes(self, ros: RosEyeState, rx: Received) -> None:
+        self.eyes.put(convert.eyes_of(ros))
 
-    def _on_frame(self, ros: Any, rx: Received) -> None:
-        fmt = "png" if "png" in str(ros.format).lower() else "jpeg"
-        seq, stamp = seq_stamp(rx)
-        self.eye_frame.put(checked(
-            EyeFrameMsg, convert.COMPRESSED_IMAGE, seq=seq, t=convert.stamp_of(ros),
-            stamp=stamp, format=fmt, data=bytes(ros.data)))
+    def _on_frame(self, ros: RosCompressedImage, rx: Received) -> None:
+        self.eye_frame.put(ros)  # decoded (and its size checked) where it is shown
 
-    def _on_arm(self, ros: Any, rx: Received) -> None:
-        goal, _ = convert.trajectory_goal(ros)  # a ``gripper`` joint (0..1) may be among them
-        seq, stamp = seq_stamp(rx)
-        self.arm.put(checked(ArmCommandMsg, convert.JOINT_TRAJECTORY, seq=seq,
-                            t=convert.stamp_of(ros), stamp=stamp, positions=goal))
+    def _on_arm(self, ros: RosJointTrajectory, rx: Received) -> None:
+        goal = convert.trajectory_goal(ros)  # a ``gripper`` joint (0..1) may be among them
+        self.arm.put(checked(convert.JOINT_TRAJECTORY,
+                             lambda: ArmCommand(goal.t, positions=goal.positions)))
 
-    def _on_arm_mode(self, ros: Any, rx: Received) -> None:
+    def _on_arm_mode(self, ros: RosString, rx: Received) -> None:
         mode = str(ros.data)
-        seq, stamp = seq_stamp(rx)
         if mode == "resume":
-            fields: dict[str, Any] = {"resume": True}
-        elif mode in ("home", "handover"):
-            fields = {"pose": mode}
+            cmd = ArmCommand(resume=True)
+        elif mode == "home":
+            cmd = ArmCommand(pose="home")
+        elif mode == "handover":
+            cmd = ArmCommand(pose="handover")
         else:
-            raise MessageError("std_msgs/msg/String",
+            raise MessageError(convert.STRING,
                                f"arm mode {mode!r}: expected home, handover or resume")
-        self.arm.put(checked(ArmCommandMsg, "std_msgs/msg/String", seq=seq, t=0.0, stamp=stamp,
-                            **fields))
+        self.arm.put(cmd)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -204,7 +204,7 @@ def build(
     names: PointNames,
     unit: str,
     defaults: tuple[str | None, str | None, str | None],
-    extra: dict[str, np.ndarray] | None = None,
+    extra: Mapping[str, np.ndarray] | None = None,
     notes: tuple[str, ...] = (),
     limits: RecordingLimits | None = None,
     where: Callable[[int], str] | None = None,
@@ -220,11 +220,14 @@ def build(
     g = pick(source, "giver_hand", names.giver_hand, available, defaults[0])
     r = pick(source, "receiver_hand", names.receiver_hand, available, defaults[1])
     f = pick(source, "giver_face", names.giver_face, available, defaults[2])
+    if g is None or r is None:  # pick raises for a hand it cannot name
+        raise RecordingError(source, "no giver and receiver hand")
     n = t.shape[0]
     # Bounded in the file's unit first: scaling 1e308 mm to m is fine, squaring it later is not.
-    chosen, dropped = {}, 0
-    for name in {g, r, f} - {None}:
-        p, k = in_workspace(points[name], limits.workspace_m / scale)  # type: ignore[index]
+    chosen: dict[str, np.ndarray] = {}
+    dropped = 0
+    for name in {g, r, *([f] if f else [])}:
+        p, k = in_workspace(points[name], limits.workspace_m / scale)
         chosen[name], dropped = p * scale, dropped + k
     face = chosen[f] if f else np.full((n, 3), np.nan)
     extra = extra or {}
@@ -242,7 +245,7 @@ def build(
         fmt,
         (g, r, f),
         tuple(available),
-        unit,  # type: ignore[arg-type]
+        unit,
         median_rate(t),
         notes,
         dropped,

@@ -72,8 +72,10 @@ def read_csv(
         if not row or all(not c.strip() for c in row):
             continue
         if len(row) != len(header):
+            col = header[min(len(row), len(header) - 1)]  # the first cell missing (or extra)
             raise RecordingError(
-                path, f"line {lineno}: expected {len(header)} cells, got {len(row)}"
+                path, f"line {lineno}, column '{col}': expected {len(header)} cells, "
+                f"got {len(row)}"
             )
         out = []
         for col, raw in zip(header, row, strict=True):
@@ -103,20 +105,22 @@ def read_csv(
         values.append(out)
         lines.append(lineno)
     data = np.array(values, dtype=float).reshape(-1, len(header))
-    col = {h: data[:, i] for i, h in enumerate(header)}
+    columns = {h: data[:, i] for i, h in enumerate(header)}
     points: dict[str, np.ndarray] = {}
     for h in header:
         if h.endswith("_x"):
             base = h[:-2]
-            if f"{base}_y" in col and f"{base}_z" in col:
-                p = np.stack([col[f"{base}_x"], col[f"{base}_y"], col[f"{base}_z"]], axis=1)
+            if f"{base}_y" in columns and f"{base}_z" in columns:
+                p = np.stack([columns[f"{base}_{axis}"] for axis in "xyz"], axis=1)
                 p[np.isnan(p).any(axis=1)] = np.nan
                 points[base] = p
-    extra = {k: col[k] for k in ("gripper_closed", "load_share") if k in col}
+    extra: dict[str, np.ndarray] = {
+        k: columns[k] for k in ("gripper_closed", "load_share") if k in columns
+    }
     return build(
         path,
         "csv",
-        col[time_col],
+        columns[time_col],
         points,
         names,
         unit,

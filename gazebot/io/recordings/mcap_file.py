@@ -16,8 +16,9 @@ import os
 import struct
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any, BinaryIO, cast
 
+from gazebot.io.recordings import ros_shapes as shape
 from gazebot.io.recordings.base import (
     PointNames,
     Recording,
@@ -45,11 +46,6 @@ _DEFAULT_SUFFIX = tuple(ros_topics.TRACKING[body].name for body in cv.BODIES)
 def _ros2_name(name: str) -> str:
     pkg, _, short = name.rpartition("/")
     return name if "/msg/" in name else f"{pkg.split('/')[0]}/msg/{short}"
-
-
-def _stamp(header: object) -> float:
-    st = header.stamp  # type: ignore[attr-defined]
-    return float(st.sec) + 1e-9 * float(st.nanosec)
 
 
 def _default(topics: list[str], suffix: str) -> str | None:
@@ -81,10 +77,10 @@ def read_mcap(
     grip: list[tuple[float, float]] = []
     load: list[tuple[float, float]] = []
 
-    def add(name: str, t: float, p: object) -> None:
+    def add(name: str, header: shape.Header, p: shape.XYZ) -> None:
         # Every row is kept here: bound_streams checks stamps and bounds coordinates (counted).
-        xyz = (float(p.x), float(p.y), float(p.z))  # type: ignore[attr-defined]
-        series.setdefault(name, []).append((t, *xyz))
+        series.setdefault(name, []).append((shape.stamp(header), float(p.x), float(p.y),
+                                            float(p.z)))
 
     notes: list[str] = []
     try:
@@ -110,19 +106,24 @@ def read_mcap(
                         f"{message.log_time * 1e-9:.3f} s is not a {typ} ({exc})",
                     ) from None
                 if typ == _TF:
-                    for tf in msg.transforms:
-                        add(tf.child_frame_id.lstrip("/"), _stamp(tf.header),
-                            tf.transform.translation)
+                    for tf in cast(shape.TFMessage, msg).transforms:
+                        add(tf.child_frame_id.lstrip("/"), tf.header, tf.transform.translation)
                 elif typ == _POINT:
-                    add(channel.topic, _stamp(msg.header), msg.point)
+                    point = cast(shape.PointStamped, msg)
+                    add(channel.topic, point.header, point.point)
                 elif typ == _POSE:
-                    add(channel.topic, _stamp(msg.header), msg.pose.position)
+                    pose = cast(shape.PoseStamped, msg)
+                    add(channel.topic, pose.header, pose.pose.position)
                 elif typ == _TRANSFORM:
-                    add(channel.topic, _stamp(msg.header), msg.transform.translation)
+                    tfs = cast(shape.TransformStamped, msg)
+                    add(channel.topic, tfs.header, tfs.transform.translation)
                 elif typ == _GRIPPER:
-                    grip.append((_stamp(msg.header), 1.0 if msg.closed else 0.0))
-                elif 0.0 <= msg.share <= 1.0:  # LoadShare; NaN or out of range: unknown
-                    load.append((_stamp(msg.header), float(msg.share)))
+                    gripper = cast(shape.GripperState, msg)
+                    grip.append((shape.stamp(gripper.header), 1.0 if gripper.closed else 0.0))
+                else:
+                    share = cast(shape.LoadShare, msg)
+                    if 0.0 <= share.share <= 1.0:  # NaN or out of range: unknown
+                        load.append((shape.stamp(share.header), float(share.share)))
     except (RecordingError, FileNotFoundError):
         raise
     except Exception as exc:  # mcap, its decompressors (zstd, lz4), struct: a damaged file
@@ -134,13 +135,14 @@ def read_mcap(
     series, beyond, namer = bound_streams(path, series, limits)
     t, points = sample_streams(series, max_gap)
     topics = sorted(points)
-    defaults = tuple(_default(topics, s) for s in _DEFAULT_SUFFIX)
+    hand, receiver, face = (_default(topics, s) for s in _DEFAULT_SUFFIX)
+    defaults = (hand, receiver, face)
     extra = {"gripper_closed": hold_values(t, grip), "load_share": hold_values(t, load)}
     rec = build(
-        path, "mcap", t, points, names or PointNames(), "m", defaults,  # type: ignore[arg-type]
+        path, "mcap", t, points, names or PointNames(), "m", defaults,
         extra, tuple(notes), limits=limits, where=namer(t),
     )
-    rec.out_of_workspace += sum(beyond[n] for n in set(rec.names) - {None})
+    rec.out_of_workspace += sum(beyond[n] for n in {n for n in rec.names if n is not None})
     return rec
 
 
@@ -186,7 +188,7 @@ def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
                 ) from None
             notes.append(
                 f"the file is cut short ({exc!r}); read the {count} messages before the cut "
-                f"(up to log time {last * 1e-9:.3f} s)"
+                f"(up to log time {(last or 0) * 1e-9:.3f} s)"
             )
         return
     yield from reader.iter_messages()

@@ -8,7 +8,9 @@ own messages, missing outside them and across gaps longer than ``max_gap``).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import cast
 
+from gazebot.io.recordings import ros_shapes as shape
 from gazebot.io.recordings.base import (
     PointNames,
     Recording,
@@ -23,11 +25,6 @@ _POSE = ("geometry_msgs/msg/PoseStamped", "geometry_msgs/PoseStamped")
 _POINT = ("geometry_msgs/msg/PointStamped", "geometry_msgs/PointStamped")
 _TF = ("geometry_msgs/msg/TransformStamped", "geometry_msgs/TransformStamped")
 _TFMSG = ("tf2_msgs/msg/TFMessage", "tf2_msgs/TFMessage")
-
-
-def _stamp(header: object) -> float:
-    st = header.stamp  # type: ignore[attr-defined]
-    return float(st.sec) + 1e-9 * float(st.nanosec)
 
 
 def read_bag(
@@ -54,19 +51,23 @@ def read_bag(
             for conn, _, raw in reader.messages(connections=conns):
                 msg = reader.deserialize(raw, conn.msgtype)
                 if conn.msgtype in _TFMSG:
-                    for tf in msg.transforms:
+                    for tf in cast(shape.TFMessage, msg).transforms:
                         tr = tf.transform.translation
                         series.setdefault(tf.child_frame_id.lstrip("/"), []).append(
-                            (_stamp(tf.header), tr.x, tr.y, tr.z)
+                            (shape.stamp(tf.header), tr.x, tr.y, tr.z)
                         )
                     continue
+                p: shape.XYZ
                 if conn.msgtype in _POSE:
-                    p = msg.pose.position
+                    pose = cast(shape.PoseStamped, msg)
+                    header, p = pose.header, pose.pose.position
                 elif conn.msgtype in _POINT:
-                    p = msg.point
+                    point = cast(shape.PointStamped, msg)
+                    header, p = point.header, point.point
                 else:
-                    p = msg.transform.translation
-                series.setdefault(conn.topic, []).append((_stamp(msg.header), p.x, p.y, p.z))
+                    tfs = cast(shape.TransformStamped, msg)
+                    header, p = tfs.header, tfs.transform.translation
+                series.setdefault(conn.topic, []).append((shape.stamp(header), p.x, p.y, p.z))
     except RecordingError:
         raise
     except Exception as exc:  # rosbags raises its own error types for unreadable bags
@@ -87,5 +88,5 @@ def read_bag(
         limits=limits,
         where=namer(t),
     )
-    rec.out_of_workspace += sum(beyond[n] for n in set(rec.names) - {None})
+    rec.out_of_workspace += sum(beyond[n] for n in {n for n in rec.names if n is not None})
     return rec

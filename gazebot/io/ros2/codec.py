@@ -46,10 +46,6 @@ class Codec:
     def type_name(self) -> str:
         return self.info.name
 
-    def new(self, *args: object, **kwargs: object) -> object:
-        """A message of this type built from its fields (rosbags' dataclass)."""
-        return self.store.types[self.info.name](*args, **kwargs)
-
     def encode(self, msg: object) -> bytes:
         """CDR bytes (little-endian, with the encapsulation header) of ``msg``.
 

@@ -1,17 +1,19 @@
 """gazebot's values <-> ROS 2 messages: the one place that maps the two.
 
+The values are the core's (:class:`~gazebot.core.types.TrackingFrame`,
+:class:`~gazebot.core.types.GazeCommand`, :class:`~gazebot.core.types.Event`) and the few the
+bus adds (:mod:`gazebot.io.ros2.values`); the messages are rosbags' generated classes of ROS 2
+Jazzy (``rosbags.typesys.stores.ros2_jazzy``) and, for ``gazebot_msgs`` (built at run time from
+the package's ``.msg`` files), the Protocols below that name their fields.
+
 SI units both sides (m, s, rad); points in the robot base frame, whose ROS name
 (``RobotConfig.base_frame``) the caller passes as ``frame_id``. Times are the robot's clock
-(simulation time in the simulator) as ``builtin_interfaces/Time``.
+(simulation time in the simulator) as ``builtin_interfaces/Time``. Nothing non-finite goes on
+the wire and nothing non-finite comes off it: a NaN or infinite coordinate, joint value or time,
+in either direction, raises :class:`~gazebot.io.ros2.errors.MessageError` (which a transport
+counts and drops), as do arrays of inconsistent lengths and images that do not decode.
 
-Engine commands are read by attribute (``t``, ``phase`` and optionally ``phase_source``,
-``target_point``, ``head``, ``eye_yaw``, ``eye_pitch``, ``blink``, ``distance``, ``events``), so
-any command value with those attributes converts. Nothing non-finite goes on the wire and
-nothing non-finite comes off it: a NaN or infinite coordinate, joint value or time, in either
-direction, raises :class:`~gazebot.io.ros2.errors.MessageError` (which a transport counts and
-drops), as do arrays of inconsistent lengths and images that do not decode.
-
-Every function takes the type system as ``store`` (default: the shipped
+The ``gazebot_msgs`` builders take the type system as ``store`` (default: the shipped
 :func:`~gazebot.io.ros2.typestore.typestore`).
 """
 
@@ -19,32 +21,80 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
-from typing import Any, Literal, get_args
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from typing import Literal, Protocol, TypeVar, cast, get_args
 
 import numpy as np
+import numpy.typing as npt
 from rosbags.typesys.store import Typestore
+from rosbags.typesys.stores import ros2_jazzy as jazzy
 
-from gazebot.core.types import (
-    PHASE_STREAM_KINDS,
-    Event,
-    EventKind,
-    Phase,
-    PhaseSource,
-    TrackingFrame,
-)
+from gazebot.core.types import Event, GazeCommand, Phase, PhaseSource, TrackingFrame
 from gazebot.io.ros2.errors import MessageError
 from gazebot.io.ros2.typestore import typestore
+from gazebot.io.ros2.values import (
+    CATEGORIES,
+    LEVELS,
+    BusEvent,
+    EventCategory,
+    EyeState,
+    JointGoal,
+    JointState,
+    Json,
+    NodeStatus,
+    category_of,
+    plain,
+)
 
-POINT_STAMPED = "geometry_msgs/msg/PointStamped"
-POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
-TRANSFORM_STAMPED = "geometry_msgs/msg/TransformStamped"
-TF_MESSAGE = "tf2_msgs/msg/TFMessage"
-JOINT_STATE = "sensor_msgs/msg/JointState"
-JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
-DIAGNOSTIC_ARRAY = "diagnostic_msgs/msg/DiagnosticArray"
-COMPRESSED_IMAGE = "sensor_msgs/msg/CompressedImage"
+__all__ = [
+    "BODIES", "CATEGORIES", "COMPRESSED_IMAGE", "DIAGNOSTIC_ARRAY", "EYE_STATE", "GRIPPER_STATE",
+    "HANDOVER_EVENT", "HANDOVER_PHASE", "JOINT_STATE", "JOINT_TRAJECTORY", "LEVELS", "LOAD_SHARE",
+    "MAX_IMAGE_SIZE", "MAX_INFO_DEPTH", "POINT_STAMPED", "POSE_STAMPED", "STRING", "TF_MESSAGE",
+    "TRANSFORM_STAMPED", "CommandMessages", "EventCategory", "Header", "NodeHealth",
+    "PhaseState", "RosCompressedImage", "RosDiagnosticArray", "RosEyeState", "RosGripperState",
+    "RosHandoverEvent", "RosHandoverPhase", "RosJointState", "RosJointTrajectory", "RosLoadShare",
+    "RosPointStamped", "RosPoseStamped", "RosString", "RosTFMessage", "RosTransformStamped",
+    "Stamped", "Time", "category_of", "command_messages", "command_phase", "compressed_image",
+    "decode_image", "diagnostics", "encode_image", "event_msg", "event_of", "eye_state",
+    "eyes_of", "from_time", "gaze_target", "gripper_state", "handover_event", "handover_phase",
+    "header", "health_of", "image_of", "image_size", "info_text", "info_value", "joint_positions",
+    "joint_state", "joint_trajectory", "load_share", "phase_of", "point_of", "point_stamped",
+    "pose_stamped", "share_of", "stamp_of", "tf_points", "to_duration", "to_time",
+    "tracking_frame", "tracking_points", "tracking_tf", "trajectory_goal",
+]
+
+# ROS 2 Jazzy's generated message classes gazebot uses.
+Duration = jazzy.builtin_interfaces__msg__Duration
+Header = jazzy.std_msgs__msg__Header
+KeyValue = jazzy.diagnostic_msgs__msg__KeyValue
+Quaternion = jazzy.geometry_msgs__msg__Quaternion
+RosCompressedImage = jazzy.sensor_msgs__msg__CompressedImage
+RosDiagnosticArray = jazzy.diagnostic_msgs__msg__DiagnosticArray
+RosDiagnosticStatus = jazzy.diagnostic_msgs__msg__DiagnosticStatus
+RosJointState = jazzy.sensor_msgs__msg__JointState
+RosJointTrajectory = jazzy.trajectory_msgs__msg__JointTrajectory
+RosJointTrajectoryPoint = jazzy.trajectory_msgs__msg__JointTrajectoryPoint
+RosPoint = jazzy.geometry_msgs__msg__Point
+RosPointStamped = jazzy.geometry_msgs__msg__PointStamped
+RosPose = jazzy.geometry_msgs__msg__Pose
+RosPoseStamped = jazzy.geometry_msgs__msg__PoseStamped
+RosString = jazzy.std_msgs__msg__String
+RosTFMessage = jazzy.tf2_msgs__msg__TFMessage
+RosTransform = jazzy.geometry_msgs__msg__Transform
+RosTransformStamped = jazzy.geometry_msgs__msg__TransformStamped
+Time = jazzy.builtin_interfaces__msg__Time
+Vector3 = jazzy.geometry_msgs__msg__Vector3
+
+POINT_STAMPED = RosPointStamped.__msgtype__
+POSE_STAMPED = RosPoseStamped.__msgtype__
+TRANSFORM_STAMPED = RosTransformStamped.__msgtype__
+TF_MESSAGE = RosTFMessage.__msgtype__
+JOINT_STATE = RosJointState.__msgtype__
+JOINT_TRAJECTORY = RosJointTrajectory.__msgtype__
+DIAGNOSTIC_ARRAY = RosDiagnosticArray.__msgtype__
+COMPRESSED_IMAGE = RosCompressedImage.__msgtype__
+STRING = RosString.__msgtype__
 EYE_STATE = "gazebot_msgs/msg/EyeState"
 HANDOVER_PHASE = "gazebot_msgs/msg/HandoverPhase"
 HANDOVER_EVENT = "gazebot_msgs/msg/HandoverEvent"
@@ -54,55 +104,134 @@ LOAD_SHARE = "gazebot_msgs/msg/LoadShare"
 #: The tracked bodies of a :class:`~gazebot.core.types.TrackingFrame`, one topic (or TF frame) each.
 BODIES = ("giver_hand", "receiver_hand", "giver_face")
 
-
-EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]
-_CATEGORIES = ("phase", "robot", "behavior", "fault", "node")
-_SOURCES = get_args(PhaseSource)
+_SOURCES: tuple[str, ...] = get_args(PhaseSource)
 _INT32 = 2**31
-_TIME_TYPES = {"Time": "builtin_interfaces/msg/Time", "Duration": "builtin_interfaces/msg/Duration"}
+_IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 
-def _store(store: Typestore | None) -> Typestore:
-    return typestore() if store is None else store
+# -- the shapes of gazebot_msgs (their classes are generated from the .msg files at run time) ---
+
+
+class Stamped(Protocol):
+    """A message with a ``std_msgs/Header``."""
+
+    @property
+    def header(self) -> Header: ...
+
+
+class RosEyeState(Protocol):
+    """``gazebot_msgs/msg/EyeState``."""
+
+    __msgtype__: str
+    header: Header
+    yaw: float
+    pitch: float
+    blink: float
+    distance: float
+
+
+class RosHandoverPhase(Protocol):
+    """``gazebot_msgs/msg/HandoverPhase``."""
+
+    __msgtype__: str
+    header: Header
+    phase: str
+    source: str
+    phase_start: Time
+    expected_end: Time
+
+
+class RosHandoverEvent(Protocol):
+    """``gazebot_msgs/msg/HandoverEvent``."""
+
+    __msgtype__: str
+    header: Header
+    source: str
+    category: str
+    kind: str
+    t: Time
+    detected_at: Time
+    info: list[KeyValue]
+
+
+class RosGripperState(Protocol):
+    """``gazebot_msgs/msg/GripperState``."""
+
+    __msgtype__: str
+    header: Header
+    closed: bool
+
+
+class RosLoadShare(Protocol):
+    """``gazebot_msgs/msg/LoadShare``."""
+
+    __msgtype__: str
+    header: Header
+    share: float
+
+
+_M = TypeVar("_M")
+
+
+def _new(store: Typestore | None, type_name: str, **fields: object) -> object:
+    """A ``gazebot_msgs`` message of ``type_name`` (of the class ``store`` generated from its
+    .msg file; the caller names its Protocol)."""
+    cls: Callable[..., object] = (typestore() if store is None else store).types[type_name]
+    return cls(**fields)
 
 
 def _finite(type_name: str, what: str, *values: float) -> None:
-    for v in values:  # a plain loop: this runs for every field of every message
+    for v in values:
         if not math.isfinite(v):
             raise MessageError(type_name, f"{what} is not finite: {values}")
+
+
+def _value(type_name: str, build: Callable[[], _M]) -> _M:
+    """``build()``, a value that refuses its fields (:class:`ValueError`) made a
+    :class:`MessageError` of ``type_name``."""
+    try:
+        return build()
+    except ValueError as exc:
+        raise MessageError(type_name, str(exc)) from None
 
 
 # -- time ---------------------------------------------------------------------------------------
 
 
-def to_time(t: float, store: Typestore | None = None, kind: str = "Time") -> object:
-    """``builtin_interfaces/{kind}`` (``Time`` or ``Duration``) of ``t`` seconds, rounded to ns.
+def _sec_nanosec(type_name: str, t: float) -> tuple[int, int]:
+    if not math.isfinite(t):
+        raise MessageError(type_name, f"time is not finite: {t}")
+    sec, nanosec = divmod(round(t * 1e9), 1_000_000_000)
+    if not -_INT32 <= sec < _INT32:
+        raise MessageError(type_name, f"{t} s is outside int32 seconds")
+    return int(sec), int(nanosec)
+
+
+def to_time(t: float) -> Time:
+    """``builtin_interfaces/Time`` of ``t`` seconds, rounded to ns.
 
     Raises:
         MessageError: ``t`` is not finite or outside the int32 seconds ROS 2 time holds.
     """
-    type_name = _TIME_TYPES[kind]
-    if not math.isfinite(t):
-        raise MessageError(type_name, f"time is not finite: {t}")
-    ns = round(t * 1e9)
-    sec, nanosec = divmod(ns, 1_000_000_000)
-    if not -_INT32 <= sec < _INT32:
-        raise MessageError(type_name, f"{t} s is outside int32 seconds")
-    return _store(store).types[type_name](sec=int(sec), nanosec=int(nanosec))
+    return Time(*_sec_nanosec(Time.__msgtype__, t))
 
 
-def from_time(stamp: Any) -> float:
+def to_duration(t: float) -> Duration:
+    """``builtin_interfaces/Duration`` of ``t`` seconds (see :func:`to_time`)."""
+    return Duration(*_sec_nanosec(Duration.__msgtype__, t))
+
+
+def from_time(stamp: Time | Duration) -> float:
     """Seconds of a ``builtin_interfaces/Time`` or ``Duration``."""
     return float(stamp.sec) + 1e-9 * float(stamp.nanosec)
 
 
-def header(t: float, frame_id: str, store: Typestore | None = None) -> object:
+def header(t: float, frame_id: str) -> Header:
     """``std_msgs/Header`` stamped ``t`` (s) in ``frame_id``."""
-    s = _store(store)
-    return s.types["std_msgs/msg/Header"](stamp=to_time(t, s), frame_id=frame_id)
+    return Header(stamp=to_time(t), frame_id=frame_id)
 
 
-def stamp_of(msg: Any) -> float:
+def stamp_of(msg: Stamped) -> float:
     """The header stamp (s) of a stamped message."""
     return from_time(msg.header.stamp)
 
@@ -110,60 +239,53 @@ def stamp_of(msg: Any) -> float:
 # -- points, poses, TF --------------------------------------------------------------------------
 
 
-def _xyz(type_name: str, point: Any) -> tuple[float, float, float]:
+def _xyz(type_name: str, point: npt.ArrayLike) -> tuple[float, float, float]:
     arr = np.asarray(point, dtype=float).reshape(-1)
     if arr.shape != (3,):
         raise MessageError(type_name, f"expected a 3D point, got shape {arr.shape}")
-    x, y, z = arr.tolist()
+    x, y, z = (float(v) for v in arr)
     _finite(type_name, "point", x, y, z)
     return x, y, z
 
 
-def point_stamped(t: float, point: Any, frame_id: str, store: Typestore | None = None) -> object:
+def point_stamped(t: float, point: npt.ArrayLike, frame_id: str) -> RosPointStamped:
     """``geometry_msgs/PointStamped`` of ``point`` (m) at ``t`` (s) in ``frame_id``.
 
     Raises:
         MessageError: ``point`` is missing (NaN) or infinite: a missing sample is not sent.
     """
-    s = _store(store)
-    x, y, z = _xyz(POINT_STAMPED, point)
-    return s.types[POINT_STAMPED](
-        header=header(t, frame_id, s), point=s.types["geometry_msgs/msg/Point"](x=x, y=y, z=z)
-    )
+    return RosPointStamped(header(t, frame_id), RosPoint(*_xyz(POINT_STAMPED, point)))
 
 
-def pose_stamped(t: float, point: Any, frame_id: str, store: Typestore | None = None) -> object:
+def pose_stamped(t: float, point: npt.ArrayLike, frame_id: str) -> RosPoseStamped:
     """``geometry_msgs/PoseStamped`` at ``point`` (m) with identity orientation (gazebot tracks
     positions only)."""
-    s = _store(store)
-    x, y, z = _xyz(POSE_STAMPED, point)
-    pose = s.types["geometry_msgs/msg/Pose"](
-        position=s.types["geometry_msgs/msg/Point"](x=x, y=y, z=z),
-        orientation=s.types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
-    )
-    return s.types[POSE_STAMPED](header=header(t, frame_id, s), pose=pose)
+    pose = RosPose(RosPoint(*_xyz(POSE_STAMPED, point)), Quaternion(*_IDENTITY))
+    return RosPoseStamped(header(t, frame_id), pose)
 
 
-def point_of(msg: Any) -> tuple[float, np.ndarray]:
+def point_of(
+    msg: RosPointStamped | RosPoseStamped | RosTransformStamped,
+) -> tuple[float, np.ndarray]:
     """``(t, point)`` of a ``PointStamped``, ``PoseStamped`` or ``TransformStamped`` (its
     position; orientation is ignored).
 
     Raises:
         MessageError: Another type, or a non-finite coordinate or stamp.
     """
-    type_name = getattr(msg, "__msgtype__", type(msg).__name__)
-    if type_name == POINT_STAMPED:
+    p: RosPoint | Vector3
+    if isinstance(msg, RosPointStamped):
         p = msg.point
-    elif type_name == POSE_STAMPED:
+    elif isinstance(msg, RosPoseStamped):
         p = msg.pose.position
-    elif type_name == TRANSFORM_STAMPED:
+    elif isinstance(msg, RosTransformStamped):
         p = msg.transform.translation
     else:
-        raise MessageError(type_name, "not a PointStamped, PoseStamped or TransformStamped")
-    t = stamp_of(msg)
+        got = getattr(msg, "__msgtype__", type(msg).__name__)
+        raise MessageError(got, "not a PointStamped, PoseStamped or TransformStamped")
     xyz = (float(p.x), float(p.y), float(p.z))
-    _finite(type_name, "point", *xyz)
-    return t, np.array(xyz)
+    _finite(msg.__msgtype__, "point", *xyz)
+    return stamp_of(msg), np.array(xyz)
 
 
 def tracking_points(frame: TrackingFrame) -> dict[str, np.ndarray]:
@@ -178,7 +300,7 @@ def tracking_points(frame: TrackingFrame) -> dict[str, np.ndarray]:
 
 def tracking_frame(
     t: float,
-    points: Mapping[str, Any],
+    points: Mapping[str, npt.ArrayLike | None],
     gripper_closed: bool | None = None,
     load_share: float | None = None,
 ) -> TrackingFrame:
@@ -187,7 +309,8 @@ def tracking_frame(
     if unknown:
         raise ValueError(f"unknown tracked bodies {sorted(unknown)}; expected {BODIES}")
     return TrackingFrame.make(
-        t, **{b: points.get(b) for b in BODIES}, gripper_closed=gripper_closed,
+        t, giver_hand=points.get("giver_hand"), receiver_hand=points.get("receiver_hand"),
+        giver_face=points.get("giver_face"), gripper_closed=gripper_closed,
         load_share=load_share,
     )
 
@@ -196,41 +319,34 @@ def tracking_tf(
     frame: TrackingFrame,
     parent_frame: str,
     child_frames: Mapping[str, str] | None = None,
-    store: Typestore | None = None,
-) -> object:
+) -> RosTFMessage:
     """``tf2_msgs/TFMessage`` with one transform per tracked body of ``frame`` (identity
     rotation), child frame names ``child_frames[body]`` (default: the body name)."""
-    s = _store(store)
     names = child_frames or {}
-    transforms = []
-    for body, p in tracking_points(frame).items():
-        x, y, z = p.tolist()
-        transforms.append(
-            s.types[TRANSFORM_STAMPED](
-                header=header(frame.t, parent_frame, s),
-                child_frame_id=names.get(body, body),
-                transform=s.types["geometry_msgs/msg/Transform"](
-                    translation=s.types["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
-                    rotation=s.types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
-                ),
-            )
+    transforms = [
+        RosTransformStamped(
+            header(frame.t, parent_frame), names.get(body, body),
+            RosTransform(Vector3(*(float(v) for v in p)), Quaternion(*_IDENTITY)),
         )
-    return s.types[TF_MESSAGE](transforms=transforms)
+        for body, p in tracking_points(frame).items()
+    ]
+    return RosTFMessage(transforms=transforms)
 
 
-def tf_points(msg: Any) -> dict[str, tuple[float, np.ndarray]]:
+def tf_points(msg: RosTFMessage) -> dict[str, tuple[float, np.ndarray]]:
     """``child_frame_id`` (leading ``/`` dropped) -> ``(t, translation)`` of a ``TFMessage``.
 
     Raises:
         MessageError: A transform with a non-finite translation or stamp.
     """
-    out = {}
-    for tf in msg.transforms:
-        out[str(tf.child_frame_id).lstrip("/")] = point_of(tf)
-    return out
+    return {str(tf.child_frame_id).lstrip("/"): point_of(tf) for tf in msg.transforms}
 
 
 # -- joints -------------------------------------------------------------------------------------
+
+
+def _floats(values: Iterable[float]) -> np.ndarray:
+    return np.array([float(v) for v in values], dtype=np.float64)
 
 
 def joint_state(
@@ -238,84 +354,69 @@ def joint_state(
     positions: Mapping[str, float],
     velocities: Mapping[str, float] | None = None,
     frame_id: str = "",
-    store: Typestore | None = None,
-) -> object:
+) -> RosJointState:
     """``sensor_msgs/JointState`` of joint positions (rad or m) by name, with velocities for the
     same joints when given (else none, as ROS allows)."""
-    s = _store(store)
     names = list(positions)
-    pos = np.array([float(positions[n]) for n in names], dtype=np.float64)
+    pos = _floats(positions[n] for n in names)
     _finite(JOINT_STATE, "position", *pos.tolist())
     vel = np.zeros(0)
     if velocities is not None:
-        vel = np.array([float(velocities[n]) for n in names], dtype=np.float64)
+        vel = _floats(velocities[n] for n in names)
         _finite(JOINT_STATE, "velocity", *vel.tolist())
-    return s.types[JOINT_STATE](
-        header=header(t, frame_id, s), name=names, position=pos, velocity=vel,
-        effort=np.zeros(0),
-    )
+    return RosJointState(header(t, frame_id), names, pos, vel, np.zeros(0))
 
 
-def joint_positions(msg: Any) -> tuple[float, dict[str, float]]:
-    """``(t, {joint: position})`` of a ``sensor_msgs/JointState``.
+def joint_positions(msg: RosJointState) -> JointState:
+    """The :class:`~gazebot.io.ros2.values.JointState` of a ``sensor_msgs/JointState``.
 
     Raises:
         MessageError: ``name`` and ``position`` differ in length, or a position is not finite.
     """
-    names = list(msg.name)
+    names = [str(n) for n in msg.name]
     pos = np.asarray(msg.position, dtype=float)
     if pos.shape != (len(names),):
         raise MessageError(
             JOINT_STATE, f"{len(names)} names but {pos.size} positions (need one per name)"
         )
     _finite(JOINT_STATE, "position", *pos.tolist())
-    return stamp_of(msg), dict(zip(names, pos.tolist(), strict=True))
+    return JointState(stamp_of(msg), dict(zip(names, pos.tolist(), strict=True)))
 
 
-# -- engine commands ----------------------------------------------------------------------------
+# -- joint goals --------------------------------------------------------------------------------
 
 
-def head_trajectory(
-    cmd: Any,
-    time_from_start: float,
-    velocities: Mapping[str, float] | None = None,
-    stamped: bool = False,
-    store: Typestore | None = None,
-) -> object:
+def joint_trajectory(goal: JointGoal, stamped: bool = False) -> RosJointTrajectory:
     """``trajectory_msgs/JointTrajectory`` with one point, as ros2_control's
-    joint_trajectory_controller takes a streamed goal: ``cmd.head`` positions (rad) in the
-    command's joint order, ``velocities`` at the goal (default 0: arrive at rest) and
-    ``time_from_start`` (s) to get there.
+    joint_trajectory_controller takes a streamed goal: ``goal.positions`` in the goal's joint
+    order, ``goal.velocities`` at the goal (absent: 0, arrive at rest) and
+    ``goal.time_from_start`` (s) to get there.
 
     ``stamped=False`` leaves ``header.stamp`` zero, which the controller reads as "start on
     receipt" (a command stamped on the robot's clock would start in the past after any
-    latency); ``True`` stamps it with ``cmd.t``.
+    latency); ``True`` stamps it with ``goal.t``.
 
     Raises:
-        MessageError: A non-finite position, velocity or time, or no head joint.
+        MessageError: No joint, or a ``time_from_start`` that is not > 0.
     """
-    s = _store(store)
-    head: Mapping[str, float] = cmd.head
-    names = list(head)
+    names = list(goal.positions)
     if not names:
-        raise MessageError(JOINT_TRAJECTORY, "the command has no head joint")
-    pos = np.array([float(head[n]) for n in names], dtype=np.float64)
-    vel = np.array([float((velocities or {}).get(n, 0.0)) for n in names], dtype=np.float64)
-    _finite(JOINT_TRAJECTORY, "head position", *pos.tolist())
-    _finite(JOINT_TRAJECTORY, "head velocity", *vel.tolist())
-    if not time_from_start > 0.0:
-        raise MessageError(JOINT_TRAJECTORY, f"time_from_start must be > 0, got {time_from_start}")
-    point = s.types["trajectory_msgs/msg/JointTrajectoryPoint"](
-        positions=pos, velocities=vel, accelerations=np.zeros(0), effort=np.zeros(0),
-        time_from_start=to_time(time_from_start, s, "Duration"),
+        raise MessageError(JOINT_TRAJECTORY, "the goal has no joint")
+    if not goal.time_from_start > 0.0:
+        raise MessageError(JOINT_TRAJECTORY,
+                           f"time_from_start must be > 0, got {goal.time_from_start}")
+    point = RosJointTrajectoryPoint(
+        positions=_floats(goal.positions[n] for n in names),
+        velocities=_floats(goal.velocities.get(n, 0.0) for n in names),
+        accelerations=np.zeros(0), effort=np.zeros(0),
+        time_from_start=to_duration(goal.time_from_start),
     )
-    return s.types[JOINT_TRAJECTORY](
-        header=header(float(cmd.t) if stamped else 0.0, "", s), joint_names=names, points=[point]
-    )
+    return RosJointTrajectory(header(goal.t if stamped else 0.0, ""), names, [point])
 
 
-def trajectory_goal(msg: Any) -> tuple[dict[str, float], float]:
-    """``({joint: position}, time_from_start)`` of a trajectory's last point.
+def trajectory_goal(msg: RosJointTrajectory) -> JointGoal:
+    """The :class:`~gazebot.io.ros2.values.JointGoal` of a trajectory's last point (``t``: the
+    header stamp; velocities only when there is one per joint).
 
     Raises:
         MessageError: No point, lengths that differ from ``joint_names``, non-finite values.
@@ -323,85 +424,57 @@ def trajectory_goal(msg: Any) -> tuple[dict[str, float], float]:
     if not msg.points:
         raise MessageError(JOINT_TRAJECTORY, "no trajectory point")
     last = msg.points[-1]
-    names = list(msg.joint_names)
+    names = [str(n) for n in msg.joint_names]
     pos = np.asarray(last.positions, dtype=float)
     if pos.shape != (len(names),):
         raise MessageError(
             JOINT_TRAJECTORY, f"{len(names)} joint_names but {pos.size} positions"
         )
     _finite(JOINT_TRAJECTORY, "position", *pos.tolist())
-    return dict(zip(names, pos.tolist(), strict=True)), from_time(last.time_from_start)
+    vel = np.asarray(last.velocities, dtype=float)
+    velocities = dict(zip(names, vel.tolist(), strict=True)) if vel.shape == pos.shape else {}
+    return _value(JOINT_TRAJECTORY, lambda: JointGoal(
+        stamp_of(msg), dict(zip(names, pos.tolist(), strict=True)), velocities,
+        from_time(last.time_from_start)))
 
 
-def gaze_target(cmd: Any, frame_id: str, store: Typestore | None = None) -> object:
+# -- engine commands ----------------------------------------------------------------------------
+
+
+def gaze_target(cmd: GazeCommand, frame_id: str) -> RosPointStamped:
     """``geometry_msgs/PointStamped``: the point ``cmd`` looks at, at ``cmd.t``, in the robot
     base frame ``frame_id``. :class:`MessageError` when the target point is unknown (NaN)."""
-    return point_stamped(float(cmd.t), cmd.target_point, frame_id, store)
+    return point_stamped(float(cmd.t), cmd.target_point, frame_id)
 
 
-def eye_state(cmd: Any, frame_id: str, store: Typestore | None = None) -> object:
-    """``gazebot_msgs/EyeState`` of ``cmd`` (``eye_yaw``, ``eye_pitch``, ``blink``,
-    ``distance``; an unknown distance is NaN on the wire) in the head's gaze frame
-    ``frame_id``."""
-    s = _store(store)
-    yaw, pitch = float(cmd.eye_yaw), float(cmd.eye_pitch)
-    blink = float(getattr(cmd, "blink", 0.0))
-    _finite(EYE_STATE, "yaw/pitch/blink", yaw, pitch, blink)
-    if not 0.0 <= blink <= 1.0:
-        raise MessageError(EYE_STATE, f"blink must be within 0..1, got {blink}")
-    distance = getattr(cmd, "distance", None)
-    d = math.nan if distance is None else float(distance)
-    if not (math.isnan(d) or (math.isfinite(d) and d > 0.0)):
-        raise MessageError(EYE_STATE, f"distance must be > 0 m or unknown, got {distance}")
-    return s.types[EYE_STATE](
-        header=header(float(cmd.t), frame_id, s), yaw=yaw, pitch=pitch, blink=blink, distance=d
-    )
+def eye_state(eyes: EyeState, frame_id: str, store: Typestore | None = None) -> RosEyeState:
+    """``gazebot_msgs/EyeState`` of ``eyes`` (an unknown distance is NaN on the wire) in the
+    head's gaze frame ``frame_id``."""
+    d = math.nan if eyes.distance is None else eyes.distance
+    msg = _new(store, EYE_STATE, header=header(eyes.t, frame_id), yaw=eyes.yaw,
+               pitch=eyes.pitch, blink=eyes.blink, distance=d)
+    return cast(RosEyeState, msg)
 
 
-@dataclass(frozen=True)
-class Eyes:
-    """What an ``EyeState`` says: ``t`` (s), ``yaw`` / ``pitch`` (rad), ``blink`` (0..1) and
-    ``distance`` (m; ``None`` when unknown)."""
-
-    t: float
-    yaw: float
-    pitch: float
-    blink: float
-    distance: float | None
-
-
-def eyes_of(msg: Any) -> Eyes:
-    """The :class:`Eyes` of an ``EyeState``.
+def eyes_of(msg: RosEyeState) -> EyeState:
+    """The :class:`~gazebot.io.ros2.values.EyeState` of an ``EyeState`` message.
 
     Raises:
         MessageError: Non-finite angles, a blink outside 0..1, a distance that is not > 0 (NaN
             is unknown).
     """
-    yaw, pitch, blink, d = float(msg.yaw), float(msg.pitch), float(msg.blink), float(msg.distance)
-    _finite(EYE_STATE, "yaw/pitch/blink", yaw, pitch, blink)
-    if not 0.0 <= blink <= 1.0:
-        raise MessageError(EYE_STATE, f"blink must be within 0..1, got {blink}")
-    if not (math.isnan(d) or (math.isfinite(d) and d > 0.0)):
-        raise MessageError(EYE_STATE, f"distance must be > 0 m or NaN (unknown), got {d}")
-    return Eyes(stamp_of(msg), yaw, pitch, blink, None if math.isnan(d) else d)
+    d = float(msg.distance)
+    return _value(EYE_STATE, lambda: EyeState(
+        stamp_of(msg), float(msg.yaw), float(msg.pitch), float(msg.blink),
+        None if math.isnan(d) else d))
 
 
 # -- phase --------------------------------------------------------------------------------------
 
 
-def phase_parts(phase: Any, source: str | None = None) -> tuple[Phase, str]:
-    """The :class:`Phase` and its source (``tracking``, ``robot``, ``gripper``): ``phase`` is a
-    plain :class:`Phase` or a value with ``phase`` and ``source`` attributes; ``source``, when
-    given, says where it came from (default ``tracking``)."""
-    src = source or getattr(phase, "source", None) or "tracking"
-    base = getattr(phase, "phase", phase)
-    return Phase(getattr(base, "value", base)), str(getattr(src, "value", src))
-
-
-def command_phase(cmd: Any) -> tuple[Phase, str]:
-    """The phase of an engine command and what decided it (``cmd.phase_source`` when the
-    command carries one)."""
-    return phase_parts(cmd.phase, getattr(cmd, "phase_source", None))
+def command_phase(cmd: GazeCommand) -> tuple[Phase, PhaseSource]:
+    """The phase of an engine command and what decided it."""
+    return cmd.phase, cmd.phase_source
 
 
 @dataclass(frozen=True)
@@ -417,27 +490,24 @@ class PhaseState:
 
 def handover_phase(
     t: float,
-    phase: Any,
+    phase: Phase,
     phase_start: float,
     expected_end: float = math.nan,
-    source: str | None = None,
+    source: str = "tracking",
     store: Typestore | None = None,
-) -> object:
-    """``gazebot_msgs/HandoverPhase`` at ``t``: ``phase`` from ``source`` (see
-    :func:`phase_parts`) started at ``phase_start``, predicted to end at ``expected_end`` (NaN:
-    unknown, zero on the wire)."""
-    s = _store(store)
-    value, source = phase_parts(phase, source)
+) -> RosHandoverPhase:
+    """``gazebot_msgs/HandoverPhase`` at ``t``: ``phase`` as decided by ``source``
+    (``tracking``, ``robot``, ``gripper``), started at ``phase_start``, predicted to end at
+    ``expected_end`` (NaN: unknown, zero on the wire)."""
     if source not in _SOURCES:
         raise MessageError(HANDOVER_PHASE, f"source must be one of {_SOURCES}, got {source!r}")
-    end = to_time(expected_end, s) if math.isfinite(expected_end) else to_time(0.0, s)
-    return s.types[HANDOVER_PHASE](
-        header=header(t, "", s), phase=value.value, source=source,
-        phase_start=to_time(phase_start, s), expected_end=end,
-    )
+    end = to_time(expected_end if math.isfinite(expected_end) else 0.0)
+    msg = _new(store, HANDOVER_PHASE, header=header(t, ""), phase=Phase(phase).value,
+               source=source, phase_start=to_time(phase_start), expected_end=end)
+    return cast(RosHandoverPhase, msg)
 
 
-def phase_of(msg: Any) -> PhaseState:
+def phase_of(msg: RosHandoverPhase) -> PhaseState:
     """The :class:`PhaseState` of a ``HandoverPhase``; :class:`MessageError` for an unknown
     phase or source."""
     try:
@@ -446,51 +516,20 @@ def phase_of(msg: Any) -> PhaseState:
         raise MessageError(HANDOVER_PHASE, f"unknown phase {msg.phase!r}") from None
     if msg.source not in _SOURCES:
         raise MessageError(HANDOVER_PHASE, f"unknown source {msg.source!r}")
-    end = from_time(msg.expected_end)
+    end = msg.expected_end
     return PhaseState(
         stamp_of(msg), phase, str(msg.source), from_time(msg.phase_start),
-        math.nan if msg.expected_end.sec == 0 and msg.expected_end.nanosec == 0 else end,
+        math.nan if end.sec == 0 and end.nanosec == 0 else from_time(end),
     )
 
 
 # -- events -------------------------------------------------------------------------------------
 
 
-def category_of(kind: str) -> EventCategory:
-    """``phase`` or ``robot`` for :class:`~gazebot.core.types.EventKind` values; ``fault`` for the
-    engine's ``fault`` and any other kind."""
-    try:
-        ek = EventKind(kind)
-    except ValueError:
-        return "fault"
-    if ek is EventKind.FAULT:
-        return "fault"
-    return "phase" if ek in PHASE_STREAM_KINDS else "robot"
-
-
-def _plain(value: Any) -> Any:
-    """``value`` with numpy scalars/arrays and str enums made plain JSON types."""
-    if isinstance(value, Mapping):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    if hasattr(value, "value") and isinstance(value.value, str):
-        return value.value
-    return value if value is None or isinstance(value, str) else str(value)
-
-
-def info_text(value: Any) -> str:
+def info_text(value: object) -> str:
     """A ``KeyValue.value``: strings as they are, anything else as JSON (NaN as null)."""
-    plain = _plain(value)
-    return plain if isinstance(plain, str) else json.dumps(plain, allow_nan=False)
+    data = plain(value)
+    return data if isinstance(data, str) else json.dumps(data, allow_nan=False)
 
 
 #: Deepest nesting of lists/objects an info value may have (gazebot's own are at most 2 deep;
@@ -498,7 +537,7 @@ def info_text(value: Any) -> str:
 MAX_INFO_DEPTH = 16
 
 
-def _depth(value: Any) -> int:
+def _depth(value: Json) -> int:
     """Nesting depth of parsed JSON (0 for a scalar), without recursion."""
     deepest, stack = 0, [(value, 0)]
     while stack:
@@ -509,7 +548,7 @@ def _depth(value: Any) -> int:
     return deepest
 
 
-def info_value(text: str, type_name: str = HANDOVER_EVENT) -> Any:
+def info_value(text: str, type_name: str = HANDOVER_EVENT) -> Json:
     """Inverse of :func:`info_text`: JSON numbers, booleans, null, lists and objects are
     parsed; any other text is a string.
 
@@ -518,7 +557,7 @@ def info_value(text: str, type_name: str = HANDOVER_EVENT) -> Any:
             message it came in).
     """
     try:
-        value = json.loads(text)
+        value: Json = json.loads(text)
     except RecursionError:
         raise MessageError(type_name, f"info value nested deeper than {MAX_INFO_DEPTH}") from None
     except ValueError:
@@ -530,100 +569,59 @@ def info_value(text: str, type_name: str = HANDOVER_EVENT) -> Any:
     return value
 
 
-def handover_event(
-    source: str,
-    category: str,
-    kind: str,
-    t: float,
-    detected_at: float,
-    stamp: float,
-    info: Mapping[str, Any] | None = None,
-    store: Typestore | None = None,
-) -> object:
-    """``gazebot_msgs/HandoverEvent`` (see the .msg for the fields; ``stamp`` is the header's).
-
-    Raises:
-        MessageError: An unknown category, an empty kind, a non-finite time.
-    """
-    s = _store(store)
-    if category not in _CATEGORIES:
-        raise MessageError(HANDOVER_EVENT, f"category must be one of {_CATEGORIES}")
-    if not kind:
-        raise MessageError(HANDOVER_EVENT, "empty kind")
-    kv = s.types["diagnostic_msgs/msg/KeyValue"]
-    return s.types[HANDOVER_EVENT](
-        header=header(stamp, "", s), source=source, category=category, kind=kind,
-        t=to_time(t, s), detected_at=to_time(detected_at, s),
-        info=[kv(key=str(k), value=info_text(v)) for k, v in (info or {}).items()],
+def handover_event(event: BusEvent, store: Typestore | None = None) -> RosHandoverEvent:
+    """``gazebot_msgs/HandoverEvent`` of a bus event (``stamp`` is the header's)."""
+    msg = _new(
+        store, HANDOVER_EVENT, header=header(event.stamp, ""), source=event.source,
+        category=event.category, kind=event.kind, t=to_time(event.t),
+        detected_at=to_time(event.detected_at),
+        info=[KeyValue(key=str(k), value=info_text(v)) for k, v in event.info.items()],
     )
+    return cast(RosHandoverEvent, msg)
 
 
 def event_msg(
     event: Event, source: str, stamp: float, store: Typestore | None = None
-) -> object:
-    """The ``HandoverEvent`` of a phase or robot :class:`~gazebot.core.types.Event`."""
-    kind = event.kind.value
-    return handover_event(
-        source, category_of(kind), kind, float(event.t), float(event.detected_at), stamp,
-        event.info, store,
-    )
+) -> RosHandoverEvent:
+    """The ``HandoverEvent`` of a core :class:`~gazebot.core.types.Event` published by
+    ``source``."""
+    return handover_event(BusEvent.of(event, source, stamp), store)
 
 
-@dataclass(frozen=True)
-class HandoverEventValue:
-    """Every field of a ``HandoverEvent`` (times in s; ``info`` values parsed back)."""
-
-    source: str
-    category: str
-    kind: str
-    t: float
-    detected_at: float
-    stamp: float
-    info: dict[str, Any] = field(default_factory=dict)
-
-    def to_event(self) -> Event | None:
-        """The :class:`~gazebot.core.types.Event` for phase and robot kinds, ``None`` otherwise."""
-        try:
-            kind = EventKind(self.kind)
-        except ValueError:
-            return None
-        return Event(kind=kind, t=self.t, detected_at=self.detected_at, info=dict(self.info))
-
-
-def event_of(msg: Any) -> HandoverEventValue:
-    """The fields of a ``HandoverEvent``; :class:`MessageError` for an unknown category or a
-    repeated info key."""
-    if msg.category not in _CATEGORIES:
-        raise MessageError(HANDOVER_EVENT, f"unknown category {msg.category!r}")
-    keys = [kv.key for kv in msg.info]
+def event_of(msg: RosHandoverEvent, seq: int = 0) -> BusEvent:
+    """The :class:`~gazebot.io.ros2.values.BusEvent` of a ``HandoverEvent`` (``seq``: the
+    publisher's sequence number); :class:`MessageError` for an unknown category, a repeated
+    info key or fields gazebot cannot use (an empty or overlong source or kind)."""
+    category = str(msg.category)
+    if category not in CATEGORIES:
+        raise MessageError(HANDOVER_EVENT, f"unknown category {category!r}")
+    keys = [str(kv.key) for kv in msg.info]
     if len(set(keys)) != len(keys):
         raise MessageError(HANDOVER_EVENT, f"repeated info keys {keys}")
-    return HandoverEventValue(
-        source=str(msg.source), category=str(msg.category), kind=str(msg.kind),
-        t=from_time(msg.t), detected_at=from_time(msg.detected_at), stamp=stamp_of(msg),
-        info={kv.key: info_value(kv.value) for kv in msg.info},
-    )
+    info = {str(kv.key): info_value(kv.value) for kv in msg.info}
+    return _value(HANDOVER_EVENT, lambda: BusEvent(
+        str(msg.source), cast(EventCategory, category), str(msg.kind), from_time(msg.t),
+        from_time(msg.detected_at), stamp_of(msg), info, max(0, seq)))
 
 
 # -- gripper and load share ---------------------------------------------------------------------
 
 
-def gripper_state(t: float, closed: bool, store: Typestore | None = None) -> object:
+def gripper_state(t: float, closed: bool, store: Typestore | None = None) -> RosGripperState:
     """``gazebot_msgs/GripperState`` at ``t``."""
-    s = _store(store)
-    return s.types[GRIPPER_STATE](header=header(t, "", s), closed=bool(closed))
+    msg = _new(store, GRIPPER_STATE, header=header(t, ""), closed=bool(closed))
+    return cast(RosGripperState, msg)
 
 
-def load_share(t: float, share: float, store: Typestore | None = None) -> object:
+def load_share(t: float, share: float, store: Typestore | None = None) -> RosLoadShare:
     """``gazebot_msgs/LoadShare`` at ``t``; :class:`MessageError` outside 0..1."""
     share = float(share)
     if not 0.0 <= share <= 1.0:
         raise MessageError(LOAD_SHARE, f"share must be within 0..1, got {share}")
-    s = _store(store)
-    return s.types[LOAD_SHARE](header=header(t, "", s), share=share)
+    return cast(RosLoadShare, _new(store, LOAD_SHARE, header=header(t, ""), share=share))
 
 
-def share_of(msg: Any) -> tuple[float, float]:
+def share_of(msg: RosLoadShare) -> tuple[float, float]:
     """``(t, share)`` of a ``LoadShare``; :class:`MessageError` outside 0..1 (or NaN)."""
     share = float(msg.share)
     if not 0.0 <= share <= 1.0:
@@ -633,59 +631,47 @@ def share_of(msg: Any) -> tuple[float, float]:
 
 # -- health -------------------------------------------------------------------------------------
 
-#: ``DiagnosticStatus.level`` of a node's state (``stopping`` is a normal shutdown: OK).
-LEVELS = {"ok": 0, "degraded": 1, "error": 2, "stopping": 0}
 
-
-def diagnostics(status: Any, t: float, store: Typestore | None = None) -> object:
-    """``diagnostic_msgs/DiagnosticArray`` with one ``DiagnosticStatus`` for a node.
-
-    ``status`` is read by attribute: ``node``, ``state`` (``ok``, ``degraded``, ``error``,
-    ``stopping``: the level), and optionally ``tracking``, ``phase``, ``uptime`` (s),
-    ``peers`` (node -> alive), ``dropped`` (topic -> count) and ``info``; they become the
-    status' key/values (``peer/<node>``: ``alive``/``lost``, ``dropped/<topic>``: count).
-    The status is named ``gazebot: <node>``.
-    """
-    s = _store(store)
-    state = str(status.state)
-    if state not in LEVELS:
-        raise MessageError(DIAGNOSTIC_ARRAY, f"state must be one of {tuple(LEVELS)}")
-    values: list[tuple[str, Any]] = []
-    for key in ("tracking", "phase", "uptime"):
-        value = getattr(status, key, None)
-        if value is not None:
-            values.append((key, value))
-    values += [(f"peer/{n}", "alive" if up else "lost")
-               for n, up in (getattr(status, "peers", None) or {}).items()]
-    values += [(f"dropped/{k}", n) for k, n in (getattr(status, "dropped", None) or {}).items()]
-    values += list((getattr(status, "info", None) or {}).items())
-    kv = s.types["diagnostic_msgs/msg/KeyValue"]
-    st = s.types["diagnostic_msgs/msg/DiagnosticStatus"](
-        level=LEVELS[state], name=f"gazebot: {status.node}", message=state, hardware_id="",
-        values=[kv(key=str(k), value=info_text(v)) for k, v in values],
+def diagnostics(status: NodeStatus, t: float) -> RosDiagnosticArray:
+    """``diagnostic_msgs/DiagnosticArray`` with one ``DiagnosticStatus`` for a node, named
+    ``gazebot: <node>``, level by ``status.state``; its key/values are ``tracking``, ``phase``
+    and ``uptime`` (when known), ``peer/<node>`` (``alive``/``lost``), ``dropped/<topic>``
+    (count) and the status' ``info``."""
+    values: list[tuple[str, object]] = [("tracking", status.tracking)]
+    if status.phase is not None:
+        values.append(("phase", status.phase))
+    values.append(("uptime", status.uptime))
+    values += [(f"peer/{n}", "alive" if up else "lost") for n, up in status.peers.items()]
+    values += [(f"dropped/{k}", n) for k, n in status.dropped.items()]
+    values += list(status.info.items())
+    st = RosDiagnosticStatus(
+        level=LEVELS[status.state], name=f"gazebot: {status.node}", message=status.state,
+        hardware_id="", values=[KeyValue(key=str(k), value=info_text(v)) for k, v in values],
     )
-    return s.types[DIAGNOSTIC_ARRAY](header=header(t, "", s), status=[st])
+    return RosDiagnosticArray(header(t, ""), [st])
 
 
 @dataclass(frozen=True)
 class NodeHealth:
-    """One ``DiagnosticStatus`` of a gazebot node: ``node``, ``level`` (0 OK, 1 WARN, 2 ERROR,
-    3 STALE), ``state`` (its message) and ``values`` parsed by :func:`info_value`."""
+    """One ``DiagnosticStatus`` of a gazebot node as read off the bus: ``node``, ``level`` (0
+    OK, 1 WARN, 2 ERROR, 3 STALE), ``state`` (its message) and ``values`` parsed by
+    :func:`info_value`."""
 
     node: str
     level: int
     state: str
-    values: dict[str, Any]
+    values: dict[str, Json]
 
 
-def health_of(msg: Any) -> list[NodeHealth]:
+def health_of(msg: RosDiagnosticArray) -> list[NodeHealth]:
     """The gazebot nodes' statuses in a ``DiagnosticArray`` (other statuses are skipped)."""
     out = []
     for st in msg.status:
-        if str(st.name).startswith("gazebot: "):
+        name = str(st.name)
+        if name.startswith("gazebot: "):
             out.append(NodeHealth(
-                str(st.name)[len("gazebot: "):], int(st.level), str(st.message),
-                {kv.key: info_value(kv.value, DIAGNOSTIC_ARRAY) for kv in st.values},
+                name[len("gazebot: "):], int(st.level), str(st.message),
+                {str(kv.key): info_value(kv.value, DIAGNOSTIC_ARRAY) for kv in st.values},
             ))
     return out
 
@@ -740,7 +726,7 @@ def image_size(data: bytes) -> tuple[str, int, int]:
 
 
 def encode_image(img: np.ndarray, fmt: Literal["jpeg", "png"] = "jpeg") -> bytes:
-    """JPEG (default: several times faster to encode than PNG at display sizes) or PNG
+    """JPEG (default; smaller at display sizes) or PNG
     (lossless) bytes of an (H, W, 3) uint8 RGB image.
 
     Raises:
@@ -782,22 +768,17 @@ def decode_image(
 
 
 def compressed_image(
-    img: np.ndarray,
-    t: float,
-    frame_id: str,
-    fmt: Literal["jpeg", "png"] = "jpeg",
-    store: Typestore | None = None,
-) -> object:
+    img: np.ndarray, t: float, frame_id: str, fmt: Literal["jpeg", "png"] = "jpeg"
+) -> RosCompressedImage:
     """``sensor_msgs/CompressedImage`` of an (H, W, 3) uint8 RGB image (see
     :func:`encode_image`)."""
-    buf = encode_image(img, fmt)
-    s = _store(store)
-    return s.types[COMPRESSED_IMAGE](
-        header=header(t, frame_id, s), format=fmt, data=np.frombuffer(buf, np.uint8)
-    )
+    data = np.frombuffer(encode_image(img, fmt), np.uint8)
+    return RosCompressedImage(header(t, frame_id), fmt, data)
 
 
-def image_of(msg: Any, max_size: tuple[int, int] = MAX_IMAGE_SIZE) -> np.ndarray:
+def image_of(
+    msg: RosCompressedImage, max_size: tuple[int, int] = MAX_IMAGE_SIZE
+) -> np.ndarray:
     """The (H, W, 3) uint8 RGB image of a ``CompressedImage`` (JPEG or PNG, at most
     ``max_size``; see :func:`decode_image`).
 
@@ -807,27 +788,33 @@ def image_of(msg: Any, max_size: tuple[int, int] = MAX_IMAGE_SIZE) -> np.ndarray
     return decode_image(np.asarray(msg.data, dtype=np.uint8).reshape(-1), max_size)
 
 
+@dataclass(frozen=True)
+class CommandMessages:
+    """The messages one engine command becomes: ``head`` (``head/command``, when the robot has
+    head joints), ``gaze_target`` (when the target point is known), ``eyes`` and ``events``
+    (the command's events, source ``engine``)."""
+
+    head: RosJointTrajectory | None
+    gaze_target: RosPointStamped | None
+    eyes: RosEyeState
+    events: list[RosHandoverEvent]
+
+
 def command_messages(
-    cmd: Any,
+    cmd: GazeCommand,
     base_frame: str,
     gaze_frame: str,
     time_from_start: float,
     store: Typestore | None = None,
-) -> dict[str, object]:
-    """The messages one engine command becomes, by role: ``head/command`` (when the robot has
-    head joints), ``gaze_target`` (when the target point is known), ``eyes`` and ``events``
-    (a list of ``HandoverEvent`` from ``cmd.events``, source ``engine``)."""
-    s = _store(store)
-    out: dict[str, object] = {}
-    if cmd.head:
-        out["head/command"] = head_trajectory(cmd, time_from_start, store=s)
+) -> CommandMessages:
+    """The messages of one engine command (its head goal reached in ``time_from_start`` s)."""
+    head = (joint_trajectory(JointGoal(cmd.t, dict(cmd.head), {}, time_from_start))
+            if cmd.head else None)
     p = np.asarray(cmd.target_point, dtype=float)
-    if p.shape == (3,) and bool(np.all(np.isfinite(p))):
-        out["gaze_target"] = gaze_target(cmd, base_frame, s)
-    out["eyes"] = eye_state(cmd, gaze_frame, s)
-    out["events"] = [event_msg(e, "engine", float(cmd.t), s) for e in _events(cmd)]
-    return out
-
-
-def _events(cmd: Any) -> Iterable[Event]:
-    return tuple(getattr(cmd, "events", ()) or ())
+    known = p.shape == (3,) and bool(np.all(np.isfinite(p)))
+    return CommandMessages(
+        head=head,
+        gaze_target=gaze_target(cmd, base_frame) if known else None,
+        eyes=eye_state(_value(EYE_STATE, lambda: EyeState.of(cmd)), gaze_frame, store),
+        events=[event_msg(e, "engine", float(cmd.t), store) for e in cmd.events],
+    )

@@ -13,32 +13,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from gazebot.core.types import Event, TrackingFrame
+from gazebot.core.types import Event, GazeCommand, Phase, TrackingFrame
 from gazebot.io.ros2 import convert as cv
 from gazebot.io.ros2 import topics as tp
 from gazebot.io.ros2.mcap_writer import McapRecorder
-
-
-@dataclass(frozen=True)
-class LoopStatus:
-    """The health a node reports on ``/diagnostics`` (read by :func:`convert.diagnostics`)."""
-
-    node: str
-    state: str
-    tracking: str
-    phase: str
-    uptime: float
-    info: dict[str, Any] = field(default_factory=dict)
+from gazebot.io.ros2.values import NodeStatus
 
 
 def _next_slot(t: float, period: float) -> float:
-    """The first multiple of ``period`` after ``t`` (less a nanosecond: tick times are sums
+    """The first multiple of ``period`` after ``t`` (less 1 ns: tick times are sums
     of floats), so a periodic topic keeps its rate on any tick grid."""
     return (math.floor(t / period + 1e-9) + 1) * period - 1e-9
 
@@ -80,7 +67,7 @@ class HandoverMcap:
         self.eye_image_period = eye_image_period
         self.diagnostics_period = diagnostics_period
         self.node = node
-        self._phase: tuple[Any, float] | None = None  # (phase, its start)
+        self._phase: tuple[Phase, float] | None = None  # (phase, its start)
         self._next_image = -math.inf
         self._next_diag = -math.inf
         self._t0: float | None = None
@@ -94,7 +81,7 @@ class HandoverMcap:
         frame: TrackingFrame | None,
         joints: Mapping[str, float] | None,
         robot_events: Sequence[Event],
-        cmd: Any | None,
+        cmd: GazeCommand | None,
     ) -> None:
         """Record one tick at robot time ``t`` (s): its input (``frame``, measured ``joints``,
         ``robot_events``) and the engine's command (``None``: none was sent)."""
@@ -114,11 +101,12 @@ class HandoverMcap:
         if cmd is None:
             return
         msgs = cv.command_messages(cmd, self.base_frame, self.gaze_frame, self.time_from_start)
-        for role, topic in (("head/command", tp.HEAD_COMMAND), ("gaze_target", tp.GAZE_TARGET),
-                            ("eyes", tp.EYES)):
-            if role in msgs:
-                self._write(topic, msgs[role], t)
-        for msg in msgs["events"]:  # type: ignore[union-attr]
+        if msgs.head is not None:
+            self._write(tp.HEAD_COMMAND, msgs.head, t)
+        if msgs.gaze_target is not None:
+            self._write(tp.GAZE_TARGET, msgs.gaze_target, t)
+        self._write(tp.EYES, msgs.eyes, t)
+        for msg in msgs.events:
             self._write(tp.EVENTS, msg, t)
         phase, source = cv.command_phase(cmd)
         if self._phase is None or self._phase[0] is not phase:
@@ -127,16 +115,13 @@ class HandoverMcap:
                                                 source=source), t)
         if self.eye_image is not None and t >= self._next_image:
             self._next_image = _next_slot(t, self.eye_image_period)
-            img = self.eye_image(cmd.eye_yaw, cmd.eye_pitch, getattr(cmd, "blink", 0.0),
-                                 getattr(cmd, "distance", None))
+            img = self.eye_image(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)
             self._write(tp.EYE_IMAGE, cv.compressed_image(img, t, "display"), t)
         if t >= self._next_diag:
             self._next_diag = _next_slot(t, self.diagnostics_period)
-            tracking = str(getattr(cmd, "tracking", "ok"))
-            state = getattr(cmd, "status", None) or ("ok" if tracking == "ok" else "degraded")
-            status = LoopStatus(
-                node=self.node, state=str(state),
-                tracking=tracking, phase=phase.value, uptime=t - self._t0,
+            status = NodeStatus(
+                node=self.node, state=cmd.status, tracking=cmd.tracking, phase=phase.value,
+                uptime=t - self._t0,
             )
             self._write(tp.DIAGNOSTICS, cv.diagnostics(status, t), t)
 

@@ -17,6 +17,8 @@ from gazebot.io.ros2.codec import MAX_PAYLOAD_BYTES
 KIB = 1024
 
 DEFAULT_NAMESPACE = "/gazebot"
+#: Frame of the eye state and eye frames: the head's ``gaze`` site.
+GAZE_FRAME = "gaze"
 
 
 @dataclass(frozen=True)

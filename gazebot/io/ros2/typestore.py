@@ -12,6 +12,7 @@ from __future__ import annotations
 from functools import cache
 from pathlib import Path
 
+from rosbags.interfaces.typing import Typesdict
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
@@ -55,7 +56,7 @@ def build_typestore(package_dir: Path | None = None) -> Typestore:
     return store
 
 
-def definition_types(type_name: str, text: str) -> dict[str, object]:
+def definition_types(type_name: str, text: str) -> Typesdict:
     """The types of a full message definition as ``ros2 bag`` embeds it in MCAP (``ros2msg``):
     ``type_name``'s own fields, then a ``===`` line and ``MSG: pkg/Name`` before each
     dependency. Returns rosbags' type dict, ready for ``Typestore.register``.
@@ -76,7 +77,7 @@ def definition_types(type_name: str, text: str) -> dict[str, object]:
             sections[-1] = (name, sections[-1][1])
         else:
             sections[-1][1].append(line)
-    types: dict[str, object] = {}
+    types: Typesdict = {}
     for name, lines in sections:
         if not name:
             raise MessageError(type_name, "a definition section without 'MSG: pkg/Name'")

@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import threading
 import time
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from drivers_fakes import wait_until
 
-from gazebot.io.drivers.payloads import EyeStateMsg
+from gazebot.io.ros2.values import EyeState
 
 pytestmark = pytest.mark.zenoh
 
@@ -73,11 +72,8 @@ def test_pupils_follow_the_eye_state_go_neutral_in_silence_and_recover(bus, tmp_
         seq = 0
         while not screen.stop.is_set():
             if yaw["on"]:
-                msg = EyeStateMsg(seq=seq, t=seq / 100, stamp=time.time(), yaw=yaw["value"],
-                                  pitch=0.0, blink=0.0)
                 eyes_pub.publish(convert.eye_state(
-                    SimpleNamespace(t=msg.t, eye_yaw=msg.yaw, eye_pitch=msg.pitch, blink=0.0,
-                                    distance=None), "gaze"))
+                    EyeState(seq / 100, yaw=yaw["value"], pitch=0.0), "gaze"))
                 seq += 1
             time.sleep(0.01)
 

@@ -17,9 +17,9 @@ from drivers_fakes import Recorder, wait_until
 from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig
 from gazebot.io.drivers.sim_node import SimNode, SimNodeConfig
 from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
-from gazebot.io.drivers.zenoh_node import event_from_ros
 from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 from gazebot.io.ros2 import convert, topics
+from gazebot.io.ros2.values import ArmCommand
 
 pytestmark = pytest.mark.zenoh
 
@@ -87,7 +87,7 @@ class Log:
     """Every event on both event topics (robot's and the others')."""
 
     def __init__(self, node):
-        self._recs = [Recorder(node, t, event_from_ros)
+        self._recs = [Recorder(node, t, convert.event_of)
                       for t in (topics.ROBOT_EVENTS, topics.EVENTS)]
 
     @property
@@ -105,7 +105,7 @@ def head_pan(sim) -> float:
 def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     sim_node, ep, sim_thread, _ = start_sim_node(bus, sim)
     events = Log(ep)
-    heads = Recorder(ep, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m)[0])
+    heads = Recorder(ep, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m).positions)
     eyes = Recorder(ep, topics.EYES, convert.eyes_of)
     target_events = lambda: [m for m in events.msgs if m.kind == "gaze_target"]  # noqa: E731
     engine_node, drv, *_ = start_engine_node(bus)
@@ -232,20 +232,18 @@ def test_run_cli_drives_a_simulator_on_the_bus_and_records_it(bus, sim, capsys, 
 
 
 def test_simulator_node_obeys_arm_commands(bus, sim):
-    from gazebot.io.drivers.payloads import ArmCommandMsg
-
     sim_node, ep, _, _ = start_sim_node(bus, sim)
     drv = ZenohRobotDriver(bus.connector(), bus.names, "operator")
     bus.closers.append(drv.close)
     assert wait_until(lambda: drv.peers().get("sim"))
     goal = {j: 0.1 * i for i, j in enumerate(sim.robot.arm_joints)}
-    drv.send_arm(ArmCommandMsg(seq=0, t=0.0, stamp=0.0, positions=goal))
-    drv.send_arm(ArmCommandMsg(seq=1, t=0.0, stamp=0.0, positions={"no_such_joint": 0.0}))
-    assert wait_until(lambda: ep.arm.peek() is not None and ep.arm.peek().seq == 1)
+    drv.send_arm(ArmCommand(positions=goal))
+    drv.send_arm(ArmCommand(positions={"no_such_joint": 0.0}))
+    assert wait_until(lambda: ep.arm.count == 2)
     sim_node.tick()  # only the newest command of a kind is applied: the bad one
     assert sim_node.rejected == {"arm": 1}
-    drv.send_arm(ArmCommandMsg(seq=2, t=0.0, stamp=0.0, positions=goal))
-    assert wait_until(lambda: ep.arm.peek().seq == 2)
+    drv.send_arm(ArmCommand(positions=goal))
+    assert wait_until(lambda: ep.arm.count == 3)
     sim_node.tick()
     acts = [sim.model.actuator(j).id for j in sim.robot.arm_joints]
     np.testing.assert_allclose(sim.data.ctrl[acts], list(goal.values()), atol=1e-9)

@@ -15,7 +15,7 @@ from gazebot.core.runtime import GazeLoop
 from gazebot.core.types import TrackingFrame
 from gazebot.io.drivers.base import RobotDriver
 from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig
-from gazebot.io.drivers.payloads import EyeStateMsg, TrackingMsg
+from gazebot.io.ros2.values import EyeState
 
 
 class MemoryDriver(RobotDriver):
@@ -24,7 +24,7 @@ class MemoryDriver(RobotDriver):
     node = "engine"
 
     def __init__(self) -> None:
-        self.eyes: list[EyeStateMsg] = []
+        self.eyes: list[EyeState] = []
         self.events: list = []
         self.statuses: list = []
         self.frames = False
@@ -80,30 +80,28 @@ class RecordingRenderer:
 
 # -- on the wire --------------------------------------------------------------------------
 def test_eye_state_distance_round_trips_and_unknown_is_nan_on_the_wire():
-    from gazebot.io.drivers.zenoh_driver import _EyeCommand
     from gazebot.io.ros2 import convert
     from gazebot.io.ros2.codec import Codec
     from gazebot.io.ros2.typestore import typestore
 
     codec = Codec.for_type(typestore(), convert.EYE_STATE)
-    msg = EyeStateMsg(seq=1, t=0.5, stamp=1.0, yaw=0.1, pitch=-0.2, blink=0.0, distance=0.8)
-    back = convert.eyes_of(codec.decode(codec.encode(convert.eye_state(_EyeCommand(msg), "gaze"))))
+    msg = EyeState(t=0.5, yaw=0.1, pitch=-0.2, blink=0.0, distance=0.8)
+    back = convert.eyes_of(codec.decode(codec.encode(convert.eye_state(msg, "gaze"))))
     assert (back.t, back.yaw, back.pitch, back.distance) == (0.5, 0.1, -0.2, 0.8)
-    unknown = EyeStateMsg(seq=3, t=0.5, stamp=1.0, yaw=0.0, pitch=0.0)
-    ros = convert.eye_state(_EyeCommand(unknown), "gaze")
+    unknown = EyeState(t=0.5, yaw=0.0, pitch=0.0)
+    ros = convert.eye_state(unknown, "gaze")
     assert math.isnan(ros.distance) and convert.eyes_of(ros).distance is None
 
 
 @pytest.mark.parametrize("bad", [0.0, -0.5, math.inf])
 def test_eye_state_distance_must_be_positive_finite_metres(bad):
     with pytest.raises(ValueError, match="distance"):
-        EyeStateMsg(seq=2, t=0.5, stamp=1.0, yaw=0.0, pitch=0.0, distance=bad)
+        EyeState(t=0.5, yaw=0.0, pitch=0.0, distance=bad)
 
 
 # -- engine node computes the distance ----------------------------------------------------
-def _tracking(t: float) -> TrackingMsg:
-    frame = TrackingFrame.make(t, giver_hand=[1.0, 0.1, 1.0], giver_face=[1.1, 0.2, 1.6])
-    return TrackingMsg.from_frame(frame, seq=int(t * 100), stamp=0.0)
+def _tracking(t: float) -> TrackingFrame:
+    return TrackingFrame.make(t, giver_hand=[1.0, 0.1, 1.0], giver_face=[1.1, 0.2, 1.6])
 
 
 def test_engine_node_sends_the_distance_from_the_gaze_site_to_the_target_and_renders_it():

@@ -17,7 +17,6 @@ from gazebot.core.runtime import GazeLoop
 from gazebot.core.types import Event, EventKind, TrackingFrame
 from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig, current_handover
 from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
-from gazebot.io.drivers.zenoh_node import event_from_ros
 from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 from gazebot.io.ros2 import convert, topics
 from gazebot.io.ros2.codec import Codec
@@ -34,7 +33,7 @@ RESYNC = EngineNodeConfig(silence_after=1e3, heartbeat_period=0.05, resync_timeo
 
 
 def events_of(node, topic=topics.EVENTS) -> Recorder:
-    return Recorder(node, topic, event_from_ros)
+    return Recorder(node, topic, convert.event_of)
 
 
 def health_of(node) -> Recorder:
@@ -44,7 +43,7 @@ def health_of(node) -> Recorder:
 
 def heads_of(node) -> Recorder:
     """The head goals (joint -> rad) sent on head/command."""
-    return Recorder(node, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m)[0])
+    return Recorder(node, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m).positions)
 
 
 def targets_of(node) -> Recorder:
@@ -98,8 +97,8 @@ def test_tracking_in_head_command_out_over_the_bus(bus):
     assert wait_until(lambda: targets.msgs and targets.msgs[-1][0] == pytest.approx(19 / 120))
     assert wait_until(lambda: ep.head.peek() is not None)
     cmd = ep.head.peek()
-    assert cmd.head["head_pan"] == pytest.approx(np.arctan2(0.3, 1.0))
-    assert cmd.time_from_start > 0 and set(cmd.velocity) == {"head_pan"}
+    assert cmd.positions["head_pan"] == pytest.approx(np.arctan2(0.3, 1.0))
+    assert cmd.time_from_start > 0 and set(cmd.velocities) == {"head_pan"}
     assert wait_until(lambda: ep.eyes.peek() is not None)
     # the fake engine's phase event is published once, with the engine as source
     assert wait_until(lambda: events.where(kind="reach_started"))
@@ -355,7 +354,7 @@ def test_eye_frames_are_rendered_only_while_someone_subscribes(bus):
     node.on_tracking(ep.publish_tracking(frame(1.0)))
     assert renderer.calls == 1
     assert wait_until(lambda: viewer.eye_frame.peek() is not None)
-    assert viewer.eye_frame.peek().image().shape == (24, 40, 3)
+    assert convert.image_of(viewer.eye_frame.peek()).shape == (24, 40, 3)
 
 
 def test_listening_on_a_taken_endpoint_is_a_clear_error(bus):
@@ -423,7 +422,8 @@ def test_pose_stamped_and_tf_frames_are_tracking_too_and_remapped_topics_are_use
         return len(got) >= 3
 
     assert wait_until(three_samples)
-    assert got[0].giver_hand == (0.9, 0.0, 1.0) and got[0].giver_face == (1.1, 0.2, 1.6)
+    assert got[0].giver_hand.tolist() == [0.9, 0.0, 1.0]
+    assert got[0].giver_face.tolist() == [1.1, 0.2, 1.6]
     node.on_tracking(got[-1])
     assert wait_until(lambda: targets.msgs)
     assert targets.msgs[-1][1].tolist() == [1.1, 0.2, 1.6]  # the fake engine looks at the face

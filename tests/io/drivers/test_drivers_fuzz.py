@@ -16,7 +16,6 @@ from hypothesis import strategies as st
 
 from gazebot.core.types import Phase, TrackingFrame
 from gazebot.io.drivers.ownership import Claim
-from gazebot.io.drivers.payloads import EyeStateMsg, HeadCommandMsg, StatusMsg
 from gazebot.io.drivers.rmw.attachment import Attachment, AttachmentError
 from gazebot.io.drivers.rmw.graph import Entity, Graph
 from gazebot.io.drivers.rmw.names import Names
@@ -24,12 +23,13 @@ from gazebot.io.drivers.rmw.node import Received
 from gazebot.io.drivers.rmw.qos import QosProfile
 from gazebot.io.drivers.session import EPHEMERAL_ENDPOINT, BusConfig, open_session
 from gazebot.io.drivers.zenoh_display import ZenohDisplayNode
-from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver, _EyeCommand
+from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
 from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 from gazebot.io.ros2 import convert, topics
 from gazebot.io.ros2.codec import Codec
 from gazebot.io.ros2.errors import MessageError
 from gazebot.io.ros2.typestore import typestore
+from gazebot.io.ros2.values import BusEvent, EyeState, JointGoal, NodeStatus
 
 FUZZ = settings(max_examples=150, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -39,25 +39,25 @@ STRING = "std_msgs/msg/String"
 def samples() -> dict[str, object]:
     """One valid message of each type gazebot subscribes to."""
     store = typestore()
-    head = HeadCommandMsg(seq=0, t=1.0, stamp=0.0, head={"head_pan": 0.1, "head_tilt": -0.2})
-    eyes = EyeStateMsg(seq=0, t=1.0, stamp=0.0, yaw=0.1, pitch=0.0, blink=0.2, distance=1.0)
-    status = StatusMsg(node="sim", seq=0, stamp=1.0, uptime=1.0, state="ok", tracking="ok",
-                       peers={"engine": True}, dropped={"/gazebot/x": 1}, phase="reach",
-                       info={"frames": 3})
+    head = JointGoal(1.0, {"head_pan": 0.1, "head_tilt": -0.2}, {}, 0.1)
+    eyes = EyeState(t=1.0, yaw=0.1, pitch=0.0, blink=0.2, distance=1.0)
+    status = NodeStatus(node="sim", seq=0, stamp=1.0, uptime=1.0, state="ok", tracking="ok",
+                        peers={"engine": True}, dropped={"/gazebot/x": 1}, phase="reach",
+                        info={"frames": 3})
     frame = TrackingFrame.make(1.0, giver_face=[1.0, 0.2, 1.5])
     return {
         convert.POINT_STAMPED: convert.point_stamped(1.0, [1.0, 0.0, 1.0], "world"),
         convert.POSE_STAMPED: convert.pose_stamped(1.0, [1.0, 0.0, 1.0], "world"),
         convert.TF_MESSAGE: convert.tracking_tf(frame, "world", {"giver_face": "mocap/face"}),
         convert.JOINT_STATE: convert.joint_state(1.0, {"head_pan": 0.1, "right_j0": 0.2}),
-        convert.JOINT_TRAJECTORY: convert.head_trajectory(head, 0.1),
+        convert.JOINT_TRAJECTORY: convert.joint_trajectory(head),
         convert.DIAGNOSTIC_ARRAY: convert.diagnostics(status, 1.0),
         convert.COMPRESSED_IMAGE: convert.compressed_image(np.zeros((4, 6, 3), np.uint8), 1.0,
                                                            "gaze"),
-        convert.EYE_STATE: convert.eye_state(_EyeCommand(eyes), "gaze"),
+        convert.EYE_STATE: convert.eye_state(eyes, "gaze"),
         convert.HANDOVER_PHASE: convert.handover_phase(1.0, Phase.REACH, 0.5),
-        convert.HANDOVER_EVENT: convert.handover_event("sim", "robot", "robot_grasped", 1.0,
-                                                       1.0, 1.0, {"planned_duration": 1.2}),
+        convert.HANDOVER_EVENT: convert.handover_event(BusEvent(
+            "sim", "robot", "robot_grasped", 1.0, 1.0, 1.0, {"planned_duration": 1.2})),
         convert.GRIPPER_STATE: convert.gripper_state(1.0, True),
         convert.LOAD_SHARE: convert.load_share(1.0, 0.5),
         STRING: store.types[STRING](data="home"),

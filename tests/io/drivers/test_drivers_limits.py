@@ -8,17 +8,17 @@ import pytest
 from drivers_fakes import wait_until
 
 from gazebot.io.drivers.event_log import EventLog, event_bytes
-from gazebot.io.drivers.payloads import EventMsg
 from gazebot.io.drivers.zenoh_display import ZenohDisplayNode
 from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
 from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 from gazebot.io.ros2 import convert, topics
 from gazebot.io.ros2.codec import MAX_PAYLOAD_BYTES, Codec
 from gazebot.io.ros2.typestore import typestore
+from gazebot.io.ros2.values import BusEvent, JointGoal
 
 
-def event(i: int, info_bytes: int = 10, source: str = "peer") -> EventMsg:
-    return EventMsg(seq=i, source=source, category="fault", kind="probe", t=float(i),
+def event(i: int, info_bytes: int = 10, source: str = "peer") -> BusEvent:
+    return BusEvent(seq=i, source=source, category="fault", kind="probe", t=float(i),
                     detected_at=float(i), stamp=1.0 + i, info={"x": "a" * info_bytes})
 
 
@@ -80,7 +80,7 @@ def test_what_gazebot_sends_fits_its_topics_cap():
     assert size(topics.GIVER_HAND, hand) < topics.GIVER_HAND.max_bytes
     # an event with the largest info the history keeps
     ev = event(0, info_bytes=16 * 1024 - 200)
-    ros = convert.handover_event(ev.source, ev.category, ev.kind, ev.t, ev.t, ev.stamp, ev.info)
+    ros = convert.handover_event(ev)
     assert size(topics.EVENTS, ros) < topics.EVENTS.max_bytes
     joints = {f"joint_{i}": 0.1 * i for i in range(60)}  # a humanoid's joint state
     state = convert.joint_state(1.0, joints)
@@ -108,8 +108,7 @@ def test_a_multi_megabyte_event_is_dropped_unread_and_the_history_stays_bounded(
     key = ep.names.key(ep.names.resolve(topics.EVENTS.name), codec.info.dds_name,
                        codec.info.hash)
     big = event(0, info_bytes=3_500_000)  # under the old 4 MiB default, over the topic's cap
-    raw = codec.encode(convert.handover_event(big.source, big.category, big.kind, big.t, big.t,
-                                              big.stamp, big.info))
+    raw = codec.encode(convert.handover_event(big))
     ep.session.put(key, raw, congestion_control=zenoh.CongestionControl.BLOCK)
     topic = ep.names.resolve(topics.EVENTS.name)
     assert wait_until(lambda: drv.dropped().get(topic) == 1)
@@ -134,12 +133,10 @@ def test_zenoh_drops_a_message_beyond_the_nodes_limit_before_it_is_reassembled(b
     for n in (ep, drv):
         bus.closers.append(n.close)
     assert wait_until(lambda: ep.peers().get("engine"))
-    from gazebot.io.drivers.payloads import HeadCommandMsg
-
     def route_up() -> bool:
         # Seeing the peer does not mean a put already reaches its subscription: a command,
         # sent until one arrives, shows the route is in place.
-        drv.send_head(HeadCommandMsg(seq=0, t=0.0, stamp=0.0, head={"head_pan": 0.0}))
+        drv.send_head(JointGoal(0.0, {"head_pan": 0.0}))
         return ep.head.peek() is not None
 
     assert wait_until(route_up, poll=0.05)
@@ -148,6 +145,6 @@ def test_zenoh_drops_a_message_beyond_the_nodes_limit_before_it_is_reassembled(b
     key = ep.names.key(head, codec.info.dds_name, codec.info.hash)
     drv.session.put(key, b"\x00\x01\x00\x00" + bytes(20 * 1024 * 1024),
                     congestion_control=zenoh.CongestionControl.BLOCK)
-    drv.send_head(HeadCommandMsg(seq=1, t=0.0, stamp=0.0, head={"head_pan": 0.3}))
-    assert wait_until(lambda: ep.head.peek().head == {"head_pan": 0.3})
+    drv.send_head(JointGoal(0.0, {"head_pan": 0.3}))
+    assert wait_until(lambda: ep.head.peek().positions == {"head_pan": 0.3})
     assert head not in ep.dropped()  # never reached the subscription

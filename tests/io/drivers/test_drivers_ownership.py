@@ -14,10 +14,10 @@ from test_drivers_faults import FAST, connected, engine_side, events_of, frame, 
 from gazebot.core.runtime import GazeLoop
 from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig, EngineRefused
 from gazebot.io.drivers.ownership import Claim
-from gazebot.io.drivers.payloads import HeadCommandMsg
 from gazebot.io.drivers.rmw.node import RosNode
 from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
 from gazebot.io.ros2 import convert, topics
+from gazebot.io.ros2.values import JointGoal
 
 pytestmark = pytest.mark.zenoh
 
@@ -107,8 +107,7 @@ def test_a_standby_engine_commands_nothing_until_the_owner_stops_then_takes_over
 
 
 def head_command(t: float, pan: float):
-    msg = HeadCommandMsg(seq=0, t=t, stamp=0.0, head={"head_pan": pan})
-    return convert.head_trajectory(msg, 0.1)
+    return convert.joint_trajectory(JointGoal(t, {"head_pan": pan}, {}, 0.1))
 
 
 def test_the_robot_reports_head_commands_from_two_publishers_by_their_gids(bus):
@@ -148,10 +147,10 @@ def test_the_robot_drops_head_commands_of_an_engine_that_does_not_own_it(bus):
     assert wait_until(lambda: drv1.owns_robot() and not drv2.owns_robot())
     assert wait_until(lambda: len(ep.owners.claims()) == 2)
     assert wait_until(lambda: len(ep.ros.graph.endpoints(ep._head_topic, "MP")) == 2)
-    drv2.send_head(HeadCommandMsg(seq=0, t=0.0, stamp=0.0, head={"head_pan": 0.5}))
+    drv2.send_head(JointGoal(0.0, {"head_pan": 0.5}))
     head = ep.names.resolve(topics.HEAD_COMMAND.name)
     assert wait_until(lambda: ep.dropped().get(head) == 1)
     assert "does not own the robot" in ep.drops.reasons()[head]
-    drv1.send_head(HeadCommandMsg(seq=0, t=0.0, stamp=0.0, head={"head_pan": 0.2}))
+    drv1.send_head(JointGoal(0.0, {"head_pan": 0.2}))
     assert wait_until(lambda: ep.head.peek() is not None)
-    assert ep.head.peek().head == {"head_pan": 0.2} and ep.head.count == 1
+    assert ep.head.peek().positions == {"head_pan": 0.2} and ep.head.count == 1

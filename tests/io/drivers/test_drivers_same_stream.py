@@ -82,7 +82,7 @@ def test_recorded_handover_gives_the_same_commands_in_process_and_over_zenoh(
     ep = ZenohRobotEndpoint(bus.listener(), bus.names, "sim")
     bus.closers.append(ep.close)
     drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
-    heads = Recorder(ep, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m)[0])
+    heads = Recorder(ep, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m).positions)
     eyes = Recorder(ep, topics.EYES, convert.eyes_of)
     targets = Recorder(ep, topics.GAZE_TARGET, convert.point_of)
     phases = Recorder(ep, topics.PHASE, convert.phase_of)

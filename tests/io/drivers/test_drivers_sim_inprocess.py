@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from gazebot.io.drivers.engine_node import EngineNode
-from gazebot.io.drivers.payloads import ArmCommandMsg, HeadCommandMsg
 from gazebot.io.drivers.sim_driver import SimRobotDriver
+from gazebot.io.ros2.values import ArmCommand, JointGoal
 
 
 def run_handover(seed: int):
@@ -17,7 +17,7 @@ def run_handover(seed: int):
 
     with HandoverSimulation("sawyer", "default", seed=seed) as sim:
         driver = SimRobotDriver(sim)
-        sent: list[HeadCommandMsg] = []
+        sent: list[JointGoal] = []
         send = driver.send_head
         driver.send_head = lambda msg: (sent.append(msg), send(msg))[1]
         node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face", seed=seed)),
@@ -38,9 +38,9 @@ def test_in_process_handover_is_deterministic_and_turns_the_head():
     phases = [m.kind for m in driver.events if m.category == "phase"]
     assert phases == ["reach_started", "transfer_started", "retreat_started", "handover_done"]
     assert any(m.source == "sim" and m.kind == "robot_grasped" for m in driver.events)
-    assert pan == pytest.approx(sent[-1].head["head_pan"], abs=0.05)
+    assert pan == pytest.approx(sent[-1].positions["head_pan"], abs=0.05)
     _, sent2, _, _ = run_handover(seed=3)
-    assert [m.head for m in sent2] == [m.head for m in sent]
+    assert [m.positions for m in sent2] == [m.positions for m in sent]
 
 
 def test_arm_commands_in_process_apply_named_poses_and_reject_the_impossible():
@@ -48,12 +48,12 @@ def test_arm_commands_in_process_apply_named_poses_and_reject_the_impossible():
 
     with HandoverSimulation("jaco2", "default", seed=0) as sim:
         driver = SimRobotDriver(sim)
-        driver.send_arm(ArmCommandMsg(seq=0, t=0.0, stamp=0.0, pose="handover"))
+        driver.send_arm(ArmCommand(pose="handover"))
         acts = [sim.model.actuator(j).id for j in sim.robot.arm_joints]
         lo, hi = sim.model.jnt_range[[sim.model.joint(j).id for j in sim.robot.arm_joints]].T
         limited = sim.model.jnt_limited[[sim.model.joint(j).id for j in sim.robot.arm_joints]]
         goal = np.where(limited, np.clip(sim.robot.handover, lo, hi), sim.robot.handover)
         np.testing.assert_allclose(sim.data.ctrl[acts], goal, atol=1e-9)
-        driver.send_arm(ArmCommandMsg(seq=1, t=0.0, stamp=0.0, positions={"bogus": 0.0}))
+        driver.send_arm(ArmCommand(positions={"bogus": 0.0}))
         assert driver.rejected == {"arm": 1}
         assert np.allclose(sim.data.ctrl[acts], goal)

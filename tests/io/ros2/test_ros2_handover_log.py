@@ -3,30 +3,22 @@ periodic topics on a fixed time grid."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from gazebot.core.types import Event, EventKind, Phase, TrackingFrame
+from gazebot.core.types import Event, EventKind, GazeCommand, Phase, TrackingFrame
 from gazebot.io.ros2 import convert as cv
 from gazebot.io.ros2.handover_log import HandoverMcap
 
 
-@dataclass(frozen=True)
-class Cmd:
-    t: float
-    phase: Phase
-    target_point: np.ndarray = field(default_factory=lambda: np.array([0.8, 0.0, 1.2]))
-    head: dict = field(default_factory=lambda: {"head_pan": 0.2})
-    eye_yaw: float = 0.1
-    eye_pitch: float = 0.0
-    blink: float = 0.0
-    distance: float | None = 1.0
-    tracking: str = "ok"
-    events: tuple = ()
+def Cmd(t: float, phase: Phase, events: tuple[Event, ...] = ()) -> GazeCommand:  # noqa: N802
+    """The engine's command at ``t`` in ``phase``, looking at a point ahead."""
+    return GazeCommand(t=t, phase=phase, target="face", target_point=np.array([0.8, 0.0, 1.2]),
+                       head={"head_pan": 0.2}, eye_yaw=0.1, eye_pitch=0.0, distance=1.0,
+                       events=events)
 
 
 def _messages(path: Path) -> dict[str, list]:

@@ -13,6 +13,7 @@ from gazebot.core.types import Event, EventKind
 from gazebot.io.ros2 import MessageError
 from gazebot.io.ros2 import convert as cv
 from gazebot.io.ros2.mcap_writer import McapRecorder
+from gazebot.io.ros2.values import EyeState
 
 
 def _record(path: Path) -> None:
@@ -25,11 +26,7 @@ def _record(path: Path) -> None:
         rec.write("/gazebot/handover/events",
                   cv.event_msg(Event(EventKind.REACH_STARTED, 0.5, 0.55, {"x": 1.5}), "e", 0.55),
                   0.55)
-        rec.write("/gazebot/eyes/state", cv.eye_state(_Cmd(), "gaze"), 0.6)
-
-
-class _Cmd:
-    t, eye_yaw, eye_pitch, blink, distance = 0.6, 0.1, -0.05, 0.0, None
+        rec.write("/gazebot/eyes/state", cv.eye_state(EyeState(0.6, 0.1, -0.05), "gaze"), 0.6)
 
 
 @pytest.fixture

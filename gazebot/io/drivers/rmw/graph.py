@@ -10,8 +10,8 @@ names are mangled (``/`` -> ``%``), the default enclave and the root namespace a
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass
-from typing import Literal
+from dataclasses import dataclass, replace
+from typing import Literal, cast
 
 from gazebot.io.drivers.rmw.names import demangle, mangle
 from gazebot.io.drivers.rmw.qos import QosProfile
@@ -92,17 +92,17 @@ class Entity:
             domain, node_id, entity_id = int(parts[1]), int(parts[3]), int(parts[4])
         except ValueError:
             raise ValueError(f"non-numeric domain or id in {key!r}") from None
-        common = dict(domain_id=domain, zid=parts[2], node_id=node_id, entity_id=entity_id,
-                      kind=kind, enclave=demangle(parts[6]), namespace=demangle(parts[7]),
-                      node=demangle(parts[8]))
+        common = cls(domain_id=domain, zid=parts[2], node_id=node_id, entity_id=entity_id,
+                     kind=cast(Kind, kind), enclave=demangle(parts[6]),
+                     namespace=demangle(parts[7]), node=demangle(parts[8]))
         if kind == "NN":
             if len(parts) != 9:
                 raise ValueError(f"node token with extra chunks: {key!r}")
-            return cls(**common)
+            return common
         if len(parts) != 13:
             raise ValueError(f"{kind} token needs 13 chunks, got {len(parts)}: {key!r}")
-        return cls(**common, topic=demangle(parts[9]), dds_type=parts[10], type_hash=parts[11],
-                   qos=QosProfile.decode(parts[12]))
+        return replace(common, topic=demangle(parts[9]), dds_type=parts[10],
+                       type_hash=parts[11], qos=QosProfile.decode(parts[12]))
 
 
 class Graph:

@@ -1,4 +1,4 @@
-"""A ROS 2 node on a Zenoh session, speaking rmw_zenoh's wire: publishers put CDR payloads with
+"""A ROS 2 node on a Zenoh session, speaking rmw_zenoh's wire: publishers put CDR messages with
 rmw_zenoh's attachment on ``<domain>/<topic>/<DDS type>/<hash>``; subscriptions decode them;
 every node, publisher and subscription holds its liveliness token under ``@ros2_lv``, and the
 node keeps the graph the other tokens describe.
@@ -110,7 +110,7 @@ class Publisher:
         self._pub = node.session.declare_publisher(self.key)
         self._token = node.session.liveliness().declare_token(self.entity.token())
 
-    def publish(self, msg: Any) -> bool:
+    def publish(self, msg: object) -> bool:
         """Serialize and put ``msg``; ``False`` once the node is closed.
 
         Raises:
