@@ -16,8 +16,11 @@ from collections.abc import Sequence
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from gazebot.core.minimum_jerk import PEAK_RATE
+from gazebot.core.minimum_jerk import minimum_jerk as min_jerk
+
 # Peak velocity of a rest-to-rest minimum-jerk move = MINJERK_PEAK * amplitude / duration.
-MINJERK_PEAK = 1.875
+MINJERK_PEAK = PEAK_RATE
 
 
 class GazeShiftConfig(BaseModel):
@@ -51,12 +54,6 @@ class GazeShiftConfig(BaseModel):
     def saccade_threshold(self) -> float:
         """The saccade threshold in rad."""
         return math.radians(self.saccade_threshold_deg)
-
-
-def min_jerk(tau: float) -> float:
-    """Normalized minimum-jerk position ``10 s^3 - 15 s^4 + 6 s^5``, ``s = clip(tau, 0, 1)``."""
-    s = min(max(tau, 0.0), 1.0)
-    return s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
 
 
 def min_jerk_duration(

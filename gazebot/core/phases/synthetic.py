@@ -34,6 +34,7 @@ from typing import Literal
 
 import numpy as np
 
+from gazebot.core.minimum_jerk import minimum_jerk as min_jerk
 from gazebot.core.phases.segment import Segment
 from gazebot.core.phases.trajectory import Trajectory
 from gazebot.core.types import Phase
@@ -41,12 +42,6 @@ from gazebot.core.types import Phase
 Posture = Literal["standing", "sitting"]
 Hold = Literal["pull", "carry", "still"]
 CaseKind = Literal["carry", "still", "quick30", "quick_noisy"]
-
-
-def min_jerk(s: np.ndarray) -> np.ndarray:
-    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (clipped to 0..1)."""
-    s = np.clip(s, 0.0, 1.0)
-    return s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
 
 
 def _bump(s: np.ndarray) -> np.ndarray:

@@ -10,7 +10,7 @@ import numpy as np
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.prediction import predict_end
 from gazebot.core.phases.rules.directed import _Quadratic, _quadratic_at
-from gazebot.core.phases.rules.sequential import _grids, min_jerk_profile, reach_evidence
+from gazebot.core.phases.rules.sequential import _grids, reach_evidence
 from gazebot.core.types import Phase
 
 
@@ -80,16 +80,6 @@ def test_a_design_shared_between_calls_fits_each_signal_as_its_own_fit_would():
     # (a negative zero is other bits: another design, the same values)
     t0 = np.array([-0.2, -0.1, 0.0])
     assert _quadratic_at(t0) is not _quadratic_at(np.array([-0.2, -0.1, -0.0]))
-
-
-def test_the_in_place_min_jerk_profile_equals_the_plain_one():
-    rng = np.random.default_rng(4)
-    s = rng.uniform(-0.5, 1.5, (7, 5, 40))
-    plain = min_jerk_profile(s)
-    scratch = s.copy()
-    assert min_jerk_profile(scratch, overwrite=True).tobytes() == plain.tobytes()
-    # the plain form leaves its argument alone
-    assert min_jerk_profile(s).tobytes() == plain.tobytes()
 
 
 def test_the_sequential_grids_are_the_configurations_and_cannot_be_changed():

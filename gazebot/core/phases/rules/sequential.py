@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.filtering import median, vector_norm
 from gazebot.core.phases.rules.directed import _quadratic_at, noise_floor
@@ -71,22 +72,6 @@ class ReachEvidence:
     amplitude: np.ndarray
     rest: np.ndarray
     sigma: float
-
-
-def min_jerk_profile(s: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
-    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (float, clipped to
-    0..1). ``overwrite``: ``s`` may be used as scratch (the test's templates are large: fewer
-    temporary arrays; the same operations in the same order, so the same values)."""
-    s = np.clip(s, 0.0, 1.0, out=s if overwrite else None)
-    # s^3 (10 + s (6 s - 15)), evaluated as ((s s) s) (10 + s (6 s - 15))
-    inner = s * 6.0
-    inner -= 15.0
-    inner *= s
-    inner += 10.0
-    out = s * s
-    out *= s
-    out *= inner
-    return out
 
 
 def _best_reduction(
@@ -152,9 +137,7 @@ def reach_evidence(
     mean_x = w @ xb / n
     xc = xb - mean_x
     # templates (onset, duration, bin), centred (weighted): the rest position is free
-    tmpl = min_jerk_profile(
-        (tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None], overwrite=True
-    )
+    tmpl = minimum_jerk((tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None])
     mean_b = tmpl @ w / n
     tmpl -= mean_b[..., None]
     wt = tmpl * w
