@@ -16,8 +16,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from gazebot.core.kinematics.config import IKSettings
 from gazebot.core.kinematics.robot import GazePose, RobotModel
+from gazebot.core.kinematics.robot_config import IKSettings
 
 _LIMIT_EPS = 1e-9
 

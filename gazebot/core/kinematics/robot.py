@@ -17,8 +17,8 @@ import numpy as np
 import pinocchio as pin
 
 from gazebot.core.config import ConfigError
-from gazebot.core.kinematics.config import RobotConfig, load_robot_config, resolve_mjcf
 from gazebot.core.kinematics.eyes import DisplayEyes
+from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config, resolve_mjcf
 
 
 @dataclass(frozen=True)

@@ -17,10 +17,6 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from gazebot.core.minimum_jerk import PEAK_RATE
-from gazebot.core.minimum_jerk import minimum_jerk as min_jerk
-
-# Peak velocity of a rest-to-rest minimum-jerk move = MINJERK_PEAK * amplitude / duration.
-MINJERK_PEAK = PEAK_RATE
 
 
 class GazeShiftConfig(BaseModel):
@@ -66,7 +62,7 @@ def min_jerk_duration(
     ``margin * velocity_limit`` for every joint."""
     amp = np.abs(np.asarray(amplitude, dtype=float))
     vmax = np.asarray(velocity_limit, dtype=float) * margin
-    need = float(np.max(MINJERK_PEAK * amp / vmax)) if amp.size else 0.0
+    need = float(np.max(PEAK_RATE * amp / vmax)) if amp.size else 0.0
     return max(nominal, need)
 
 

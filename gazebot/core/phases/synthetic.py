@@ -34,7 +34,7 @@ from typing import Literal
 
 import numpy as np
 
-from gazebot.core.minimum_jerk import minimum_jerk as min_jerk
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases.segment import Segment
 from gazebot.core.phases.trajectory import Trajectory
 from gazebot.core.types import Phase
@@ -70,7 +70,7 @@ class _Path:
         prev = self.start
         for t0, dur, to, bump in self.moves:
             s = (t - t0) / dur
-            out += min_jerk(s)[:, None] * (to - prev) + _bump(s)[:, None] * bump
+            out += minimum_jerk(s)[:, None] * (to - prev) + _bump(s)[:, None] * bump
             prev = to
         return out
 
@@ -424,7 +424,7 @@ def rest_recording(
             way = rng.normal(size=3)
             if rng.random() < 0.5:
                 way[0] = -abs(way[0])  # toward the receiver (at -x)
-            g += min_jerk((t - t0) / dur)[:, None] * (
+            g += minimum_jerk((t - t0) / dur)[:, None] * (
                 rng.uniform(*FIDGET_AMPLITUDE) * way / np.linalg.norm(way)
             )
             t0 += dur + rng.uniform(0.2, 1.0)

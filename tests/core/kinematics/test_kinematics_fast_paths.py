@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from gazebot.core.kinematics import GazeController, RobotModel
-from gazebot.core.kinematics.controller import HeadEyeState
+from gazebot.core.kinematics.gaze_controller import HeadEyeState
 
 
 @pytest.fixture(scope="module")

@@ -36,12 +36,8 @@ import numpy as np
 from gazebot.core.kinematics.eyes import angle_of, eye_angles_of, residual_of
 from gazebot.core.kinematics.look_at import IKConfig, RawSolution, solve_ik_raw
 from gazebot.core.kinematics.robot import RobotModel
-from gazebot.core.kinematics.shifts import (
-    MINJERK_PEAK,
-    GazeShiftConfig,
-    MinJerkTrajectory,
-    min_jerk,
-)
+from gazebot.core.kinematics.shifts import GazeShiftConfig, MinJerkTrajectory
+from gazebot.core.minimum_jerk import PEAK_RATE, minimum_jerk
 from gazebot.core.types import F64, filled
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
@@ -290,7 +286,7 @@ class GazeController:
         yaw, pitch, saturated = eyes.clip(yaw, pitch)  # eyes.look((x, y, z))
         if self._saccade is not None:
             t0, dur, (y0, p0) = self._saccade
-            s = min_jerk((self._clock - t0) / dur)
+            s = minimum_jerk((self._clock - t0) / dur)
             yaw, pitch = y0 + s * (yaw - y0), p0 + s * (pitch - p0)
             if s >= 1.0:
                 self._saccade = None
@@ -432,7 +428,7 @@ class GazeController:
             d = abs(g - a)
             if d > move:
                 move = d
-            d = MINJERK_PEAK * d / (vlim * margin)
+            d = PEAK_RATE * d / (vlim * margin)
             if d > need:
                 need = d
             d = abs(g - old_g)
@@ -457,7 +453,7 @@ class GazeController:
             amp = math.hypot(yaw - self._eyes[0], pitch - self._eyes[1])
             dur = max(
                 cfg.eye_duration_s,
-                MINJERK_PEAK * amp / (self.robot.eye_velocity_limit * margin),
+                PEAK_RATE * amp / (self.robot.eye_velocity_limit * margin),
             )
             self._saccade = (t_start, dur, self._eyes)
             return float(amplitude)
