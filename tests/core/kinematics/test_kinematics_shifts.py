@@ -269,19 +269,19 @@ def test_non_numeric_time_is_a_clear_error(jaco2):
         c.update(None, jaco2.points["face"])
 
 
-def test_of_floats_plans_the_same_trajectory_as_the_constructor():
-    args = (0.25, 1, [0.1, -0.4], [0.6, 0.2], [0.05, -0.3], (1.5, 0.0))
-    ref, fast = MinJerkTrajectory(*args), MinJerkTrajectory.of_floats(*args)
-    assert fast.end_time == ref.end_time and fast.duration == ref.duration == 1.0
-    for t in (0.0, 0.25, 0.5, 0.9, 1.25, 2.0):
-        assert fast.sample(t) == ref.sample(t)
+def test_a_trajectory_rests_exactly_on_its_goal_after_its_end_and_at_its_start_before():
+    traj = MinJerkTrajectory(0.25, 1, [0.1, -0.4], [0.6, 0.2], [0.05, -0.3], (1.5, 0.0))
+    assert traj.duration == 1.0 and traj.end_time == 1.25
+    for t in (1.25, 2.0):
+        pos, vel, acc = traj.evaluate(t)
+        assert pos.tolist() == [0.6, 0.2] and not vel.any() and not acc.any()
+    pos, vel, acc = traj.evaluate(0.0)
+    assert pos.tolist() == [0.1, -0.4] and vel.tolist() == [0.05, -0.3]
+    assert acc.tolist() == [1.5, 0.0]
 
 
-def test_sample_position_is_the_position_sample_gives_before_during_and_after_the_plan():
-    traj = MinJerkTrajectory.of_floats(0.25, 1.0, [0.1, -0.4], [0.6, 0.2], [0.05, -0.3],
-                                       [1.5, 0.0])
-    for t in (0.0, 0.25, 0.5, 0.9, 1.25, 2.0):
-        fresh = MinJerkTrajectory.of_floats(0.25, 1.0, [0.1, -0.4], [0.6, 0.2], [0.05, -0.3],
-                                            [1.5, 0.0])
-        assert traj.sample_position(t) == list(fresh.sample(t)[0])
-    assert traj.sample_position(2.0) == [0.6, 0.2]  # exactly on the goal afterwards
+def test_a_trajectory_refuses_boundary_conditions_of_other_lengths():
+    with pytest.raises(ValueError, match="same length"):
+        MinJerkTrajectory(0.0, 1.0, [0.1, -0.4], [0.6])
+    with pytest.raises(ValueError, match="positive"):
+        MinJerkTrajectory(0.0, 0.0, [0.1], [0.6])

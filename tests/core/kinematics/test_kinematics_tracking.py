@@ -51,8 +51,8 @@ def test_within_the_goal_deadband_the_head_goal_is_kept_and_the_eyes_stay_exact(
     robot = RobotModel.load(name)
     cfg = IKConfig()
     solves = []
-    solve = controller.solve_ik_raw
-    monkeypatch.setattr(controller, "solve_ik_raw",
+    solve = controller.solve_head
+    monkeypatch.setattr(controller, "solve_head",
                         lambda *a, **k: solves.append(1) or solve(*a, **k))
     ctrl = GazeController(robot)
     exact = GazeController(robot, ik=IKConfig(goal_deadband=0.0))
@@ -90,8 +90,8 @@ def test_with_the_eyes_at_their_range_the_goal_deadband_still_keeps_the_head_goa
     assert settled.eyes_saturated and settled.residual > 0.1
 
     solves = []
-    solve = controller.solve_ik_raw
-    monkeypatch.setattr(controller, "solve_ik_raw",
+    solve = controller.solve_head
+    monkeypatch.setattr(controller, "solve_head",
                         lambda *a, **k: solves.append(1) or solve(*a, **k))
     lo, hi = robot.lower, robot.upper
     for i in range(150, 158):  # 0.25 mm per tick sideways: 2 mm ~ 0.2 deg from the head
