@@ -67,11 +67,16 @@ class EyesLike(Protocol):
 class RobotLike(Protocol):
     """What the loop reads of the robot (:class:`gazebot.core.kinematics.RobotModel`)."""
 
-    head_joints: Sequence[str]
-    lower: np.ndarray
-    upper: np.ndarray
-    rest: np.ndarray
-    eyes: EyesLike
+    @property
+    def head_joints(self) -> Sequence[str]: ...
+    @property
+    def lower(self) -> np.ndarray: ...
+    @property
+    def upper(self) -> np.ndarray: ...
+    @property
+    def rest(self) -> np.ndarray: ...
+    @property
+    def eyes(self) -> EyesLike: ...
 
     def gaze_frame_lists(self, q_head: Sequence[float]) -> list[list[float]]: ...
 
@@ -79,8 +84,8 @@ class RobotLike(Protocol):
 class EngineLike(Protocol):
     """What the loop drives (:class:`gazebot.core.engine.GazeEngine`)."""
 
-    robot: RobotLike
-
+    @property
+    def robot(self) -> RobotLike: ...
     @property
     def phase(self) -> Phase: ...
 
