@@ -150,7 +150,7 @@ def test_a_reach_ends_no_earlier_than_the_receivers_first_fast_sample_predicts()
 def _directed_reference(traj, c, after):
     """The constant-acceleration rule in its straightforward form: every sample read, every
     fit with its errors (the form the rule had before it skipped work)."""
-    from gazebot.core.phases.filtering import median, vector_norm
+    from gazebot.core.phases.filtering import vector_norm
     from gazebot.core.phases.rules.directed import noise_floor
     from gazebot.core.phases.rules.onset import min_jerk_span
 
@@ -170,7 +170,7 @@ def _directed_reference(traj, c, after):
     if fit.size < c.predict_min_samples or rest.size == 0:
         return None
     steps = np.diff(t_all[fit])
-    if float(steps.max()) > c.predict_gap_factor * median(steps):
+    if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
         return None
     g_rest = g[rest].mean(axis=0)
     line = r[-1] - g_rest

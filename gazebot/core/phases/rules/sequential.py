@@ -47,7 +47,7 @@ import numpy as np
 
 from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import median, vector_norm
+from gazebot.core.phases.filtering import vector_norm
 from gazebot.core.phases.rules.directed import _quadratic_at, noise_floor
 from gazebot.core.phases.trajectory import Trajectory
 
@@ -213,7 +213,7 @@ def sequential_reach(
     # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
     steps = tw[1:] - tw[:-1]  # (np.diff's subtraction)
     recent = tw[1:] >= now - c.predict_window
-    step = median(steps)
+    step = float(np.median(steps))
     if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
         return None
     # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import Signals, nanmax, quantile, vector_norm
+from gazebot.core.phases.filtering import Signals, nanmax, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 
 
@@ -228,7 +228,7 @@ def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
     carrying the object, the ``hold_floor_quantile`` of its relative speed."""
     hold = s.rel_speed[a : b + 1]
     hold = hold[np.isfinite(hold)]
-    return quantile(hold, c.hold_floor_quantile) if hold.size else 0.0  # (np.quantile's)
+    return float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
 
 
 def v_settle_fraction(s: Signals, c: PhaseConfig, lo: int, a: int) -> float:
