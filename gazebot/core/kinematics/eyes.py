@@ -16,21 +16,26 @@ import numpy as np
 
 def eye_angles(v: np.ndarray | Sequence[float]) -> tuple[float, float]:
     """Yaw and pitch (rad) that point the eyes along ``v`` (gaze frame, any length > 0)."""
-    x, y, z = (float(c) for c in v)
+    x, y, z = map(float, v)
     return math.atan2(y, x), math.atan2(-z, math.hypot(x, y))
 
 
 def eye_direction(yaw: float, pitch: float) -> np.ndarray:
     """Unit line of sight (gaze frame) of eyes at ``(yaw, pitch)``."""
+    return np.array(_direction(yaw, pitch))
+
+
+def _direction(yaw: float, pitch: float) -> tuple[float, float, float]:
+    """:func:`eye_direction` as a tuple."""
     cp = math.cos(pitch)
-    return np.array([cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch)])
+    return cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch)
 
 
 def angle_between(a: np.ndarray | Sequence[float], b: np.ndarray | Sequence[float]) -> float:
     """Angle (rad) between two non-zero 3-vectors, accurate for small and large angles
     (``atan2(|a x b|, a . b)``; computed in double precision whatever the input's)."""
-    ax, ay, az = (float(c) for c in a)
-    bx, by, bz = (float(c) for c in b)
+    ax, ay, az = map(float, a)
+    bx, by, bz = map(float, b)
     cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
     return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
 
@@ -56,4 +61,4 @@ class DisplayEyes:
 
     def residual(self, yaw: float, pitch: float, v: np.ndarray | Sequence[float]) -> float:
         """Angle (rad) between the eyes' line of sight and ``v`` (gaze frame)."""
-        return angle_between(eye_direction(yaw, pitch).tolist(), v)
+        return angle_between(_direction(yaw, pitch), v)

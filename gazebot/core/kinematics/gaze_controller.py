@@ -35,8 +35,14 @@ from typing import NamedTuple
 import numpy as np
 
 from gazebot.core.kinematics.eyes import angle_between
-from gazebot.core.kinematics.look_at import HeadSolution, IKConfig, solve_head
-from gazebot.core.kinematics.robot import GazePose, RobotModel
+from gazebot.core.kinematics.look_at import (
+    GazeFrame,
+    HeadSolution,
+    IKConfig,
+    Vector3,
+    solve_head,
+)
+from gazebot.core.kinematics.robot import RobotModel
 from gazebot.core.kinematics.shifts import GazeShiftConfig, MinJerkTrajectory, min_jerk_duration
 from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.types import filled
@@ -110,6 +116,13 @@ class GazeController:
         self.shifts = shifts if shifts is not None else robot.config.shifts
         self.ik = ik if ik is not None else IKConfig.from_settings(robot.config.ik)
         self._names = tuple(robot.head_joints)
+        # Per head joint: velocity limit and position limits.
+        self._limits = list(
+            zip(
+                robot.velocity_limits.tolist(), robot.lower.tolist(), robot.upper.tolist(),
+                strict=True,
+            )
+        )
         # The head goal deadband needs eyes that can take the difference (not head-only).
         eyes = robot.eyes
         movable = eyes.yaw_range[0] < eyes.yaw_range[1] or eyes.pitch_range[0] < eyes.pitch_range[1]
@@ -141,13 +154,13 @@ class GazeController:
         self._goal_final = False
         self._residual = 0.0
         # Gaze pose at the head command: (head vector, arm revision, pose).
-        self._pose: tuple[list[float], int, GazePose] | None = None
+        self._frame: tuple[list[float], int, GazeFrame] | None = None
         # The last IK solution (its q is ``_goal``) and the arm revision it was solved for: its
         # gaze frame and Jacobian seed the next warm start.
         self._solution: tuple[HeadSolution, int] | None = None
         # The goal's gaze origin and the unit direction from it to the target the goal was
         # solved for (the deadband's reference), or None.
-        self._solved_for: tuple[np.ndarray, np.ndarray] | None = None
+        self._solved_for: tuple[GazeFrame, Vector3] | None = None
         # The last update's target was a finite point; the eyes were at their range.
         self._target_valid = True
         self._eyes_saturated = False
@@ -220,7 +233,7 @@ class GazeController:
             shift = self._retarget(target, self._clock - dt)
         if dt > 0.0:
             if self._traj is not None:
-                self._follow(self._traj.position(self._clock), dt)
+                self._follow(self._traj.position(self._clock).tolist(), dt)
             else:
                 self._vel = [0.0] * len(self._q)
         self._target_valid = target is not None
@@ -241,21 +254,21 @@ class GazeController:
             return None
         return (x, y, z)
 
-    def _follow(self, pos: np.ndarray, dt: float) -> None:
+    def _follow(self, pos: list[float], dt: float) -> None:
         """Move the head command toward the plan's position ``pos`` within the velocity and
         joint limits (a non-finite result keeps the last command)."""
-        q_prev = np.array(self._q)
-        reach = self.robot.velocity_limits * dt
-        q = np.minimum(np.maximum(pos, q_prev - reach), q_prev + reach)
-        q = np.minimum(np.maximum(q, self.robot.lower), self.robot.upper)
-        if np.isfinite(q).all():
-            self._vel = ((q - q_prev) / dt).tolist()
-            self._q = q.tolist()
+        q = []
+        for p, last, (vlim, lo, hi) in zip(pos, self._q, self._limits, strict=True):
+            step = vlim * dt
+            q.append(min(max(min(max(p, last - step), last + step), lo), hi))
+        if all(map(math.isfinite, q)):
+            self._vel = [(a - last) / dt for a, last in zip(q, self._q, strict=True)]
+            self._q = q
 
     def _aim_eyes(self, dt: float) -> bool:
         """Aim the eyes at the target from the head command (saccade profile, speed limit,
         range); returns whether they are at their range."""
-        local = self._gaze_pose().to_local(self._target).tolist()  # type: ignore[arg-type]
+        local = self._gaze_frame().to_local(self._target)  # type: ignore[arg-type]
         if not math.hypot(*local) >= self.ik.min_distance:
             return False  # too close for a direction (or not a number): the eyes stay
         eyes = self.robot.eyes
@@ -290,17 +303,16 @@ class GazeController:
         self._clock += dt
         return dt
 
-    def _gaze_pose(self) -> GazePose:
-        """Gaze pose at the head command (kept: the eyes of one tick and the re-plan of the next
-        both need it)."""
+    def _gaze_frame(self) -> GazeFrame:
+        """Gaze frame at the head command (kept: the eyes of one tick and the re-plan of the
+        next both need it)."""
         revision = self.robot.arm_revision
-        kept = self._pose
+        kept = self._frame
         if kept is not None and kept[1] == revision and kept[0] == self._q:
             return kept[2]
-        rows = np.array(self.robot.gaze_frame_lists(self._q))
-        pose = GazePose(rows[:, 3], rows[:, :3])
-        self._pose = (self._q, revision, pose)
-        return pose
+        frame = GazeFrame.of_rows(self.robot.gaze_frame_lists(self._q))
+        self._frame = (self._q, revision, frame)
+        return frame
 
     def _in_deadband(self, target: tuple[float, float, float]) -> bool:
         """The target is within ``ik.goal_deadband`` of the one the head goal was solved for,
@@ -310,23 +322,23 @@ class GazeController:
         re-solved. (``_solved_for`` is None without a deadband, as in ``head-only`` mode.)"""
         if self._solved_for is None or self._saccade is not None:
             return False
-        origin, direction = self._solved_for
-        return angle_between(direction, np.asarray(target) - origin) <= self._deadband
+        solved, direction = self._solved_for
+        return angle_between(direction, solved.offset(target)) <= self._deadband
 
     def _retarget(self, target: tuple[float, float, float], t_start: float) -> float:
         """Solve IK for a new target and (re)plan neck and eyes from the state at ``t_start``
         (the previous tick); returns the shift amplitude (rad, 0 when tracking)."""
         # The shift's size: from the gaze origin, between the new target and the old one (or
         # the line of sight).
-        pose = self._gaze_pose()
+        frame = self._gaze_frame()
         revision = self.robot.arm_revision
-        seen = np.asarray(target) - pose.position
+        seen = frame.offset(target)
         old = self._target
         if old is None:
-            amplitude = angle_between(seen, pose.line_of_sight)
+            amplitude = angle_between(seen, frame.x)
             new_shift = True
         else:
-            amplitude = angle_between(seen, np.asarray(old) - pose.position)
+            amplitude = angle_between(seen, frame.offset(old))
             new_shift = amplitude > self.shifts.saccade_threshold
 
         # A target that moved without a gaze shift is followed at the tracking tolerance; a new
@@ -350,9 +362,10 @@ class GazeController:
         self._solution = (sol, revision)
         self._target = target
         if self._deadband > 0.0 and sol.kinematics is not None:
-            origin = sol.kinematics.pose.position
-            seen = np.asarray(target) - origin
-            self._solved_for = (origin, seen / np.linalg.norm(seen))  # > 0: the solve was valid
+            solved = GazeFrame.of_rows(sol.kinematics.frame)
+            seen = solved.offset(target)
+            norm = math.hypot(*seen)  # > 0: the solve was valid
+            self._solved_for = (solved, (seen[0] / norm, seen[1] / norm, seen[2] / norm))
         # A solve stopped by the iteration cap or at the tracking tolerance is refined on the
         # next tick even if nothing moved.
         self._goal_final = sol.converged
@@ -390,7 +403,7 @@ class GazeController:
     def _plan_saccade(self, target: tuple[float, float, float], t_start: float) -> None:
         """Start an eye saccade at ``t_start`` from where the eyes are toward the target (its
         end is re-aimed every tick); it takes at least ``eye_duration_s``."""
-        yaw, pitch, _ = self.robot.eyes.look(self._gaze_pose().to_local(target))
+        yaw, pitch, _ = self.robot.eyes.look(self._gaze_frame().to_local(target))
         amplitude = math.hypot(yaw - self._eyes[0], pitch - self._eyes[1])
         duration = min_jerk_duration(
             amplitude,

@@ -194,6 +194,39 @@ def _invalid(robot: RobotModel, q: np.ndarray, message: str) -> LookAtSolution:
     )
 
 
+Vector3 = tuple[float, float, float]
+
+
+class GazeFrame(NamedTuple):
+    """The gaze frame in the base frame, as floats: its origin and its x (line of sight), y
+    and z axes."""
+
+    origin: Vector3
+    x: Vector3
+    y: Vector3
+    z: Vector3
+
+    @classmethod
+    def of_rows(cls, rows: list[list[float]]) -> GazeFrame:
+        """From :meth:`RobotModel.gaze_frame_lists` rows ``[R_i0, R_i1, R_i2, p_i]``."""
+        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = rows
+        return cls((px, py, pz), (r00, r10, r20), (r01, r11, r21), (r02, r12, r22))
+
+    def offset(self, point: Sequence[float]) -> Vector3:
+        """``point - origin`` (base frame axes)."""
+        ox, oy, oz = self.origin
+        return (point[0] - ox, point[1] - oy, point[2] - oz)
+
+    def to_local(self, point: Sequence[float]) -> Vector3:
+        """``point`` (base frame) in the gaze frame."""
+        d = self.offset(point)
+        return (_dot(self.x, d), _dot(self.y, d), _dot(self.z, d))
+
+
+def _dot(a: Vector3, b: Vector3) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
 @dataclass(frozen=True)
 class HeadKinematics:
     """The gaze frame (and, once computed, its Jacobian) at one head vector and arm pose.
@@ -247,14 +280,12 @@ def _unusable(q: list[float], iterations: int) -> HeadSolution:
     return HeadSolution(q, False, (nan, nan, nan), nan, iterations, False, False, False)
 
 
-def _distance_and_cos(frame: list[list[float]], target: np.ndarray) -> tuple[float, float]:
+def _distance_and_cos(frame: GazeFrame, target: Vector3) -> tuple[float, float]:
     """The target's distance from the gaze origin and the cosine of its angle to the line of
-    sight (NaN at the origin; frame rows as in :class:`HeadKinematics`)."""
-    rows = np.asarray(frame)
-    offset = target - rows[:, 3]
-    dist = math.sqrt(offset @ offset)
-    along = float(rows[:, 0] @ offset)
-    return dist, along / dist if dist > 0.0 else math.nan
+    sight (NaN at the origin)."""
+    offset = frame.offset(target)
+    dist = math.hypot(*offset)
+    return dist, _dot(frame.x, offset) / dist if dist > 0.0 else math.nan
 
 
 def _nudge_off_saddle(q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
@@ -286,6 +317,7 @@ def _damped_step(
     lower, upper, rest = bounds
     at_lower = q <= lower + _LIMIT_EPS
     at_upper = q >= upper - _LIMIT_EPS
+    any_at_limit = bool(at_lower.any() or at_upper.any())
     free = np.ones(q.shape, dtype=bool)
     while free.any():
         J = de_dq * free  # frozen joints' columns are zero
@@ -297,6 +329,8 @@ def _damped_step(
         if reducible > cfg.posture_off and cfg.posture_gain > 0.0:
             pull = cfg.posture_gain * (rest - q) * free
             dq += pull - pinv @ (J @ pull)  # its null-space projection
+        if not any_at_limit:
+            return dq, reducible
         blocked = free & ((at_lower & (dq < 0.0)) | (at_upper & (dq > 0.0)))
         if not blocked.any():
             return dq, reducible
@@ -368,7 +402,7 @@ def solve_head(
     if not max_iterations:
         converged = stalled = True
     for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported afterwards)
-        dist, cos = _distance_and_cos(kin.frame, aim)
+        dist, cos = _distance_and_cos(GazeFrame.of_rows(kin.frame), target)
         if dist < cfg.min_distance:
             return _unusable(q.tolist(), iterations)
         if cos >= cos_tolerance:
@@ -397,11 +431,10 @@ def solve_head(
         q, stepped = q_new, True
         kin = HeadKinematics(robot.gaze_frame_lists(q.tolist()))
 
-    pose = kin.pose
-    offset = aim - pose.position
-    if not max_iterations and math.sqrt(offset @ offset) < cfg.min_distance:
+    frame = GazeFrame.of_rows(kin.frame)
+    if not max_iterations and math.hypot(*frame.offset(target)) < cfg.min_distance:
         return _unusable(q.tolist(), 0)
-    local = pose.rotation.T @ offset
+    local = frame.to_local(target)
     residual = math.atan2(math.hypot(local[1], local[2]), local[0])  # from the line of sight
     reached = residual <= cfg.tolerance
     if jacobian and kin.jacobian is None:
@@ -409,7 +442,7 @@ def solve_head(
     return HeadSolution(
         q.tolist(),
         True,
-        (float(local[0]), float(local[1]), float(local[2])),
+        local,
         residual,
         iterations,
         converged or stalled or reached,

@@ -164,6 +164,12 @@ class MinJerkTrajectory(Trajectory):
         pos, vel, acc = _power_basis(s) @ self._coeffs
         return pos, vel, acc
 
+    def position(self, t: float) -> np.ndarray:
+        s = min(max(t - self.t0, 0.0), self.duration)
+        if s >= self.duration:
+            return self._goal.copy()
+        return _power_basis(s)[0] @ self._coeffs
+
 
 def _power_basis(s: float) -> np.ndarray:
     """Rows: ``(1, s, ..., s^5)`` and its first and second derivatives in ``s``, so that the
