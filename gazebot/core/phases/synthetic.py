@@ -320,8 +320,8 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
         load[:] = 0.0
         for t_close, release, t_open in grip_events:
             closed[(ts >= t_close) & (ts < t_open)] = 1.0
-            hold = (ts >= t_close) & (ts < release)
-            load[hold] = 0.15 + 0.7 * (ts[hold] - t_close) / (release - t_close)
+            holding = (ts >= t_close) & (ts < release)
+            load[holding] = 0.15 + 0.7 * (ts[holding] - t_close) / (release - t_close)
             after = (ts >= release) & (ts < t_open)
             load[after] = np.minimum(1.0, 0.85 + 3.0 * (ts[after] - release))
     traj = Trajectory(ts, gh, rh, gf, closed, load)

@@ -86,12 +86,8 @@ class _SuffixMax:
 
 
 def _fmax(values: list[float]) -> float:
-    """``np.fmax.reduce`` of plain floats: the largest that is not NaN, NaN if none."""
-    out = math.nan
-    for v in values:
-        if v > out or math.isnan(out):
-            out = v
-    return out
+    """The largest value that is not NaN (``np.fmax.reduce``), NaN if none."""
+    return max((v for v in values if not math.isnan(v)), default=math.nan)
 
 
 class GazebotTrigger:

@@ -126,8 +126,7 @@ def noise_floor(x: np.ndarray) -> float:
     little at tracking rates, and the median ignores a fidget)."""
     if x.shape[0] < 4:
         return 0.0
-    d1 = x[1:] - x[:-1]  # (np.diff(x, n=2, axis=0): the difference of the differences)
-    d2 = (d1[1:] - d1[:-1]).reshape(-1)
+    d2 = np.diff(x, n=2, axis=0).reshape(-1)
     mad = float(np.median(np.abs(d2 - np.median(d2))))
     return 1.4826 * mad / math.sqrt(6.0)
 
@@ -181,7 +180,7 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if fit.size < c.predict_min_samples or rest.size == 0:
         return None
     t_fit = t_all[fit]
-    steps = t_fit[1:] - t_fit[:-1]  # (np.diff's subtraction)
+    steps = np.diff(t_fit)
     if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
         return None  # a dropout inside the window leaves the model unconstrained there
     # The line from the giver's resting hand to the receiver's hand now.

@@ -211,7 +211,7 @@ def sequential_reach(
     # A dropout only matters where the gap's closing is fitted (the last predict_window): the
     # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
     # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
-    steps = tw[1:] - tw[:-1]  # (np.diff's subtraction)
+    steps = np.diff(tw)
     recent = tw[1:] >= now - c.predict_window
     step = float(np.median(steps))
     if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:

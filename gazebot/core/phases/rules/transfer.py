@@ -59,7 +59,7 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Inclusive index ranges of the True runs of ``mask``."""
     if mask.size == 0:
         return []
-    padded = np.zeros(mask.size + 2, dtype=bool)  # (not a concatenation of converted lists)
+    padded = np.zeros(mask.size + 2, dtype=bool)
     padded[1:-1] = mask
     bounds = (padded[1:] != padded[:-1]).nonzero()[0].tolist()
     return [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
@@ -105,8 +105,8 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
     if d.shape[0] == 0:
         return out
     if d.dtype.kind != "f" or d.dtype.itemsize < 8:
-        # (a narrower or integer signal compared in float64, as the zigzag's plain floats
-        # compare it; a wider one keeps its precision, as its tolist() does)
+        # (a narrower or integer signal is compared in float64; a wider one keeps its
+        # precision)
         d = d.astype(float)
     ok = np.isfinite(d)
     if ok.all():
