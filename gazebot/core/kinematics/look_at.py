@@ -392,7 +392,7 @@ def solve_head(
     loose = cfg.tracking_tolerance if tracking else 0.0
     cos_tolerance = math.cos(cfg.tolerance)
     cos_loose = math.cos(loose) if tracking else 2.0  # 2: never
-    kin = warm if warm is not None else HeadKinematics(robot.gaze_frame_lists(q.tolist()))
+    kin = warm if warm is not None else _kinematics_at(robot, q)
     iterations = 0
     converged = stalled = nudged = False
     stepped = False  # the looser tracking stop applies only after a step
@@ -410,13 +410,12 @@ def solve_head(
             break
         if stepped and cos >= cos_loose:
             break
-        if kin.jacobian is None:
-            kin = HeadKinematics(kin.frame, np.array(robot.gaze_jacobian_rows(q.tolist())))
+        kin = _with_jacobian(robot, kin, q)
         error, de_dq = pointing_error(kin.pose, kin.jacobian, aim)  # type: ignore[arg-type]
-        if not nudged and error @ error > 2.0 and np.sum((error @ de_dq) ** 2) < 1e-20:
+        if not nudged and _at_saddle(error, de_dq):
             nudged = _nudge_off_saddle(q, lower, upper)
             if nudged:
-                kin = HeadKinematics(robot.gaze_frame_lists(q.tolist()))
+                kin = _kinematics_at(robot, q)
                 continue
         dq, reducible = _damped_step(error, de_dq, q, bounds, cfg)
         if reducible <= cfg.tolerance:
@@ -429,7 +428,7 @@ def solve_head(
             stalled = True
             break
         q, stepped = q_new, True
-        kin = HeadKinematics(robot.gaze_frame_lists(q.tolist()))
+        kin = _kinematics_at(robot, q)
 
     frame = GazeFrame.of_rows(kin.frame)
     if not max_iterations and math.hypot(*frame.offset(target)) < cfg.min_distance:
@@ -437,19 +436,35 @@ def solve_head(
     local = frame.to_local(target)
     residual = math.atan2(math.hypot(local[1], local[2]), local[0])  # from the line of sight
     reached = residual <= cfg.tolerance
-    if jacobian and kin.jacobian is None:
-        kin = HeadKinematics(kin.frame, np.array(robot.gaze_jacobian_rows(q.tolist())))
     return HeadSolution(
-        q.tolist(),
-        True,
-        local,
-        residual,
-        iterations,
-        converged or stalled or reached,
-        stalled,
-        reached,
-        kin,
+        q=q.tolist(),
+        valid=True,
+        local=local,
+        residual=residual,
+        iterations=iterations,
+        converged=converged or stalled or reached,
+        stalled=stalled,
+        reached=reached,
+        kinematics=_with_jacobian(robot, kin, q) if jacobian else kin,
     )
+
+
+def _kinematics_at(robot: RobotModel, q: np.ndarray) -> HeadKinematics:
+    """The gaze frame at head vector ``q`` (its Jacobian computed when first needed)."""
+    return HeadKinematics(robot.gaze_frame_lists(q.tolist()))
+
+
+def _with_jacobian(robot: RobotModel, kin: HeadKinematics, q: np.ndarray) -> HeadKinematics:
+    """``kin`` (the kinematics at ``q``) with its Jacobian."""
+    if kin.jacobian is not None:
+        return kin
+    return HeadKinematics(kin.frame, np.array(robot.gaze_jacobian_rows(q.tolist())))
+
+
+def _at_saddle(error: np.ndarray, de_dq: np.ndarray) -> bool:
+    """Looking about straight away from the target (an error beyond ~80 deg) where the error's
+    gradient vanishes: a saddle, where a Gauss-Newton step picks no side."""
+    return bool(error @ error > 2.0 and np.sum((error @ de_dq) ** 2) < 1e-20)
 
 
 def solve_ik(
