@@ -33,7 +33,7 @@ import math
 import numpy as np
 from scipy.optimize import minimize
 
-from gazebot.core.phases.rules.sequential import min_jerk_profile
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases.synthetic import FIDGET_AMPLITUDE, FIDGET_DURATION, SyntheticHandover
 
 ONSET_STEP = 0.005  # s between the fidget onsets tried
@@ -47,7 +47,7 @@ def _reduction(
     """Per (onset, duration): how much of the centred samples' sum of squares ``xc`` (N, 3) the
     best fidget of that timing (amplitude up to the class's, along the best direction)
     explains (m^2)."""
-    tmpl = min_jerk_profile((t[None, None, :] - onsets[:, None, None]) / durations[None, :, None])
+    tmpl = minimum_jerk((t[None, None, :] - onsets[:, None, None]) / durations[None, :, None])
     tmpl -= tmpl.mean(axis=-1, keepdims=True)  # centred: the rest position is free
     energy = np.einsum("abn,abn->ab", tmpl, tmpl)
     prod = tmpl @ xc  # (onset, duration, 3): the best direction is along it

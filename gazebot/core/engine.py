@@ -387,7 +387,7 @@ class GazeEngine:
         """The command for ``kind`` at ``point``; the last safe one (or rest) if the kinematics
         fail or give a non-finite value."""
         try:
-            q, yaw, pitch, residual, shift = self.gaze.update_raw(t, point, arm)
+            q, yaw, pitch, residual, shift = self.gaze.step(t, point, arm)
             # One float sum instead of a check per value: finite values of these sizes (angles,
             # rad) cannot overflow, so the sum is finite exactly when every value is.
             ok = math.isfinite(yaw + pitch + residual + shift + sum(q))

@@ -46,7 +46,7 @@ def _loaders():
     from gazebot.apps.render.eye_style import load_eye_style
     from gazebot.apps.sim.scene_config import load_scene
     from gazebot.core.behaviors.registry import load_behavior
-    from gazebot.core.kinematics.config import load_robot_config
+    from gazebot.core.kinematics.robot_config import load_robot_config
     from gazebot.core.phases.config import load_phase_config
 
     return [load_behavior, load_robot_config, load_scene, load_phase_config,

@@ -133,7 +133,7 @@ def bus_names(args: argparse.Namespace, base_frame: str = "world") -> Names:
 
 def robot_base_frame(robot: str) -> str:
     """The base frame of robot ``robot`` (name or YAML file) as its YAML names it."""
-    from gazebot.core.kinematics.config import load_robot_config
+    from gazebot.core.kinematics.robot_config import load_robot_config
 
     return load_robot_config(robot)[0].base_frame
 

@@ -16,7 +16,7 @@ from gazebot.apps.cli.argtypes import seed_value
 from gazebot.apps.cli.errors import UsageError, option_error, robot_with_gaze_mode
 
 if TYPE_CHECKING:
-    from gazebot.core.kinematics.config import RobotConfig
+    from gazebot.core.kinematics.robot_config import RobotConfig
     from gazebot.io.ros2.handover_log import HandoverMcap
 
 EXIT_INFEASIBLE = 3  # the reach controller found no feasible reach and the robot stopped
@@ -227,7 +227,7 @@ def default_robot(args: argparse.Namespace) -> str:
 
 
 def run_demo(args: argparse.Namespace) -> int:
-    from gazebot.core.kinematics.config import GAZE_MODES
+    from gazebot.core.kinematics.robot_config import GAZE_MODES
 
     args.robot = default_robot(args)
     from gazebot.apps.render.gl_check import OffscreenRenderingError
@@ -374,7 +374,7 @@ def handover_mcap(robot: str | Path | RobotConfig, path: Path) -> HandoverMcap:
     at 5 Hz from the robot's own eye renderer (JPEG at the display's size costs milliseconds)."""
     from gazebot.apps.render import EyeRenderer
     from gazebot.apps.sim.record import CONTROL_HZ
-    from gazebot.core.kinematics.config import RobotConfig, load_robot_config
+    from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config
     from gazebot.io.ros2.handover_log import HandoverMcap
 
     config = robot if isinstance(robot, RobotConfig) else load_robot_config(robot)[0]

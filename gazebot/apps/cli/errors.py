@@ -17,9 +17,9 @@ class UsageError(ValueError):
 
 def robot_with_gaze_mode(robot: Any, mode: str | None) -> Any:
     """``robot`` in the ``--gaze-mode`` ``mode``
-    (:func:`gazebot.core.kinematics.config.with_gaze_mode`);
+    (:func:`gazebot.core.kinematics.robot_config.with_gaze_mode`);
     an unknown mode is a :class:`UsageError` naming the known ones."""
-    from gazebot.core.kinematics.config import GAZE_MODES, with_gaze_mode
+    from gazebot.core.kinematics.robot_config import GAZE_MODES, with_gaze_mode
 
     if mode is not None and mode not in GAZE_MODES:
         raise UsageError(f"--gaze-mode must be one of {', '.join(GAZE_MODES)}, not {mode!r}")

@@ -243,7 +243,7 @@ def _check_robot(name: str | None) -> None:
     hour into rendering."""
     if name is None:
         return
-    from gazebot.core.kinematics.config import robot_config_path
+    from gazebot.core.kinematics.robot_config import robot_config_path
 
     try:
         robot_config_path(name)

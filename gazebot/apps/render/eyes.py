@@ -38,7 +38,7 @@ from gazebot.apps.render.eye_style import EyeStyle, load_eye_style
 from gazebot.apps.render.eyes_display import robot_display
 
 if TYPE_CHECKING:
-    from gazebot.core.kinematics.config import RobotConfig
+    from gazebot.core.kinematics.robot_config import RobotConfig
 
 _SHIFT = 4  # fixed-point bits for OpenCV drawing: positions at 1/16 px
 _ONE = 1 << _SHIFT
@@ -238,7 +238,7 @@ class EyeRenderer:
         style: EyeStyle | str | Path | None = None,
     ) -> EyeRenderer:
         """The renderer for a robot's head screen; ``robot`` is a name (``"sawyer"``), a robot
-        YAML path or a parsed :class:`~gazebot.core.kinematics.config.RobotConfig`. Size, style and
+        YAML path or a parsed :class:`~gazebot.core.kinematics.RobotConfig`. Size, style and
         eye range come from its config; keyword arguments override."""
         info = robot_display(robot)
         return cls(

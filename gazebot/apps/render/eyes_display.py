@@ -1,6 +1,6 @@
 """Which screen a robot's eyes are drawn on: resolution, eye style and eye range.
 
-Read from the robot's parsed config (:class:`gazebot.core.kinematics.config.RobotConfig`, the one
+Read from the robot's parsed config (:class:`gazebot.core.kinematics.RobotConfig`, the one
 parser of ``configs/robots/<name>.yaml``): ``display.width_px``/``height_px``, ``eye_style`` and
 ``eyes.yaw_range_deg``/``pitch_range_deg``. A robot name or YAML path is resolved through the
 kinematics loader, so a custom robot YAML works wherever a shipped robot does.
@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from gazebot.core.kinematics.config import RobotConfig
+    from gazebot.core.kinematics.robot_config import RobotConfig
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,7 @@ def robot_display(robot: str | Path | RobotConfig) -> RobotDisplay:
     """
     # Imported here: the kinematics package pulls in Pinocchio, which the eye renderer alone
     # (e.g. ``gazebot render eyes --width --height``) does not need.
-    from gazebot.core.kinematics.config import RobotConfig, load_robot_config
+    from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config
 
     if isinstance(robot, RobotConfig):
         config, source = robot, f"<robot config {robot.name!r}>"

@@ -7,20 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gazebot.core.minimum_jerk import PEAK_RATE, minimum_jerk, minimum_jerk_rate
 
-def min_jerk_phase(tau: float | np.ndarray) -> float | np.ndarray:
-    """Normalized position s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, tau clipped to [0, 1]."""
-    tau = np.clip(tau, 0.0, 1.0)
-    return tau**3 * (10.0 + tau * (-15.0 + 6.0 * tau))
-
-
-def min_jerk_rate(tau: float | np.ndarray) -> float | np.ndarray:
-    """ds/dtau = 30 tau^2 (1 - tau)^2: zero at both ends, peak 1.875 at tau = 0.5."""
-    tau = np.clip(tau, 0.0, 1.0)
-    return 30.0 * tau**2 * (1.0 - tau) ** 2
-
-
-PEAK_RATE = 1.875  # max of min_jerk_rate; peak speed = PEAK_RATE * distance / duration
+__all__ = ["PEAK_RATE", "MinJerkSegment"]
 
 
 @dataclass(frozen=True)
@@ -47,11 +36,11 @@ class MinJerkSegment:
         return float(np.clip((t - self.t0) / self.duration, 0.0, 1.0))
 
     def position(self, t: float) -> np.ndarray:
-        s = min_jerk_phase(self.tau(t))
+        s = minimum_jerk(self.tau(t))
         return self.start + (self.goal - self.start) * s
 
     def velocity(self, t: float) -> np.ndarray:
-        ds = min_jerk_rate(self.tau(t)) / self.duration
+        ds = minimum_jerk_rate(self.tau(t)) / self.duration
         return (self.goal - self.start) * ds
 
     def done(self, t: float) -> bool:

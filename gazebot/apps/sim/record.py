@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gazebot.apps.render.timeline import TickRecord
-from gazebot.core.kinematics.config import RobotConfig
+from gazebot.core.kinematics.robot_config import RobotConfig
 from gazebot.core.runtime import GazeLoop
 from gazebot.core.types import Event, Phase
 

@@ -2,7 +2,7 @@
 arm's home and predefined handover poses.
 
 The robot YAML (``configs/robots/<name>.yaml``) has one parser, the kinematics package's pydantic
-:class:`~gazebot.core.kinematics.config.RobotConfig`; this module only converts the parsed config to
+:class:`~gazebot.core.kinematics.RobotConfig`; this module only converts the parsed config to
 what the simulation uses (radians, joint order, the resolved MJCF path), so the simulation, the
 gaze engine and the eye renderer all read the same description.
 """
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from gazebot.core.config import ConfigError
-from gazebot.core.kinematics.config import RobotConfig, load_robot_config, resolve_mjcf
+from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config, resolve_mjcf
 
 
 @dataclass(frozen=True)

@@ -45,7 +45,7 @@ from gazebot.apps.sim.torque_arm import (
     is_torque_motor,
 )
 from gazebot.apps.sim.tracking import TrackingNoise
-from gazebot.core.kinematics.config import RobotConfig
+from gazebot.core.kinematics.robot_config import RobotConfig
 from gazebot.core.types import Event, EventKind, TrackingFrame
 
 if TYPE_CHECKING:
@@ -123,7 +123,7 @@ class HandoverSimulation:
     Args:
         robot: Robot name (``sawyer``, ``jaco2``, ``panda``: a torque-motor arm whose position
             goals go through joint impedance, :mod:`gazebot.apps.sim.torque_arm`), robot YAML path,
-            parsed :class:`~gazebot.core.kinematics.config.RobotConfig` or a :class:`SimRobot`.
+            parsed :class:`~gazebot.core.kinematics.RobotConfig` or a :class:`SimRobot`.
         scene: Scene name (``configs/scenes/<name>.yaml``), YAML path or a :class:`SceneConfig`.
         seed: Seeds the giver's timing and the tracking noise (same seed, same handover).
         tracking_noise: Overrides the scene's tracking noise (``None``: the scene's).

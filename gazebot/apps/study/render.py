@@ -96,7 +96,7 @@ def render_handover_in_gaze_mode(
     from gazebot.apps.sim.record import record_handover
 
     try:
-        from gazebot.core.kinematics.config import with_gaze_mode
+        from gazebot.core.kinematics.robot_config import with_gaze_mode
     except ImportError:  # a gazebot without gaze modes: only the robot's own mode exists
         if gaze_mode != "head-and-eyes":
             raise ValueError(f"this gazebot cannot render gaze mode {gaze_mode!r}") from None

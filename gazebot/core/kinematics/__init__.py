@@ -4,7 +4,11 @@ Entry points: :meth:`RobotModel.load`, :func:`solve_ik` (one look-at solve) and
 :class:`GazeController` (timed neck + eye commands for a stream of targets).
 """
 
-from gazebot.core.kinematics.config import (
+from gazebot.core.kinematics.eyes import DisplayEyes, eye_angles, eye_direction
+from gazebot.core.kinematics.gaze_controller import GazeController, HeadEyeState
+from gazebot.core.kinematics.look_at import IKConfig, LookAtSolution, solve_ik
+from gazebot.core.kinematics.robot import GazePose, RobotModel
+from gazebot.core.kinematics.robot_config import (
     GAZE_MODES,
     GazeMode,
     IKSettings,
@@ -12,11 +16,7 @@ from gazebot.core.kinematics.config import (
     load_robot_config,
     with_gaze_mode,
 )
-from gazebot.core.kinematics.controller import GazeController, HeadEyeState
-from gazebot.core.kinematics.eyes import DisplayEyes, eye_angles, eye_direction
-from gazebot.core.kinematics.look_at import IKConfig, LookAtSolution, solve_ik
-from gazebot.core.kinematics.robot import GazePose, RobotModel
-from gazebot.core.kinematics.shifts import GazeShiftConfig, MinJerkTrajectory, min_jerk
+from gazebot.core.kinematics.shifts import GazeShiftConfig, MinJerkTrajectory
 
 __all__ = [
     "GAZE_MODES",
@@ -35,7 +35,6 @@ __all__ = [
     "eye_angles",
     "eye_direction",
     "load_robot_config",
-    "min_jerk",
     "solve_ik",
     "with_gaze_mode",
 ]

@@ -16,28 +16,26 @@ import numpy as np
 
 def eye_angles(v: np.ndarray | Sequence[float]) -> tuple[float, float]:
     """Yaw and pitch (rad) that point the eyes along ``v`` (gaze frame, any length > 0)."""
-    return eye_angles_of(v[0], v[1], v[2])  # math's functions take them as floats
-
-
-def eye_angles_of(x: float, y: float, z: float) -> tuple[float, float]:
-    """:func:`eye_angles` of ``(x, y, z)`` given as floats (the gaze controller's per-tick form)."""
+    x, y, z = map(float, v)
     return math.atan2(y, x), math.atan2(-z, math.hypot(x, y))
 
 
 def eye_direction(yaw: float, pitch: float) -> np.ndarray:
     """Unit line of sight (gaze frame) of eyes at ``(yaw, pitch)``."""
+    return np.array(_direction(yaw, pitch))
+
+
+def _direction(yaw: float, pitch: float) -> tuple[float, float, float]:
+    """:func:`eye_direction` as a tuple."""
     cp = math.cos(pitch)
-    return np.array([cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch)])
+    return cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch)
 
 
 def angle_between(a: np.ndarray | Sequence[float], b: np.ndarray | Sequence[float]) -> float:
-    """Angle (rad) between two non-zero 3-vectors, accurate for small and large angles."""
-    return angle_of(float(a[0]), float(a[1]), float(a[2]), float(b[0]), float(b[1]), float(b[2]))
-
-
-def angle_of(ax: float, ay: float, az: float, bx: float, by: float, bz: float) -> float:
-    """:func:`angle_between` of ``(ax, ay, az)`` and ``(bx, by, bz)`` given as floats (the gaze
-    controller's per-tick form: no conversions)."""
+    """Angle (rad) between two non-zero 3-vectors, accurate for small and large angles
+    (``atan2(|a x b|, a . b)``; computed in double precision whatever the input's)."""
+    ax, ay, az = map(float, a)
+    bx, by, bz = map(float, b)
     cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
     return math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
 
@@ -51,17 +49,10 @@ class DisplayEyes:
     velocity_limit: float
 
     def clip(self, yaw: float, pitch: float) -> tuple[float, float, bool]:
-        """Clip to the eye range; the flag says whether anything was clipped."""
-        # min(max(v, lo), hi) as comparisons (the same result, NaN included): this runs twice
-        # per controller tick and once per loop tick.
-        lo, hi = self.yaw_range
-        y = lo if yaw < lo else yaw
-        if y > hi:
-            y = hi
-        lo, hi = self.pitch_range
-        p = lo if pitch < lo else pitch
-        if p > hi:
-            p = hi
+        """Clip to the eye range; the flag says whether anything was clipped (a NaN stays
+        NaN)."""
+        y = min(max(yaw, self.yaw_range[0]), self.yaw_range[1])
+        p = min(max(pitch, self.pitch_range[0]), self.pitch_range[1])
         return y, p, (y != yaw or p != pitch)
 
     def look(self, v: np.ndarray | Sequence[float]) -> tuple[float, float, bool]:
@@ -70,15 +61,4 @@ class DisplayEyes:
 
     def residual(self, yaw: float, pitch: float, v: np.ndarray | Sequence[float]) -> float:
         """Angle (rad) between the eyes' line of sight and ``v`` (gaze frame)."""
-        # (float() on v: a float32 or float16 component would otherwise keep the products in
-        # its own precision.)
-        return residual_of(yaw, pitch, float(v[0]), float(v[1]), float(v[2]))
-
-
-def residual_of(yaw: float, pitch: float, x: float, y: float, z: float) -> float:
-    """Angle (rad) between the line of sight of eyes at ``(yaw, pitch)`` and ``(x, y, z)`` (gaze
-    frame, floats): :meth:`DisplayEyes.residual`'s arithmetic, the gaze controller's per-tick
-    form."""
-    # eye_direction() as floats: numpy's per-call overhead would cost more than the arithmetic.
-    cp = math.cos(pitch)
-    return angle_of(cp * math.cos(yaw), cp * math.sin(yaw), -math.sin(pitch), x, y, z)
+        return angle_between(_direction(yaw, pitch), v)

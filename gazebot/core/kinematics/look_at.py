@@ -11,13 +11,14 @@ null space of the pointing task.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 
-from gazebot.core.kinematics.config import IKSettings
 from gazebot.core.kinematics.robot import GazePose, RobotModel
+from gazebot.core.kinematics.robot_config import IKSettings
 
 _LIMIT_EPS = 1e-9
 
@@ -39,7 +40,7 @@ class IKConfig:
         min_step: A step smaller than this (rad) means the head cannot do better.
         posture_off: Reducible pointing error (rad) below which the posture pull stops.
         tracking_tolerance: Looser stop (rad) for a target that moved slightly since the last
-            solve (see :func:`solve_ik_raw`): the gaze controller uses it while following a
+            solve (see :func:`solve_head`): the gaze controller uses it while following a
             moving target, where one Gauss-Newton step from the last solution usually meets it.
         goal_deadband: The gaze controller keeps its head goal while a tracked target (one
             that moved without a gaze shift) stays within this angle (rad), seen from the
@@ -130,11 +131,11 @@ def pointing_error(
     """Pointing error ``e = (azimuth, elevation)`` of the target seen from the line of sight, and
     its exact Jacobian ``de/dq``.
 
-    The angles are measured in a roll-free tangent frame of the line of sight ``x``: ``b1`` is
-    horizontal (``up x x``, the robot's left when upright), ``b2 = x x b1``. A head roll about the
-    line of sight changes neither ``x`` nor the target direction ``u``, so its column is zero and
-    the null-space posture pull keeps the display upright; ``atan2`` keeps the error meaningful
-    up to 180 deg.
+    The angles are measured in a roll-free tangent frame ``F = (x, b1, b2)`` of the line of sight
+    ``x``: ``b1`` is horizontal (``up x x``, the robot's left when upright), ``b2 = x x b1``. A
+    head roll about the line of sight changes neither ``x`` nor the target direction ``u``, so
+    its column is zero and the null-space posture pull keeps the display upright; ``atan2``
+    keeps the error meaningful up to 180 deg.
 
     Args:
         pose: Gaze frame pose.
@@ -144,63 +145,39 @@ def pointing_error(
     Returns:
         ``e`` (2,) in rad and ``de/dq`` (2 x n).
     """
-    e0, e1, d_az, d_el = _pointing_error(
-        pose.rotation.tolist(), pose.position.tolist(), J.tolist(), target
-    )
-    return np.array([e0, e1]), np.array([d_az, d_el])
-
-
-def _pointing_error(
-    R: list[list[float]], p: list[float], rows: list[list[float]], target
-) -> tuple[float, float, list[float], list[float]]:
-    """Core of :func:`pointing_error` on plain lists (rotation rows, extra columns ignored;
-    origin; Jacobian rows)."""
-    # Scalar arithmetic on purpose: for 3-vectors and n <= 4 columns it is several times faster
-    # than numpy's per-call overhead, and this runs in every IK iteration.
-    px, py, pz = p
-    tx, ty, tz = float(target[0]) - px, float(target[1]) - py, float(target[2]) - pz
-    dist = math.sqrt(tx * tx + ty * ty + tz * tz)
-    ux, uy, uz = tx / dist, ty / dist, tz / dist
-    xx, xy, xz = R[0][0], R[1][0], R[2][0]
-    wn = math.hypot(xx, xy)  # |up x x|
-    horizontal = wn > 1e-6
+    x0, x1, x2 = x = pose.rotation[:, 0].tolist()
+    offset = np.asarray(target, dtype=float) - pose.position
+    dist = math.sqrt(offset @ offset)
+    horizontal_norm = math.hypot(x0, x1)  # |up x x|
+    horizontal = horizontal_norm > 1e-6
     if horizontal:
-        b1x, b1y, b1z = -xy / wn, xx / wn, 0.0
-        roll = xz / wn
+        b1 = [-x1 / horizontal_norm, x0 / horizontal_norm, 0.0]
     else:  # looking straight up or down: fall back on the display's left axis
-        b1x, b1y, b1z = R[0][1], R[1][1], R[2][1]
-        roll = 0.0
-    b2x, b2y, b2z = xy * b1z - xz * b1y, xz * b1x - xx * b1z, xx * b1y - xy * b1x
-    # The target direction in the tangent frame F = (x, b1, b2).
-    a = ux * xx + uy * xy + uz * xz
-    b = ux * b1x + uy * b1y + uz * b1z
-    c = ux * b2x + uy * b2y + uz * b2z
-    rho2 = a * a + b * b
-    if rho2 < 1e-18:  # max(rho2, 1e-18) without the call
-        rho2 = 1e-18
+        b1 = pose.rotation[:, 1].tolist()
+    b2 = [x1 * b1[2] - x2 * b1[1], x2 * b1[0] - x0 * b1[2], x0 * b1[1] - x1 * b1[0]]  # x cross b1
+    F = np.array([x, b1, b2])  # rows: the tangent frame's axes
+    u = F @ (offset / dist)  # the target direction in F
+    a, b, c = u.tolist()
+    rho2 = max(a * a + b * b, 1e-18)
     rho = math.sqrt(rho2)
     n2 = rho2 + c * c
-    d_az: list[float] = []
-    d_el: list[float] = []
-    for vx, vy, vz, wx, wy, wz in zip(*rows, strict=True):  # columns
-        # Origin velocity v and angular velocity w in F. F turns with w about b1 and b2 (that
-        # moves the line of sight); about x it turns so that b1 stays horizontal (o0 = o2 xz /
-        # |up x x|), or with the head when b1 is the display's axis.
-        v0 = vx * xx + vy * xy + vz * xz
-        v1 = vx * b1x + vy * b1y + vz * b1z
-        v2 = vx * b2x + vy * b2y + vz * b2z
-        o1 = wx * b1x + wy * b1y + wz * b1z
-        o2 = wx * b2x + wy * b2y + wz * b2z
-        o0 = o2 * roll if horizontal else wx * xx + wy * xy + wz * xz
-        # d(u in F) = F^T du - o x (u in F), with du = (u (u.v) - v) / dist
-        uv = a * v0 + b * v1 + c * v2
-        da = (a * uv - v0) / dist - (o1 * c - o2 * b)
-        db = (b * uv - v1) / dist - (o2 * a - o0 * c)
-        dc = (c * uv - v2) / dist - (o0 * b - o1 * a)
-        d_rho = (a * da + b * db) / rho
-        d_az.append((a * db - b * da) / rho2)
-        d_el.append((rho * dc - c * d_rho) / n2)
-    return math.atan2(b, a), math.atan2(c, rho), d_az, d_el
+    # Per joint (columns): the gaze origin's velocity V and the angular velocity W of F, both
+    # in F. F turns with the head about b1 and b2 (that moves the line of sight); about x it
+    # turns so that b1 stays horizontal (W0 = W2 x_z / |up x x|), or with the head when b1 is
+    # the display's axis.
+    V = F @ J[:3]
+    W = F @ J[3:]
+    if horizontal:
+        W[0] = W[2] * (x2 / horizontal_norm)
+    # d(u in F)/dq = F^T du - W x u, with du = (u (u . v) - v) / dist; u x W = [u]x W.
+    u_cross = np.array([[0.0, -c, b], [c, 0.0, -a], [-b, a, 0.0]])
+    du = (np.outer(u, u @ V) - V) / dist + u_cross @ W
+    # The gradient of (atan2(b, a), atan2(c, rho)) with respect to u = (a, b, c).
+    angles_by_u = np.array(
+        [[-b / rho2, a / rho2, 0.0], [-a * c / (rho * n2), -b * c / (rho * n2), rho / n2]]
+    )
+    error = np.array([math.atan2(b, a), math.atan2(c, rho)])
+    return error, angles_by_u @ du
 
 
 def _invalid(robot: RobotModel, q: np.ndarray, message: str) -> LookAtSolution:
@@ -217,8 +194,61 @@ def _invalid(robot: RobotModel, q: np.ndarray, message: str) -> LookAtSolution:
     )
 
 
-class RawSolution(NamedTuple):
-    """Result of :func:`solve_ik_raw` in plain floats (rad).
+Vector3 = tuple[float, float, float]
+
+
+class GazeFrame(NamedTuple):
+    """The gaze frame in the base frame, as floats: its origin and its x (line of sight), y
+    and z axes."""
+
+    origin: Vector3
+    x: Vector3
+    y: Vector3
+    z: Vector3
+
+    @classmethod
+    def of_rows(cls, rows: list[list[float]]) -> GazeFrame:
+        """From :meth:`RobotModel.gaze_frame_lists` rows ``[R_i0, R_i1, R_i2, p_i]``."""
+        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = rows
+        return cls((px, py, pz), (r00, r10, r20), (r01, r11, r21), (r02, r12, r22))
+
+    def offset(self, point: Sequence[float]) -> Vector3:
+        """``point - origin`` (base frame axes)."""
+        ox, oy, oz = self.origin
+        return (point[0] - ox, point[1] - oy, point[2] - oz)
+
+    def to_local(self, point: Sequence[float]) -> Vector3:
+        """``point`` (base frame) in the gaze frame."""
+        d = self.offset(point)
+        return (_dot(self.x, d), _dot(self.y, d), _dot(self.z, d))
+
+
+def _dot(a: Vector3, b: Vector3) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@dataclass(frozen=True)
+class HeadKinematics:
+    """The gaze frame (and, once computed, its Jacobian) at one head vector and arm pose.
+
+    Attributes:
+        frame: Gaze frame rows ``[R_i0, R_i1, R_i2, p_i]`` (see
+            :meth:`RobotModel.gaze_frame_lists`).
+        jacobian: The gaze frame Jacobian (6 x n; linear, angular) or ``None``.
+    """
+
+    frame: list[list[float]]
+    jacobian: np.ndarray | None = None
+
+    @property
+    def pose(self) -> GazePose:
+        """The frame as a :class:`GazePose`."""
+        rows = np.array(self.frame)
+        return GazePose(rows[:, 3], rows[:, :3])
+
+
+class HeadSolution(NamedTuple):
+    """Result of :func:`solve_head` (rad).
 
     Attributes:
         q: Head joint goals (``robot.head_joints`` order).
@@ -230,8 +260,7 @@ class RawSolution(NamedTuple):
         converged: On target, or no joint can turn closer (``False``: the iteration cap).
         stalled: No joint can turn closer.
         reached: Within the tolerance.
-        frame: Gaze frame rows at ``q`` (see :meth:`RobotModel.gaze_frame_lists`).
-        rows: Gaze Jacobian rows at ``q`` if the solver computed them, else ``None``.
+        kinematics: Gaze frame (and Jacobian, if computed) at ``q``: the next solve's warm start.
     """
 
     q: list[float]
@@ -242,209 +271,200 @@ class RawSolution(NamedTuple):
     converged: bool
     stalled: bool
     reached: bool
-    frame: list[list[float]] | None = None
-    rows: list[list[float]] | None = None
+    kinematics: HeadKinematics | None = None
 
 
-def solve_ik_raw(
+def _unusable(q: list[float], iterations: int) -> HeadSolution:
+    """The :class:`HeadSolution` of a target at the gaze origin."""
+    nan = math.nan
+    return HeadSolution(q, False, (nan, nan, nan), nan, iterations, False, False, False)
+
+
+def _distance_and_cos(frame: GazeFrame, target: Vector3) -> tuple[float, float]:
+    """The target's distance from the gaze origin and the cosine of its angle to the line of
+    sight (NaN at the origin)."""
+    offset = frame.offset(target)
+    dist = math.hypot(*offset)
+    return dist, _dot(frame.x, offset) / dist if dist > 0.0 else math.nan
+
+
+def _nudge_off_saddle(q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+    """Turn the first joint that can move by 0.1 rad (up, or down at its upper limit): looking
+    straight away from the target is a saddle of the error, where the gradient picks no side.
+    Returns whether a joint moved (``q`` is changed in place)."""
+    movable = np.flatnonzero(upper - lower > 1e-6)
+    if movable.size == 0:
+        return False
+    j = movable[0]
+    q[j] = q[j] + 0.1 if q[j] + 0.1 <= upper[j] else q[j] - 0.1
+    return True
+
+
+def _damped_step(
+    error: np.ndarray,
+    de_dq: np.ndarray,
+    q: np.ndarray,
+    bounds: tuple[np.ndarray, np.ndarray, np.ndarray],
+    cfg: IKConfig,
+) -> tuple[np.ndarray, float]:
+    """The damped least-squares step ``dq`` toward the target, with the rest posture pulled in
+    the null space of the pointing task, and how much of the error the joints can reduce
+    (``|de/dq dq|`` of the pointing part, rad).
+
+    Active set: a joint at a limit that the step pushes further is frozen (its column dropped)
+    and the step recomputed with the others.
+    """
+    lower, upper, rest = bounds
+    at_lower = q <= lower + _LIMIT_EPS
+    at_upper = q >= upper - _LIMIT_EPS
+    any_at_limit = bool(at_lower.any() or at_upper.any())
+    free = np.ones(q.shape, dtype=bool)
+    while free.any():
+        J = de_dq * free  # frozen joints' columns are zero
+        pinv = J.T @ _inverse_2x2(J @ J.T, cfg.damping)  # J^T (J J^T + damping I)^-1
+        dq = -(pinv @ error)
+        reducible = math.hypot(*(J @ dq).tolist())
+        # The posture pull only shapes the big first steps; near the best pointing it would
+        # keep trading redundant joints and slow the final convergence.
+        if reducible > cfg.posture_off and cfg.posture_gain > 0.0:
+            pull = cfg.posture_gain * (rest - q) * free
+            dq += pull - pinv @ (J @ pull)  # its null-space projection
+        if not any_at_limit:
+            return dq, reducible
+        blocked = free & ((at_lower & (dq < 0.0)) | (at_upper & (dq > 0.0)))
+        if not blocked.any():
+            return dq, reducible
+        free &= ~blocked
+    return np.zeros_like(q), 0.0
+
+
+def _inverse_2x2(A: np.ndarray, damping: float) -> np.ndarray:
+    """``(A + damping I)^-1`` of a symmetric 2 x 2 ``A`` in closed form."""
+    (a11, a12), (_, a22) = A.tolist()
+    a11 += damping
+    a22 += damping
+    det = a11 * a22 - a12 * a12
+    return np.array([[a22, -a12], [-a12, a11]]) / det
+
+
+def _take_step(
+    q: np.ndarray, dq: np.ndarray, cfg: IKConfig, lower: np.ndarray, upper: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """``q + dq`` with ``dq`` scaled down to at most ``cfg.max_step`` per joint, clipped to the
+    joint limits, and the largest joint change it made."""
+    biggest = float(abs(dq).max())
+    scale = cfg.max_step / biggest if biggest > cfg.max_step else 1.0
+    q_new = np.minimum(np.maximum(q + scale * dq, lower), upper)
+    return q_new, float(abs(q_new - q).max())
+
+
+def solve_head(
     robot: RobotModel,
     target: tuple[float, float, float],
-    qs: list[float],
+    q0: Sequence[float],
     cfg: IKConfig,
-    frame: list[list[float]] | None = None,
-    rows: list[list[float]] | None = None,
+    warm: HeadKinematics | None = None,
     jacobian: bool = False,
     tracking: bool = False,
-) -> RawSolution:
-    """The look-at iterations of :func:`solve_ik` on plain floats, for hot paths (the gaze
-    controller calls this every tick).
+) -> HeadSolution:
+    """The look-at iterations of :func:`solve_ik` (the gaze controller calls this every tick the
+    target moves): Gauss-Newton steps (:func:`_damped_step`) from ``q0`` until the head points
+    within ``cfg.tolerance``, no joint can turn it closer, or ``cfg.max_iterations``.
 
     Args:
         robot: The robot model.
         target: Finite 3D point (base frame).
-        qs: Warm start: finite head vector within limits.
+        q0: Warm start: finite head vector within limits.
         cfg: Solver settings.
-        frame, rows: The gaze frame (and Jacobian rows) at ``qs`` when known, e.g. from the
-            :class:`RawSolution` that produced ``qs`` (the same arm pose): saves recomputing them.
-        jacobian: Also return the Jacobian rows at the solution (to warm-start the next solve).
+        warm: The gaze frame (and Jacobian) at ``q0`` when known, e.g. the
+            :attr:`HeadSolution.kinematics` of the solve that produced ``q0`` (the same arm
+            pose): saves recomputing them.
+        jacobian: Also return the Jacobian at the solution (to warm-start the next solve).
         tracking: After the first step, stop as soon as the head points within
             ``cfg.tracking_tolerance`` of the target, or its joints can reduce the error by no
             more than that; such a solution reports ``converged`` only if it also meets
             ``cfg.tolerance``. (The first step is always taken, so the goal follows every
             move of the target, as with a full solve.)
     """
-    lower, upper, rest = robot.head_bounds
-    n = len(qs)
-    lam = cfg.damping
-    tol = cfg.tolerance
-    cos_tol = math.cos(tol)
+    lower, upper, _ = bounds = (robot.lower, robot.upper, robot.rest)
+    aim = np.array(target, dtype=float)
+    q = np.array(q0, dtype=float)
     loose = cfg.tracking_tolerance if tracking else 0.0
-    cos_loose = math.cos(loose) if tracking else 2.0
-    gain = cfg.posture_gain
-    posture_off = cfg.posture_off
-    tx, ty, tz = target
-    qs = list(qs)
+    cos_tolerance = math.cos(cfg.tolerance)
+    cos_loose = math.cos(loose) if tracking else 2.0  # 2: never
+    kin = warm if warm is not None else _kinematics_at(robot, q)
     iterations = 0
-    converged = False
-    stalled = False
-    nudged = False
+    converged = stalled = nudged = False
     stepped = False  # the looser tracking stop applies only after a step
-    # Only the pose is needed to test convergence; the Jacobian is computed for the steps (a
-    # warm start on a slowly moving target converges in one step: one Jacobian, two poses).
-    if frame is None:
-        frame = robot.gaze_frame_lists(qs)
-        rows = None
     # A head that holds still (eyes-only gaze mode, or no head joints) takes no step: the eyes do
     # all the pointing from where it is.
-    max_iterations = cfg.max_iterations if n and robot.head_moves else 0
+    max_iterations = cfg.max_iterations if q.size and robot.head_moves else 0
     if not max_iterations:
         converged = stalled = True
-    # Plain-Python floats on purpose: with n <= 4 joints numpy's per-call overhead would dominate.
     for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported afterwards)
-        (r00, _, _, px), (r10, _, _, py), (r20, _, _, pz) = frame
-        dx, dy, dz = tx - px, ty - py, tz - pz
-        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        dist, cos = _distance_and_cos(GazeFrame.of_rows(kin.frame), target)
         if dist < cfg.min_distance:
-            nan = math.nan
-            return RawSolution(qs, False, (nan, nan, nan), nan, iterations, False, False, False)
-        cos = (r00 * dx + r10 * dy + r20 * dz) / dist
-        if cos >= cos_tol:
+            return _unusable(q.tolist(), iterations)
+        if cos >= cos_tolerance:
             converged = True
             break
         if stepped and cos >= cos_loose:
             break
-        if rows is None:
-            rows = robot.gaze_jacobian_rows(qs)
-        e0, e1, r0, r1 = _pointing_error(frame, (px, py, pz), rows, target)
-        if not nudged and e0 * e0 + e1 * e1 > 2.0:
-            g2 = sum((a * e0 + b * e1) ** 2 for a, b in zip(r0, r1, strict=True))
-            if g2 < 1e-20:
-                # Looking straight away from the target (a saddle of the error): nudge the first
-                # joint that can move so the gradient picks a side.
-                for j in range(n):
-                    if upper[j] - lower[j] > 1e-6:
-                        qs[j] = qs[j] + 0.1 if qs[j] + 0.1 <= upper[j] else qs[j] - 0.1
-                        nudged = True
-                        break
-                if nudged:
-                    frame, rows = robot.gaze_frame_lists(qs), None
-                    continue
-        # The active set below only matters when some joint is at a limit.
-        at_limit = False
-        for q, lo, hi in zip(qs, lower, upper, strict=True):
-            if q <= lo + _LIMIT_EPS or q >= hi - _LIMIT_EPS:
-                at_limit = True
-                break
-        free = range(n)
-        dq = [0.0] * n
-        reducible = 0.0
-        for _ in range(n):
-            a11 = a12 = a22 = 0.0
-            for j in free:
-                v, w = r0[j], r1[j]
-                a11 += v * v
-                a12 += v * w
-                a22 += w * w
-            a11 += lam
-            a22 += lam
-            det = a11 * a22 - a12 * a12
-            i11, i12, i22 = a22 / det, -a12 / det, a11 / det
-            # damped pseudo-inverse columns (pinv = Jf^T (Jf Jf^T + lam I)^-1)
-            p0 = [0.0] * n
-            p1 = [0.0] * n
-            dq = [0.0] * n
-            j0 = j1 = 0.0
-            for j in free:
-                v, w = r0[j], r1[j]
-                a, b = v * i11 + w * i12, v * i12 + w * i22
-                p0[j] = a
-                p1[j] = b
-                s_ = -(a * e0 + b * e1)
-                dq[j] = s_
-                j0 += v * s_
-                j1 += w * s_
-            reducible = math.hypot(j0, j1)
-            # The posture pull only shapes the big first steps; near the best pointing it would
-            # keep trading redundant joints and slow the final convergence.
-            if reducible > posture_off and gain > 0.0:
-                y = [0.0] * n
-                y0 = y1 = 0.0
-                for j in free:
-                    yj = gain * (rest[j] - qs[j])
-                    y[j] = yj
-                    y0 += r0[j] * yj
-                    y1 += r1[j] * yj
-                # null-space projection: y - pinv (Jf y)
-                for j in free:
-                    dq[j] = dq[j] + y[j] - (p0[j] * y0 + p1[j] * y1)
-            if not at_limit:
-                break
-            blocked = [
-                j
-                for j in free
-                if (qs[j] <= lower[j] + _LIMIT_EPS and dq[j] < 0.0)
-                or (qs[j] >= upper[j] - _LIMIT_EPS and dq[j] > 0.0)
-            ]
-            if not blocked:
-                break
-            free = [j for j in free if j not in blocked]
-            if not free:
-                dq = [0.0] * n
-                reducible = 0.0
-                break
-        if reducible <= tol:
+        kin = _with_jacobian(robot, kin, q)
+        error, de_dq = pointing_error(kin.pose, kin.jacobian, aim)  # type: ignore[arg-type]
+        if not nudged and _at_saddle(error, de_dq):
+            nudged = _nudge_off_saddle(q, lower, upper)
+            if nudged:
+                kin = _kinematics_at(robot, q)
+                continue
+        dq, reducible = _damped_step(error, de_dq, q, bounds, cfg)
+        if reducible <= cfg.tolerance:
             stalled = True  # the joints can no longer turn the gaze closer: the eyes take the rest
             break
         if stepped and reducible <= loose:
             break
-        biggest = max(map(abs, dq))
-        scale = cfg.max_step / biggest if biggest > cfg.max_step else 1.0
-        q_new = []
-        moved = 0.0
-        for a, b, lo, hi in zip(qs, dq, lower, upper, strict=True):
-            x = a + scale * b
-            if x < lo:
-                x = lo
-            if x > hi:
-                x = hi
-            q_new.append(x)
-            d = abs(x - a)
-            if d > moved:
-                moved = d
+        q_new, moved = _take_step(q, dq, cfg, lower, upper)
         if moved < cfg.min_step:
             stalled = True
             break
-        qs = q_new
-        stepped = True
-        frame, rows = robot.gaze_frame_lists(qs), None
+        q, stepped = q_new, True
+        kin = _kinematics_at(robot, q)
 
-    (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = frame
-    dx, dy, dz = tx - px, ty - py, tz - pz
-    if not max_iterations and math.sqrt(dx * dx + dy * dy + dz * dz) < cfg.min_distance:
-        nan = math.nan
-        return RawSolution(qs, False, (nan, nan, nan), nan, 0, False, False, False)
-    local = (
-        r00 * dx + r10 * dy + r20 * dz,
-        r01 * dx + r11 * dy + r21 * dz,
-        r02 * dx + r12 * dy + r22 * dz,
+    frame = GazeFrame.of_rows(kin.frame)
+    if not max_iterations and math.hypot(*frame.offset(target)) < cfg.min_distance:
+        return _unusable(q.tolist(), 0)
+    local = frame.to_local(target)
+    residual = math.atan2(math.hypot(local[1], local[2]), local[0])  # from the line of sight
+    reached = residual <= cfg.tolerance
+    return HeadSolution(
+        q=q.tolist(),
+        valid=True,
+        local=local,
+        residual=residual,
+        iterations=iterations,
+        converged=converged or stalled or reached,
+        stalled=stalled,
+        reached=reached,
+        kinematics=_with_jacobian(robot, kin, q) if jacobian else kin,
     )
-    # angle_between((1, 0, 0), local) with its zero terms dropped (the same floats).
-    residual = math.atan2(math.sqrt(local[2] * local[2] + local[1] * local[1]), local[0])
-    reached = residual <= tol
-    if jacobian and rows is None:
-        rows = robot.gaze_jacobian_rows(qs)
-    return RawSolution(
-        qs,
-        True,
-        local,
-        residual,
-        iterations,
-        converged or stalled or reached,
-        stalled,
-        reached,
-        frame,
-        rows,
-    )
+
+
+def _kinematics_at(robot: RobotModel, q: np.ndarray) -> HeadKinematics:
+    """The gaze frame at head vector ``q`` (its Jacobian computed when first needed)."""
+    return HeadKinematics(robot.gaze_frame_lists(q.tolist()))
+
+
+def _with_jacobian(robot: RobotModel, kin: HeadKinematics, q: np.ndarray) -> HeadKinematics:
+    """``kin`` (the kinematics at ``q``) with its Jacobian."""
+    if kin.jacobian is not None:
+        return kin
+    return HeadKinematics(kin.frame, np.array(robot.gaze_jacobian_rows(q.tolist())))
+
+
+def _at_saddle(error: np.ndarray, de_dq: np.ndarray) -> bool:
+    """Looking about straight away from the target (an error beyond ~80 deg) where the error's
+    gradient vanishes: a saddle, where a Gauss-Newton step picks no side."""
+    return bool(error @ error > 2.0 and np.sum((error @ de_dq) ** 2) < 1e-20)
 
 
 def solve_ik(
@@ -487,7 +507,7 @@ def solve_ik(
             robot, q, f"target is farther than {cfg.max_distance:g} m: holding the previous pose"
         )
 
-    out = solve_ik_raw(robot, tuple(t.tolist()), q.tolist(), cfg)
+    out = solve_head(robot, tuple(t.tolist()), q.tolist(), cfg)
     if not out.valid:
         message = "target is at the gaze origin: no direction to look"
         return _invalid(robot, np.array(out.q), message)

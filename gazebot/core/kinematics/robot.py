@@ -17,8 +17,14 @@ import numpy as np
 import pinocchio as pin
 
 from gazebot.core.config import ConfigError
-from gazebot.core.kinematics.config import RobotConfig, load_robot_config, resolve_mjcf
 from gazebot.core.kinematics.eyes import DisplayEyes
+from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config, resolve_mjcf
+
+
+def _radians(degrees: Sequence[float]) -> tuple[float, float]:
+    """A ``(min, max)`` range in degrees, in rad."""
+    lo, hi = degrees
+    return math.radians(lo), math.radians(hi)
 
 
 @dataclass(frozen=True)
@@ -33,7 +39,7 @@ class GazePose:
         """Unit +x axis of the gaze frame."""
         return self.rotation[:, 0]
 
-    def to_local(self, point: np.ndarray) -> np.ndarray:
+    def to_local(self, point: np.ndarray | Sequence[float]) -> np.ndarray:
         """``point`` (base frame) expressed in the gaze frame."""
         return self.rotation.T @ (np.asarray(point, dtype=float) - self.position)
 
@@ -53,7 +59,6 @@ class RobotModel:
         lower, upper: Head joint position limits (rad), from the MJCF.
         velocity_limits: Head joint velocity limits (rad/s), from the YAML.
         rest: Head rest posture (rad).
-        head_bounds: ``(lower, upper, rest)`` as lists of floats (read-only arrays above).
         eye_yaw_range, eye_pitch_range: Eye ranges (rad) as ``(min, max)``.
         eye_velocity_limit: Eye speed limit (rad/s).
         eyes: The display eyes (range and speed) as a :class:`DisplayEyes`; in ``head-only``
@@ -112,20 +117,14 @@ class RobotModel:
         )
         rest = np.radians([config.head_rest_deg.get(n, 0.0) for n in self.head_joints])
         self.rest = np.clip(rest, self.lower, self.upper)
-        # Read-only, so the plain-float copies the hot paths use cannot go stale.
-        for arr in (self.lower, self.upper, self.rest):
+        for arr in (self.lower, self.upper, self.rest, self.velocity_limits):
             arr.flags.writeable = False
-        self.head_bounds = (self.lower.tolist(), self.upper.tolist(), self.rest.tolist())
         self.gaze_mode = config.gaze_mode
         self.head_moves = bool(self.head_joints) and self.gaze_mode != "eyes-only"
         fixed_eyes = self.gaze_mode == "head-only"
-        self.eye_yaw_range = (
-            (0.0, 0.0) if fixed_eyes else tuple(math.radians(v) for v in config.eyes.yaw_range_deg)
-        )
+        self.eye_yaw_range = (0.0, 0.0) if fixed_eyes else _radians(config.eyes.yaw_range_deg)
         self.eye_pitch_range = (
-            (0.0, 0.0)
-            if fixed_eyes
-            else tuple(math.radians(v) for v in config.eyes.pitch_range_deg)
+            (0.0, 0.0) if fixed_eyes else _radians(config.eyes.pitch_range_deg)
         )
         self.eye_velocity_limit = math.radians(config.eyes.velocity_limit_deg_s)
         self.eyes = DisplayEyes(self.eye_yaw_range, self.eye_pitch_range, self.eye_velocity_limit)
@@ -135,15 +134,9 @@ class RobotModel:
         for name, i in zip(self.passive_joints, self.passive_idx, strict=True):
             self._q[i] = self.arm_home.get(name, 0.0)
         self._q[self.head_idx] = self.rest
-        # Hot-path helpers: a scratch configuration (its head entries are overwritten by every
-        # list-based kinematics call), a basic slice for the head when its indices are
-        # contiguous (cheaper than fancy indexing), and a counter of arm moves for pose caches.
+        # A scratch configuration (its head entries are overwritten by every list-based
+        # kinematics call) and a counter of arm moves, the key of kept poses.
         self._q_work = self._q.copy()
-        first = int(self.head_idx[0]) if len(self.head_idx) else 0
-        contiguous = self.head_idx.tolist() == list(range(first, first + len(self.head_idx)))
-        self._head_sel = slice(first, first + len(self.head_idx)) if contiguous else self.head_idx
-        # A one-joint head's index: setting one item costs a quarter of a slice set from a list.
-        self._head_one = first if len(self.head_idx) == 1 else None
         self._arm_revision = 0
         # (head vector, arm revision) whose forward kinematics :attr:`data` holds, or None.
         self._kinematics_of: tuple[tuple[float, ...], int] | None = None
@@ -253,27 +246,25 @@ class RobotModel:
         """Gaze frame pose for head vector ``q_head`` as plain lists: three rows ``[R_i0, R_i1,
         R_i2, p_i]`` (rotation columns = x, y, z; origin ``p``).
 
-        The hot paths (look-at solver, gaze controller) use lists: with 3-vectors and <= 4 joints,
-        numpy's per-call overhead would dominate. The last frame is kept and returned again for
-        the same head vector and arm pose (the same list: callers must not change it).
+        The last frame is kept and returned again for the same head vector and arm pose (the
+        same list: callers must not change it): the gaze controller computes the frame at the
+        head command and the runtime loop asks for it again in the same tick.
+
+        Raises:
+            ValueError: ``q_head`` has not one value per head joint.
         """
         key = (tuple(q_head), self._arm_revision)
         last = self._last_frame
         if last is not None and last[0] == key:
             return last[1]
         q = self._q_work
-        one = self._head_one
-        if one is not None:
-            if len(key[0]) != 1:
-                raise ValueError(f"expected 1 head joint value, got {len(key[0])}")
-            q[one] = key[0][0]  # (an item set: a quarter of the slice set's cost)
-        else:
-            q[self._head_sel] = q_head
+        if len(key[0]) != self.n_head:
+            raise ValueError(f"expected {self.n_head} head joint values, got {len(key[0])}")
+        q[self.head_idx] = key[0]
         pin.forwardKinematics(self.model, self.data, q)
         M = pin.updateFramePlacement(self.model, self.data, self.gaze_frame_id)
         self._kinematics_of = key
-        rows = M.homogeneous.tolist()
-        del rows[3]  # (0, 0, 0, 1): cheaper than converting a sliced copy of the matrix
+        rows = M.homogeneous[:3].tolist()
         self._last_frame = (key, rows)
         return rows
 
@@ -289,11 +280,11 @@ class RobotModel:
             pin.computeJointJacobians(self.model, self.data)
         else:
             q = self._q_work
-            q[self._head_sel] = q_head
+            q[self.head_idx] = q_head
             pin.computeJointJacobians(self.model, self.data, q)
             self._kinematics_of = (tuple(q_head), self._arm_revision)
         J = pin.getFrameJacobian(self.model, self.data, self.gaze_frame_id, pin.LOCAL_WORLD_ALIGNED)
-        return J[:, self._head_sel].tolist()
+        return J[:, self.head_idx].tolist()
 
     def gaze_jacobian(self, q_head: np.ndarray) -> tuple[GazePose, np.ndarray]:
         """Gaze pose and its frame Jacobian (6 x n_head) in LOCAL_WORLD_ALIGNED: linear velocity

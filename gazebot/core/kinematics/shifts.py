@@ -16,8 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-# Peak velocity of a rest-to-rest minimum-jerk move = MINJERK_PEAK * amplitude / duration.
-MINJERK_PEAK = 1.875
+from gazebot.core.minimum_jerk import PEAK_RATE
 
 
 class GazeShiftConfig(BaseModel):
@@ -53,12 +52,6 @@ class GazeShiftConfig(BaseModel):
         return math.radians(self.saccade_threshold_deg)
 
 
-def min_jerk(tau: float) -> float:
-    """Normalized minimum-jerk position ``10 s^3 - 15 s^4 + 6 s^5``, ``s = clip(tau, 0, 1)``."""
-    s = min(max(tau, 0.0), 1.0)
-    return s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
-
-
 def min_jerk_duration(
     amplitude: np.ndarray | float,
     nominal: float,
@@ -69,7 +62,7 @@ def min_jerk_duration(
     ``margin * velocity_limit`` for every joint."""
     amp = np.abs(np.asarray(amplitude, dtype=float))
     vmax = np.asarray(velocity_limit, dtype=float) * margin
-    need = float(np.max(MINJERK_PEAK * amp / vmax)) if amp.size else 0.0
+    need = float(np.max(PEAK_RATE * amp / vmax)) if amp.size else 0.0
     return max(nominal, need)
 
 
@@ -90,25 +83,41 @@ class Trajectory(ABC):
         return self.evaluate(t)[0]
 
 
-# Position, velocity and acceleration of every joint as plain floats.
-Sample = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]
+# c3, c4, c5 of the quintic: _HIGH_ORDER @ (d, v0 T, a0 T^2), each divided by 2 T^k.
+_HIGH_ORDER = np.array([[20.0, -12.0, -3.0], [-30.0, 16.0, 3.0], [12.0, -6.0, -1.0]])
+_HIGH_ORDER_SCALE = 0.5
+_HIGH_POWERS = np.array([[3.0], [4.0], [5.0]])
+for _constant in (_HIGH_ORDER, _HIGH_POWERS):
+    _constant.flags.writeable = False
 
 
-def _floats(x: np.ndarray | Sequence[float]) -> list[float]:
-    """A flat list of Python floats."""
-    if isinstance(x, np.ndarray):
-        return x.astype(float, copy=False).reshape(-1).tolist()
-    if type(x) is list or type(x) is tuple:
-        return list(map(float, x))
-    return np.asarray(x, dtype=float).reshape(-1).tolist()
+def _joint_vector(x: np.ndarray | Sequence[float] | None, n: int, name: str) -> np.ndarray:
+    """``x`` as a float vector of ``n`` values (``None``: zeros).
+
+    Raises:
+        ValueError: ``x`` has another length.
+    """
+    if x is None:
+        return np.zeros(n)
+    v = np.asarray(x, dtype=float).reshape(-1)
+    if v.shape != (n,):
+        raise ValueError(f"p0, p1, v0 and a0 must have the same length ({name}: {v.size} != {n})")
+    return v
 
 
 class MinJerkTrajectory(Trajectory):
     """Quintic from ``(p0, v0, a0)`` at ``t0`` to ``(p1, 0, 0)`` at ``t0 + duration``.
 
-    With ``v0 = a0 = 0`` this is the classic minimum-jerk profile; non-zero initial velocity and
-    acceleration let a moving neck re-plan toward a new goal without a jump in velocity or
-    acceleration (the minimum-jerk solution for those boundary conditions).
+    With ``v0 = a0 = 0`` this is the classic minimum-jerk profile
+    (:func:`gazebot.core.minimum_jerk.minimum_jerk`); non-zero initial velocity and acceleration
+    let a moving neck re-plan toward a new goal without a jump in velocity or acceleration (the
+    minimum-jerk solution for those boundary conditions). Per joint, with ``d = p1 - p0`` and
+    ``s = t - t0`` in ``[0, T]``:
+
+        p(s) = p0 + v0 s + a0/2 s^2 + c3 s^3 + c4 s^4 + c5 s^5,
+        c3 = (20 d - 12 v0 T - 3 a0 T^2) / (2 T^3),
+        c4 = (-30 d + 16 v0 T + 3 a0 T^2) / (2 T^4),
+        c5 = (12 d - 6 v0 T - a0 T^2) / (2 T^5).
     """
 
     def __init__(
@@ -122,118 +131,57 @@ class MinJerkTrajectory(Trajectory):
     ) -> None:
         if not duration > 0.0:
             raise ValueError(f"duration must be positive, got {duration}")
-        # Plain floats on purpose: the gaze controller re-plans every tick for 1-4 joints, where
-        # numpy's per-call overhead would cost more than the arithmetic.
-        start = _floats(p0)
-        n = len(start)
-        self._plan(
-            float(t0),
-            float(duration),
-            start,
-            _floats(p1),
-            [0.0] * n if v0 is None else _floats(v0),
-            [0.0] * n if a0 is None else _floats(a0),
-        )
-
-    @classmethod
-    def of_floats(
-        cls,
-        t0: float,
-        duration: float,
-        p0: Sequence[float],
-        p1: Sequence[float],
-        v0: Sequence[float],
-        a0: Sequence[float],
-    ) -> MinJerkTrajectory:
-        """The trajectory ``MinJerkTrajectory(t0, duration, p0, p1, v0, a0)`` gives, from values
-        that already are Python floats (``duration > 0``, sequences of equal length): the gaze
-        controller re-plans every tick and skips the conversions (a duration from the config
-        may be an int)."""
-        traj = cls.__new__(cls)
-        traj._plan(t0, float(duration), p0, p1, v0, a0)
-        return traj
-
-    def _plan(
-        self,
-        t0: float,
-        T: float,
-        start: Sequence[float],
-        goal: Sequence[float],
-        vel: Sequence[float],
-        acc: Sequence[float],
-    ) -> None:
-        """The quintic's coefficients per joint from floats."""
-        n = len(start)
-        if not len(goal) == len(vel) == len(acc) == n:
-            raise ValueError("p0, p1, v0 and a0 must have the same length")
-        k3, k4, k5 = 0.5 / T**3, 0.5 / T**4, 0.5 / T**5
-        self.t0 = t0
+        start = np.asarray(p0, dtype=float).reshape(-1)
+        n = start.size
+        goal = _joint_vector(p1, n, "p1")
+        vel = _joint_vector(v0, n, "v0")
+        acc = _joint_vector(a0, n, "a0")
+        T = float(duration)
+        self.t0 = float(t0)
         self.duration = T
-        self._goal = tuple(goal)
-        coeffs = []
-        for p, g, v, a in zip(start, goal, vel, acc, strict=True):
-            d, vt, at2 = g - p, v * T, a * T * T
-            coeffs.append(
-                (
-                    p,
-                    v,
-                    0.5 * a,
-                    (20.0 * d - 12.0 * vt - 3.0 * at2) * k3,
-                    (-30.0 * d + 16.0 * vt + 3.0 * at2) * k4,
-                    (12.0 * d - 6.0 * vt - at2) * k5,
-                )
-            )
-        self._coeffs = coeffs
-        self._last: tuple[float, Sample] | None = None
+        self._goal = goal
+        # Rows: the coefficients of s^0 .. s^5, one column per joint (see the class docstring).
+        boundary = np.array([goal - start, vel * T, acc * T * T])
+        self._coeffs = np.vstack(
+            [start, vel, 0.5 * acc, (_HIGH_ORDER @ boundary) * _HIGH_ORDER_SCALE / T**_HIGH_POWERS]
+        )
 
     @property
     def goal(self) -> np.ndarray:
         """The end position."""
-        return np.array(self._goal)
+        return self._goal.copy()
 
     @property
     def end_time(self) -> float:
         return self.t0 + self.duration
 
-    def sample(self, t: float) -> Sample:
-        """:meth:`evaluate` as tuples of floats (position, velocity, acceleration)."""
-        last = self._last
-        if last is not None and last[0] == t:
-            # A plan asked twice for the same time (e.g. a re-plan's start state) is computed once.
-            return last[1]
+    def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         s = min(max(t - self.t0, 0.0), self.duration)
         if s >= self.duration:
             # Exactly at rest on the goal afterwards (no round-off creep).
-            zeros = (0.0,) * len(self._goal)
-            out: Sample = (self._goal, zeros, zeros)
-        else:
-            pos, vel, acc = [], [], []
-            for c0, c1, c2, c3, c4, c5 in self._coeffs:
-                pos.append(c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5)))))
-                vel.append(c1 + s * (2 * c2 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5))))
-                acc.append(2 * c2 + s * (6 * c3 + s * (12 * c4 + s * 20 * c5)))
-            out = (tuple(pos), tuple(vel), tuple(acc))
-        self._last = (t, out)
-        return out
+            zeros = np.zeros_like(self._goal)
+            return self._goal.copy(), zeros, zeros.copy()
+        pos, vel, acc = _power_basis(s) @ self._coeffs
+        return pos, vel, acc
 
-    def sample_position(self, t: float) -> list[float]:
-        """The position of :meth:`sample` alone, as a list of floats (the gaze controller's
-        command each tick; velocity and acceleration are needed only to re-plan)."""
-        # min(max(t - t0, 0), duration) as comparisons (the same float, NaN and -0.0
-        # included): this runs every tick the neck moves.
-        s = t - self.t0
-        if 0.0 > s:
-            s = 0.0
-        duration = self.duration
-        if duration < s:
-            s = duration
-        if s >= duration:
-            return list(self._goal)
-        return [
-            c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))))
-            for c0, c1, c2, c3, c4, c5 in self._coeffs
+    def position(self, t: float) -> np.ndarray:
+        s = min(max(t - self.t0, 0.0), self.duration)
+        if s >= self.duration:
+            return self._goal.copy()
+        return _power_basis(s)[0] @ self._coeffs
+
+
+def _power_basis(s: float) -> np.ndarray:
+    """Rows: ``(1, s, ..., s^5)`` and its first and second derivatives in ``s``, so that the
+    quintic's coefficient rows ``c`` give position, velocity and acceleration as
+    ``_power_basis(s) @ c``."""
+    s2 = s * s
+    s3 = s2 * s
+    s4 = s3 * s
+    return np.array(
+        [
+            [1.0, s, s2, s3, s4, s4 * s],
+            [0.0, 1.0, 2.0 * s, 3.0 * s2, 4.0 * s3, 5.0 * s4],
+            [0.0, 0.0, 2.0, 6.0 * s, 12.0 * s2, 20.0 * s3],
         ]
-
-    def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        pos, vel, acc = self.sample(t)
-        return np.array(pos), np.array(vel), np.array(acc)
+    )

@@ -9,24 +9,16 @@
    velocities by central differences, unknown next to a tracking gap (where the window is
    one-sided and would flatten the motion into a false rest).
 
-Both hands go through each step together (one array of six columns): the online detector runs
-this every few ticks on a few hundred samples, where numpy's per-call overhead, not the
-arithmetic, sets the cost. The result is, bit for bit, what the steps give one hand at a time
-(``tests/core/phases/signals_reference.py`` keeps that form and the tests compare the two). Online,
-a :class:`SignalCache` keeps the last result, and the next analysis of the same window a few
-samples longer computes only the rows those samples change (the same result, bit for bit).
-
-Here and in the rules, the arrays' own methods (``a.searchsorted(x)``, ``m.nonzero()[0]``,
-``a.argmax()``) stand for numpy's functions of the same name (``np.searchsorted``,
-``np.flatnonzero``, ``np.argmax``), and ``x[1:] - x[:-1]`` for ``np.diff(x)`` (the subtraction
-it makes): the same computation without the functions' Python-level dispatch, which costs
-more than the work on these short arrays.
+Both hands go through each step together (one array of six columns). The result is, bit for
+bit, what the steps give one hand at a time (``tests/core/phases/signals_reference.py`` keeps
+that form and the tests compare the two). Online, a :class:`SignalCache` keeps the last result,
+and the next analysis of the same window a few samples longer computes only the rows those
+samples change (the same result, bit for bit).
 """
 
 from __future__ import annotations
 
 import math
-import operator
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -199,16 +191,12 @@ def smooth(x: np.ndarray, m: np.ndarray, sigma: float) -> tuple[np.ndarray, np.n
 
 
 def _smooth_all_seen(x: np.ndarray, hands: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`smooth` of at least two rows, every one seen (the usual case: only the positions
-    need smoothing; the seen share is the same at every row), ``sigma`` > 0."""
+    """:func:`smooth` of at least two rows, every one seen (only the positions need
+    smoothing; the seen share is the same at every row), ``sigma`` > 0."""
     share = _seen_share(sigma)
-    den = np.empty((x.shape[0], hands))
-    den.fill(share)  # (np.full's work without its argument handling)
-    # (an output array given: scipy allocates none, skipping its dtype-name lookup, a few
-    # microseconds a call)
-    out = np.empty_like(x)
-    correlate1d(x, gaussian_weights(sigma), axis=0, output=out, mode="nearest")
-    np.divide(out, max(share, 1e-12), out=out)
+    den = np.full((x.shape[0], hands), share)
+    out = correlate1d(x, gaussian_weights(sigma), axis=0, mode="nearest")
+    out /= max(share, 1e-12)
     if share < 0.5:
         out[:] = np.nan
     return out, den
@@ -263,74 +251,16 @@ def smooth_seen_prefix(x: np.ndarray, seen: int, sigma: float) -> tuple[np.ndarr
     return out, share
 
 
-# What np.nanmax (np.nanmin) computes for a float array: the largest (smallest) value that is
-# not NaN, NaN if all are, ``initial`` taking part if given. numpy's own reduction, without
-# its argument handling and all-NaN warning (the rules read several per analysis).
+# The largest (smallest) value of a float array that is not NaN, NaN if all are, ``initial``
+# taking part if given: numpy's fmax (fmin) reduction, which is np.nanmax (np.nanmin) without
+# its all-NaN warning (a window may hold no known value).
 nanmax = np.fmax.reduce
 nanmin = np.fmin.reduce
 
 
-def nanargmax(x: np.ndarray) -> int:
-    """``int(np.nanargmax(x))`` of a 1-D float array: the index of the first largest value
-    that is not NaN (NaN read as -inf; ``ValueError`` if all are NaN or none are given, as
-    numpy), without numpy's copy and fill when no value is NaN."""
-    nan = np.isnan(x)
-    if not nan.any():
-        return int(x.argmax())
-    if nan.all():
-        raise ValueError("All-NaN slice encountered")
-    return int(np.where(nan, -np.inf, x).argmax())
-
-
-def median(x: np.ndarray) -> float:
-    """``np.median`` of a non-empty 1-D float array (the middle value, or the mean of the two
-    middle ones; NaN if any is NaN), without its generic machinery (tens of microseconds a
-    call: the analysis reads several)."""
-    n = x.shape[0]
-    h = n // 2
-    kth = [h, n - 1] if n % 2 else [h - 1, h, n - 1]
-    part = np.partition(x, kth)
-    if math.isnan(part[-1]):
-        return math.nan
-    return float(part[h]) if n % 2 else (float(part[h - 1]) + float(part[h])) / 2.0
-
-
-def quantile(x: np.ndarray, q: float) -> float:
-    """``np.quantile(x, q)`` (its default ``linear`` method) of a non-empty 1-D float array
-    without NaN: the two order statistics around ``(n - 1) q`` and numpy's interpolation
-    between them, without its generic machinery (the transfer rule reads one per analysis)."""
-    n = x.shape[0]
-    vi = (n - 1) * q
-    if vi >= n - 1:
-        lo = hi = n - 1
-    elif vi < 0:
-        lo = hi = 0
-    else:
-        lo = math.floor(vi)
-        hi = lo + 1
-    part = np.partition(x, [lo, hi] if hi != lo else [lo])
-    a, b = float(part[lo]), float(part[hi])
-    gamma = vi - lo
-    # numpy's _lerp: from the nearer end
-    diff = b - a
-    return b - diff * (1.0 - gamma) if gamma >= 0.5 else a + diff * gamma
-
-
 def vector_norm(v: np.ndarray) -> float:
-    """``float(np.linalg.norm(v))`` of a float64 array (its entries' 2-norm): numpy's own
-    arithmetic for it, the square root of the flattened array's dot with itself, without its
-    argument handling (a few microseconds a call: the rules read single vectors' norms in
-    loops). Not a sum of squares in another order: numpy's dot may fuse them, so only this is
-    bit-equal."""
-    x = v.ravel(order="K")
-    return math.sqrt(float(x.dot(x)))
-
-
-def row_norms(x: np.ndarray) -> np.ndarray:
-    """Row norms of real (N, 3) ``x``: what ``np.linalg.norm(x, axis=1)`` computes (the squares
-    summed in its order, pinned by the tests against it), column by column: numpy's reduction
-    over a length-3 axis (and its argument handling) costs more than the three columns."""
-    return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])
+    """The 2-norm of ``v``'s entries as a float."""
+    return float(np.linalg.norm(v))
 
 
 def _derived_into(
@@ -349,13 +279,11 @@ def _derived_into(
     the closing, common and hold speeds (see :class:`Signals`). Each ``q[i]`` must be
     contiguous (as the einsum reads it)."""
     gv, rv = q[2], q[3]
-    # The five vectors whose norms are needed, in one block: what row_norms computes for each,
-    # in a few numpy calls instead of six per vector.
+    # The five vectors whose norms are needed, in one block.
     np.subtract(x[:, 3:], x[:, :3], out=q[0])
     np.subtract(rv, gv, out=q[1])
     np.add(gv, rv, out=q[4])
-    sq = q * q
-    np.sqrt(sq[:, :, 0] + sq[:, :, 1] + sq[:, :, 2], out=norms)
+    norms[:] = np.linalg.norm(q, axis=2)
     np.multiply(0.5, norms[4], out=common)
     np.negative(np.einsum("ij,ij->i", q[1], q[0]), out=closing)
     np.divide(closing, np.maximum(norms[0], 1e-9), out=closing)
@@ -383,13 +311,10 @@ def _by_hand(rows: np.ndarray) -> np.ndarray:
 
 
 def _velocities(x: np.ndarray, full: np.ndarray, dt: float) -> np.ndarray:
-    """Velocities of the smoothed rows ``x`` (at least two): np.gradient's central differences
-    inside, one-sided at the ends (its arithmetic, without its generic set-up), NaN where the
-    smoothing window held less than ``FULL_WINDOW`` data (``full``, per row and hand)."""
-    v = np.empty_like(x)
-    v[1:-1] = (x[2:] - x[:-2]) / (2.0 * dt)
-    v[0] = (x[1] - x[0]) / dt
-    v[-1] = (x[-1] - x[-2]) / dt
+    """Velocities of the smoothed rows ``x`` (at least two): central differences inside,
+    one-sided at the ends, NaN where the smoothing window held less than ``FULL_WINDOW`` data
+    (``full``, per row and hand)."""
+    v = np.gradient(x, dt, axis=0)
     # Next to a tracking gap the window is one-sided and flattens the motion: velocities
     # there are unknown, not slow.
     v = v.reshape(v.shape[0], 2, 3)
@@ -445,7 +370,7 @@ def compute_signals(
         )
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has
     # corners at every sample that would otherwise show up as speed spikes.
-    med_dt = median(t[1:] - t[:-1]) if n > 1 else dt
+    med_dt = float(np.median(np.diff(t))) if n > 1 else dt
     sigma_s = max(0.5 * config.smoothing, 0.5 * med_dt)
     fin = np.isfinite(x)
     m = fin[:, 0::3] & fin[:, 1::3] & fin[:, 2::3]  # (rows, hands)
@@ -524,7 +449,7 @@ class SignalCache:
         self._g = np.empty((0, 3))
         self._r = np.empty((0, 3))
         # per sample and hand: every coordinate seen, and also not a stale repeat; None while
-        # every sample kept is both (_clean: the interpolation's fast path)
+        # every sample kept is both (_clean: one interpolation for both hands)
         self._seen: np.ndarray | None = None
         self._ok: np.ndarray | None = None
         self._clean = False
@@ -644,27 +569,20 @@ class SignalCache:
         # The new samples: seen and valid per hand. The usual case, every one seen and none
         # repeating a coordinate of the one before, needs no per-hand search.
         tail = np.concatenate((g_in[n0 - 1 :], r_in[n0 - 1 :]), axis=1)
-        # (a sum is finite only if every term is; one that overflows only costs the search)
-        # (the ufuncs' reductions and count_nonzero: what .sum() and .any() compute, without
-        # their Python-level wrappers; a microsecond or two an analysis)
         clean = (
-            self._clean
-            and math.isfinite(float(np.add.reduce(tail, axis=None)))
-            and not np.count_nonzero(tail[1:] == tail[:-1])
+            self._clean and bool(np.isfinite(tail).all()) and not (tail[1:] == tail[:-1]).any()
         )
         if not clean:
             sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
             sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
             seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
-        # (few new samples: their largest step in plain floats, each later minus earlier)
-        new_t = t[n0 - 1 :].tolist()
-        max_dt = max(self._max_dt, max(map(operator.sub, new_t[1:], new_t)))
+        max_dt = max(self._max_dt, float(np.diff(t[n0 - 1 :]).max()))
         dt = 1.0 / config.analysis_rate
         # The smoothing width: half the median sample interval only counts when it exceeds
         # half the smoothing, which needs an interval that long.
         sigma_s = 0.5 * config.smoothing
         if max_dt > config.smoothing:
-            sigma_s = max(sigma_s, 0.5 * median(t[1:] - t[:-1]))
+            sigma_s = max(sigma_s, 0.5 * float(np.median(np.diff(t))))
         if sigma_s / dt != self._sigma:
             return None
         grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
@@ -732,22 +650,11 @@ class SignalCache:
             xs, full = smooth(xr, m, self._sigma)
         b["x"][a:rows] = xs[lead:]
         b["full"][a:rows] = full[lead:]
-        # velocities from row a - 1 (its central difference reads row a): _velocities'
-        # arithmetic, written in place where _derived_into reads them (giver, receiver)
+        # velocities from row a - 1 (its central difference reads row a), as _velocities
+        # gives them, written where _derived_into reads them (giver, receiver)
         x, q = b["x"], b["q"][:, a - 1 : rows]
         vq = q[2:4]
-        # (differenced and scaled on contiguous rows, the last one-sided, then copied into
-        # the hands' blocks in one go: half the time of the same arithmetic on the blocks'
-        # strided views)
-        diff = np.empty((rows - a + 1, 6))
-        np.subtract(x[a:rows], x[a - 2 : rows - 2], out=diff[:-1])
-        np.subtract(x[rows - 1], x[rows - 2], out=diff[-1])
-        diff[:-1] /= 2.0 * dt
-        diff[-1] /= dt
-        vq[:] = _by_hand(diff)
-        shares = b["full"][a - 1 : rows]
-        if np.minimum.reduce(shares, axis=None) < FULL_WINDOW:  # (.min(); away from gaps, none is)
-            vq[shares.T < FULL_WINDOW] = np.nan
+        vq[:] = _by_hand(_velocities(x[a - 2 : rows], b["full"][a - 2 : rows], dt)[1:])
         sp = b["speeds"][:, a - 1 : rows]
         _derived_into(x[a - 1 : rows], q, b["norms"][:, a - 1 : rows], sp[0], sp[1], sp[2])
         if not self._append_only:
@@ -759,7 +666,7 @@ class SignalCache:
             self._seen = np.concatenate((seen_old, seen_new))
             self._ok = np.concatenate((ok_old, ok_new))
             self._last_seen = [self._last_of(self._seen[:, h]) for h in (0, 1)]
-        self._n, self._t_last = n, new_t[-1]
+        self._n, self._t_last = n, float(t[-1])
         self._clean = clean
         self._max_dt = max_dt
         self._grid, self._rows = grid, rows

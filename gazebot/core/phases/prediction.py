@@ -33,21 +33,12 @@ def _mirrored(
     t, v = t[:k], v[:k]
     if not k:
         return onset + nominal
-    # argmax returns the first NaN if there is one, and +inf is the largest value: with a
-    # finite largest value and a finite last one, the peak and the last known speed are what
-    # the NaN-aware reads below give (the usual case: no mask to build)
-    i = int(v.argmax())
+    known = np.flatnonzero(np.isfinite(v))
+    if known.size == 0:
+        return onset + nominal
+    i = int(np.nanargmax(v))  # the peak speed (NaN: unknown)
     peak = float(v[i])
-    last = float(v[-1])
-    if not (math.isfinite(peak) and math.isfinite(last)):
-        ok = np.isfinite(v)
-        if not ok.any():
-            return onset + nominal
-        # np.nanargmax(v): argmax with NaN as -inf (its own implementation, without its
-        # copies and checks)
-        i = int(np.where(np.isnan(v), -np.inf, v).argmax())
-        last = float(v[ok.shape[0] - 1 - int(ok[::-1].argmax())])  # the last known
-        peak = float(v[i])
+    last = float(v[known[-1]])  # the last known speed
     if peak > c.reach_onset_speed and last < c.peak_passed_fraction * peak:
         return onset + 2.0 * max(float(t[i]) - onset, 0.0)
     return onset + nominal

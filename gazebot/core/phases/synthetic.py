@@ -34,6 +34,7 @@ from typing import Literal
 
 import numpy as np
 
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases.segment import Segment
 from gazebot.core.phases.trajectory import Trajectory
 from gazebot.core.types import Phase
@@ -41,12 +42,6 @@ from gazebot.core.types import Phase
 Posture = Literal["standing", "sitting"]
 Hold = Literal["pull", "carry", "still"]
 CaseKind = Literal["carry", "still", "quick30", "quick_noisy"]
-
-
-def min_jerk(s: np.ndarray) -> np.ndarray:
-    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (clipped to 0..1)."""
-    s = np.clip(s, 0.0, 1.0)
-    return s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
 
 
 def _bump(s: np.ndarray) -> np.ndarray:
@@ -75,7 +70,7 @@ class _Path:
         prev = self.start
         for t0, dur, to, bump in self.moves:
             s = (t - t0) / dur
-            out += min_jerk(s)[:, None] * (to - prev) + _bump(s)[:, None] * bump
+            out += minimum_jerk(s)[:, None] * (to - prev) + _bump(s)[:, None] * bump
             prev = to
         return out
 
@@ -325,8 +320,8 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
         load[:] = 0.0
         for t_close, release, t_open in grip_events:
             closed[(ts >= t_close) & (ts < t_open)] = 1.0
-            hold = (ts >= t_close) & (ts < release)
-            load[hold] = 0.15 + 0.7 * (ts[hold] - t_close) / (release - t_close)
+            holding = (ts >= t_close) & (ts < release)
+            load[holding] = 0.15 + 0.7 * (ts[holding] - t_close) / (release - t_close)
             after = (ts >= release) & (ts < t_open)
             load[after] = np.minimum(1.0, 0.85 + 3.0 * (ts[after] - release))
     traj = Trajectory(ts, gh, rh, gf, closed, load)
@@ -429,7 +424,7 @@ def rest_recording(
             way = rng.normal(size=3)
             if rng.random() < 0.5:
                 way[0] = -abs(way[0])  # toward the receiver (at -x)
-            g += min_jerk((t - t0) / dur)[:, None] * (
+            g += minimum_jerk((t - t0) / dur)[:, None] * (
                 rng.uniform(*FIDGET_AMPLITUDE) * way / np.linalg.norm(way)
             )
             t0 += dur + rng.uniform(0.2, 1.0)

@@ -116,10 +116,8 @@ class BlinkModel:
         Raises ``ValueError`` for a non-finite ``t`` or shift, or a ``t`` earlier than the last one
         (call :meth:`reset` to start over).
         """
-        # (the loop's values already are floats: no conversion calls; this runs every tick)
-        if type(t) is not float:
-            t = float(t)
-        shift = gaze_shift_rad if type(gaze_shift_rad) is float else float(gaze_shift_rad)
+        t = float(t)
+        shift = float(gaze_shift_rad)
         if not math.isfinite(t):
             raise ValueError(f"t must be finite, got {t}")
         if not math.isfinite(shift):
@@ -131,20 +129,12 @@ class BlinkModel:
             self._next = t + self._interval()
         if t < last - 1e-9:
             raise ValueError(f"t went backwards ({t} < {last}); call reset() to restart")
-        dt = t - last
-        if dt < 0.0:  # max(dt, 0.0) as a comparison
-            dt = 0.0
+        dt = max(t - last, 0.0)
         self._t = t
-        # The decayed sum of shifts. Nothing built up (0.0, never -0.0) decays to 0.0 (the
-        # factor is in [0, 1], never NaN: dt >= 0 and the window a finite > 0), and the usual
-        # tick adds no shift (acc + 0.0 is acc): those calls are skipped.
-        acc = self._acc
-        if acc != 0.0:
-            acc *= math.exp(-dt / c.shift_window_s)
-        if shift != 0.0:
-            # (no gaze shift is more than a half turn: a larger value counts as one, so the
-            # sum stays finite and decays, where inf would decay to NaN and disarm for good)
-            acc += abs(shift) if -math.pi <= shift <= math.pi else math.pi
+        # The decayed sum of gaze shifts. No shift is more than a half turn: a larger value
+        # counts as one, so the sum stays finite and decays (inf would decay to NaN and disarm
+        # the shift rule for good).
+        acc = self._acc * math.exp(-dt / c.shift_window_s) + min(abs(shift), math.pi)
         self._acc = acc
         if acc < 0.5 * c.shift_threshold_rad:
             self._armed = True
@@ -154,8 +144,6 @@ class BlinkModel:
             if self._rng.random() < c.shift_probability and not in_blink:
                 self._begin(t)
                 in_blink = True
-        if not in_blink:
-            if t < self._next:
-                return 0.0  # what value_at(t) gives with no blink under way (most calls)
+        if not in_blink and t >= self._next:
             self._begin(t)
         return self.value_at(t)

@@ -39,7 +39,6 @@ import numpy as np
 
 from gazebot.core.runtime.blink import BlinkModel
 from gazebot.core.types import (
-    F64,
     Event,
     GazeCommand,
     Phase,
@@ -68,11 +67,16 @@ class EyesLike(Protocol):
 class RobotLike(Protocol):
     """What the loop reads of the robot (:class:`gazebot.core.kinematics.RobotModel`)."""
 
-    head_joints: Sequence[str]
-    lower: np.ndarray
-    upper: np.ndarray
-    rest: np.ndarray
-    eyes: EyesLike
+    @property
+    def head_joints(self) -> Sequence[str]: ...
+    @property
+    def lower(self) -> np.ndarray: ...
+    @property
+    def upper(self) -> np.ndarray: ...
+    @property
+    def rest(self) -> np.ndarray: ...
+    @property
+    def eyes(self) -> EyesLike: ...
 
     def gaze_frame_lists(self, q_head: Sequence[float]) -> list[list[float]]: ...
 
@@ -80,8 +84,8 @@ class RobotLike(Protocol):
 class EngineLike(Protocol):
     """What the loop drives (:class:`gazebot.core.engine.GazeEngine`)."""
 
-    robot: RobotLike
-
+    @property
+    def robot(self) -> RobotLike: ...
     @property
     def phase(self) -> Phase: ...
 
@@ -113,16 +117,16 @@ class GazeLoop:
         self.faults = 0  # ticks the engine raised on (answered with None)
         self.ticks = 0
         self._t = -math.inf
-        # (the last gaze frame: its head pose, arm revision and rows)
-        self._frame_pose: list[float] | None = None
-        self._frame_revision: object = None
-        self._frame_rows: list[list[float]] = []
-        robot = self._robot = engine.robot  # (the engine's robot never changes)
-        # (per tick: each head joint's name, limits and rest value, and the eyes' range)
-        self._joints = [(str(n), float(lo), float(hi), float(r))
-                        for n, lo, hi, r in zip(robot.head_joints, robot.lower, robot.upper,
-                                                robot.rest, strict=True)]
-        self._eyes = robot.eyes
+        # The last gaze frame and its key (head pose, arm revision): a head at rest needs no
+        # forward kinematics.
+        self._frame: tuple[tuple[tuple[float, ...], object], list[list[float]]] | None = None
+        robot = engine.robot  # (the engine's robot never changes)
+        # Each head joint's name, limits and rest value.
+        self._joints = [
+            (str(n), float(lo), float(hi), float(r))
+            for n, lo, hi, r in zip(robot.head_joints, robot.lower, robot.upper, robot.rest,
+                                    strict=True)
+        ]
 
     @classmethod
     def from_config(
@@ -192,7 +196,7 @@ class GazeLoop:
                 raise ValueError(f"tick: t={t} disagrees with the frame's t={ft}")
         self.ticks += 1
         try:
-            cmd = self.engine.step(frame, joints)  # (arm: positional, a cheaper call)
+            cmd = self.engine.step(frame, joints)
         except Exception:  # noqa: BLE001 - a node never dies on input; the tick sends nothing
             self.faults += 1
             return None
@@ -201,69 +205,19 @@ class GazeLoop:
     def _finish(
         self, cmd: GazeCommand, answers: bool, joints: Mapping[str, float] | None
     ) -> GazeCommand | None:
-        # What GazeCommand.is_finite() checks, in one pass with the limits: a NaN or infinite
-        # head goal fails its limit comparison and non-finite eyes are clipped. The checks and
-        # the rest below are written out in this one function (no helper calls, no key tuple):
-        # they run every tick and their calls were most of the loop's cost.
-        isfinite = math.isfinite
-        head = cmd.head
-        if not (isfinite(cmd.t) and isfinite(cmd.blink) and isfinite(cmd.gaze_shift)):
+        """The safe command with lids, vergence distance and ``answers_sample`` filled in, or
+        ``None`` (counted in :attr:`unsafe`)."""
+        pose = self._safe_head(cmd)
+        if pose is None:
             self.unsafe += 1
             return None
-        # Every head goal is for a joint of the robot and within its limits (a check, not a
-        # clip: the gaze controller clips); on the way, the commanded head vector (rest for a
-        # joint the command lacks).
-        pose = []
-        known = 0
-        for name, lo, hi, rest in self._joints:
-            if name in head:
-                v = head[name]
-                if not lo <= v <= hi:
-                    self.unsafe += 1
-                    return None
-                known += 1
-                pose.append(v)
-            else:
-                pose.append(rest)
-        if known != len(head) or self._eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]:
-            self.unsafe += 1
-            return None
-        distance = None
-        point = cmd.target_point
-        if type(point) is np.ndarray and (point.dtype is F64 or point.dtype.kind == "f") and (
-            point.shape == (3,)
-        ):
-            # The engine's points are such arrays (float64: ``is`` first, NumPy's dtype is one
-            # object). No finiteness check: a NaN or infinite coordinate makes the distance NaN
-            # or infinite, which the range test below refuses.
-            x, y, z = point.tolist()
-            valid = True
-        elif is_valid_point(point):
-            x, y, z = np.asarray(point, dtype=float).tolist()
-            valid = True
-        else:
-            valid = False
-        if valid:
-            if joints:
-                # The display is where the measured head is, when all its joints are known.
-                pose = self._measured_pose(joints) or pose
-            rows = self._gaze_frame(pose)
-            dx, dy, dz = x - rows[0][3], y - rows[1][3], z - rows[2][3]
-            d = math.sqrt(dx * dx + dy * dy + dz * dz)
-            # A target at the display itself (or beyond any float) has no defined vergence.
-            distance = d if 1e-3 < d < math.inf else None
-        # Blink times never go back (the engine's t never does either): max(cmd.t, self._t)
-        # as a comparison.
-        t = cmd.t
-        if self._t > t:
-            t = self._t
-        self._t = t
-        # min(max(b, 0), 1) as comparisons (the same result, NaN and -0.0 included)
-        blink = float(self.blinks.update(t, cmd.gaze_shift))
-        if blink < 0.0:
-            blink = 0.0
-        if blink > 1.0:
-            blink = 1.0
+        if joints:
+            # The display is where the measured head is, when all its joints are known.
+            pose = self._measured_pose(joints) or pose
+        distance = self._vergence_distance(cmd.target_point, pose)
+        # Blink times never go back (the engine's t never does either).
+        t = self._t = max(cmd.t, self._t)
+        blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
         # cmd.replaced(...) without its field-name check (these are GazeCommand's fields); a
         # copy, then the three fields (their places in the dict are kept).
         fields = cmd.__dict__.copy()
@@ -272,18 +226,44 @@ class GazeLoop:
         fields["answers_sample"] = answers
         return from_fields(GazeCommand, fields)
 
+    def _safe_head(self, cmd: GazeCommand) -> list[float] | None:
+        """The commanded head vector (rest for a joint the command lacks), or ``None`` if the
+        command is unsafe: a non-finite value (what :meth:`GazeCommand.is_finite` checks, and
+        the gaze shift), a head goal outside its joint's limits or for a joint the robot lacks,
+        or eyes outside their range. (A check, not a clip: the gaze controller clips.)"""
+        if not all(map(math.isfinite, (cmd.t, cmd.blink, cmd.gaze_shift))):
+            return None
+        head = cmd.head
+        if not set(head) <= {name for name, _, _, _ in self._joints}:
+            return None
+        pose = []
+        for name, lo, hi, rest in self._joints:
+            value = head.get(name, rest)
+            if not lo <= value <= hi:  # NaN fails too
+                return None
+            pose.append(value)
+        if self.engine.robot.eyes.clip(cmd.eye_yaw, cmd.eye_pitch)[2]:  # NaN is clipped too
+            return None
+        return pose
+
+    def _vergence_distance(self, point: np.ndarray | None, pose: list[float]) -> float | None:
+        """Distance (m) from the ``gaze`` frame origin at head ``pose`` to ``point``; ``None``
+        without a finite point, or for one at the display itself."""
+        if not is_valid_point(point):
+            return None
+        rows = self._gaze_frame(pose)
+        origin = (rows[0][3], rows[1][3], rows[2][3])
+        distance = math.dist(np.asarray(point, dtype=float).tolist(), origin)
+        # A target at the display itself (or beyond any float) has no defined vergence.
+        return distance if 1e-3 < distance < math.inf else None
+
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
-        the arm carrying the head moved (a head at rest: no forward kinematics)."""
-        robot = self._robot
-        revision = getattr(robot, "arm_revision", None)
-        # (pose and revision compared apart: equal to comparing them as one tuple, without
-        # building it)
-        if pose != self._frame_pose or revision != self._frame_revision:
-            self._frame_pose = pose
-            self._frame_revision = revision
-            self._frame_rows = robot.gaze_frame_lists(pose)
-        return self._frame_rows
+        the arm carrying the head moved."""
+        key = (tuple(pose), getattr(self.engine.robot, "arm_revision", None))
+        if self._frame is None or self._frame[0] != key:
+            self._frame = (key, self.engine.robot.gaze_frame_lists(pose))
+        return self._frame[1]
 
     def _measured_pose(self, joints: Mapping[str, float]) -> list[float] | None:
         """The measured head vector clipped into the limits, or ``None`` unless every head

@@ -118,7 +118,7 @@ def test_custom_robot_yaml_path_gives_its_own_display(tmp_path):
 
 
 def test_for_robot_takes_a_parsed_robot_config(tmp_path):
-    from gazebot.core.kinematics.config import load_robot_config
+    from gazebot.core.kinematics.robot_config import load_robot_config
 
     path, _ = _custom_robot_yaml(tmp_path, width_px=320, height_px=200)
     config, _ = load_robot_config(path)

@@ -10,7 +10,7 @@ import pytest
 
 from gazebot.apps.sim.record import record_handover
 from gazebot.apps.sim.scene import DISPLAY_GEOM, OBSERVER
-from gazebot.core.kinematics.config import with_gaze_mode
+from gazebot.core.kinematics.robot_config import with_gaze_mode
 
 
 def screen_seen(model, data, n: int = 5) -> tuple[float, float]:

@@ -281,7 +281,7 @@ def test_plan_gaze_mode_reaches_the_renderer_and_sets_the_robot_config(monkeypat
 
     monkeypatch.setattr(record, "record_handover", fake_record)
     try:
-        from gazebot.core.kinematics.config import with_gaze_mode  # noqa: F401
+        from gazebot.core.kinematics.robot_config import with_gaze_mode  # noqa: F401
     except ImportError:  # a gazebot without gaze modes in the robot config
         with pytest.raises(ValueError, match="cannot render gaze mode 'eyes-only'"):
             render_handover_in_gaze_mode(

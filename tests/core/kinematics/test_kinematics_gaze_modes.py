@@ -18,7 +18,7 @@ from gazebot.core.kinematics import (
     solve_ik,
     with_gaze_mode,
 )
-from gazebot.core.kinematics.config import robot_config_path
+from gazebot.core.kinematics.robot_config import robot_config_path
 from gazebot.core.phases.synthetic import SyntheticOptions, generate
 
 ROBOTS = ["sawyer", "jaco2"]

@@ -205,7 +205,7 @@ def test_an_ik_setting_in_the_robot_yaml_changes_the_solve(tmp_path):
     import yaml
 
     from gazebot.core.kinematics import GazeController
-    from gazebot.core.kinematics.config import robot_config_path
+    from gazebot.core.kinematics.robot_config import robot_config_path
 
     data = yaml.safe_load(robot_config_path("jaco2").read_text())
     data["mjcf"] = str((robot_config_path("jaco2").parents[2] / "gazebot/assets/robots"
@@ -227,7 +227,7 @@ def test_a_bad_ik_setting_names_the_file_and_the_field(tmp_path):
 
     from gazebot.core.config import ConfigError
     from gazebot.core.kinematics import load_robot_config
-    from gazebot.core.kinematics.config import robot_config_path
+    from gazebot.core.kinematics.robot_config import robot_config_path
 
     data = yaml.safe_load(robot_config_path("sawyer").read_text())
     data["ik"] = {"max_iterations": 0}

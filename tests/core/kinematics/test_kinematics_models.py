@@ -12,7 +12,7 @@ import pytest
 
 from gazebot.core.config import ConfigError
 from gazebot.core.kinematics import RobotModel, load_robot_config
-from gazebot.core.kinematics.config import resolve_mjcf
+from gazebot.core.kinematics.robot_config import resolve_mjcf
 
 ROBOTS = ["sawyer", "jaco2"]
 

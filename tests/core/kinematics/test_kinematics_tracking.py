@@ -46,13 +46,13 @@ def test_tracking_goals_stay_within_the_tracking_tolerance_of_the_target(jaco2):
 def test_within_the_goal_deadband_the_head_goal_is_kept_and_the_eyes_stay_exact(
     name, monkeypatch
 ):
-    import gazebot.core.kinematics.controller as controller
+    import gazebot.core.kinematics.gaze_controller as controller
 
     robot = RobotModel.load(name)
     cfg = IKConfig()
     solves = []
-    solve = controller.solve_ik_raw
-    monkeypatch.setattr(controller, "solve_ik_raw",
+    solve = controller.solve_head
+    monkeypatch.setattr(controller, "solve_head",
                         lambda *a, **k: solves.append(1) or solve(*a, **k))
     ctrl = GazeController(robot)
     exact = GazeController(robot, ik=IKConfig(goal_deadband=0.0))
@@ -77,7 +77,7 @@ def test_with_the_eyes_at_their_range_the_goal_deadband_still_keeps_the_head_goa
     beyond their reach. Moving inside the deadband it keeps the head goal (no solve); every
     command stays finite and within the limits, and the gaze misses it by at most the
     deadband more than with the goal re-solved every tick. Leaving the deadband re-solves."""
-    import gazebot.core.kinematics.controller as controller
+    import gazebot.core.kinematics.gaze_controller as controller
 
     robot = RobotModel.load("sawyer")
     cfg = IKConfig()
@@ -90,8 +90,8 @@ def test_with_the_eyes_at_their_range_the_goal_deadband_still_keeps_the_head_goa
     assert settled.eyes_saturated and settled.residual > 0.1
 
     solves = []
-    solve = controller.solve_ik_raw
-    monkeypatch.setattr(controller, "solve_ik_raw",
+    solve = controller.solve_head
+    monkeypatch.setattr(controller, "solve_head",
                         lambda *a, **k: solves.append(1) or solve(*a, **k))
     lo, hi = robot.lower, robot.upper
     for i in range(150, 158):  # 0.25 mm per tick sideways: 2 mm ~ 0.2 deg from the head
@@ -114,7 +114,7 @@ def test_with_the_eyes_at_their_range_the_goal_deadband_still_keeps_the_head_goa
 
 
 def test_fixed_eyes_get_no_goal_deadband():
-    from gazebot.core.kinematics.config import with_gaze_mode
+    from gazebot.core.kinematics.robot_config import with_gaze_mode
 
     robot = RobotModel.load(with_gaze_mode("jaco2", "head-only"))
     ctrl = GazeController(robot)
@@ -129,7 +129,7 @@ def test_fixed_eyes_get_no_goal_deadband():
 
 
 def test_the_goal_deadband_is_a_robot_yaml_setting_in_degrees():
-    from gazebot.core.kinematics.config import IKSettings
+    from gazebot.core.kinematics.robot_config import IKSettings
 
     assert IKConfig.from_settings(IKSettings(goal_deadband_deg=1.0)).goal_deadband == (
         pytest.approx(math.radians(1.0))

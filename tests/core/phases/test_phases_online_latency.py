@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from phase_truth import PHASE_KINDS, event_errors
 
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases import Trajectory, run_online
 from gazebot.core.phases.synthetic import rest_recording, synthetic_set
 from gazebot.core.types import EventKind
@@ -74,11 +75,6 @@ def test_handovers_with_5mm_noise_give_exactly_their_events():
         assert kinds == list(PHASE_KINDS) * len(case.truth), case.options
 
 
-def _min_jerk(s):
-    s = np.clip(s, 0.0, 1.0)
-    return s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
-
-
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_a_fidgeting_giver_gives_no_event(seed):
     # Small adjustments at rest: 0.8-2 cm in 0.25-0.6 s (peak speed up to 15 cm/s), any
@@ -94,8 +90,8 @@ def test_a_reach_taken_back_ends_as_aborted_without_transfer(rate):
     target = np.array([-0.25, -0.03, -0.05])
 
     def hand(t):
-        out = _min_jerk((t - 2.0) / 0.6)[:, None] * target
-        return out - _min_jerk((t - 2.9) / 0.7)[:, None] * target
+        out = minimum_jerk((t - 2.0) / 0.6)[:, None] * target
+        return out - minimum_jerk((t - 2.9) / 0.7)[:, None] * target
 
     traj = _rest_recording(rate, 0.3, 0.002, 6.0, seed=7, hand=hand)
     events = _phase_events(traj)
@@ -140,7 +136,7 @@ def test_a_reach_away_from_the_receiver_is_not_predicted():
     target = np.array([0.25, 0.0, 0.0])
 
     def hand(t):
-        return _min_jerk((t - 2.0) / 0.6)[:, None] * target
+        return minimum_jerk((t - 2.0) / 0.6)[:, None] * target
 
     traj = _rest_recording(120.0, 0.0, 0.001, 2.15, seed=3, hand=hand)
     c = PhaseConfig()

@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases import PhaseConfig, PhaseDetector, Trajectory, run_online
-from gazebot.core.phases.synthetic import min_jerk, rest_recording, synthetic_set
+from gazebot.core.phases.synthetic import rest_recording, synthetic_set
 from gazebot.core.types import EventKind
 
 
@@ -22,7 +23,7 @@ def _motions(rate: float, seconds: float, seed: int):
     t = np.arange(0.0, seconds, 1.0 / rate)
 
     def mj(t0: float, dur: float) -> np.ndarray:
-        return min_jerk((t - t0) / dur)[:, None]
+        return minimum_jerk((t - t0) / dur)[:, None]
 
     return t, np.random.default_rng(seed), mj
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases import PhaseConfig, Trajectory
 from gazebot.core.phases.rules.sequential import sequential_reach
-from gazebot.core.phases.synthetic import min_jerk
 
 RATES = (8.0, 15.0, 30.0, 120.0)
 NOISES = (0.0, 0.002, 0.005)
@@ -27,7 +27,7 @@ def _recording(rate: float, noise: float, move: np.ndarray, duration: float, sec
     t = np.arange(0.0, seconds, 1.0 / rate)
     t = t + rng.uniform(-0.2, 0.2, t.shape) / rate  # jittered sampling
     t[0] = 0.0
-    g = np.array([1.05, -0.2, 0.9]) + min_jerk((t - ONSET) / duration)[:, None] * move
+    g = np.array([1.05, -0.2, 0.9]) + minimum_jerk((t - ONSET) / duration)[:, None] * move
     g = g + noise * rng.standard_normal(g.shape)
     r = np.array([0.35, -0.3, 0.9]) + min(noise, 0.0003) * rng.standard_normal(g.shape)
     return Trajectory(t, g, r)

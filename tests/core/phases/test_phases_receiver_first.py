@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gazebot.core.minimum_jerk import minimum_jerk as mj
 from gazebot.core.phases import PhaseConfig, run_online, segment
 from gazebot.core.phases.filtering import compute_signals
 from gazebot.core.phases.rules.reach import reach_start
 from gazebot.core.phases.synthetic import SyntheticOptions, generate
-from gazebot.core.phases.synthetic import min_jerk as mj
 from gazebot.core.phases.trajectory import Trajectory
 from gazebot.core.types import EventKind, Phase
 

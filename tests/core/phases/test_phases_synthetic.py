@@ -3,12 +3,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gazebot.core.phases.synthetic import SyntheticOptions, generate, min_jerk, synthetic_set
+from gazebot.core.minimum_jerk import minimum_jerk
+from gazebot.core.phases.synthetic import SyntheticOptions, generate, synthetic_set
 
 
 def test_min_jerk_profile_starts_and_ends_at_rest():
     s = np.linspace(0, 1, 1001)
-    x = min_jerk(s)
+    x = minimum_jerk(s)
     assert x[0] == 0 and x[-1] == pytest.approx(1)
     v = np.gradient(x, s)
     assert abs(v[0]) < 1e-3 and abs(v[-1]) < 1e-3

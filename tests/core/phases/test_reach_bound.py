@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from benchmarks.reach_bound import bound_latencies, fidget_residual
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases.synthetic import (
     FIDGET_AMPLITUDE,
     FIDGET_DURATION,
     SyntheticOptions,
     generate,
-    min_jerk,
     synthetic_set,
 )
 
@@ -24,7 +24,7 @@ from gazebot.core.phases.synthetic import (
 def test_a_fidget_of_the_class_stays_within_one_noise_variance(duration):
     t = np.arange(0.0, 1.5, 1.0 / 240.0)
     way = np.array([-0.6, 0.5, 0.62])
-    x = np.array([1.0, -0.2, 0.9]) + min_jerk((t - 0.513) / duration)[:, None] * (
+    x = np.array([1.0, -0.2, 0.9]) + minimum_jerk((t - 0.513) / duration)[:, None] * (
         FIDGET_AMPLITUDE[1] * way / np.linalg.norm(way)
     )
     for end in (0.6, 0.75, 1.0, 1.5):  # during the fidget and after it

@@ -10,7 +10,7 @@ import numpy as np
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.prediction import predict_end
 from gazebot.core.phases.rules.directed import _Quadratic, _quadratic_at
-from gazebot.core.phases.rules.sequential import _grids, min_jerk_profile, reach_evidence
+from gazebot.core.phases.rules.sequential import _grids, reach_evidence
 from gazebot.core.types import Phase
 
 
@@ -82,16 +82,6 @@ def test_a_design_shared_between_calls_fits_each_signal_as_its_own_fit_would():
     assert _quadratic_at(t0) is not _quadratic_at(np.array([-0.2, -0.1, -0.0]))
 
 
-def test_the_in_place_min_jerk_profile_equals_the_plain_one():
-    rng = np.random.default_rng(4)
-    s = rng.uniform(-0.5, 1.5, (7, 5, 40))
-    plain = min_jerk_profile(s)
-    scratch = s.copy()
-    assert min_jerk_profile(scratch, overwrite=True).tobytes() == plain.tobytes()
-    # the plain form leaves its argument alone
-    assert min_jerk_profile(s).tobytes() == plain.tobytes()
-
-
 def test_the_sequential_grids_are_the_configurations_and_cannot_be_changed():
     c = PhaseConfig()
     durations, lags = _grids(
@@ -160,7 +150,7 @@ def test_a_reach_ends_no_earlier_than_the_receivers_first_fast_sample_predicts()
 def _directed_reference(traj, c, after):
     """The constant-acceleration rule in its straightforward form: every sample read, every
     fit with its errors (the form the rule had before it skipped work)."""
-    from gazebot.core.phases.filtering import median, vector_norm
+    from gazebot.core.phases.filtering import vector_norm
     from gazebot.core.phases.rules.directed import noise_floor
     from gazebot.core.phases.rules.onset import min_jerk_span
 
@@ -180,7 +170,7 @@ def _directed_reference(traj, c, after):
     if fit.size < c.predict_min_samples or rest.size == 0:
         return None
     steps = np.diff(t_all[fit])
-    if float(steps.max()) > c.predict_gap_factor * median(steps):
+    if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
         return None
     g_rest = g[rest].mean(axis=0)
     line = r[-1] - g_rest

@@ -118,43 +118,6 @@ def test_trigger_rows_hold_the_period_means_and_numpys_distances() -> None:
     np.testing.assert_array_equal(rows[k:, 11], np.linalg.norm(g[k:] - g[:-k], axis=1))
 
 
-def test_median_of_the_sample_steps_is_numpys() -> None:
-    from gazebot.core.phases.filtering import median
-
-    rng = np.random.default_rng(1)
-    for n in (1, 2, 3, 4, 7, 10, 101):
-        x = rng.uniform(0.004, 0.03, size=n)
-        assert median(x) == float(np.median(x))
-        x[n // 2] = np.nan
-        assert np.isnan(median(x))
-
-
-def test_quantile_is_numpys_linear_quantile() -> None:
-    from gazebot.core.phases.filtering import quantile
-
-    rng = np.random.default_rng(2)
-    for n in (1, 2, 3, 5, 8, 33, 200):
-        x = rng.gamma(2.0, 0.02, size=n)
-        x[rng.random(n) < 0.1] = 0.05  # ties
-        for q in (0.0, 0.1, 0.25, 0.3333, 0.5, 0.75, 0.9, 1.0, float(rng.random())):
-            assert quantile(x, q) == float(np.quantile(x, q)), (n, q)
-
-
-def test_vector_norm_is_numpys_norm_bit_for_bit() -> None:
-    """The rules' single-vector norm equals ``np.linalg.norm`` exactly (numpy's dot may fuse
-    the products, so a plain sum of squares would not), on rows, strided views, 2-D blocks,
-    NaN, infinity and an empty vector."""
-    from gazebot.core.phases.filtering import vector_norm
-
-    rng = np.random.default_rng(4)
-    x = rng.normal(size=(4000, 3)) * rng.choice([1e-4, 1.0, 1e3], size=(4000, 1))
-    for v in [*x, *x.T[:, ::7], x[:5], np.array([np.nan, 1.0, 2.0]),
-              np.array([np.inf, 0.0, 1.0]), np.zeros(0)]:
-        want = float(np.linalg.norm(v))
-        got = vector_norm(v)
-        assert got == want or (np.isnan(got) and np.isnan(want))
-
-
 def test_nanmax_and_nanmin_are_numpys() -> None:
     """The rules' NaN-skipping extrema equal ``np.nanmax`` / ``np.nanmin``, with and without
     ``initial``, on rows with NaN, all NaN and (with ``initial``) none."""
@@ -175,24 +138,6 @@ def test_nanmax_and_nanmin_are_numpys() -> None:
                         np.testing.assert_array_equal(ours(a, **kw), theirs(a, **kw))
                     if n:
                         np.testing.assert_array_equal(ours(a), theirs(a))
-
-
-def test_nanargmax_is_numpys() -> None:
-    """The rules' NaN-skipping argmax equals ``np.nanargmax`` (ties: the first; -inf values
-    and NaN), and fails like it on all NaN and on nothing."""
-    from gazebot.core.phases.filtering import nanargmax
-
-    rng = np.random.default_rng(6)
-    for n in (1, 2, 5, 40):
-        for _ in range(50):
-            x = rng.choice([-np.inf, -1.0, 0.0, 1.0, 2.0, np.nan], size=n)
-            if not np.isnan(x).all():
-                assert nanargmax(x) == int(np.nanargmax(x)), x
-    for bad in (np.full(3, np.nan), np.zeros(0)):
-        with pytest.raises(ValueError):
-            np.nanargmax(bad)
-        with pytest.raises(ValueError):
-            nanargmax(bad)
 
 
 def test_two_row_nanmean_is_numpys() -> None:
@@ -236,81 +181,3 @@ def test_suffix_max_is_numpys_fmax_over_the_span() -> None:
         got = sm.update(values[base:], base, first - base, end - base)
         want = np.fmax.reduce(col[first:end])
         assert got == want or (np.isnan(got) and np.isnan(want)), (first, end)
-
-
-def test_row_norms_are_numpys_row_norms() -> None:
-    """``row_norms`` (the rules' per-row 3-vector norms, column by column) equals
-    ``np.linalg.norm(x, axis=1)`` bit for bit, NaN and infinite entries and extreme scales too."""
-    from gazebot.core.phases.filtering import row_norms
-
-    rng = np.random.default_rng(5)
-    for scale in (1e-160, 1e-3, 1.0, 1e3, 1e160):
-        x = rng.normal(size=(20000, 3)) * scale
-        x[rng.random(x.shape) < 0.01] = np.nan
-        x[rng.random(x.shape) < 0.005] = np.inf
-        with np.errstate(over="ignore"):  # (1e160 squared overflows in both)
-            np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=1))
-
-
-def test_trigger_norm_bar_decides_as_numpys_norm() -> None:
-    """The trigger's plain-float test ``|v| >= bar`` decides as ``vector_norm`` (numpy's dot)
-    does, at near ties, NaN, infinite and zero vectors too."""
-    from gazebot.core.phases.filtering import vector_norm
-    from gazebot.core.phases.methods.gazebot_trigger import _norm_at_least
-
-    rng = np.random.default_rng(7)
-    vs = rng.normal(size=(20000, 3)) * rng.choice([1e-3, 1.0, 1e3], size=(20000, 1))
-    vs[::50] = [0.0, 0.0, 0.0]
-    vs[1::97, 1] = np.nan
-    vs[2::89, 0] = np.inf
-    for v in vs:
-        norm = vector_norm(v)
-        for bar in (0.0, 0.005, norm, np.nextafter(norm, 0.0), np.nextafter(norm, np.inf)):
-            if np.isfinite(bar):
-                assert _norm_at_least(v.tolist(), float(bar)) == (norm >= bar), (v, bar)
-
-
-def test_trigger_dot_bar_decides_as_numpys_dot() -> None:
-    """The trigger's plain-float test ``a . b / d >= bar`` (the giver's own share of the
-    closing) decides as numpy's dot does, at near ties, cancellation, NaN and infinities."""
-    from gazebot.core.phases.methods.gazebot_trigger import _dot_over_at_least
-
-    rng = np.random.default_rng(8)
-    ab = rng.normal(size=(20000, 2, 3)) * rng.choice([1e-3, 1.0, 1e3], size=(20000, 1, 1))
-    ab[::7, 1] = ab[::7, 0] * [1.0, -1.0, 0.0]  # (products that cancel)
-    ab[::14, 0, 1] = ab[::14, 0, 0]  # (... exactly)
-    ab[1::97, 0, 1] = np.nan
-    ab[2::89, 1, 0] = np.inf
-    for (a, b), d in zip(ab, rng.uniform(1e-9, 2.0, size=20000), strict=True):
-        own = float(np.dot(a, b)) / d
-        for bar in (0.005, own, np.nextafter(own, -np.inf), np.nextafter(own, np.inf)):
-            if np.isfinite(bar):
-                got = _dot_over_at_least(a.tolist(), b.tolist(), float(d), float(bar))
-                assert got == (own >= bar), (a, b, d, bar)
-
-
-def test_the_subtractions_standing_for_np_diff_give_its_bits() -> None:
-    """``x[1:] - x[:-1]`` (filtering, the reach rules' steps) and the difference of the
-    differences (the noise floor's) are np.diff's values, n=1 and n=2, on a strided column,
-    NaN and inf included; the max and median read from them are then the same too."""
-    from gazebot.core.phases.filtering import median
-    from gazebot.core.phases.rules.directed import noise_floor
-
-    rng = np.random.default_rng(8)
-    rows = rng.normal(size=(50, 7))
-    rows[rng.random((50, 7)) < 0.04] = np.nan
-    rows[3, 2] = np.inf
-    t = rows[:, 0]  # (strided, as the detector's window columns are)
-    np.testing.assert_array_equal((t[1:] - t[:-1]).view(np.int64), np.diff(t).view(np.int64))
-    x = rows[:, 1:4]
-    d1 = x[1:] - x[:-1]
-    np.testing.assert_array_equal(
-        (d1[1:] - d1[:-1]).view(np.int64), np.diff(x, n=2, axis=0).view(np.int64)
-    )
-    clean = np.cumsum(rng.uniform(0.005, 0.01, 60))
-    assert float((clean[1:] - clean[:-1]).max()) == float(np.max(np.diff(clean)))
-    assert median(clean[1:] - clean[:-1]) == float(np.median(np.diff(clean)))
-    hand = rng.normal(size=(40, 3)) * 0.002
-    d2 = np.diff(hand, n=2, axis=0).reshape(-1)
-    want = 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0)
-    assert noise_floor(hand) == want

@@ -187,9 +187,9 @@ class GazebotSegmenter(Segmenter):
             out.append(Segment(Phase.RETREAT, t_end, retreat_end, k, open=not seen))
             prev_end_idx = int(s.t.searchsorted(retreat_end))
         if trailing_ok and (not out or out[-1].phase is Phase.RETREAT):
-            onset = trailing_reach(s, c, min(prev_end_idx, n - 1))
-            if onset is not None:
-                start = max(onset, out[-1].end) if out else onset
+            trailing_onset = trailing_reach(s, c, min(prev_end_idx, n - 1))
+            if trailing_onset is not None:
+                start = max(trailing_onset, out[-1].end) if out else trailing_onset
                 k = out[-1].handover + 1 if out else 0
                 out.append(Segment(Phase.REACH, min(start, t_last), t_last, k, open=True))
         # The next reach may begin before the retreat looked finished: clip the retreat.

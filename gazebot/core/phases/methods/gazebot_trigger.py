@@ -28,55 +28,29 @@ _STEP = 11  # the giver's step column: |giver - giver trigger_speed_baseline ear
 
 
 def _nanmean2(a: Sequence[float], b: Sequence[float]) -> list[float]:
-    """``np.nanmean([a, b], axis=0)`` of two 3-vectors: per coordinate the sum of the values
-    that are not NaN (NaN counted as 0) over their count, NaN if none (numpy's arithmetic,
-    without its generic machinery and warning)."""
-    a0, a1, a2 = a
-    b0, b1, b2 = b
-    if a0 == a0 and a1 == a1 and a2 == a2 and b0 == b0 and b1 == b1 and b2 == b2:
-        # (no NaN, the usual case: each mean is the sum over 2, without the per-value tests)
-        return [(a0 + b0) / 2, (a1 + b1) / 2, (a2 + b2) / 2]
+    """``np.nanmean([a, b], axis=0)`` of two 3-vectors: per coordinate the mean of the values
+    that are not NaN, NaN if neither is (without numpy's all-NaN warning)."""
     out = []
-    for u, w in zip(map(float, a), map(float, b), strict=True):  # (bools that add to 2)
-        u_ok, w_ok = u == u, w == w
-        n = u_ok + w_ok
-        out.append(((u if u_ok else 0.0) + (w if w_ok else 0.0)) / n if n else math.nan)
+    for u, w in zip(a, b, strict=True):
+        known = [x for x in (float(u), float(w)) if not math.isnan(x)]
+        out.append(sum(known) / len(known) if known else math.nan)
     return out
 
 
 def _norm_at_least(v: Sequence[float], bar: float) -> bool:
-    """``vector_norm(np.array(v)) >= bar`` (a 3-vector, ``bar`` >= 0), decided in plain floats
-    unless the squares' sum is within rounding of ``bar``'s square: numpy's dot may sum the
-    squares in another order, which moves the norm by a few ulps, so only a near tie needs
-    it."""
-    x, y, z = v
-    sq, b2 = x * x + y * y + z * z, bar * bar
-    if sq < b2 * (1.0 - 1e-9):
-        return False
-    if sq > b2 * (1.0 + 1e-9):
-        return True
-    return vector_norm(np.array(v)) >= bar  # (a near tie, or NaN)
+    """``|v| >= bar`` for a 3-vector (the rules' :func:`vector_norm`; False for NaN)."""
+    return vector_norm(np.asarray(v, dtype=float)) >= bar
 
 
 def _dot_over_at_least(a: Sequence[float], b: Sequence[float], d: float, bar: float) -> bool:
-    """``float(np.dot(np.array(a), np.array(b))) / d >= bar`` (3-vectors, ``d`` > 0), decided
-    in plain floats unless within rounding: numpy's dot may sum the products in another
-    order, which moves the sum by a few ulps of the products' magnitudes, so only a near tie
-    needs it."""
-    p0, p1, p2 = a[0] * b[0], a[1] * b[1], a[2] * b[2]
-    gap = (p0 + p1 + p2) - bar * d
-    tol = 1e-9 * (abs(p0) + abs(p1) + abs(p2) + abs(bar * d))
-    if gap > tol:
-        return True
-    if gap < -tol:
-        return False
-    return float(np.dot(np.array(a), np.array(b))) / d >= bar  # (a near tie, or NaN)
+    """``a . b / d >= bar`` for 3-vectors, ``d`` > 0 (False for NaN)."""
+    return float(np.dot(np.asarray(a, dtype=float), np.asarray(b, dtype=float))) / d >= bar
 
 
 def _search(times: list[float], x: float, lo: int, hi: int) -> int:
     """``np.searchsorted`` (side left) of ``x`` in the increasing ``times[lo:hi]``, as an
     index of ``times``: NaN sorts after every time, as numpy sorts it."""
-    return bisect_left(times, x, lo, hi) if x == x else hi
+    return hi if math.isnan(x) else bisect_left(times, x, lo, hi)
 
 
 class _SuffixMax:
@@ -100,7 +74,7 @@ class _SuffixMax:
             self._end = a0
         for i in range(self._end, a_end):
             v = col[i - base]
-            if v != v:
+            if math.isnan(v):
                 continue  # (np.fmax passes over NaN)
             while q and q[-1][1] <= v:
                 q.pop()
@@ -112,23 +86,18 @@ class _SuffixMax:
 
 
 def _fmax(values: list[float]) -> float:
-    """``np.fmax.reduce`` of plain floats: the largest that is not NaN, NaN if none."""
-    out = math.nan
-    for v in values:
-        if v > out or out != out:
-            out = v
-    return out
+    """The largest value that is not NaN (``np.fmax.reduce``), NaN if none."""
+    return max((v for v in values if not math.isnan(v)), default=math.nan)
 
 
 class GazebotTrigger:
     """Per-period mean positions of both hands, and the loosened rule of the current phase.
 
-    The rows are kept in plain Python lists (a column each): a period appends one row and
-    reads a few, where numpy's per-call overhead would cost more than the arithmetic. The rules
-    read maxima and means over the rows since a time that stays put while a phase lasts (its
-    start, the floor): those are kept as running values, extended by each new row, and
-    recomputed from the rows only when that time or the window's start moved (so a period
-    costs a few float operations, not a pass over the window).
+    The rows are kept in Python lists (a column each): a period appends one row and reads a
+    few. The rules read maxima and means over the rows since a time that stays put while a
+    phase lasts (its start, the floor): those are kept as running values, extended by each new
+    row, and recomputed from the rows only when that time or the window's start moved (so a
+    period reads the new row, not the whole window).
 
     Attributes:
         config: The settings (``trigger_*`` factors, ``online_window``, ``online_period``).
@@ -156,9 +125,8 @@ class GazebotTrigger:
         self._speed_rows = int((c.smoothing + c.edge_guard + c.trigger_speed_baseline) / period)
         self._step_time = self._k * period  # s a giver step spans
         self._onset_bar = c.trigger_distance_factor * c.reach_onset_speed
-        # Sums of the positions seen this period and their counts, per hand, in plain floats:
-        # a sample costs a few additions, not numpy calls, and nothing is kept per sample
-        # (tracking lost for long skips the periods' close, not the samples).
+        # Sums of the positions seen this period and their counts, per hand: nothing is kept
+        # per sample (tracking lost for long skips the periods' close, not the samples).
         self._sums = [0.0] * 6  # giver xyz, receiver xyz
         self._ng = self._nr = 0
         # The rows kept are items _s0.. of each column (times, giver means, receiver means,
@@ -321,7 +289,7 @@ class GazebotTrigger:
         if k0 != a0 or k_end > a_end:
             k_end, sums, count = a0, [0.0, 0.0, 0.0], 0
         for x, y, z in self._rel[k_end - self._base : end]:
-            if x == x and y == y and z == z and abs(x) + abs(y) + abs(z) < math.inf:
+            if math.isfinite(x) and math.isfinite(y) and math.isfinite(z):
                 if count:
                     sums = [sums[0] + x, sums[1] + y, sums[2] + z]
                 else:

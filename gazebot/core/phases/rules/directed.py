@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import median, vector_norm
+from gazebot.core.phases.filtering import vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 from gazebot.core.phases.trajectory import Trajectory
 
@@ -115,8 +115,7 @@ def _quadratic_of(t_bits: bytes) -> _Quadratic:
 def _quadratic_at(t: np.ndarray) -> _Quadratic:
     """The shared :class:`_Quadratic` of the float64 times ``t``: at a regular sample rate the
     fit windows of successive analyses hold the same relative times, bit for bit, so their
-    design, its inverse (a LAPACK call that costs tens of microseconds with its code out of
-    the caches) and identical fits are made once. Keyed by the times' bytes: the same bits,
+    design, its inverse and identical fits are made once. Keyed by the times' bytes: the same bits,
     the same design, so the same values as a fresh one."""
     return _quadratic_of(np.ascontiguousarray(t, dtype=float).tobytes())
 
@@ -127,9 +126,8 @@ def noise_floor(x: np.ndarray) -> float:
     little at tracking rates, and the median ignores a fidget)."""
     if x.shape[0] < 4:
         return 0.0
-    d1 = x[1:] - x[:-1]  # (np.diff(x, n=2, axis=0): the difference of the differences)
-    d2 = (d1[1:] - d1[:-1]).reshape(-1)
-    mad = median(np.abs(d2 - median(d2)))
+    d2 = np.diff(x, n=2, axis=0).reshape(-1)
+    mad = float(np.median(np.abs(d2 - np.median(d2))))
     return 1.4826 * mad / math.sqrt(6.0)
 
 
@@ -182,8 +180,8 @@ def directed_reach(traj: Trajectory, c: PhaseConfig, after: float) -> float | No
     if fit.size < c.predict_min_samples or rest.size == 0:
         return None
     t_fit = t_all[fit]
-    steps = t_fit[1:] - t_fit[:-1]  # (np.diff's subtraction)
-    if float(steps.max()) > c.predict_gap_factor * median(steps):
+    steps = np.diff(t_fit)
+    if float(steps.max()) > c.predict_gap_factor * float(np.median(steps)):
         return None  # a dropout inside the window leaves the model unconstrained there
     # The line from the giver's resting hand to the receiver's hand now.
     g_rest = g[rest].mean(axis=0)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import Signals, nanargmax, nanmax, nanmin, vector_norm
+from gazebot.core.phases.filtering import Signals, nanmax, nanmin, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 
 
@@ -44,7 +44,7 @@ def _onset(
     v = speed[lo : hi + 1]
     if not nanmax(v, initial=0.0) >= c.reach_onset_speed:
         return None
-    peak = nanargmax(v)
+    peak = int(np.nanargmax(v))
     head = v[: peak + 1]
     seen = np.isfinite(head)
     slow = (seen & (head < c.reach_onset_speed)).nonzero()[0]
@@ -77,7 +77,7 @@ def trailing_reach(s: Signals, c: PhaseConfig, lo: int) -> float | None:
     seen = np.isfinite(d).nonzero()[0]
     if seen.size < 3:
         return None
-    i_max = nanargmax(d)
+    i_max = int(np.nanargmax(d))
     i_last = int(seen[-1])
     last = float(d[i_last])
     closed = float(d[i_max]) - last

@@ -22,14 +22,14 @@ import math
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import Signals, median, row_norms, vector_norm
+from gazebot.core.phases.filtering import Signals, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 from gazebot.core.phases.rules.transfer import TransferCore, hold_floor
 
 
 def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np.ndarray) -> float:
     """Separation from the held pose that marks the release (m)."""
-    dev = row_norms(s.rel[held_idx] - held)
+    dev = np.linalg.norm(s.rel[held_idx] - held, axis=1)
     dev = dev[np.isfinite(dev)]
     jitter = float(np.sqrt(np.mean(dev**2))) if dev.size else 0.0
     return max(c.release_distance, c.release_noise_factor * jitter)
@@ -55,8 +55,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     idx = np.arange(max(i0, i_h - window), i_h + 1)
     rows = s.rel[idx]
     rows = rows[np.isfinite(rows).all(axis=1)]
-    # (np.median(rows, axis=0): each column's median)
-    held = np.array([median(rows[:, k]) for k in range(3)]) if rows.size else np.full(3, np.nan)
+    held = np.median(rows, axis=0) if rows.size else np.full(3, np.nan)
     sep_min = release_threshold(s, c, idx, held)
     n = s.t.shape[0]
     j = i_h

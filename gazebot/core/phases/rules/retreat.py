@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import Signals, nanargmax, row_norms, vector_norm
+from gazebot.core.phases.filtering import Signals, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 
 
@@ -47,7 +47,7 @@ def far_after(s: Signals, c: PhaseConfig, i_end: int) -> float:
         k -= 1
     if k < 0:
         return math.inf
-    moved = row_norms(s.giver[i_end:] - s.giver[k])
+    moved = np.linalg.norm(s.giver[i_end:] - s.giver[k], axis=1)
     far = (moved >= c.retreat_far_distance).nonzero()[0]
     return float(s.t[i_end + int(far[0])]) if far.size else math.inf
 
@@ -103,7 +103,7 @@ def _landing(s: Signals, c: PhaseConfig, i0: int, t_release: float) -> float | N
     ok = np.isfinite(v)
     if not ok.any():
         return None
-    k = nanargmax(v)
+    k = int(np.nanargmax(v))
     peak = float(v[k])
     last = int(ok.nonzero()[0][-1])
     moved = vector_norm(s.giver[i0 + last] - s.giver[i0])

@@ -45,8 +45,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import median, vector_norm
+from gazebot.core.phases.filtering import vector_norm
 from gazebot.core.phases.rules.directed import _quadratic_at, noise_floor
 from gazebot.core.phases.trajectory import Trajectory
 
@@ -71,22 +72,6 @@ class ReachEvidence:
     amplitude: np.ndarray
     rest: np.ndarray
     sigma: float
-
-
-def min_jerk_profile(s: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
-    """Minimum-jerk position profile 0 -> 1 over normalised time ``s`` (float, clipped to
-    0..1). ``overwrite``: ``s`` may be used as scratch (the test's templates are large: fewer
-    temporary arrays; the same operations in the same order, so the same values)."""
-    s = np.clip(s, 0.0, 1.0, out=s if overwrite else None)
-    # s^3 (10 + s (6 s - 15)), evaluated as ((s s) s) (10 + s (6 s - 15))
-    inner = s * 6.0
-    inner -= 15.0
-    inner *= s
-    inner += 10.0
-    out = s * s
-    out *= s
-    out *= inner
-    return out
 
 
 def _best_reduction(
@@ -152,9 +137,7 @@ def reach_evidence(
     mean_x = w @ xb / n
     xc = xb - mean_x
     # templates (onset, duration, bin), centred (weighted): the rest position is free
-    tmpl = min_jerk_profile(
-        (tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None], overwrite=True
-    )
+    tmpl = minimum_jerk((tb[None, None, :] - onsets[:, None, None]) / durations[None, :, None])
     mean_b = tmpl @ w / n
     tmpl -= mean_b[..., None]
     wt = tmpl * w
@@ -228,9 +211,9 @@ def sequential_reach(
     # A dropout only matters where the gap's closing is fitted (the last predict_window): the
     # templates are whole minimum-jerk motions, fitted to the samples there are, so a gap
     # earlier in the window leaves them constrained (it used to suspend the test for 0.8 s).
-    steps = tw[1:] - tw[:-1]  # (np.diff's subtraction)
+    steps = np.diff(tw)
     recent = tw[1:] >= now - c.predict_window
-    step = median(steps)
+    step = float(np.median(steps))
     if recent.any() and float(steps[recent].max()) > c.predict_gap_factor * step:
         return None
     # The hands' gap closing at a reach's pace (the receiver moving away, or a hand adjusted

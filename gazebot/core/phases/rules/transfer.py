@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import Signals, nanmax, quantile, vector_norm
+from gazebot.core.phases.filtering import Signals, nanmax, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 
 
@@ -59,7 +59,7 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Inclusive index ranges of the True runs of ``mask``."""
     if mask.size == 0:
         return []
-    padded = np.zeros(mask.size + 2, dtype=bool)  # (not a concatenation of converted lists)
+    padded = np.zeros(mask.size + 2, dtype=bool)
     padded[1:-1] = mask
     bounds = (padded[1:] != padded[:-1]).nonzero()[0].tolist()
     return [(a, b - 1) for a, b in zip(bounds[::2], bounds[1::2], strict=True)]
@@ -105,8 +105,8 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
     if d.shape[0] == 0:
         return out
     if d.dtype.kind != "f" or d.dtype.itemsize < 8:
-        # (a narrower or integer signal compared in float64, as the zigzag's plain floats
-        # compare it; a wider one keeps its precision, as its tolist() does)
+        # (a narrower or integer signal is compared in float64; a wider one keeps its
+        # precision)
         d = d.astype(float)
     ok = np.isfinite(d)
     if ok.all():
@@ -228,7 +228,7 @@ def hold_floor(s: Signals, c: PhaseConfig, a: int, b: int) -> float:
     carrying the object, the ``hold_floor_quantile`` of its relative speed."""
     hold = s.rel_speed[a : b + 1]
     hold = hold[np.isfinite(hold)]
-    return quantile(hold, c.hold_floor_quantile) if hold.size else 0.0  # (np.quantile's)
+    return float(np.quantile(hold, c.hold_floor_quantile)) if hold.size else 0.0
 
 
 def v_settle_fraction(s: Signals, c: PhaseConfig, lo: int, a: int) -> float:

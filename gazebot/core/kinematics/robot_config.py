@@ -120,8 +120,8 @@ class RobotConfig(BaseModel):
     arm_home_deg: dict[str, float]
     arm_handover_deg: dict[str, float]
     eyes: EyeConfig
-    shifts: GazeShiftConfig = Field(default_factory=GazeShiftConfig)
-    ik: IKSettings = Field(default_factory=IKSettings)
+    shifts: GazeShiftConfig = Field(default_factory=lambda: GazeShiftConfig.model_validate({}))
+    ik: IKSettings = Field(default_factory=lambda: IKSettings.model_validate({}))
     gaze_mode: GazeMode = "head-and-eyes"
     points: dict[str, Point]
     # Tracked points farther than this from the robot base are implausible (a tracker's glitch,

@@ -1,5 +1,5 @@
-"""The per-tick shortcuts give exactly what the plain computation gives: the gaze frame kept for
-the last head pose and arm pose, and the head state filled without the dataclass ``__init__``."""
+"""What the gaze kinematics keep between calls changes no result: the gaze frame kept for the last
+head pose and arm pose, the controller's step and its full state, the head state value."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from gazebot.core.kinematics import GazeController, RobotModel
-from gazebot.core.kinematics.controller import HeadEyeState
+from gazebot.core.kinematics.gaze_controller import HeadEyeState
 
 
 @pytest.fixture(scope="module")
@@ -83,9 +83,9 @@ def test_head_state_has_every_dataclass_field_and_compares_like_one(sawyer):
 
 
 @pytest.mark.parametrize("name", ["sawyer", "jaco2"])
-def test_update_raw_gives_the_floats_of_update(name):
+def test_step_gives_the_floats_of_update(name):
     robot_a, robot_b = RobotModel.load(name), RobotModel.load(name)
-    full, raw = GazeController(robot_a), GazeController(robot_b)
+    full, bare = GazeController(robot_a), GazeController(robot_b)
     shifts = []
     for i in range(240):  # a drifting hand, a gaze shift, a missing sample, time going back
         t = i / 120 if i != 150 else 100 / 120
@@ -95,7 +95,7 @@ def test_update_raw_gives_the_floats_of_update(name):
         if i == 100:
             target = np.full(3, math.nan)
         state = full.update(t, target)
-        head, yaw, pitch, residual, shift = raw.update_raw(t, target)
+        head, yaw, pitch, residual, shift = bare.step(t, target)
         assert head == list(state.head.values())  # bit for bit, in head_joints order
         assert (yaw, pitch, residual, shift) == (
             state.eye_yaw, state.eye_pitch, state.residual, state.shift_amplitude
