@@ -224,8 +224,9 @@ def register_table(sub: argparse._SubParsersAction) -> None:
 
 def run_reach_table(args: argparse.Namespace) -> int:
     from gazebot.apps.controllers.config import load_controllers_config
-    from gazebot.apps.controllers.giving_motions import motion_from_recording, simulated_motions
+    from gazebot.apps.controllers.giving_motions import motion_from_recording
     from gazebot.apps.controllers.reach_table import table_4_4
+    from gazebot.apps.sim.giving_motions import simulated_motions
     from gazebot.io.recordings import RecordingError
 
     if not 0 <= args.motions <= 1000:

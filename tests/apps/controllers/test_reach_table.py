@@ -14,9 +14,9 @@ from gazebot.apps.controllers.giving_motions import (
     SEED_V1,
     motion_from_path,
     seed_reach_phase,
-    simulated_motions,
 )
 from gazebot.apps.controllers.reach_table import SEED_TABLE_4_4, table_4_4, table_config
+from gazebot.apps.sim.giving_motions import simulated_motions
 
 
 def test_seed_reach_phase_starts_past_d1_of_the_way_and_ends_below_v1_of_the_peak_speed():
