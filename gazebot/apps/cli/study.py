@@ -491,7 +491,7 @@ def _register_analyses(study: argparse._SubParsersAction) -> None:
         "in-person",
         help="in-person study: ANOVA of reach-start time over gaze conditions, familiarity",
         description="One-way ANOVA of the giver's reach-start time across the gaze conditions "
-        "and the familiarity question's mean and SD (seed 6.4.5), from a responses CSV.",
+        "and the familiarity question's mean and SD (seed 6.3.3, 6.4.5), from a responses CSV.",
     )
     ip.add_argument("responses", type=Path, help="responses CSV (`gazebot study export`)")
     ip.add_argument("--json", action="store_true", help="print one JSON document")

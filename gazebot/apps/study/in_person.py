@@ -1,14 +1,15 @@
-"""The in-person study's two further analyses (seed section 6.4.5 and its setup):
+"""The in-person studies' two further analyses (seed sections 6.3.3 and 6.4.5):
 
-- a one-way ANOVA on the giver's reach-start time across the gaze conditions. The seed, quoted:
-  "We conducted a one-way ANOVA on the human's *reach start time* for four gaze conditions. The
-  results indicated no detectable difference between the four conditions (F = 0.429,
-  p = 0.732)." The reach-start time is "the difference between the start of the human hand's
-  reaching motion and the start of the robot arm's reaching motion", one per handover; a
-  handover's condition is the gaze behavior the robot showed in it.
-- the familiarity question, asked once per participant: "How familiar are you with a
-  collaborative robot (such as the one shown)?", 1 "Not at all familiar" to 5 "Extremely
-  familiar", reported as its mean and standard deviation ("M = 1.49, SD = 0.60").
+- a one-way ANOVA on the giver's reach-start time across the gaze conditions. The seed's
+  in-person study of 6.3.3, quoted: "We conducted a one-way ANOVA on the human's *reach start
+  time* for four gaze conditions. The results indicated no detectable difference between the
+  four conditions (F = 0.429, p = 0.732)." The reach-start time is "the difference between the
+  start of the human hand's reaching motion and the start of the robot arm's reaching motion",
+  one per handover; a handover's condition is the gaze behavior the robot showed in it.
+- the familiarity question, asked once per participant, worded in 6.4.5: "How familiar are you
+  with a collaborative robot (such as the one shown)?", 1 "Not at all familiar" to 5
+  "Extremely familiar", reported as its mean and standard deviation (6.4.5: "M = 1.49,
+  SD = 0.60"; 6.3.3: "M = 1.29, SD = 0.55").
 
 Both read the responses CSV (``gazebot study export``): ``first``/``second`` with
 ``first_reach_start_time``/``second_reach_start_time`` (s; empty: not measured) and

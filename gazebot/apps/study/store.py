@@ -20,8 +20,8 @@ Tables:
   restarts, so a link handed out stays valid).
 - ``secrets(name, value)``: the server's secrets (the CSRF key), made once.
 - ``familiarity(participant, answer, answered_at)``: the in-person study's familiarity question
-  (1-5, seed 6.4: "How familiar are you with a collaborative robot (such as the one shown)?"),
-  entered by the experimenter with the first live pair; a later entry corrects it.
+  (1-5, seed 6.3.3 and 6.4.5: "How familiar are you with a collaborative robot (such as the one
+  shown)?"), entered by the experimenter with the first live pair; a later entry corrects it.
 - ``reach_starts(participant, session, first_s, second_s)``: the giver's reach-start time in each
   live handover of an in-person session (s, the human's reach start minus the robot's; NULL: not
   measured), entered by the experimenter with the session's answers.

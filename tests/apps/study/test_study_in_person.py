@@ -1,5 +1,5 @@
-"""The in-person study's reach-start ANOVA and familiarity (seed 6.4.5), pinned against sums of
-squares and moments written out by hand."""
+"""The in-person studies' reach-start ANOVA and familiarity (seed 6.3.3, 6.4.5), pinned against
+sums of squares and moments written out by hand."""
 
 from __future__ import annotations
 
