@@ -88,3 +88,43 @@ def test_reach_table_cli_names_a_missing_recording(capsys):
 
     assert main(["reach-table", "--motions", "0", "--recording", "/no/such/folder"]) == 2
     assert "/no/such/folder" in capsys.readouterr().err
+
+
+def _pose_folder(path, rate=120.0):
+    """A KTH-like pose folder: the giver's right hand reaches 0.6 m toward the taker in 1 s
+    (minimum jerk) after 0.5 s at rest; the taker's hand and shoulder stand still."""
+    path.mkdir()
+    t = np.arange(0.0, 2.5, 1.0 / rate)
+    tau = np.clip(t - 0.5, 0, 1)
+    s = tau**3 * (10 - 15 * tau + 6 * tau**2)
+    bodies = {
+        "giver_RHand": np.column_stack([1.2 - 0.6 * s, 0 * t, 1.0 + 0 * t]),
+        "taker_RHand": np.tile([0.3, 0.1, 1.0], (len(t), 1)),
+        "taker_RShoulder": np.tile([0.0, 0.2, 1.4], (len(t), 1)),
+    }
+    for name, xyz in bodies.items():
+        rows = "\n".join(",".join(f"{v:.6f}" for v in (*p, 1, 0, 0, 0)) for p in xyz)
+        (path / f"{name}_pose_saved.csv").write_text("x,y,z,q0,q1,q2,q3\n" + rows + "\n")
+    return path
+
+
+def test_a_recording_gives_a_motion_in_the_receivers_frame(tmp_path):
+    from gazebot.apps.controllers.giving_motions import motion_from_recording
+
+    m = motion_from_recording(_pose_folder(tmp_path / "rec"), "giver_RHand", "taker_RHand",
+                              "taker_RShoulder", rate=120.0)
+    assert m is not None
+    assert np.allclose(m.robot_start, [0.3, -0.1, -0.4])  # the taker's hand from its shoulder
+    assert np.allclose(m.hand[0], [1.2, -0.2, -0.4])
+    assert np.allclose(np.diff(m.t), 1 / 7)  # the seed's 7 Hz
+    assert 0.5 < m.t[m.reach_start] < m.t[m.reach_end] < 1.5
+
+
+def test_reach_table_cli_adds_recordings(tmp_path, capsys):
+    from gazebot.apps.cli import main
+
+    rec = _pose_folder(tmp_path / "rec")
+    assert main(["reach-table", "--motions", "0", "--recording", str(rec), "--rate", "120",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["motions"] == 1 and out["recordings"] == [str(rec)]
