@@ -2,6 +2,7 @@
 
   gazebot gps train --controllers 8|12 --trainer static|moving
       --state reduced|full|relative --out DIR
+  gazebot gps train --add-controllers 4 --from DIR8 --out DIR12
   gazebot gps evaluate DIR --tester static|moving [--mass KG] [--grid N] [--json] [--plot PNG]
   gazebot gps demo DIR [--out VIDEO.mp4] [--tester static|moving] [--target X Y Z]
   gazebot gps figures LABEL=RESULT.npz... --out PNG
@@ -31,12 +32,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     gsub.required = True
 
     t = gsub.add_parser("train", help="train a global policy (writes DIR/policy.npz, meta.json)")
-    t.add_argument("--controllers", type=int, choices=(8, 12), default=8,
-                   help="local controllers: the shell's 8 corners, or 12 with its middle plane")
-    t.add_argument("--trainer", choices=("static", "moving"), default="static",
-                   help="the trainer holds its hand still or reaches (eq. 5.12)")
-    t.add_argument("--state", choices=("reduced", "full", "relative"), default="reduced",
-                   help="state representation (eqs. 5.8-5.10)")
+    t.add_argument("--controllers", type=int, choices=(8, 12), default=None,
+                   help="local controllers: the shell's 8 corners (default), or 12 with its "
+                   "middle plane, trained from scratch")
+    t.add_argument("--trainer", choices=("static", "moving"), default=None,
+                   help="the trainer holds its hand still (default) or reaches (eq. 5.12)")
+    t.add_argument("--state", choices=("reduced", "full", "relative"), default=None,
+                   help="state representation (eqs. 5.8-5.10; default reduced)")
+    t.add_argument("--add-controllers", type=int, choices=(4,), default=None,
+                   help="continue the 8-controller run --from DIR with the 4 local controllers "
+                   "of the shell's middle plane added (the seed's 12-controller run)")
+    t.add_argument("--from", dest="from_dir", default=None, metavar="DIR",
+                   help="the trained run --add-controllers continues (its config, trainer and "
+                   "state are kept)")
     t.add_argument("--iterations", type=int_at_least(1), default=None,
                    help="GPS iterations (default: the config's, the seed's 12)")
     t.add_argument("--config", default=None, help="GPS YAML (default: configs/gps.yaml)")
@@ -87,11 +95,17 @@ def _train(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out: {out} exists and is not a directory")
-    cfg = load_gps_config(args.config)
+    if (args.add_controllers is None) != (args.from_dir is None):
+        raise UsageError("--add-controllers and --from go together (continue a trained run)")
     start = time.monotonic()
     try:
-        result = train(cfg, args.controllers, args.trainer == "moving", StateKind(args.state),
-                       iterations=args.iterations, progress=not args.quiet)
+        if args.from_dir is not None:
+            result, cfg = _continue(args)
+        else:
+            cfg = load_gps_config(args.config)
+            result = train(cfg, args.controllers or 8, args.trainer == "moving",
+                           StateKind(args.state or "reduced"), iterations=args.iterations,
+                           progress=not args.quiet)
     except UnreachableTarget as exc:
         raise UsageError(f"the configuration's shell is out of the tester's reach: {exc}") from exc
     seconds = time.monotonic() - start
@@ -99,6 +113,35 @@ def _train(args: argparse.Namespace) -> int:
     print(json.dumps({"out": str(out), "train_error_m": float(result.train_errors_m.mean()),
                       "seconds": round(seconds, 1)}))
     return 0
+
+
+def _continue(args: argparse.Namespace):
+    """``--add-controllers 4 --from DIR``: the 8-controller run in DIR continued with the 4
+    middle-plane controllers (its config, trainer and state representation kept)."""
+    import numpy as np
+
+    from gazebot.apps.gps.badmm import continue_training
+    from gazebot.apps.gps.shell import training_targets
+    from gazebot.apps.gps.store import load_checkpoint
+
+    for option, value in (("--controllers", args.controllers), ("--config", args.config)):
+        if value is not None:
+            raise UsageError(f"{option} does not go with --from: the run's own is kept")
+    if Path(args.from_dir).resolve() == Path(args.out).resolve():
+        raise UsageError("--out must differ from --from (the 8-controller run stays as it was)")
+    previous, cfg = load_checkpoint(args.from_dir)
+    for option, value, kept in (("--trainer", args.trainer,
+                                 "moving" if previous.moving else "static"),
+                                ("--state", args.state, previous.kind.value)):
+        if value is not None and value != kept:
+            raise UsageError(f"{option} {value}: the run in {args.from_dir} was trained with "
+                             f"{kept}, which continuing keeps")
+    twelve = training_targets(cfg.shell, 12)
+    if len(previous.targets) != 8 or not np.allclose(previous.targets, twelve[:8]):
+        raise UsageError(f"--from {args.from_dir}: expected a run of the shell's 8 corner "
+                         f"controllers, got {len(previous.targets)} controllers")
+    return continue_training(cfg, previous, twelve[8:], iterations=args.iterations,
+                             progress=not args.quiet), cfg
 
 
 def _evaluate(args: argparse.Namespace) -> int:

@@ -85,6 +85,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run_reach_plan)
+    register_table(sub)
 
 
 def controllers_config_from_args(args: argparse.Namespace):
@@ -189,4 +190,79 @@ def run_reach_plan(args: argparse.Namespace) -> int:
             f"final gap {result['final_gap_m']} m; solve {result['solve_ms']} ms median "
             f"(max {result['solve_ms_max']}) per {result['control_period_ms']:.0f} ms step"
         )
+    return 0
+
+
+# ---------------------------------------------------------------------------- reach-table
+def register_table(sub: argparse._SubParsersAction) -> None:
+    """``gazebot reach-table``: the seed's Table 4.4 (module
+    :mod:`gazebot.apps.controllers.reach_table`)."""
+    p = sub.add_parser(
+        "reach-table",
+        help="the seed's Table 4.4: STL success rate over giving motions per t1 and u_max",
+        description="Simulate the STL reach controller (eps_p 0.01 m, dt 0.2 s, H 20) on the "
+        "reach phase of each giving motion and print the share it finds feasible per reach "
+        "time and speed cap, beside the seed's Table 4.4.",
+    )
+    p.add_argument("--motions", type=int, default=70,
+                   help="simulated giving motions (default 70, the seed's table's count)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the simulated motions")
+    p.add_argument("--recording", type=Path, action="append", default=[],
+                   help="a human-human recording to add (any format gazebot reads, e.g. a KTH "
+                   "pose folder), repeatable")
+    p.add_argument("--rate", type=float, help="sampling rate of pose-folder recordings, Hz")
+    p.add_argument("--giver-hand", default="giver_RHand", help="recording: the giver's hand")
+    p.add_argument("--receiver-hand", default="taker_RHand",
+                   help="recording: the receiver's hand (where the robot's gripper starts)")
+    p.add_argument("--receiver-base", default="taker_RShoulder",
+                   help="recording: the receiver's point the robot's base stands at")
+    p.add_argument("--config", type=Path,
+                   help="controllers YAML (default: configs/controllers.yaml)")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=run_reach_table)
+
+
+def run_reach_table(args: argparse.Namespace) -> int:
+    from gazebot.apps.controllers.config import load_controllers_config
+    from gazebot.apps.controllers.giving_motions import motion_from_recording
+    from gazebot.apps.controllers.reach_table import table_4_4
+    from gazebot.apps.sim.giving_motions import simulated_motions
+    from gazebot.io.recordings import RecordingError
+
+    if not 0 <= args.motions <= 1000:
+        raise UsageError(f"--motions must be in [0, 1000], got {args.motions}")
+    motions = simulated_motions(args.motions, args.seed)
+    skipped = args.motions - len(motions)
+    for path in args.recording:
+        try:
+            m = motion_from_recording(
+                path, args.giver_hand, args.receiver_hand, args.receiver_base, args.rate
+            )
+        except RecordingError as exc:
+            raise UsageError(str(exc)) from None
+        if m is None:
+            skipped += 1
+        else:
+            motions.append(m)
+    if not motions:
+        raise UsageError("no giving motion with a valid reach phase: give --motions or --recording")
+    rows = table_4_4(motions, load_controllers_config(args.config))
+    if args.json:
+        print(json.dumps({
+            "motions": len(motions),
+            "skipped": skipped,
+            "recordings": [str(p) for p in args.recording],
+            "rows": [
+                {"u_max_m_s": r.u_max_m_s, "t1_s": r.reach_time_s, "succeeded": r.succeeded,
+                 "percent": round(r.percent, 1), "seed_percent": r.seed_percent}
+                for r in rows
+            ],
+        }))
+        return 0
+    print(f"Table 4.4 over {len(motions)} giving motions ({skipped} without a valid reach phase "
+          "skipped)")
+    print(f"{'u_max (m/s)':>11}  {'t1 (s)':>6}  {'gazebot':>8}  {'seed':>6}")
+    for r in rows:
+        seed = "" if r.seed_percent is None else f"{r.seed_percent:.1f}%"
+        print(f"{r.u_max_m_s:>11g}  {r.reach_time_s:>6g}  {r.percent:>7.1f}%  {seed:>6}")
     return 0

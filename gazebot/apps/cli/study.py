@@ -214,6 +214,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     f.add_argument("--json", action="store_true", help="print one JSON document")
     f.set_defaults(func=_input_errors(_fit_wins))
+    _register_analyses(study)
 
 
 def _finite(value: float, option: str, low: float = 0.0, high: float = math.inf) -> float:
@@ -481,4 +482,77 @@ def _export(args: argparse.Namespace) -> int:
 
     out, n = export_responses(args.dir, args.out, args.include_practice)
     print(f"wrote {n} answered sessions to {out}")
+    return 0
+
+
+# ------------------------------------------------------- in-person and chapter 3 analyses
+def _register_analyses(study: argparse._SubParsersAction) -> None:
+    ip = study.add_parser(
+        "in-person",
+        help="in-person study: ANOVA of reach-start time over gaze conditions, familiarity",
+        description="One-way ANOVA of the giver's reach-start time across the gaze conditions "
+        "and the familiarity question's mean and SD (seed 6.3.3, 6.4.5), from a responses CSV.",
+    )
+    ip.add_argument("responses", type=Path, help="responses CSV (`gazebot study export`)")
+    ip.add_argument("--json", action="store_true", help="print one JSON document")
+    ip.set_defaults(func=_input_errors(_in_person))
+    ms = study.add_parser(
+        "measures",
+        help="UEQ scales, NASA TLX items and their Pearson correlations (seed ch. 3, App. A)",
+        description="Score a questionnaire CSV: UEQ scale means, NASA TLX item means and the "
+        "Pearson correlations of the seed's Appendix A, per controller and round.",
+    )
+    ms.add_argument("questionnaire", type=Path, help="questionnaire CSV (ueq1..ueq26, tlx_*)")
+    ms.add_argument("--json", action="store_true", help="print one JSON document")
+    ms.set_defaults(func=_input_errors(_measures))
+
+
+def _in_person(args: argparse.Namespace) -> int:
+    from gazebot.apps.study.in_person import (
+        familiarity_summary,
+        reach_start_anova,
+        read_in_person,
+    )
+
+    data = read_in_person(args.responses)
+    anova = reach_start_anova(data.reach_start) if data.reach_start else None
+    fam = familiarity_summary(data.familiarity) if data.familiarity else None
+    if anova is None and fam is None:
+        raise UsageError(
+            f"{args.responses}: no in-person reach-start times and no familiarity answers "
+            "(columns first_reach_start_time, second_reach_start_time, familiarity)"
+        )
+    if args.json:
+        print(json.dumps({
+            "reach_start_anova": anova.to_json() if anova else None,
+            "familiarity": fam.to_json() if fam else None,
+        }))
+        return 0
+    if anova is not None:
+        print(f"reach-start time, one-way ANOVA over {len(anova.groups)} gaze conditions: "
+              f"F({anova.df_between}, {anova.df_within}) = {anova.f:.3f}, p = {anova.p:.3f}")
+        for k, v in anova.groups.items():
+            print(f"  {k}: mean {sum(v) / len(v):.3f} s (n={len(v)})")
+    if fam is not None:
+        print(f"familiarity (1-5): M = {fam.mean:.2f}, SD = {fam.sd:.2f} (n={fam.n})")
+    return 0
+
+
+def _measures(args: argparse.Namespace) -> int:
+    from gazebot.apps.study.measures import analyze_measures, read_questionnaire
+
+    result = analyze_measures(read_questionnaire(args.questionnaire))
+    doc = result.to_json()
+    if args.json:
+        print(json.dumps(doc))
+        return 0
+    for group, parts in doc.items():
+        print(f"## {group}")
+        for s, v in parts["ueq"].items():
+            print(f"  UEQ {s}: M = {v['M']:.2f} (1-7: {v['M'] + 4:.2f}), SD = {v['SD']:.2f} "
+                  f"(n={v['n']})")
+        for t, v in parts["tlx"].items():
+            print(f"  TLX {t}: M = {v['M']:.2f}, SD = {v['SD']:.2f} (n={v['n']})")
+        for c in parts["pearson"]:
+            print(f"  r({c['tlx']}, {c['ue']}) = {c['r']:.3f}, p = {c['p']:.3f}")
     return 0

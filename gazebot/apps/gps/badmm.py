@@ -54,12 +54,18 @@ class GPSState:
 
 @dataclass(frozen=True)
 class TrainResult:
+    """A run's outcome and everything another run needs to continue it
+    (:func:`continue_training`): the BADMM state, the dynamics prior's transition buffer and the
+    sampling generator's state."""
+
     policy: PolicyParams
     state: GPSState
     kind: StateKind
     targets: np.ndarray
     moving: bool
     train_errors_m: np.ndarray  # the global policy's final error per training target
+    buffer: list[np.ndarray] = field(default_factory=list)
+    rng_state: dict | None = None
 
 
 def cost_for(cfg: GPSFileConfig, kind: StateKind) -> ReachCost:
@@ -258,27 +264,65 @@ def iterate(cfg: GPSFileConfig, scene: HandoverScene, motions: list[TesterMotion
     return entry
 
 
-def train(cfg: GPSFileConfig, controllers: int, moving: bool, kind: StateKind,
-          iterations: int | None = None, targets: np.ndarray | None = None,
-          progress: bool = False) -> TrainResult:
-    """Train a global policy with ``controllers`` local controllers (8 or 12 shell targets unless
-    ``targets`` are given) against a static or moving trainer."""
+def _run(cfg: GPSFileConfig, targets: np.ndarray, moving: bool, kind: StateKind,
+         st: GPSState | None, buffer: list[np.ndarray], rng: np.random.Generator,
+         n_iter: int, progress: bool) -> TrainResult:
+    """``n_iter`` iterations on ``targets`` from ``st`` (None: fresh PD controllers and policy),
+    numbered after the iterations already in its log."""
     from tqdm import tqdm
 
-    tg = training_targets(cfg.shell, controllers) if targets is None else np.asarray(targets)
-    motions = [motion_to(p, moving, cfg.scene.tester) for p in tg]
+    motions = [motion_to(p, moving, cfg.scene.tester) for p in targets]
     scene = HandoverScene(cfg.scene)
-    rng = np.random.default_rng(cfg.gps.seed)
     prior = GMMPrior(cfg.gps.gmm_clusters, cfg.gps.seed)
-    buffer: list[np.ndarray] = []
-    n_iter = cfg.gps.iterations if iterations is None else iterations
     with threadpool_limits(1):  # the machine is shared; BLAS threads only oversubscribe it
-        st = initial_state(cfg, scene, motions, kind)
-        bar = tqdm(range(n_iter), desc="GPS", unit="it", disable=not progress)
+        if st is None:
+            st = initial_state(cfg, scene, motions, kind)
+        done = len(st.log)
+        bar = tqdm(range(done, done + n_iter), desc="GPS", unit="it", disable=not progress)
         for it in bar:
             e = iterate(cfg, scene, motions, kind, st, prior, buffer, rng, it)
             bar.set_postfix(local_mm=f"{1e3 * e.local_error_m:.0f}",
                             policy_mm=f"{1e3 * e.policy_error_m:.0f}", kl=f"{e.policy_kl:.2f}")
         errs = np.array([run_trial(scene, mo, kind, policy_act(st.policy)).final_error()
                          for mo in motions])
-    return TrainResult(st.policy, st, kind, tg, moving, errs)
+    return TrainResult(st.policy, st, kind, np.asarray(targets), moving, errs, buffer,
+                       dict(rng.bit_generator.state))
+
+
+def train(cfg: GPSFileConfig, controllers: int, moving: bool, kind: StateKind,
+          iterations: int | None = None, targets: np.ndarray | None = None,
+          progress: bool = False) -> TrainResult:
+    """Train a global policy with ``controllers`` local controllers (8 or 12 shell targets unless
+    ``targets`` are given) against a static or moving trainer."""
+    tg = training_targets(cfg.shell, controllers) if targets is None else np.asarray(targets)
+    rng = np.random.default_rng(cfg.gps.seed)
+    n_iter = cfg.gps.iterations if iterations is None else iterations
+    return _run(cfg, tg, moving, kind, None, [], rng, n_iter, progress)
+
+
+def continue_training(cfg: GPSFileConfig, previous: TrainResult, new_targets: np.ndarray,
+                      iterations: int | None = None, progress: bool = False) -> TrainResult:
+    """The seed's 12-controller run, "adding four additional local controllers" to a trained
+    run: ``previous``'s local controllers, their multipliers and KL weights, the global policy,
+    the prior's transition buffer and the generator's state are kept; one fresh local
+    controller (the initial PD law, lambda 0, nu_init) is added per ``new_targets`` row; then
+    ``iterations`` (default: the config's) more iterations train all of them."""
+    new_targets = np.atleast_2d(np.asarray(new_targets, float))
+    old = previous.state
+    scene = HandoverScene(cfg.scene)
+    motions = [motion_to(p, previous.moving, cfg.scene.tester) for p in new_targets]
+    fresh = initial_state(cfg, scene, motions, previous.kind)
+    st = GPSState(
+        controllers=[*old.controllers, *fresh.controllers],
+        lam=np.concatenate([old.lam, fresh.lam]),
+        nu=np.concatenate([old.nu, fresh.nu]),
+        policy=old.policy,
+        log=list(old.log),
+    )
+    rng = np.random.default_rng(cfg.gps.seed)
+    if previous.rng_state is not None:
+        rng.bit_generator.state = previous.rng_state  # the sampling continues where it stopped
+    targets = np.concatenate([previous.targets, new_targets])
+    n_iter = cfg.gps.iterations if iterations is None else iterations
+    return _run(cfg, targets, previous.moving, previous.kind, st, list(previous.buffer), rng,
+                n_iter, progress)

@@ -1,5 +1,8 @@
-"""A trained policy on disk: ``DIR/policy.npz`` (network) and ``DIR/meta.json`` (how it was
-trained: state kind, trainer, targets, the configuration, the iteration log)."""
+"""A trained policy on disk: ``DIR/policy.npz`` (network), ``DIR/meta.json`` (how it was
+trained: state kind, trainer, targets, the configuration, the iteration log, the sampling
+generator's state) and ``DIR/state.npz`` (what continuing the run needs: the local controllers,
+their Lagrange multipliers and KL weights, the dynamics prior's transition buffer;
+``gazebot gps train --add-controllers N --from DIR``)."""
 
 from __future__ import annotations
 
@@ -10,8 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gazebot.apps.gps.badmm import TrainResult
+from gazebot.apps.gps.badmm import GPSState, IterationLog, TrainResult
 from gazebot.apps.gps.config import GPSFileConfig
+from gazebot.apps.gps.lingauss import LinearGaussian
 from gazebot.apps.gps.policy import PolicyParams
 from gazebot.apps.gps.scene import DU
 from gazebot.apps.gps.state import DIMS, StateKind
@@ -41,8 +45,22 @@ def save(result: TrainResult, cfg: GPSFileConfig, out: Path, seconds: float) -> 
         "train_seconds": seconds,
         "log": [asdict(e) for e in result.state.log],
         "config": cfg.model_dump(mode="json"),
+        "rng_state": result.rng_state,
     }
+    st = result.state
+    arrays: dict[str, np.ndarray] = {
+        "K": np.array([c.K for c in st.controllers]),
+        "k": np.array([c.k for c in st.controllers]),
+        "cov": np.array([c.cov for c in st.controllers]),
+        "lam": st.lam,
+        "nu": st.nu,
+        **{f"buffer_{i}": b for i, b in enumerate(result.buffer)},
+    }
+    np.savez(out / STATE_FILE, **arrays)  # type: ignore[arg-type]
     (out / "meta.json").write_text(json.dumps(meta, indent=2) + "\n", encoding="utf-8")
+
+
+STATE_FILE = "state.npz"
 
 
 def load(directory: str | Path) -> TrainedPolicy:
@@ -80,3 +98,42 @@ def load(directory: str | Path) -> TrainedPolicy:
     return TrainedPolicy(policy, cfg, kind, meta["trainer"] == "moving",
                          np.asarray(meta["targets_m"], dtype=float), int(meta["controllers"]),
                          list(meta.get("log", [])))
+
+
+def load_checkpoint(directory: str | Path) -> tuple[TrainResult, GPSFileConfig]:
+    """A trained run as :func:`gazebot.apps.gps.badmm.continue_training` takes it, and the
+    configuration it was trained with.
+
+    Raises:
+        ConfigError: not a run directory, a run saved without ``state.npz`` (trained before
+            runs could be continued), or arrays that do not fit its controllers and state.
+    """
+    trained = load(directory)
+    d = Path(directory)
+    path = d / STATE_FILE
+    if not path.is_file():
+        raise ConfigError(path, "<file>", "the run's BADMM state (written by `gazebot gps "
+                          "train` since --add-controllers exists)", "no state.npz: retrain it")
+    meta = json.loads((d / "meta.json").read_text(encoding="utf-8"))
+    try:
+        with np.load(path) as z:
+            arrays = {name: z[name] for name in z.files}
+    except (OSError, ValueError, zipfile.BadZipFile) as exc:
+        raise ConfigError(path, "<file>", "the run's BADMM state arrays", str(exc)) from exc
+    c, horizon, dx = trained.controllers, trained.cfg.scene.horizon, DIMS[trained.kind]
+    shapes = {"K": (c, horizon, DU, dx), "k": (c, horizon, DU), "cov": (c, horizon, DU, DU),
+              "lam": (c, horizon, DU), "nu": (c, horizon)}
+    for name, shape in shapes.items():
+        got = arrays.get(name)
+        if got is None or got.shape != shape or not np.all(np.isfinite(got)):
+            raise ConfigError(path, name, f"finite values of shape {shape}",
+                              "missing" if got is None else got.shape)
+    buffer = [arrays[f"buffer_{i}"] for i in range(len(arrays)) if f"buffer_{i}" in arrays]
+    controllers = [LinearGaussian(K, k, cov)
+                   for K, k, cov in zip(arrays["K"], arrays["k"], arrays["cov"], strict=True)]
+    log = [IterationLog(**e) for e in trained.log]
+    state = GPSState(controllers, arrays["lam"], arrays["nu"], trained.policy, log)
+    result = TrainResult(trained.policy, state, trained.kind, trained.targets, trained.moving,
+                         np.asarray(meta.get("train_errors_m", []), float), buffer,
+                         meta.get("rng_state"))
+    return result, trained.cfg

@@ -1,7 +1,9 @@
 """``gazebot study export``: the answers stored by ``gazebot study serve`` as the responses CSV
 that ``gazebot study analyze`` reads (:mod:`gazebot.apps.study.analysis`), with timestamps, the time
 spent per session and the seed's reach-start time of both handovers (giver's reach start minus
-the robot's, s; empty when unknown)."""
+the robot's, s; empty when unknown: for a video session the rendered videos', for an in-person
+session the times the experimenter measured), and the in-person familiarity answer (1-5), which
+``gazebot study in-person`` analyses (:mod:`gazebot.apps.study.in_person`)."""
 
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ EXPORT_COLUMNS = (
     "gaze_mode",
     "first_reach_start_time",
     "second_reach_start_time",
+    "familiarity",
     "shown_at",
     "submitted_at",
     "seconds",
@@ -57,7 +60,10 @@ def export_responses(
     out = check_output_file(out, "responses", ".csv")
     if not study.database.is_file():
         raise ValueError(f"{study.root}: no answers yet (no {study.database.name})")
-    answers = study.store().answers(include_practice=include_practice)
+    store = study.store()
+    answers = store.answers(include_practice=include_practice)
+    familiarity = store.familiarity()
+    measured = store.reach_starts()
     by_key = {(s.participant, s.session): s for s in study.plan}
     two_groups = len({a.mode for a in answers}) > 1
     with atomic_path(out) as tmp, tmp.open("w", newline="", encoding="utf-8") as fh:
@@ -75,6 +81,14 @@ def export_responses(
                 shown = study.session_videos(a.participant, a.session)
             except KeyError:
                 shown = None
+            if a.mode == "in-person":  # live handovers: what was measured, not the videos'
+                times = measured.get((a.participant, a.session), (None, None))
+            else:
+                times = (
+                    shown.first_reach_start_time if shown else None,
+                    shown.second_reach_start_time if shown else None,
+                )
+            fam = familiarity.get(a.participant)
             writer.writerow(
                 [
                     a.participant,
@@ -90,8 +104,9 @@ def export_responses(
                     s.scene if s else "",
                     s.robot if s else "",
                     study.gaze_mode,
-                    fmt_seconds(shown.first_reach_start_time if shown else None),
-                    fmt_seconds(shown.second_reach_start_time if shown else None),
+                    fmt_seconds(times[0]),
+                    fmt_seconds(times[1]),
+                    "" if fam is None else fam,
                     _iso(a.shown_at),
                     _iso(a.submitted_at),
                     "" if seconds is None else f"{seconds:.3f}",

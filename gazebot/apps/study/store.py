@@ -19,6 +19,12 @@ Tables:
 - ``links(participant, token)``: each participant's random link token (made once, kept across
   restarts, so a link handed out stays valid).
 - ``secrets(name, value)``: the server's secrets (the CSRF key), made once.
+- ``familiarity(participant, answer, answered_at)``: the in-person study's familiarity question
+  (1-5, seed 6.3.3 and 6.4.5: "How familiar are you with a collaborative robot (such as the one
+  shown)?"), entered by the experimenter with the first live pair; a later entry corrects it.
+- ``reach_starts(participant, session, first_s, second_s)``: the giver's reach-start time in each
+  live handover of an in-person session (s, the human's reach start minus the robot's; NULL: not
+  measured), entered by the experimenter with the session's answers.
 
 Times are UTC seconds since the epoch (floats).
 """
@@ -72,6 +78,18 @@ CREATE TABLE IF NOT EXISTS links (
 CREATE TABLE IF NOT EXISTS secrets (
     name TEXT PRIMARY KEY,
     value TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS familiarity (
+    participant INTEGER PRIMARY KEY,
+    answer INTEGER NOT NULL CHECK (answer BETWEEN 1 AND 5),
+    answered_at REAL NOT NULL
+);
+CREATE TABLE IF NOT EXISTS reach_starts (
+    participant INTEGER NOT NULL,
+    session INTEGER NOT NULL,
+    first_s REAL,
+    second_s REAL,
+    PRIMARY KEY (participant, session)
 );
 """
 
@@ -276,6 +294,43 @@ class ResponseStore:
         with self._connect() as con:
             ids = [r[0] for r in con.execute("SELECT participant FROM participants ORDER BY 1")]
         return [self.progress(p) for p in ids]
+
+    def set_familiarity(self, participant: int, answer: int, now: float | None = None) -> None:
+        """Record (or correct) the participant's familiarity answer, 1-5."""
+        if answer not in range(1, 6):
+            raise ValueError(f"familiarity must be 1-5, got {answer!r}")
+        with self._transaction() as con:
+            con.execute(
+                "INSERT INTO familiarity (participant, answer, answered_at) VALUES (?, ?, ?) "
+                "ON CONFLICT (participant) DO UPDATE SET answer = excluded.answer, "
+                "answered_at = excluded.answered_at",
+                (participant, answer, now or time.time()),
+            )
+
+    def familiarity(self) -> dict[int, int]:
+        """Every recorded familiarity answer by participant."""
+        with self._connect() as con:
+            return dict(con.execute("SELECT participant, answer FROM familiarity").fetchall())
+
+    def set_reach_starts(
+        self, participant: int, session: int, first_s: float | None, second_s: float | None
+    ) -> None:
+        """Record the measured reach-start times (s) of a session's two live handovers."""
+        with self._transaction() as con:
+            con.execute(
+                "INSERT INTO reach_starts (participant, session, first_s, second_s) "
+                "VALUES (?, ?, ?, ?) ON CONFLICT (participant, session) DO UPDATE SET "
+                "first_s = excluded.first_s, second_s = excluded.second_s",
+                (participant, session, first_s, second_s),
+            )
+
+    def reach_starts(self) -> dict[tuple[int, int], tuple[float | None, float | None]]:
+        """Measured reach-start times by (participant, session)."""
+        with self._connect() as con:
+            rows = con.execute(
+                "SELECT participant, session, first_s, second_s FROM reach_starts"
+            ).fetchall()
+        return {(p, k): (a, b) for p, k, a, b in rows}
 
     def answers(self, include_practice: bool = False) -> list[Answer]:
         """Every stored answer by (participant, session)."""

@@ -443,3 +443,62 @@ def test_serve_on_all_interfaces_prints_an_address_a_browser_can_open():
     assert base_url("::", 80).startswith(f"http://{socket.gethostname()}")
     assert base_url("127.0.0.1", 8000) == "http://127.0.0.1:8000"
     assert base_url("::1", 8000) == "http://[::1]:8000"
+
+
+def test_in_person_familiarity_and_measured_reach_starts_reach_the_export_and_the_anova(
+    fresh, tmp_path
+):
+    """The experimenter enters the familiarity answer with the first live pair and the measured
+    reach-start times with each pair; the export carries them (not the videos' times) and
+    ``study in-person``'s ANOVA and familiarity summary read them back."""
+    from scipy import stats
+
+    from gazebot.apps.study.in_person import (
+        FAMILIARITY_QUESTION,
+        familiarity_summary,
+        reach_start_anova,
+        read_in_person,
+    )
+
+    study = load_study(fresh)
+    c = client(fresh, admin=True)
+    fam = {3: 1, 4: 2, 5: 2}
+    sent: dict[str, list[float]] = {}
+    for p, answer in fam.items():
+        for i, s in enumerate(study.sessions_of(p)):
+            page = c.get(f"/admin/in-person/{p}").get_data(as_text=True)
+            assert (FAMILIARITY_QUESTION in page) == (i == 0)  # asked once
+            t1, t2 = round(0.1 * p + 0.01 * i, 3), round(-0.25 + 0.03 * i, 3)
+            data = {**ANSWERS, "session": str(s.session), "first_reach_start_time": str(t1),
+                    "second_reach_start_time": str(t2)}
+            if i == 0:
+                data["familiarity"] = str(answer)
+            assert c.post(f"/admin/in-person/{p}", data=data).status_code == 303
+            sent.setdefault(s.first, []).append(t1)
+            sent.setdefault(s.second, []).append(t2)
+    out, _ = export_responses(fresh, tmp_path / "r.csv")
+    data = read_in_person(out)
+    assert data.familiarity == {("", "3"): 1, ("", "4"): 2, ("", "5"): 2}
+    assert {k: sorted(v) for k, v in data.reach_start.items()} == {
+        k: sorted(v) for k, v in sent.items()
+    }
+    # Not the rendered videos' reach-start times: the measured ones.
+    assert reach_start_time_of("face") not in data.reach_start["face"]
+    anova = reach_start_anova(data.reach_start)
+    expected = stats.f_oneway(*(sent[k] for k in sorted(sent)))
+    assert (anova.f, anova.p) == pytest.approx((expected.statistic, expected.pvalue))
+    summary = familiarity_summary(data.familiarity)
+    assert (summary.mean, summary.sd) == pytest.approx((5 / 3, np.sqrt(1 / 3)))
+
+
+def test_in_person_entry_refuses_a_reach_start_that_is_not_seconds(fresh):
+    study = load_study(fresh)
+    c = client(fresh, admin=True)
+    s = study.sessions_of(3)[0]
+    resp = c.post("/admin/in-person/3", data={**ANSWERS, "session": str(s.session),
+                                               "first_reach_start_time": "soon"})
+    assert resp.status_code == 400 and b"Reach-start time of handover 1" in resp.data
+    resp = c.post("/admin/in-person/3", data={**ANSWERS, "session": str(s.session),
+                                               "familiarity": "9"})
+    assert resp.status_code == 400 and b"Familiarity must be 1-5" in resp.data
+    assert study.store().answers() == []

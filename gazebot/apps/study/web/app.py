@@ -41,6 +41,7 @@ from flask import (
 )
 
 from gazebot.apps.study.folder import PRACTICE, StudyFolder, load_study
+from gazebot.apps.study.in_person import FAMILIARITY_QUESTION
 from gazebot.apps.study.plan import Session
 from gazebot.apps.study.questionnaire import (
     COMMENT_QUESTION,
@@ -74,6 +75,7 @@ DEFAULT_CONSENT = (
     "Your answers are stored under your participant number only."
 )
 MAX_COMMENT = 4000  # characters kept of a comment
+MAX_REACH_START_S = 60.0  # a measured reach-start time beyond +-this is a typo, not a handover
 
 
 @dataclass(frozen=True)
@@ -505,9 +507,37 @@ def create_app(
             total=n_sessions[participant],
             questions=questions("in-person"),
             comment_question=COMMENT_QUESTION,
+            familiarity_question=FAMILIARITY_QUESTION,
+            ask_familiarity=participant not in store.familiarity(),
             errors=errors or [],
             values=values or {},
         )
+
+    def parse_in_person_extras() -> tuple[int | None, list[float | None], list[str]]:
+        """The in-person form's optional fields: the familiarity answer (1-5) and the measured
+        reach-start time of each handover (s); empty fields are None."""
+        errors: list[str] = []
+        fam_raw = request.form.get("familiarity", "").strip()
+        fam = None
+        if fam_raw:
+            if fam_raw in ("1", "2", "3", "4", "5"):
+                fam = int(fam_raw)
+            else:
+                errors.append(f"Familiarity must be 1-5, got {fam_raw[:20]!r}.")
+        times: list[float | None] = []
+        for k, name in enumerate(("first_reach_start_time", "second_reach_start_time"), 1):
+            raw = request.form.get(name, "").strip()
+            try:
+                value = float(raw) if raw else None
+            except ValueError:
+                value = float("nan")
+            if value is not None and not abs(value) <= MAX_REACH_START_S:
+                errors.append(f"Reach-start time of handover {k}: seconds within "
+                              f"+-{MAX_REACH_START_S:g}, or empty if not measured; "
+                              f"got {raw[:20]!r}.")
+                value = None
+            times.append(value)
+        return fam, times, errors
 
     @app.get("/admin/in-person/<int:participant>")
     @admin_only
@@ -529,12 +559,17 @@ def create_app(
         if nxt is None or not (k.isascii() and k.isdigit()) or int(k) != nxt.session:
             return redirect(url_for("in_person", participant=participant), 303)
         answers, comment, errors = parse_answers("in-person")
-        if errors:
-            return in_person_form(participant, errors, form_values(), status=400)
+        fam, times, extra_errors = parse_in_person_extras()
+        if errors or extra_errors:
+            return in_person_form(participant, errors + extra_errors, form_values(), status=400)
         now = time.time()
         if prog.mode is None:
             store.give_consent(participant, "in-person", now)
             store.read_instructions(participant, now)
+        if fam is not None:
+            store.set_familiarity(participant, fam, now)
+        if any(t is not None for t in times):
+            store.set_reach_starts(participant, nxt.session, times[0], times[1])
         store.submit(
             participant, nxt.session, answers, comment, "in-person", last_session[participant]
         )
