@@ -97,7 +97,7 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
     equal ones) is the minimum until a sample rises ``depth`` above it; going up, the highest
     so far until one falls ``depth`` below it. Each leg is found with running extrema
     (:func:`_leg_end`: a few numpy calls a leg, not a Python step per sample: the online
-    analysis reads the dips of hundreds of samples every period); ``tests/phases`` pins it to
+    analysis reads the dips of hundreds of samples every period); ``tests/core/phases`` pins it to
     the sample-by-sample form."""
     if not depth > 0:
         raise ValueError(f"dips: depth must be > 0, got {depth}")
