@@ -6,10 +6,23 @@ from __future__ import annotations
 from gazebot.core.handover.state import (
     RULES,
     HandoverState,
+    HandoverView,
     PhaseChange,
+    PhaseFollower,
     Rule,
+    apply_event,
     event_source,
     machine_definition,
 )
 
-__all__ = ["RULES", "HandoverState", "PhaseChange", "Rule", "event_source", "machine_definition"]
+__all__ = [
+    "RULES",
+    "HandoverState",
+    "HandoverView",
+    "PhaseChange",
+    "PhaseFollower",
+    "Rule",
+    "apply_event",
+    "event_source",
+    "machine_definition",
+]

@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from transitions import Machine
 
@@ -211,6 +211,75 @@ def machine_definition(
     }
 
 
+class HandoverView(Protocol):
+    """What the phase detector reads of the handover state (read-only; a
+    :class:`HandoverState` is one)."""
+
+    @property
+    def phase(self) -> Phase:
+        """The current phase."""
+        ...
+
+    @property
+    def phase_start(self) -> float:
+        """Its start (s; -inf before any handover)."""
+        ...
+
+    @property
+    def handover(self) -> int:
+        """Index of the current (or last) handover, -1 before the first."""
+        ...
+
+    @property
+    def handover_t0(self) -> float:
+        """Events at or after this belong to the current handover (s): the previous
+        handover's end, -inf for the first."""
+        ...
+
+    @property
+    def reach_tracked(self) -> bool:
+        """The tracking reported the current handover's reach start (False while a reach
+        only the robot started waits for the giver's: the first reach wins)."""
+        ...
+
+    @property
+    def entry(self) -> int:
+        """Grows whenever the phase the tracking follows is entered or its start moves (a
+        reach only the robot started is not one until the giver's joins it)."""
+        ...
+
+
+class PhaseFollower(Protocol):
+    """What reacts to the handover state's changes (the behavior machine)."""
+
+    def advance(self, t: float) -> None:
+        """Bring everything due by ``t`` up to date (before a phase change at ``t``)."""
+
+    def on_phase(self, change: PhaseChange) -> None:
+        """The state changed phase."""
+
+    def on_tracking(self, event: Event) -> None:
+        """``tracking_lost`` / ``tracking_restored``."""
+
+
+def apply_event(state: HandoverState, follower: PhaseFollower, event: Event) -> PhaseChange | None:
+    """Apply one event to ``state`` and tell ``follower``: tracking events go to it alone; a
+    phase or robot event that moves the phase first lets it catch up to the event's time
+    (what is due by then is the gaze that carries on), then tells it the change. Returns the
+    change, else ``None``."""
+    kind = getattr(event, "kind", None)
+    if kind is EventKind.TRACKING_LOST or kind is EventKind.TRACKING_RESTORED:
+        follower.on_tracking(event)
+        return None
+    t = state.would_move(event)
+    if t is not None:
+        follower.advance(t)
+    change = state.apply(event)
+    if change is not None:
+        follower.on_phase(change)
+    return change
+
+
 class _Model:
     """The object whose ``state`` (a phase's value) the handover machine drives."""
 
@@ -239,6 +308,9 @@ class HandoverState:
         #: Counts every change of what the behavior's timing reads (phase, its start, robot
         #: events); never goes back, not even on :meth:`reset`.
         self.revision = 0
+        #: Counts the entries of the phase the tracking follows (see :class:`HandoverView`);
+        #: never goes back, not even on :meth:`reset`.
+        self.entry = 0
         self.reset()
 
     def reset(self) -> None:
@@ -259,11 +331,17 @@ class HandoverState:
         self._robot: dict[EventKind, Event] = {}
         self._change: PhaseChange | None = None
         self.revision += 1
+        self.entry += 1
 
     @property
     def phase(self) -> Phase:
         """The current phase (the machine's state)."""
         return _PHASE_OF_STATE[self._model.state]
+
+    @property
+    def reach_tracked(self) -> bool:
+        """The tracking reported the current handover's reach start."""
+        return "giver" in self._reach_by
 
     # ----------------------------------------------------------------- input
     def apply(self, event: Event) -> PhaseChange | None:
@@ -379,11 +457,15 @@ class HandoverState:
         """The other party's reach start of the current handover: the reach starts with the
         first. An earlier start also takes over the phase's source: the reach is the earlier
         party's, whichever was told first."""
-        self._reach_by.add("robot" if kind is EventKind.ROBOT_REACH_STARTED else "giver")
-        if t < self.phase_start:
+        by_robot = kind is EventKind.ROBOT_REACH_STARTED
+        self._reach_by.add("robot" if by_robot else "giver")
+        moved = t < self.phase_start
+        if moved:
             self.phase_start = t
             self.source = event_source(event)
             self.revision += 1
+        if moved or not by_robot:  # the tracking follows the reach from now on
+            self.entry += 1
 
     def _enter(self, rule: Rule, t: float, event: Event) -> PhaseChange:
         """Enter ``rule.dest`` at ``t`` (called before the machine moves: :attr:`phase` is
@@ -407,9 +489,11 @@ class HandoverState:
             }
             self.handover += 1
             self._reach_by = set()
+        by_robot = rule.trigger is EventKind.ROBOT_REACH_STARTED
         if phase is Phase.REACH:
-            by_robot = rule.trigger is EventKind.ROBOT_REACH_STARTED
             self._reach_by.add("robot" if by_robot else "giver")
+        if not by_robot:  # (a reach only the robot started is none the tracking follows yet)
+            self.entry += 1
         self.phase_start = t
         self._last_change = t
         self.source = event_source(event)
