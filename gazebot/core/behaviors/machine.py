@@ -2,8 +2,9 @@
 
 The machine keeps **no phase of its own**: it reads the one
 :class:`~gazebot.core.handover.HandoverState` (the engine's, or its own when run alone) and reacts
-to
-its phase changes. :func:`machine_definition` builds one ``transitions`` hierarchical machine
+to its phase changes and to the tick; it never passes events on to the state (whoever applies
+them, the engine, tells it: :func:`gazebot.core.handover.apply_event`).
+:func:`machine_definition` builds one ``transitions`` hierarchical machine
 with two parallel regions under the root state ``behavior``; every rule that decides the gaze
 target is one of its transitions, with a named condition, and runs in it:
 
@@ -84,13 +85,11 @@ from gazebot.core.behaviors.spec import (
 )
 from gazebot.core.handover import HandoverState, PhaseChange
 from gazebot.core.types import (
-    F64,
     Event,
     EventKind,
     GazeContext,
     GazeTarget,
     Phase,
-    from_fields,
 )
 
 _ROOT, _GAZE, _TRACKING = "behavior", "behavior_gaze", "behavior_tracking"
@@ -373,15 +372,17 @@ class _Model:
 
 
 class BehaviorMachine:
-    """Runs a :class:`BehaviorSpec`: feed events with :meth:`handle` (or phase changes with
-    :meth:`on_phase`), ask :meth:`target` each tick.
+    """Runs a :class:`BehaviorSpec`: it follows its handover state (phase changes through
+    :meth:`on_phase`, tracking events through :meth:`on_tracking`: whoever applies events to
+    the state tells it, see :func:`gazebot.core.handover.apply_event`) and is asked
+    :meth:`target` each tick.
 
     Args:
         spec: The behavior.
         seed: Seed for behaviors that draw timings (``human-receiver``); equal seeds and equal
             inputs give equal outputs.
         handover: The handover state to read the phase from (the engine's); ``None``: one of its
-            own, fed by :meth:`handle`.
+            own (:attr:`handover`, fed with :func:`~gazebot.core.handover.apply_event`).
         defaults: Fallback positions (base frame, m) per target kind, for a kind never seen yet
             (the engine's: the robot's default face, its ``handover_location`` for the hand).
     """
@@ -563,7 +564,7 @@ class BehaviorMachine:
     # ----------------------------------------------------------------- state
     def reset(self, seed: int | None = None) -> None:
         """Forget everything (back to ``idle``; a machine with its own handover state resets
-        it too), optionally with a new seed; cheaper than building a new machine."""
+        it too), optionally with a new seed (building a new machine takes milliseconds)."""
         if seed is not None:
             self.seed = int(seed)
         if self._owns_handover:
@@ -659,22 +660,6 @@ class BehaviorMachine:
         """True while tracking is lost."""
         return self._model.state[1] != _TRACKING_OK
 
-    def handle(self, event: Event) -> PhaseChange | None:
-        """Apply one event; never raises. Phase and robot events go through the handover state
-        (its phase change, returned, moves the gaze), tracking events to the ``tracking``
-        region."""
-        kind = getattr(event, "kind", None)
-        if kind is EventKind.TRACKING_LOST or kind is EventKind.TRACKING_RESTORED:
-            self.on_tracking(event)
-            return None
-        t = self.handover.would_move(event)
-        if t is not None:
-            self.advance(t)  # what is due by the event's time is the gaze that carries on
-        change = self.handover.apply(event)
-        if change is not None:
-            self.on_phase(change)
-        return change
-
     def on_tracking(self, event: Event) -> None:
         """Apply ``tracking_lost`` / ``tracking_restored`` (stale or duplicate ones ignored)."""
         t = self._time(event)
@@ -718,22 +703,17 @@ class BehaviorMachine:
     def target(self, ctx: GazeContext) -> GazeTarget:
         """Where to look at ``ctx.t``: a target kind and its current point."""
         kind, point = self.aim(ctx.t, ctx.points, ctx.tracking_end)
-        return from_fields(GazeTarget, {"kind": kind, "point": point})
+        return GazeTarget(kind=kind, point=point)
 
     def aim(
         self, t: float, points: dict[str, np.ndarray], tracking_end: float
     ) -> tuple[str, np.ndarray]:
         """:meth:`target` from the context's fields, as the kind and the point (the engine's
         tick: no context or target value to build and read back)."""
-        end = tracking_end
-        # (the engine's floats skip the general checks: this runs every tick)
-        if type(t) is not float or not math.isfinite(t):
-            t = float(t) if _finite(t) else self.handover.phase_start
-        if type(end) is not float or not math.isfinite(end):
-            # (a float NaN, the usual unknown end, needs no _finite call)
-            end = end if type(end) is not float and _finite(end) else math.nan
+        t = float(t) if _finite(t) else self.handover.phase_start
+        end = float(tracking_end) if _finite(tracking_end) else math.nan
         self.advance(t, end)
-        if type(points) is not dict and not isinstance(points, dict):  # (``is``: the usual one)
+        if not isinstance(points, dict):
             points = {}
         gaze, tracking = self._model.state
         lost_kind = self._lost_kind
@@ -758,16 +738,7 @@ class BehaviorMachine:
 
     def _point(self, kind: str, points: dict[str, np.ndarray]) -> np.ndarray:
         """The point of ``kind`` in ``points`` if valid, else its last known or default one."""
-        arr = points.get(kind)
-        # The usual point (a finite float64 3-vector) checked here: a _valid call costs more.
-        if type(arr) is np.ndarray and arr.dtype is F64 and arr.shape == (3,):
-            x, y, z = arr.tolist()
-            # Finite exactly when v - v is 0 for each coordinate (inf - inf and NaN are NaN):
-            # three subtractions cost less than three isfinite calls.
-            if not (x - x == 0.0 and y - y == 0.0 and z - z == 0.0):
-                arr = None
-        else:
-            arr = self._valid(arr)
+        arr = self._valid(points.get(kind))
         if arr is not None:
             self._known[kind] = arr
             return arr
@@ -791,15 +762,10 @@ class BehaviorMachine:
         """``p`` as a finite (3,) float array, or None."""
         if p is None:
             return None
-        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more
-        arr = p if type(p) is np.ndarray and (p.dtype is F64 or p.dtype == F64) else _as3(p)
-        if arr is None or arr.shape != (3,):
+        arr = p if isinstance(p, np.ndarray) and p.dtype == np.float64 else _as3(p)
+        if arr is None or arr.shape != (3,) or not np.isfinite(arr).all():
             return None
-        # Scalar checks on one list: much cheaper than np.isfinite(...).all() on a 3-vector,
-        # or than three NumPy scalars.
-        x, y, z = arr.tolist()
-        isfinite = math.isfinite
-        return arr if isfinite(x) and isfinite(y) and isfinite(z) else None
+        return arr
 
 
 def _as3(p: object) -> np.ndarray | None:

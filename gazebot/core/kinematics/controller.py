@@ -42,7 +42,7 @@ from gazebot.core.kinematics.shifts import (
     MinJerkTrajectory,
     min_jerk,
 )
-from gazebot.core.types import F64, filled
+from gazebot.core.types import F64
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
 _REPLAN_EPS = 1e-6
@@ -183,8 +183,7 @@ class GazeController:
         shift = self.update_raw(t, target_point, arm)[4]
         valid, eyes_saturated = self._target_valid, self._eyes_saturated
         names = self._names
-        state = filled(
-            HeadEyeState,
+        state = HeadEyeState(
             head=dict(zip(names, self._q, strict=True)),
             eye_yaw=float(self._eyes[0]),
             eye_pitch=float(self._eyes[1]),

@@ -45,7 +45,6 @@ from gazebot.core.types import (
     Phase,
     TrackingFrame,
     TrackingState,
-    from_fields,
     is_valid_point,
 )
 
@@ -264,13 +263,7 @@ class GazeLoop:
             blink = 0.0
         if blink > 1.0:
             blink = 1.0
-        # cmd.replaced(...) without its field-name check (these are GazeCommand's fields); a
-        # copy, then the three fields (their places in the dict are kept).
-        fields = cmd.__dict__.copy()
-        fields["blink"] = blink
-        fields["distance"] = distance
-        fields["answers_sample"] = answers
-        return from_fields(GazeCommand, fields)
+        return cmd.replaced(blink=blink, distance=distance, answers_sample=answers)
 
     def _gaze_frame(self, pose: list[float]) -> list[list[float]]:
         """The ``gaze`` frame at head ``pose``; the last one again while neither the pose nor
