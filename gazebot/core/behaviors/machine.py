@@ -429,7 +429,7 @@ class BehaviorMachine:
                 # with this target (the drawn pattern's).
                 return (
                     self._schedule.follow == index
-                    and self._active_phase is phase
+                    and self.handover.phase is phase
                     and self._segments[index].target == target
                 )
 
@@ -487,7 +487,7 @@ class BehaviorMachine:
             return
         self._scheduled = tick
         state = self.handover
-        phase = self._active_phase
+        phase = state.phase
         timings = self._timings
         anchors = [
             state.anchor(at.after) if isinstance(at, AtEvent) else math.nan for at in timings
@@ -540,7 +540,6 @@ class BehaviorMachine:
     def _enter_phase(self, change: PhaseChange) -> None:
         """The phase's segments, none started yet."""
         phase = change.phase
-        self._active_phase = phase
         self._segments = self._plan.get(phase, [])
         self._timings = [self.spec.resolve(s) for s in self._segments]
         self._started = [False] * len(self._segments)
@@ -573,7 +572,6 @@ class BehaviorMachine:
         self.pattern = ""  # name of the drawn pattern (data-driven behaviors)
         self._rng = np.random.default_rng(self.seed)
         self._plan: dict[Phase, list[Segment]] = self._draw_plan()
-        self._active_phase = Phase.IDLE
         self._segments: list[Segment] = []
         self._timings: list[Any] = []
         self._started: list[bool] = []
