@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
@@ -129,7 +129,13 @@ class GazeEngine:
         # The workspace sphere's squared radius, finite even for an absurd radius (so a sum of
         # squares that overflowed to inf is always beyond it).
         self._radius_sq = min(radius * radius, sys.float_info.max)
-        self._seed = seed
+        #: The one handover state: the phase, its start and the handover index.
+        self.handover = HandoverState()
+        self.behavior = BehaviorMachine(
+            behavior, seed=seed, handover=self.handover, defaults=self._defaults
+        )
+        self.detector: PhaseDetectorLike = make_detector(self._phase_config)
+        self._pending: list[Event] = []  # robot events for the next tick
         self.reset()
 
     @classmethod
@@ -168,7 +174,7 @@ class GazeEngine:
         """The behavior's tracking state after the last step: ``ok``; ``hold`` while tracking is
         lost and the behavior holds the gaze (its ``tracking_lost.hold_s``); ``lost`` once it
         looks at its ``tracking_lost`` target."""
-        return self.behavior.tracking  # type: ignore[return-value]
+        return self.behavior.tracking
 
     def notify(self, events: Event | Iterable[Event]) -> None:
         """Queue one robot event or several (e.g. ``robot_reach_started`` with
@@ -249,19 +255,12 @@ class GazeEngine:
 
     def reset(self, head: Mapping[str, float] | None = None) -> None:
         """Forget the current handover (e.g. after a restart) and optionally the head pose."""
-        self.detector: PhaseDetectorLike = make_detector(self._phase_config)
-        if hasattr(self, "behavior"):  # reuse the machine: building one takes milliseconds
-            self.handover.reset()
-            self.behavior.reset()
-        else:
-            self.handover = HandoverState()
-            self.behavior = BehaviorMachine(
-                self.behavior_spec, seed=self._seed, handover=self.handover,
-                defaults=self._defaults,
-            )
+        self.detector = make_detector(self._phase_config)
+        self.handover.reset()
+        self.behavior.reset()  # (the machine is kept: building one takes milliseconds)
         self.gaze.reset(head)
         self.stats = EngineStats()
-        self._pending: list[Event] = []
+        self._pending = []
         self._last_t = -math.inf
         self._last_target: tuple[str, np.ndarray] = (
             self.behavior_spec.before,
@@ -300,7 +299,16 @@ class GazeEngine:
             if r2 > self._radius_sq:
                 self.stats.implausible += 1
                 changed[name] = NAN3.copy()
-        return replace(frame, **changed) if changed else frame
+        if not changed:
+            return frame
+        return TrackingFrame(
+            t=frame.t,
+            giver_hand=changed.get("giver_hand", frame.giver_hand),
+            receiver_hand=changed.get("receiver_hand", frame.receiver_hand),
+            giver_face=changed.get("giver_face", frame.giver_face),
+            gripper_closed=frame.gripper_closed,
+            load_share=frame.load_share,
+        )
 
     def _take(self, event: Event, t: float, stream: list[Event], faults: list[Event]) -> None:
         """Apply ``event`` (the detector's or the robot's) and add what it publishes to

@@ -8,6 +8,7 @@ frame unless a name says otherwise.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, fields, replace
 from enum import Enum
 from typing import Any, Literal
@@ -17,6 +18,17 @@ import numpy as np
 NAN3 = np.full(3, np.nan)
 #: NumPy's float64 dtype (the dtype of every point gazebot makes).
 F64 = np.dtype(np.float64)
+
+def finite_float(value: object) -> float | None:
+    """``value`` as a float when it is a finite real number (Python or NumPy), else ``None``."""
+    if not isinstance(value, numbers.Real):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:  # an int beyond float's range
+        return None
+    return x if math.isfinite(x) else None
+
 
 def as_point(value: Any) -> np.ndarray:
     """Return ``value`` as a float (3,) array; ``None`` becomes all-NaN (a missing sample)."""

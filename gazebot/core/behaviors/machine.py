@@ -90,24 +90,18 @@ from gazebot.core.types import (
     GazeContext,
     GazeTarget,
     Phase,
+    TrackingState,
+    finite_float,
 )
 
 _ROOT, _GAZE, _TRACKING = "behavior", "behavior_gaze", "behavior_tracking"
-_TRACKING_STATES = ("ok", "hold", "lost")
+_TRACKING_STATES: tuple[TrackingState, ...] = ("ok", "hold", "lost")
 _TRACKING_OK, _TRACKING_HOLD = f"{_TRACKING}_ok", f"{_TRACKING}_hold"
 _NEW, _DONE, _CARRY = "new handover", "handover done", "same handover: the gaze carries"
 _RESTORED = "after the loss"
 _STAYS = "due, but before the followed segment's start: the latest start wins, the gaze stays"
 
 
-
-
-def _finite(x: object) -> bool:
-    """True for a finite real number (Python or NumPy scalar)."""
-    try:
-        return math.isfinite(x)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        return False
 
 
 def _state_name(target: str) -> str:
@@ -369,6 +363,7 @@ class _Model:
     """The object whose ``state`` the ``transitions`` machine drives."""
 
     state: list[str]
+    trigger: Callable[..., bool]  # added by the machine: fires a trigger, True if it moved
 
 
 class BehaviorMachine:
@@ -386,6 +381,20 @@ class BehaviorMachine:
         defaults: Fallback positions (base frame, m) per target kind, for a kind never seen yet
             (the engine's: the robot's default face, its ``handover_location`` for the hand).
     """
+
+    # The memory of the current handover (set by reset()).
+    _plan: dict[Phase, list[Segment]]  # its segments per phase
+    _segments: list[Segment]  # the current phase's
+    _timings: list[AtFraction | AtEvent | AtNever]  # ... and when each starts
+    _started: list[bool]
+    _latest: float  # start time of the segment the gaze state follows
+    _scheduled: Tick | None  # the tick the last schedule was made for
+    _wake_revision: int | None  # the evidence wake holds for; None: any
+    _wake_end: float | None
+    # The last (kind, point) aimed at with tracking ok, and the one held while lost.
+    _held: tuple[str, np.ndarray] | None
+    _last_target: tuple[str, np.ndarray] | None
+    _known: dict[str, np.ndarray]  # the last valid point of each kind
 
     def __init__(
         self,
@@ -421,10 +430,11 @@ class BehaviorMachine:
     def _condition(self, key: tuple, label: str) -> Callable[[Any], bool]:
         """The runtime condition of a transition (see :data:`ConditionFactory`)."""
         kind = key[0]
+        condition: Callable[[Any], bool]
         if kind == "segment":
             _, phase, index, target = key
 
-            def condition(tick: Tick) -> bool:
+            def follows(tick: Tick) -> bool:
                 # The segment the gaze follows now (the tick's schedule: the latest due start),
                 # with this target (the drawn pattern's).
                 return (
@@ -433,30 +443,35 @@ class BehaviorMachine:
                     and self._segments[index].target == target
                 )
 
+            condition = follows
         elif kind == "stays":
 
-            def condition(tick: Tick) -> bool:
+            def stays(tick: Tick) -> bool:
                 return bool(self._schedule.fired) and self._schedule.follow is None
 
+            condition = stays
         elif kind == "phase":
             rule = key[1]
 
-            def condition(change: PhaseChange) -> bool:
+            def moves(change: PhaseChange) -> bool:
                 if rule == _DONE:
                     return change.phase is Phase.DONE
                 return change.new_handover is (rule == _NEW) and change.phase is not Phase.DONE
 
+            condition = moves
         elif kind == "held":
             hold_s = self.spec.tracking_lost.hold_s
 
-            def condition(tick: Tick) -> bool:
+            def held(tick: Tick) -> bool:
                 return hold_over(self._lost_since, hold_s, tick.t)
 
+            condition = held
         else:  # restored
 
-            def condition(t: float) -> bool:
+            def restored(t: float) -> bool:
                 return t >= self._lost_since  # an older restore is stale
 
+            condition = restored
         condition.__name__ = label
         return condition
 
@@ -571,23 +586,22 @@ class BehaviorMachine:
         self._ignored = 0  # tracking events ignored as stale or duplicated
         self.pattern = ""  # name of the drawn pattern (data-driven behaviors)
         self._rng = np.random.default_rng(self.seed)
-        self._plan: dict[Phase, list[Segment]] = self._draw_plan()
-        self._segments: list[Segment] = []
-        self._timings: list[Any] = []
-        self._started: list[bool] = []
-        self._latest = -math.inf  # start time of the segment the gaze state follows
+        self._plan = self._draw_plan()
+        self._segments = []
+        self._timings = []
+        self._started = []
+        self._latest = -math.inf
         self._schedule = Schedule((), (), None, math.inf, False, False)
-        self._scheduled: Tick | None = None
+        self._scheduled = None
         self._wake = math.inf
-        self._wake_revision: int | None = None  # the evidence wake holds for; None: any
-        self._wake_end: float | None = None
+        self._wake_revision = None
+        self._wake_end = None
         self._tracking_end = math.nan
         self._lost_since = math.nan
         self._hold_until = math.inf
-        # The last (kind, point) aimed at with tracking ok, and the one held while lost.
-        self._held: tuple[str, np.ndarray] | None = None
-        self._last_target: tuple[str, np.ndarray] | None = None
-        self._known: dict[str, np.ndarray] = {}
+        self._held = None
+        self._last_target = None
+        self._known = {}
         self._machine.set_state([f"{_GAZE}_{_state_name(self.spec.before)}", _TRACKING_OK])
         self.origin = GazeOrigin(Phase.IDLE, "before", self.gaze)
 
@@ -648,7 +662,7 @@ class BehaviorMachine:
         return self._target_of[self._gaze_leaf[self._model.state[0]]]
 
     @property
-    def tracking(self) -> str:
+    def tracking(self) -> TrackingState:
         """The ``tracking`` region's state: ``ok``, ``hold`` (tracking lost, the gaze held for
         ``tracking_lost.hold_s``) or ``lost`` (looking at the ``tracking_lost`` target)."""
         return self._tracking_leaf[self._model.state[1]]
@@ -708,8 +722,11 @@ class BehaviorMachine:
     ) -> tuple[str, np.ndarray]:
         """:meth:`target` from the context's fields, as the kind and the point (the engine's
         tick: no context or target value to build and read back)."""
-        t = float(t) if _finite(t) else self.handover.phase_start
-        end = float(tracking_end) if _finite(tracking_end) else math.nan
+        now = finite_float(t)
+        t = now if now is not None else self.handover.phase_start
+        end = finite_float(tracking_end)
+        if end is None:
+            end = math.nan
         self.advance(t, end)
         if not isinstance(points, dict):
             points = {}
@@ -730,8 +747,9 @@ class BehaviorMachine:
     @staticmethod
     def _time(event: Event) -> float | None:
         for value in (getattr(event, "t", None), getattr(event, "detected_at", None)):
-            if _finite(value):
-                return float(value)
+            t = finite_float(value)
+            if t is not None:
+                return t
         return None
 
     def _point(self, kind: str, points: dict[str, np.ndarray]) -> np.ndarray:

@@ -39,7 +39,15 @@ from typing import Any, Protocol
 
 from transitions import Machine
 
-from gazebot.core.types import EVENT_OF_PHASE, PHASE_OF_EVENT, Event, EventKind, Phase, PhaseSource
+from gazebot.core.types import (
+    EVENT_OF_PHASE,
+    PHASE_OF_EVENT,
+    Event,
+    EventKind,
+    Phase,
+    PhaseSource,
+    finite_float,
+)
 
 _ORDER = {Phase.IDLE: 0, Phase.REACH: 1, Phase.TRANSFER: 2, Phase.RETREAT: 3, Phase.DONE: 4}
 _BETWEEN = (Phase.IDLE, Phase.DONE)
@@ -133,13 +141,6 @@ class PhaseChange:
     rule: Rule
 
 
-def _finite(x: object) -> bool:
-    try:
-        return math.isfinite(x)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        return False
-
-
 def _parse(event: Event) -> tuple[EventKind, float] | None:
     """``(kind, time)`` of an event (its ``t``, else ``detected_at``); ``None`` when the kind is
     unknown or no time is finite."""
@@ -148,8 +149,9 @@ def _parse(event: Event) -> tuple[EventKind, float] | None:
     except ValueError:
         return None
     for value in (getattr(event, "t", None), getattr(event, "detected_at", None)):
-        if _finite(value):
-            return kind, float(value)
+        t = finite_float(value)
+        if t is not None:
+            return kind, t
     return None
 
 
@@ -284,6 +286,7 @@ class _Model:
     """The object whose ``state`` (a phase's value) the handover machine drives."""
 
     state: str
+    trigger: Callable[..., bool]  # added by the machine: fires a trigger, True if it moved
 
 
 class HandoverState:
@@ -297,8 +300,10 @@ class HandoverState:
 
     def __init__(self) -> None:
         self._model = _Model()
+        # Each rule's condition, built once: the machine runs them, would_move asks them.
+        self._checks = {rule: self._condition(rule) for rule in RULES}
         #: The machine's definition (``transitions`` keyword arguments), live callables included.
-        self.definition = machine_definition(self._condition, self._callback)
+        self.definition = machine_definition(self._checks.__getitem__, self._callback)
         self._machine = Machine(
             model=self._model,
             **self.definition,
@@ -374,14 +379,15 @@ class HandoverState:
     def would_move(self, event: Event) -> float | None:
         """The time (s) at which ``event`` would change the phase, ``None`` if it would not
         (nothing changes: the behavior first brings its gaze up to that time). Asks the
-        machine which of its transitions would apply."""
+        rule table, whose conditions the machine runs."""
         parsed = _parse(event)
         if parsed is None or parsed[0] not in _PHASE_TRIGGERS:
             return None
         kind, t = parsed
-        for transition in self._machine.events[kind.value].transitions[self._model.state]:
-            if all(c.func(t, event) is c.target for c in transition.conditions):
-                return t if transition.dest is not None else None
+        phase = self.phase
+        for rule in RULES:  # (the machine's transitions, in its order)
+            if rule.trigger is kind and phase in rule.sources and self._checks[rule](t, event):
+                return t if rule.dest is not None else None
         return None
 
     # ----------------------------------------------------------------- the machine's rules
@@ -440,8 +446,8 @@ class HandoverState:
         ev = self._robot.get(motion) if motion is not None else None
         if ev is None or ev.t < self.handover_t0:
             return math.nan
-        planned = ev.info.get("planned_duration")
-        return ev.t + float(planned) if _finite(planned) and planned > 0 else math.nan
+        planned = finite_float(ev.info.get("planned_duration"))
+        return ev.t + planned if planned is not None and planned > 0 else math.nan
 
     # ----------------------------------------------------------------- internals
     def _keep_robot(self, kind: EventKind, t: float, event: Event) -> bool:
@@ -499,6 +505,7 @@ class HandoverState:
         self.source = event_source(event)
         info = event.info if isinstance(event.info, dict) else {}
         expected = info.get("expected_end", math.nan)
-        self.event_end = float(expected) if _finite(expected) else math.nan
+        end = finite_float(expected)
+        self.event_end = end if end is not None else math.nan
         self.revision += 1
         return PhaseChange(phase, t, previous, self.source, new, rule)
