@@ -281,3 +281,15 @@ def test_an_earlier_giver_reach_told_late_takes_the_source_without_a_second_reac
     cmd = eng.step(TrackingFrame.make(0.85))
     assert (cmd.phase, cmd.phase_source, eng.handover.phase_start) == (Phase.REACH, "tracking", 0.5)
     assert not [e for e in cmd.events if e.kind is EventKind.REACH_STARTED]
+
+
+def test_the_phase_has_one_owner_the_handover_state():
+    # Issue 31: no stage keeps a phase of its own; the state's machine holds it.
+    eng = GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
+    eng.notify(Event(EventKind.ROBOT_REACH_STARTED, 0.1, 0.1, {"planned_duration": 1.0}))
+    eng.step(TrackingFrame.make(0.1))
+    eng.notify(Event(EventKind.ROBOT_GRASPED, 0.2, 0.2))
+    cmd = eng.step(TrackingFrame.make(0.2))
+    for stage in (eng, eng.detector, eng.behavior, eng.handover):
+        assert not [k for k, v in vars(stage).items() if isinstance(v, Phase)], stage
+    assert cmd.phase is eng.phase is eng.behavior.phase is eng.handover.phase is Phase.TRANSFER
