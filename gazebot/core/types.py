@@ -1,8 +1,9 @@
 """Values that flow between gazebot's stages.
 
-Data flows one way: ``TrackingFrame`` -> phases (``Event``) -> behavior (``GazeTarget``) ->
-kinematics -> ``GazeCommand``. All quantities are SI (m, s, rad); points are in the robot base
-frame unless a name says otherwise.
+Data flows one way: ``TrackingFrame`` -> phases (``Event``) -> handover state -> behavior
+(``GazeTarget``) -> kinematics -> ``GazeCommand``; the phase is the handover state's alone (the
+phase detector reads it, the engine applies events to it). All quantities are SI (m, s, rad);
+points are in the robot base frame unless a name says otherwise.
 """
 
 from __future__ import annotations

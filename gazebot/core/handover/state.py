@@ -25,9 +25,12 @@ condition a named condition of it), which ``gazebot behaviors show NAME --diagra
   was missed) or from idle/done starts a **new handover**: the robot events of the previous one
   stop counting.
 
-Besides the phase, the state keeps what the behavior's timing reads: the robot events of the
-current handover (anchors of ``{after: EVENT}`` segments and their ``planned_duration``), and the
-estimates of the phase's end (the phase event's ``expected_end``, the robot's motion plan).
+The state is the phase's one owner: the phase detector reads it (:class:`HandoverView`) and
+reports what the tracking shows; the engine applies those events and the robot's to it
+(:func:`apply_event`, which tells the behavior). Besides the phase, the state keeps what the
+behavior's timing reads: the robot events of the current handover (anchors of
+``{after: EVENT}`` segments and their ``planned_duration``), and the estimates of the phase's end
+(the phase event's ``expected_end``, the robot's motion plan).
 """
 
 from __future__ import annotations
