@@ -246,11 +246,13 @@ class GazeEngine:
     def resync(self, events: Iterable[Event]) -> None:
         """Catch up with a handover already under way (e.g. after an engine restart): replay the
         phase and robot events published before the restart, oldest first, into the handover
-        state (the phase detector then joins the phase under way)."""
-        entry = self.handover.entry
-        for event in sorted(_events(events), key=lambda e: e.t):
+        state; the phase detector then joins the phase under way, and takes the next frame's
+        robot evidence as a baseline."""
+        replay = sorted(_events(events), key=lambda e: e.t)
+        for event in replay:
             apply_event(self.handover, self.behavior, event)
-        if self.handover.entry != entry:
+        if replay:
+            # (also after a finished handover: a gripper still closed is no new grasp)
             self.detector.resync()
 
     def reset(self, head: Mapping[str, float] | None = None) -> None:
