@@ -219,7 +219,6 @@ class PhaseDetector:
         self._trigger = self.segmenter.trigger()
         self._last_full = -math.inf
         self._reach_missing_since = math.nan
-        self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
         self._joined_late = False
         # The hands' distance when the current reach began, as last read while the analysis
@@ -275,6 +274,12 @@ class PhaseDetector:
             return math.nan
         return view.phase_start if phase is view.phase else view.handover_t0
 
+    @property
+    def _floor(self) -> float:
+        """The next phase never starts before this (s): the current phase's start."""
+        start = self._phase_start
+        return -math.inf if math.isnan(start) else start
+
     def _state(self) -> HandoverView:
         if self._view is None:
             raise RuntimeError("the phase detector reads a handover state only while updated")
@@ -299,7 +304,6 @@ class PhaseDetector:
     def _enter(self, phase: Phase, t0: float) -> None:
         # Joined late: fewer than two samples seen before the phase's start.
         self._joined_late = len(self._samples) < 3 or self._samples.time(1) >= t0
-        self._floor = t0 if not math.isnan(t0) else -math.inf
         self._reach_missing_since = math.nan
         self._reach_d0 = math.nan
         self._expected_end = predict_end(phase, t0, self._signals, t0, self.config)
