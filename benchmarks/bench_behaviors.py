@@ -24,6 +24,7 @@ import numpy as np
 
 from benchmarks.common import Result, median_time
 from gazebot.core.behaviors import BehaviorMachine, load_behavior
+from gazebot.core.handover import apply_event
 from gazebot.core.types import Event, EventKind, GazeContext, GazeTarget, Phase
 
 _REPO = Path(__file__).resolve().parents[1]
@@ -101,7 +102,10 @@ def _run(machine, contexts: list[GazeContext]) -> list[str]:
     kinds = []
     for i, ctx in enumerate(contexts):
         for event in _EVENTS.get(i, ()):
-            machine.handle(event)
+            if isinstance(machine, BehaviorMachine):
+                apply_event(machine.handover, machine, event)
+            else:
+                machine.handle(event)
         kinds.append(machine.target(ctx).kind)
     return kinds
 

@@ -25,7 +25,7 @@ import numpy as np
 from benchmarks.common import Result
 from benchmarks.kth_data import RATE, force_truth, kth_dir
 from benchmarks.reach_bound import bound_latencies
-from gazebot.core.phases import PhaseConfig, PhaseDetector, Trajectory, run_online, segment
+from gazebot.core.phases import OnlineDetector, PhaseConfig, Trajectory, run_online, segment
 from gazebot.core.phases.methods import PHASE_METHODS
 from gazebot.core.phases.synthetic import CASE_KINDS, case_set, rest_recording, synthetic_set
 from gazebot.core.types import EventKind, Phase
@@ -277,7 +277,7 @@ def run() -> list[Result]:
 
     def one_pass(cfg):
         def run_pass() -> None:
-            det = PhaseDetector(cfg)
+            det = OnlineDetector(cfg)
             for f in frames:
                 det.update(f)
 

@@ -4,20 +4,21 @@ one tick at a time.
 The engine owns no transport and no simulator; a robot stack calls :meth:`GazeEngine.step` with each
 tracking frame and sends the returned :class:`~gazebot.core.types.GazeCommand` wherever it likes.
 
-One handover state (:class:`~gazebot.core.handover.HandoverState`) merges the phase detector's
-events
-and the robot's (:meth:`GazeEngine.notify`); the behavior reads its phase, and the command
-reports it with its source. The engine never dies on input: a tracked point beyond the robot's
-``workspace_radius_m`` is a missing sample (counted in :attr:`GazeEngine.stats`), and whatever a
-sample or an event makes a stage raise is caught, reported as a ``fault`` event and the command's
-``status: degraded``, and the tick still answers with a safe command.
+One handover state (:class:`~gazebot.core.handover.HandoverState`) holds the phase. Each tick the
+phase detector reads it and reports the boundaries the tracking shows; the engine applies those
+and the robot's events (:meth:`GazeEngine.notify`) to the state; the behavior reacts to its
+phase changes and to the tick, and the command reports the phase with its source. The engine
+never dies on input: a tracked point beyond the robot's ``workspace_radius_m`` is a missing
+sample (counted in :attr:`GazeEngine.stats`), and whatever a sample or an event makes a stage
+raise is caught, reported as a ``fault`` event and the command's ``status: degraded``, and the
+tick still answers with a safe command.
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -26,7 +27,7 @@ import numpy as np
 
 from gazebot.core.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
 from gazebot.core.config import ConfigError
-from gazebot.core.handover import HandoverState, PhaseChange
+from gazebot.core.handover import HandoverState, HandoverView, apply_event
 from gazebot.core.kinematics import (
     GazeController,
     GazeShiftConfig,
@@ -37,7 +38,6 @@ from gazebot.core.kinematics import (
 from gazebot.core.phases import PhaseConfig, load_phase_config, make_detector
 from gazebot.core.types import (
     EVENT_OF_PHASE,
-    F64,
     NAN3,
     PHASE_OF_EVENT,
     Event,
@@ -45,29 +45,24 @@ from gazebot.core.types import (
     GazeCommand,
     Phase,
     PhaseSource,
-    Status,
     TrackingFrame,
     TrackingState,
-    from_fields,
 )
 
 # Targets the engine fills from tracking each tick; all others come from the robot config.
 _TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
-# Robot events whose phase change the phase detector adopts (it cannot see a grasp).
-_DETECTOR_ADOPTS = frozenset({EventKind.ROBOT_GRASPED, EventKind.ROBOT_RELEASED})
 
 
 class PhaseDetectorLike(Protocol):
     """What the engine needs of a phase detector (:class:`gazebot.core.phases.PhaseDetector`)."""
 
-    phase: Phase
-    expected_phase_end: float
+    def update(
+        self, frame: TrackingFrame, view: HandoverView, report: Callable[[Event], object]
+    ) -> None: ...
 
-    def update_all(self, frame: TrackingFrame) -> list[Event]: ...
+    def expected_end(self, view: HandoverView) -> float: ...
 
-    def resync(self, event: Event) -> None: ...
-
-    def adopt(self, phase: Phase, t0: float) -> None: ...
+    def resync(self) -> None: ...
 
 
 @dataclass
@@ -76,6 +71,10 @@ class EngineStats:
 
     implausible: int = 0  # tracked points beyond the workspace, treated as missing
     faults: int = 0  # exceptions a sample or an event caused, caught and reported
+
+
+# The tracked points of a frame, in the order the engine checks them.
+_POINTS = ("giver_hand", "receiver_hand", "giver_face")
 
 
 def _events(events: Event | Iterable[Event]) -> list[Event]:
@@ -126,11 +125,17 @@ class GazeEngine:
             "object": fixed["handover_location"],
             "receiver_hand": fixed["rest"],
         }
-        self._radius = float(robot.config.workspace_radius_m)
+        radius = float(robot.config.workspace_radius_m)
         # The workspace sphere's squared radius, finite even for an absurd radius (so a sum of
         # squares that overflowed to inf is always beyond it).
-        self._radius_sq = min(self._radius * self._radius, sys.float_info.max)
-        self._seed = seed
+        self._radius_sq = min(radius * radius, sys.float_info.max)
+        #: The one handover state: the phase, its start and the handover index.
+        self.handover = HandoverState()
+        self.behavior = BehaviorMachine(
+            behavior, seed=seed, handover=self.handover, defaults=self._defaults
+        )
+        self.detector: PhaseDetectorLike = make_detector(self._phase_config)
+        self._pending: list[Event] = []  # robot events for the next tick
         self.reset()
 
     @classmethod
@@ -169,7 +174,7 @@ class GazeEngine:
         """The behavior's tracking state after the last step: ``ok``; ``hold`` while tracking is
         lost and the behavior holds the gaze (its ``tracking_lost.hold_s``); ``lost`` once it
         looks at its ``tracking_lost`` target."""
-        return self.behavior.tracking  # type: ignore[return-value]
+        return self.behavior.tracking
 
     def notify(self, events: Event | Iterable[Event]) -> None:
         """Queue one robot event or several (e.g. ``robot_reach_started`` with
@@ -188,49 +193,40 @@ class GazeEngine:
         for what a sample or an event holds (see the module docstring).
         """
         faults: list[Event] = []
-        t = frame.t
-        # The usual frame's time (a float after the last one) without _time's checks.
-        if type(t) is float and self._last_t < t < math.inf:
-            self._last_t = t
-        else:
-            t = self._time(frame)
-        frame = self._plausible(frame)
-        try:
-            # Every event this sample reveals (a gripper closing can reveal a reach and a
-            # transfer).
-            events = self.detector.update_all(frame)
-        except Exception as err:  # noqa: BLE001 - a sample must never kill the engine
-            events = []
-            faults.append(self._fault(t, "phases", err))
-        if self._pending:
-            events.extend(self._pending)
-            self._pending.clear()
         stream: list[Event] = []  # the tick's events, phase events as the handover state's
-        for event in events:
-            try:
-                stream.extend(self._apply(event))
-            except Exception as err:  # noqa: BLE001 - an event must never kill the engine
-                faults.append(self._fault(t, f"event {getattr(event, 'kind', event)!r}", err))
-        detector = self.detector
-        state = self.handover
-        tracking_end = (
-            detector.expected_phase_end if detector.phase is state.phase else math.nan
-        )
-        # The behavior's points: the robot's fixed ones and the tracked ones (a copy then item
-        # sets: cheaper than a ``{**fixed, ...}`` merge, with the same key order).
-        points = self._fixed_points.copy()
-        points["face"] = frame.giver_face
-        points["hand"] = points["object"] = frame.giver_hand
-        points["receiver_hand"] = frame.receiver_hand
+        t = self._time(frame)
+        frame = self._plausible(frame)
+
+        def report(event: Event) -> None:
+            self._take(event, t, stream, faults)
+
         try:
-            # behavior.target(GazeContext(...)) without the two values it would build
+            # Every event this sample reveals, each applied before the detector looks further
+            # (a gripper closing can reveal a reach and a transfer).
+            self.detector.update(frame, self.handover, report)
+        except Exception as err:  # noqa: BLE001 - a sample must never kill the engine
+            faults.append(self._fault(t, "phases", err))
+        pending, self._pending = self._pending, []
+        for event in pending:
+            report(event)
+        try:
+            tracking_end = self.detector.expected_end(self.handover)
+        except Exception as err:  # noqa: BLE001
+            faults.append(self._fault(t, "phases", err))
+            tracking_end = math.nan
+        points = {
+            **self._fixed_points,
+            "face": frame.giver_face,
+            "hand": frame.giver_hand,
+            "object": frame.giver_hand,
+            "receiver_hand": frame.receiver_hand,
+        }
+        try:
             kind, point = self.behavior.aim(t, points, tracking_end)
         except Exception as err:  # noqa: BLE001
             faults.append(self._fault(t, "behavior", err))
             kind, point = self._last_target
-        # (the usual tick has no event: no tuple to build)
-        published = (*stream, *faults) if stream or faults else ()
-        return self._command(t, kind, point, arm, published, faults)
+        return self._command(t, kind, point, arm, (*stream, *faults), faults)
 
     def look_at(
         self,
@@ -249,26 +245,24 @@ class GazeEngine:
 
     def resync(self, events: Iterable[Event]) -> None:
         """Catch up with a handover already under way (e.g. after an engine restart): replay the
-        phase and robot events published before the restart, oldest first."""
-        for event in sorted(_events(events), key=lambda e: e.t):
-            self.detector.resync(event)
-            self.behavior.handle(event)
+        phase and robot events published before the restart, oldest first, into the handover
+        state; the phase detector then joins the phase under way, and takes the next frame's
+        robot evidence as a baseline."""
+        replay = sorted(_events(events), key=lambda e: e.t)
+        for event in replay:
+            apply_event(self.handover, self.behavior, event)
+        if replay:
+            # (also after a finished handover: a gripper still closed is no new grasp)
+            self.detector.resync()
 
     def reset(self, head: Mapping[str, float] | None = None) -> None:
         """Forget the current handover (e.g. after a restart) and optionally the head pose."""
-        self.detector: PhaseDetectorLike = make_detector(self._phase_config)
-        if hasattr(self, "behavior"):  # reuse the machine: building one costs milliseconds
-            self.handover.reset()
-            self.behavior.reset()
-        else:
-            self.handover = HandoverState()
-            self.behavior = BehaviorMachine(
-                self.behavior_spec, seed=self._seed, handover=self.handover,
-                defaults=self._defaults,
-            )
+        self.detector = make_detector(self._phase_config)
+        self.handover.reset()
+        self.behavior.reset()  # (the machine is kept: building one takes milliseconds)
         self.gaze.reset(head)
         self.stats = EngineStats()
-        self._pending: list[Event] = []
+        self._pending = []
         self._last_t = -math.inf
         self._last_target: tuple[str, np.ndarray] = (
             self.behavior_spec.before,
@@ -280,61 +274,33 @@ class GazeEngine:
     def _time(self, frame: TrackingFrame) -> float:
         """The tick's time: the frame's, never earlier than the last one; a frame without a
         usable time is answered at the last known time."""
-        t = frame.t
-        if type(t) is not float:  # (a frame's usual t already is one)
-            try:
-                t = float(t)
-            except (TypeError, ValueError, OverflowError):
-                t = math.nan
-        if math.isfinite(t) and t > self._last_t:  # max() as a comparison (the hot path)
+        try:
+            t = float(frame.t)
+        except (TypeError, ValueError, OverflowError):
+            t = math.nan
+        if math.isfinite(t) and t > self._last_t:
             self._last_t = t
         return self._last_t if math.isfinite(self._last_t) else 0.0
 
     def _plausible(self, frame: TrackingFrame) -> TrackingFrame:
         """``frame`` with every point beyond the workspace (or not a numeric 3-vector) missing."""
-        rr = self._radius_sq
-        f64 = F64
-        hand, receiver, face = frame.giver_hand, frame.receiver_hand, frame.giver_face
-        # The usual frame (three float64 3-vectors, each inside the workspace or all-NaN) in
-        # one test: a fifth cheaper than the loop below, which decides every other frame.
-        if (
-            type(hand) is np.ndarray
-            and type(receiver) is np.ndarray
-            and type(face) is np.ndarray
-            and hand.dtype is f64
-            and receiver.dtype is f64
-            and face.dtype is f64
-            and hand.shape == receiver.shape == face.shape == (3,)
-        ):
-            x, y, z = hand.tolist()
-            a, b, c = receiver.tolist()
-            u, v, w = face.tolist()
-            s1, s2, s3 = x * x + y * y + z * z, a * a + b * b + c * c, u * u + v * v + w * w
-            if (s1 <= rr or s1 != s1) and (s2 <= rr or s2 != s2) and (s3 <= rr or s3 != s3):
-                return frame
-        changed = {}
-        for name, p in (("giver_hand", hand), ("receiver_hand", receiver), ("giver_face", face)):
-            # ``is`` first: the usual array's dtype is the float64 singleton (cheaper than .kind)
-            if (
-                type(p) is np.ndarray
-                and (p.dtype is f64 or p.dtype.kind == "f")
-                and p.shape == (3,)
-            ):
-                x, y, z = p.tolist()  # plain floats: numpy per-call overhead is microseconds
-            else:
-                try:
-                    x, y, z = (float(v) for v in np.asarray(p, dtype=float).reshape(3))
-                except (TypeError, ValueError, OverflowError):
-                    changed[name] = NAN3.copy()
-                    continue
+        changed: dict[str, np.ndarray] = {}
+        for name in _POINTS:
+            p = getattr(frame, name)
+            kept = _is_float3(p)
+            try:
+                x, y, z = (p if kept else np.asarray(p, dtype=float).reshape(3)).tolist()
+            except (TypeError, ValueError, OverflowError):
+                changed[name] = NAN3.copy()
+                continue
+            if not kept:
                 changed[name] = np.array([x, y, z])
-            # One comparison for the usual point: a float product overflows to inf (beyond
-            # the radius, as it should be), never raises; any NaN coordinate makes it NaN.
-            s = x * x + y * y + z * z
-            if s <= rr or s != s:
-                continue  # within the workspace, or already missing (NaN)
-            self.stats.implausible += 1
-            changed[name] = NAN3.copy()
+            # A float product overflows to inf (beyond the radius, as it should be), never
+            # raises; any NaN coordinate makes the sum NaN: a point already missing.
+            r2 = x * x + y * y + z * z
+            if r2 > self._radius_sq:
+                self.stats.implausible += 1
+                changed[name] = NAN3.copy()
         if not changed:
             return frame
         return TrackingFrame(
@@ -346,21 +312,25 @@ class GazeEngine:
             load_share=frame.load_share,
         )
 
+    def _take(self, event: Event, t: float, stream: list[Event], faults: list[Event]) -> None:
+        """Apply ``event`` (the detector's or the robot's) and add what it publishes to
+        ``stream``; an event that raises is a fault."""
+        try:
+            stream.extend(self._apply(event))
+        except Exception as err:  # noqa: BLE001 - an event must never kill the engine
+            faults.append(self._fault(t, f"event {getattr(event, 'kind', event)!r}", err))
+
     def _apply(self, event: Event) -> list[Event]:
-        """One event through the behavior (and so the handover state); returns what it adds
-        to the tick's events. A phase event is passed on only when it changed the handover's
-        phase (the stream published is the one phase stream); a robot event that changed it
-        is followed by that phase's event (``info.source`` ``robot`` or ``gripper``,
-        ``info.evidence`` the robot event). A grasp or a release the detector cannot see moves
-        its phase too."""
-        change: PhaseChange | None = self.behavior.handle(event)
-        kind = getattr(event, "kind", None)
-        if kind in PHASE_OF_EVENT:
+        """One event through the handover state (the behavior follows its changes); returns
+        what it adds to the tick's events. A phase event is passed on only when it changed the
+        handover's phase (the stream published is the one phase stream); a robot event that
+        changed it is followed by that phase's event (``info.source`` ``robot`` or
+        ``gripper``, ``info.evidence`` the robot event)."""
+        change = apply_event(self.handover, self.behavior, event)
+        if getattr(event, "kind", None) in PHASE_OF_EVENT:
             return [event] if change is not None else []
         out = [event]
         if change is not None:
-            if change.rule.trigger in _DETECTOR_ADOPTS:
-                self.detector.adopt(change.phase, change.t)
             info = {
                 "handover": self.handover.handover,
                 "source": change.source,
@@ -388,16 +358,11 @@ class GazeEngine:
         fail or give a non-finite value."""
         try:
             q, yaw, pitch, residual, shift = self.gaze.step(t, point, arm)
-            # One float sum instead of a check per value: finite values of these sizes (angles,
-            # rad) cannot overflow, so the sum is finite exactly when every value is.
-            ok = math.isfinite(yaw + pitch + residual + shift + sum(q))
             names = self._head_names
-            n = len(names)
-            # A goal for every head joint, checked by length (zip's strict mode costs more).
-            if len(q) != n:
-                raise ValueError(f"{len(q)} head joint goals for {n} head joints")
-            # (a one-joint head's dict as a display: a quarter of dict(zip())'s cost)
-            head = {names[0]: q[0]} if n == 1 else dict(zip(names, q))  # noqa: B905 - checked
+            if len(q) != len(names):
+                raise ValueError(f"{len(q)} head joint goals for {len(names)} head joints")
+            head = dict(zip(names, q, strict=True))
+            ok = all(math.isfinite(v) for v in (yaw, pitch, residual, shift, *q))
         except Exception as err:  # noqa: BLE001 - e.g. a joint reading that is no number
             faults.append(self._fault(t, "kinematics", err))
             events = (*events, faults[-1])
@@ -409,32 +374,26 @@ class GazeEngine:
             residual = last.residual if last is not None else 0.0
             shift = 0.0
         self._last_target = (kind, point)
-        status: Status = "degraded" if faults or not ok else "ok"
-        handover = self.handover
-        # ``is`` first: comparing a dtype with the np.float64 type converts it on every call
-        if type(point) is not np.ndarray or (point.dtype is not F64 and point.dtype != F64):
-            point = np.asarray(point, float)  # (the behavior's points already are)
-        cmd = from_fields(
-            GazeCommand,
-            {  # every field, in field order (GazeCommand's dataclass fields)
-                "t": t,
-                "phase": handover.phase,
-                "target": kind,
-                "target_point": point,
-                "head": head,
-                "eye_yaw": yaw,
-                "eye_pitch": pitch,
-                "residual": residual,
-                "phase_source": handover.source,
-                "gaze_shift": shift,
-                "tracking": self.behavior.tracking,
-                "status": status,
-                "blink": 0.0,
-                "distance": None,
-                "answers_sample": True,
-                "events": events,
-            },
+        cmd = GazeCommand(
+            t=t,
+            phase=self.handover.phase,
+            target=kind,
+            target_point=np.asarray(point, dtype=float),
+            head=head,
+            eye_yaw=yaw,
+            eye_pitch=pitch,
+            residual=residual,
+            phase_source=self.handover.source,
+            gaze_shift=shift,
+            tracking=self.behavior.tracking,
+            status="degraded" if faults or not ok else "ok",
+            events=events,
         )
         if ok:
             self._last_safe = cmd
         return cmd
+
+
+def _is_float3(p: object) -> bool:
+    """``p`` is a float array of three values (kept as it is)."""
+    return isinstance(p, np.ndarray) and p.dtype.kind == "f" and p.shape == (3,)

@@ -94,6 +94,8 @@ class Registry(Generic[T]):
             self._add_entry_points()
 
     def _add_entry_points(self) -> None:
+        if self.group is None:
+            return
         for ep in importlib.metadata.entry_points(group=self.group):
             if ep.name in self._entries:
                 warnings.warn(f"{self.kind} {ep.name!r} of entry point {ep.value!r} ignored: "

@@ -1,52 +1,34 @@
 """Values that flow between gazebot's stages.
 
-Data flows one way: ``TrackingFrame`` -> phases (``Event``) -> behavior (``GazeTarget``) ->
-kinematics -> ``GazeCommand``. All quantities are SI (m, s, rad); points are in the robot base
-frame unless a name says otherwise.
+Data flows one way: ``TrackingFrame`` -> phases (``Event``) -> handover state -> behavior
+(``GazeTarget``) -> kinematics -> ``GazeCommand``; the phase is the handover state's alone (the
+phase detector reads it, the engine applies events to it). All quantities are SI (m, s, rad);
+points are in the robot base frame unless a name says otherwise.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+import numbers
+from dataclasses import dataclass, field, fields, replace
 from enum import Enum
-from typing import Any, Literal, TypeVar
+from typing import Any, Literal
 
 import numpy as np
 
 NAN3 = np.full(3, np.nan)
-# NumPy's float64 dtype: one object, so an ``is`` test settles the usual array's dtype on the
-# per-tick paths (cheaper than comparing dtypes).
+#: NumPy's float64 dtype (the dtype of every point gazebot makes).
 F64 = np.dtype(np.float64)
 
-_T = TypeVar("_T")
-
-# object's own constructor and setter, looked up once: filled() runs several times per tick.
-_new_object = object.__new__
-_set_attribute = object.__setattr__
-
-
-def filled(cls: type[_T], fields: dict[str, Any] | None = None, /, **values: Any) -> _T:
-    """An instance of the frozen dataclass ``cls`` with its fields set straight from
-    ``values`` (or from ``fields``, a new dict in field order that the instance keeps as its
-    attributes): the per-tick stages (engine, controller, behavior, detector, loop) build their
-    values this way, because a frozen dataclass's generated ``__init__`` sets each field through
-    ``object.__setattr__`` (microseconds per tick). No defaults and no checks: the caller
-    passes every field. A value with many fields is cheaper from a dict literal than from
-    keywords (Python's keyword-argument handling costs about 50 ns a name)."""
-    if fields is not None and values:
-        raise TypeError("filled() takes a fields dict or keywords, not both")
-    # A keywords dict is always new.
-    return from_fields(cls, values if fields is None else fields)
-
-
-def from_fields(cls: type[_T], fields: dict[str, Any], /) -> _T:
-    """:func:`filled` from a fields dict alone (a new dict in field order, which the instance
-    keeps as its attributes, uncopied): the form for every tick, since a function that also
-    takes keywords builds an empty keywords dict on each call (about 0.1 us)."""
-    obj = _new_object(cls)
-    _set_attribute(obj, "__dict__", fields)
-    return obj
+def finite_float(value: object) -> float | None:
+    """``value`` as a float when it is a finite real number (Python or NumPy), else ``None``."""
+    if not isinstance(value, numbers.Real):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:  # an int beyond float's range
+        return None
+    return x if math.isfinite(x) else None
 
 
 def as_point(value: Any) -> np.ndarray:
@@ -61,15 +43,13 @@ def as_point(value: Any) -> np.ndarray:
 
 def is_valid_point(p: np.ndarray | None) -> bool:
     """True when ``p`` is a finite 3D point."""
-    if type(p) is np.ndarray and p.shape == (3,) and p.dtype.kind == "f":
-        # Scalar checks: this runs several times per engine tick, where numpy's per-call
-        # overhead would cost microseconds.
-        x, y, z = p.tolist()
-        return math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
     if p is None:
         return False
-    arr = np.asarray(p, dtype=float)
-    return arr.shape == (3,) and bool(np.all(np.isfinite(arr)))
+    try:
+        arr = np.asarray(p, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return arr.shape == (3,) and bool(np.isfinite(arr).all())
 
 
 class Phase(str, Enum):
@@ -276,13 +256,12 @@ class GazeCommand:
     events: tuple[Event, ...] = ()
 
     def replaced(self, **changes: Any) -> GazeCommand:
-        """This command with ``changes`` (field names) applied: what
-        :func:`dataclasses.replace` does, without its per-call field inspection (the runtime loop
-        calls this every tick; ``replace`` would cost more than the rest of the loop)."""
+        """This command with ``changes`` (field names) applied (:func:`dataclasses.replace`;
+        a name that is no field is a ``TypeError`` naming it)."""
         unknown = changes.keys() - _COMMAND_FIELDS
         if unknown:
             raise TypeError(f"GazeCommand has no fields {sorted(unknown)}")
-        return from_fields(GazeCommand, {**self.__dict__, **changes})
+        return replace(self, **changes)
 
     def is_finite(self) -> bool:
         """True when every joint and eye value (and the time) is finite."""

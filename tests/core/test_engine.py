@@ -8,11 +8,7 @@ import numpy as np
 import pytest
 
 from gazebot import Event, EventKind, GazeEngine, Phase, TrackingFrame
-
-
-def _min_jerk(s: np.ndarray) -> np.ndarray:
-    s = np.clip(s, 0.0, 1.0)
-    return 10 * s**3 - 15 * s**4 + 6 * s**5
+from gazebot.core.minimum_jerk import minimum_jerk
 
 
 def handover_frames(rate: float = 120.0, seed: int = 0) -> list[TrackingFrame]:
@@ -27,10 +23,10 @@ def handover_frames(rate: float = 120.0, seed: int = 0) -> list[TrackingFrame]:
     frames = []
     for t in np.arange(0.0, 5.0, 1.0 / rate):
         if t < 2.6:
-            hand = hand_rest + (meet - hand_rest) * _min_jerk((t - 1.0) / 1.0)
+            hand = hand_rest + (meet - hand_rest) * minimum_jerk((t - 1.0) / 1.0)
         else:
-            hand = meet + (hand_rest - meet) * _min_jerk((t - 2.6) / 1.0)
-        grip = grip_home + (grip_meet - grip_home) * _min_jerk((t - 1.2) / 0.9)
+            hand = meet + (hand_rest - meet) * minimum_jerk((t - 2.6) / 1.0)
+        grip = grip_home + (grip_meet - grip_home) * minimum_jerk((t - 1.2) / 0.9)
         noise = rng.normal(0.0, 0.002, size=(2, 3))
         frames.append(
             TrackingFrame.make(
@@ -263,7 +259,9 @@ def test_the_command_reports_the_gripper_as_the_source_of_a_grasped_transfer():
     eng.notify([Event(EventKind.ROBOT_GRASPED, 0.2, 0.2)])  # one event or many
     cmd = eng.step(TrackingFrame.make(0.2))
     assert (cmd.phase, cmd.phase_source) == (Phase.TRANSFER, "gripper")
-    assert eng.detector.phase is Phase.TRANSFER  # the detector adopted what it cannot see
+    # The detector keeps no phase: it follows the state's transfer (it cannot see a grasp).
+    assert not hasattr(eng.detector, "phase")
+    assert eng.detector.expected_end(eng.handover) >= 0.2
 
 
 def test_an_earlier_giver_reach_told_late_takes_the_source_without_a_second_reach_event():
@@ -279,3 +277,15 @@ def test_an_earlier_giver_reach_told_late_takes_the_source_without_a_second_reac
     cmd = eng.step(TrackingFrame.make(0.85))
     assert (cmd.phase, cmd.phase_source, eng.handover.phase_start) == (Phase.REACH, "tracking", 0.5)
     assert not [e for e in cmd.events if e.kind is EventKind.REACH_STARTED]
+
+
+def test_the_phase_has_one_owner_the_handover_state():
+    # Issue 31: no stage keeps a phase of its own; the state's machine holds it.
+    eng = GazeEngine.from_config(robot="sawyer", behavior="face-hand-face")
+    eng.notify(Event(EventKind.ROBOT_REACH_STARTED, 0.1, 0.1, {"planned_duration": 1.0}))
+    eng.step(TrackingFrame.make(0.1))
+    eng.notify(Event(EventKind.ROBOT_GRASPED, 0.2, 0.2))
+    cmd = eng.step(TrackingFrame.make(0.2))
+    for stage in (eng, eng.detector, eng.behavior, eng.handover):
+        assert not [k for k, v in vars(stage).items() if isinstance(v, Phase)], stage
+    assert cmd.phase is eng.phase is eng.behavior.phase is eng.handover.phase is Phase.TRANSFER

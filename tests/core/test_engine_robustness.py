@@ -80,11 +80,14 @@ def test_a_sample_with_huge_finite_values_does_not_kill_the_loop(loop, huge):
 class _Exploding:
     """A phase detector that raises on every sample (a bug a sample triggers)."""
 
-    phase = None
-    expected_phase_end = math.nan
-
-    def update_all(self, frame):
+    def update(self, frame, view, report):
         raise ZeroDivisionError("boom")
+
+    def expected_end(self, view):
+        return math.nan
+
+    def resync(self):
+        pass
 
 
 def test_a_stage_raising_on_a_sample_is_reported_as_a_fault_and_the_engine_goes_on():

@@ -30,6 +30,7 @@ from gazebot.apps.annotations.rules import DEFAULT_RULE, GazeRule
 from gazebot.apps.annotations.three_phase import HANDOVER_PHASES
 from gazebot.core.behaviors.machine import BehaviorMachine
 from gazebot.core.behaviors.spec import BehaviorSpec
+from gazebot.core.handover import apply_event
 from gazebot.core.types import EVENT_OF_PHASE, Event, EventKind, GazeContext, Phase
 
 _START_EVENT = {p.value: k for p, k in EVENT_OF_PHASE.items() if p is not Phase.DONE}
@@ -149,7 +150,7 @@ def replay_handover(
     by_phase = {p: [0, 0] for p in HANDOVER_PHASES}
     for i, label in enumerate(phases):
         for event in events.get(i, ()):
-            machine.handle(event)
+            apply_event(machine.handover, machine, event)
         ctx = GazeContext(i / FPS, _POINTS, tracking_end=ends[i])
         kind = machine.target(ctx).kind
         human = rule.target(gaze[i])

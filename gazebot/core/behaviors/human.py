@@ -30,7 +30,9 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from gazebot.core.behaviors.segment import AtFraction, Segment, check_target_name
 
-PHASES = ("reach", "transfer", "retreat")
+#: A phase that has segments.
+PhaseName = Literal["reach", "transfer", "retreat"]
+PHASES: tuple[PhaseName, ...] = ("reach", "transfer", "retreat")
 
 
 class _Strict(BaseModel):
@@ -49,7 +51,7 @@ class BetaFraction(_Strict):
 class HumanShift(_Strict):
     """When the ``index``-th target of ``phase`` (``from_target`` -> ``to_target``) begins."""
 
-    phase: Literal["reach", "transfer", "retreat"]
+    phase: PhaseName
     index: int = Field(ge=1)
     from_target: str
     to_target: str
@@ -119,8 +121,10 @@ class HumanGazeModel(_Strict):
         return pattern.name, segments
 
 
-def _shift_keys(pattern: HumanPattern, only: str | None = None) -> list[tuple[str, int, str, str]]:
-    keys = []
+def _shift_keys(
+    pattern: HumanPattern, only: PhaseName | None = None
+) -> list[tuple[PhaseName, int, str, str]]:
+    keys: list[tuple[PhaseName, int, str, str]] = []
     for phase in PHASES if only is None else (only,):
         targets = getattr(pattern, phase)
         keys += [(phase, i, targets[i - 1], targets[i]) for i in range(1, len(targets))]

@@ -2,8 +2,9 @@
 
 The machine keeps **no phase of its own**: it reads the one
 :class:`~gazebot.core.handover.HandoverState` (the engine's, or its own when run alone) and reacts
-to
-its phase changes. :func:`machine_definition` builds one ``transitions`` hierarchical machine
+to its phase changes and to the tick; it never passes events on to the state (whoever applies
+them, the engine, tells it: :func:`gazebot.core.handover.apply_event`).
+:func:`machine_definition` builds one ``transitions`` hierarchical machine
 with two parallel regions under the root state ``behavior``; every rule that decides the gaze
 target is one of its transitions, with a named condition, and runs in it:
 
@@ -84,31 +85,23 @@ from gazebot.core.behaviors.spec import (
 )
 from gazebot.core.handover import HandoverState, PhaseChange
 from gazebot.core.types import (
-    F64,
     Event,
     EventKind,
     GazeContext,
     GazeTarget,
     Phase,
-    from_fields,
+    TrackingState,
+    finite_float,
 )
 
 _ROOT, _GAZE, _TRACKING = "behavior", "behavior_gaze", "behavior_tracking"
-_TRACKING_STATES = ("ok", "hold", "lost")
+_TRACKING_STATES: tuple[TrackingState, ...] = ("ok", "hold", "lost")
 _TRACKING_OK, _TRACKING_HOLD = f"{_TRACKING}_ok", f"{_TRACKING}_hold"
 _NEW, _DONE, _CARRY = "new handover", "handover done", "same handover: the gaze carries"
 _RESTORED = "after the loss"
 _STAYS = "due, but before the followed segment's start: the latest start wins, the gaze stays"
 
 
-
-
-def _finite(x: object) -> bool:
-    """True for a finite real number (Python or NumPy scalar)."""
-    try:
-        return math.isfinite(x)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        return False
 
 
 def _state_name(target: str) -> str:
@@ -370,21 +363,38 @@ class _Model:
     """The object whose ``state`` the ``transitions`` machine drives."""
 
     state: list[str]
+    trigger: Callable[..., bool]  # added by the machine: fires a trigger, True if it moved
 
 
 class BehaviorMachine:
-    """Runs a :class:`BehaviorSpec`: feed events with :meth:`handle` (or phase changes with
-    :meth:`on_phase`), ask :meth:`target` each tick.
+    """Runs a :class:`BehaviorSpec`: it follows its handover state (phase changes through
+    :meth:`on_phase`, tracking events through :meth:`on_tracking`: whoever applies events to
+    the state tells it, see :func:`gazebot.core.handover.apply_event`) and is asked
+    :meth:`target` each tick.
 
     Args:
         spec: The behavior.
         seed: Seed for behaviors that draw timings (``human-receiver``); equal seeds and equal
             inputs give equal outputs.
         handover: The handover state to read the phase from (the engine's); ``None``: one of its
-            own, fed by :meth:`handle`.
+            own (:attr:`handover`, fed with :func:`~gazebot.core.handover.apply_event`).
         defaults: Fallback positions (base frame, m) per target kind, for a kind never seen yet
             (the engine's: the robot's default face, its ``handover_location`` for the hand).
     """
+
+    # The memory of the current handover (set by reset()).
+    _plan: dict[Phase, list[Segment]]  # its segments per phase
+    _segments: list[Segment]  # the current phase's
+    _timings: list[AtFraction | AtEvent | AtNever]  # ... and when each starts
+    _started: list[bool]
+    _latest: float  # start time of the segment the gaze state follows
+    _scheduled: Tick | None  # the tick the last schedule was made for
+    _wake_revision: int | None  # the evidence wake holds for; None: any
+    _wake_end: float | None
+    # The last (kind, point) aimed at with tracking ok, and the one held while lost.
+    _held: tuple[str, np.ndarray] | None
+    _last_target: tuple[str, np.ndarray] | None
+    _known: dict[str, np.ndarray]  # the last valid point of each kind
 
     def __init__(
         self,
@@ -420,42 +430,48 @@ class BehaviorMachine:
     def _condition(self, key: tuple, label: str) -> Callable[[Any], bool]:
         """The runtime condition of a transition (see :data:`ConditionFactory`)."""
         kind = key[0]
+        condition: Callable[[Any], bool]
         if kind == "segment":
             _, phase, index, target = key
 
-            def condition(tick: Tick) -> bool:
+            def follows(tick: Tick) -> bool:
                 # The segment the gaze follows now (the tick's schedule: the latest due start),
                 # with this target (the drawn pattern's).
                 return (
                     self._schedule.follow == index
-                    and self._active_phase is phase
+                    and self.handover.phase is phase
                     and self._segments[index].target == target
                 )
 
+            condition = follows
         elif kind == "stays":
 
-            def condition(tick: Tick) -> bool:
+            def stays(tick: Tick) -> bool:
                 return bool(self._schedule.fired) and self._schedule.follow is None
 
+            condition = stays
         elif kind == "phase":
             rule = key[1]
 
-            def condition(change: PhaseChange) -> bool:
+            def moves(change: PhaseChange) -> bool:
                 if rule == _DONE:
                     return change.phase is Phase.DONE
                 return change.new_handover is (rule == _NEW) and change.phase is not Phase.DONE
 
+            condition = moves
         elif kind == "held":
             hold_s = self.spec.tracking_lost.hold_s
 
-            def condition(tick: Tick) -> bool:
+            def held(tick: Tick) -> bool:
                 return hold_over(self._lost_since, hold_s, tick.t)
 
+            condition = held
         else:  # restored
 
-            def condition(t: float) -> bool:
+            def restored(t: float) -> bool:
                 return t >= self._lost_since  # an older restore is stale
 
+            condition = restored
         condition.__name__ = label
         return condition
 
@@ -486,7 +502,7 @@ class BehaviorMachine:
             return
         self._scheduled = tick
         state = self.handover
-        phase = self._active_phase
+        phase = state.phase
         timings = self._timings
         anchors = [
             state.anchor(at.after) if isinstance(at, AtEvent) else math.nan for at in timings
@@ -539,7 +555,6 @@ class BehaviorMachine:
     def _enter_phase(self, change: PhaseChange) -> None:
         """The phase's segments, none started yet."""
         phase = change.phase
-        self._active_phase = phase
         self._segments = self._plan.get(phase, [])
         self._timings = [self.spec.resolve(s) for s in self._segments]
         self._started = [False] * len(self._segments)
@@ -563,7 +578,7 @@ class BehaviorMachine:
     # ----------------------------------------------------------------- state
     def reset(self, seed: int | None = None) -> None:
         """Forget everything (back to ``idle``; a machine with its own handover state resets
-        it too), optionally with a new seed; cheaper than building a new machine."""
+        it too), optionally with a new seed (building a new machine takes milliseconds)."""
         if seed is not None:
             self.seed = int(seed)
         if self._owns_handover:
@@ -571,24 +586,22 @@ class BehaviorMachine:
         self._ignored = 0  # tracking events ignored as stale or duplicated
         self.pattern = ""  # name of the drawn pattern (data-driven behaviors)
         self._rng = np.random.default_rng(self.seed)
-        self._plan: dict[Phase, list[Segment]] = self._draw_plan()
-        self._active_phase = Phase.IDLE
-        self._segments: list[Segment] = []
-        self._timings: list[Any] = []
-        self._started: list[bool] = []
-        self._latest = -math.inf  # start time of the segment the gaze state follows
+        self._plan = self._draw_plan()
+        self._segments = []
+        self._timings = []
+        self._started = []
+        self._latest = -math.inf
         self._schedule = Schedule((), (), None, math.inf, False, False)
-        self._scheduled: Tick | None = None
+        self._scheduled = None
         self._wake = math.inf
-        self._wake_revision: int | None = None  # the evidence wake holds for; None: any
-        self._wake_end: float | None = None
+        self._wake_revision = None
+        self._wake_end = None
         self._tracking_end = math.nan
         self._lost_since = math.nan
         self._hold_until = math.inf
-        # The last (kind, point) aimed at with tracking ok, and the one held while lost.
-        self._held: tuple[str, np.ndarray] | None = None
-        self._last_target: tuple[str, np.ndarray] | None = None
-        self._known: dict[str, np.ndarray] = {}
+        self._held = None
+        self._last_target = None
+        self._known = {}
         self._machine.set_state([f"{_GAZE}_{_state_name(self.spec.before)}", _TRACKING_OK])
         self.origin = GazeOrigin(Phase.IDLE, "before", self.gaze)
 
@@ -649,7 +662,7 @@ class BehaviorMachine:
         return self._target_of[self._gaze_leaf[self._model.state[0]]]
 
     @property
-    def tracking(self) -> str:
+    def tracking(self) -> TrackingState:
         """The ``tracking`` region's state: ``ok``, ``hold`` (tracking lost, the gaze held for
         ``tracking_lost.hold_s``) or ``lost`` (looking at the ``tracking_lost`` target)."""
         return self._tracking_leaf[self._model.state[1]]
@@ -658,22 +671,6 @@ class BehaviorMachine:
     def lost(self) -> bool:
         """True while tracking is lost."""
         return self._model.state[1] != _TRACKING_OK
-
-    def handle(self, event: Event) -> PhaseChange | None:
-        """Apply one event; never raises. Phase and robot events go through the handover state
-        (its phase change, returned, moves the gaze), tracking events to the ``tracking``
-        region."""
-        kind = getattr(event, "kind", None)
-        if kind is EventKind.TRACKING_LOST or kind is EventKind.TRACKING_RESTORED:
-            self.on_tracking(event)
-            return None
-        t = self.handover.would_move(event)
-        if t is not None:
-            self.advance(t)  # what is due by the event's time is the gaze that carries on
-        change = self.handover.apply(event)
-        if change is not None:
-            self.on_phase(change)
-        return change
 
     def on_tracking(self, event: Event) -> None:
         """Apply ``tracking_lost`` / ``tracking_restored`` (stale or duplicate ones ignored)."""
@@ -718,22 +715,20 @@ class BehaviorMachine:
     def target(self, ctx: GazeContext) -> GazeTarget:
         """Where to look at ``ctx.t``: a target kind and its current point."""
         kind, point = self.aim(ctx.t, ctx.points, ctx.tracking_end)
-        return from_fields(GazeTarget, {"kind": kind, "point": point})
+        return GazeTarget(kind=kind, point=point)
 
     def aim(
         self, t: float, points: dict[str, np.ndarray], tracking_end: float
     ) -> tuple[str, np.ndarray]:
         """:meth:`target` from the context's fields, as the kind and the point (the engine's
         tick: no context or target value to build and read back)."""
-        end = tracking_end
-        # (the engine's floats skip the general checks: this runs every tick)
-        if type(t) is not float or not math.isfinite(t):
-            t = float(t) if _finite(t) else self.handover.phase_start
-        if type(end) is not float or not math.isfinite(end):
-            # (a float NaN, the usual unknown end, needs no _finite call)
-            end = end if type(end) is not float and _finite(end) else math.nan
+        now = finite_float(t)
+        t = now if now is not None else self.handover.phase_start
+        end = finite_float(tracking_end)
+        if end is None:
+            end = math.nan
         self.advance(t, end)
-        if type(points) is not dict and not isinstance(points, dict):  # (``is``: the usual one)
+        if not isinstance(points, dict):
             points = {}
         gaze, tracking = self._model.state
         lost_kind = self._lost_kind
@@ -752,22 +747,14 @@ class BehaviorMachine:
     @staticmethod
     def _time(event: Event) -> float | None:
         for value in (getattr(event, "t", None), getattr(event, "detected_at", None)):
-            if _finite(value):
-                return float(value)
+            t = finite_float(value)
+            if t is not None:
+                return t
         return None
 
     def _point(self, kind: str, points: dict[str, np.ndarray]) -> np.ndarray:
         """The point of ``kind`` in ``points`` if valid, else its last known or default one."""
-        arr = points.get(kind)
-        # The usual point (a finite float64 3-vector) checked here: a _valid call costs more.
-        if type(arr) is np.ndarray and arr.dtype is F64 and arr.shape == (3,):
-            x, y, z = arr.tolist()
-            # Finite exactly when v - v is 0 for each coordinate (inf - inf and NaN are NaN):
-            # three subtractions cost less than three isfinite calls.
-            if not (x - x == 0.0 and y - y == 0.0 and z - z == 0.0):
-                arr = None
-        else:
-            arr = self._valid(arr)
+        arr = self._valid(points.get(kind))
         if arr is not None:
             self._known[kind] = arr
             return arr
@@ -791,15 +778,10 @@ class BehaviorMachine:
         """``p`` as a finite (3,) float array, or None."""
         if p is None:
             return None
-        # ``is`` first: NumPy's float64 dtype is one object, and comparing dtypes costs more
-        arr = p if type(p) is np.ndarray and (p.dtype is F64 or p.dtype == F64) else _as3(p)
-        if arr is None or arr.shape != (3,):
+        arr = p if isinstance(p, np.ndarray) and p.dtype == np.float64 else _as3(p)
+        if arr is None or arr.shape != (3,) or not np.isfinite(arr).all():
             return None
-        # Scalar checks on one list: much cheaper than np.isfinite(...).all() on a 3-vector,
-        # or than three NumPy scalars.
-        x, y, z = arr.tolist()
-        isfinite = math.isfinite
-        return arr if isfinite(x) and isfinite(y) and isfinite(z) else None
+        return arr
 
 
 def _as3(p: object) -> np.ndarray | None:

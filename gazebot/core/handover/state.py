@@ -25,9 +25,12 @@ condition a named condition of it), which ``gazebot behaviors show NAME --diagra
   was missed) or from idle/done starts a **new handover**: the robot events of the previous one
   stop counting.
 
-Besides the phase, the state keeps what the behavior's timing reads: the robot events of the
-current handover (anchors of ``{after: EVENT}`` segments and their ``planned_duration``), and the
-estimates of the phase's end (the phase event's ``expected_end``, the robot's motion plan).
+The state is the phase's one owner: the phase detector reads it (:class:`HandoverView`) and
+reports what the tracking shows; the engine applies those events and the robot's to it
+(:func:`apply_event`, which tells the behavior). Besides the phase, the state keeps what the
+behavior's timing reads: the robot events of the current handover (anchors of
+``{after: EVENT}`` segments and their ``planned_duration``), and the estimates of the phase's end
+(the phase event's ``expected_end``, the robot's motion plan).
 """
 
 from __future__ import annotations
@@ -35,11 +38,19 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from transitions import Machine
 
-from gazebot.core.types import EVENT_OF_PHASE, PHASE_OF_EVENT, Event, EventKind, Phase, PhaseSource
+from gazebot.core.types import (
+    EVENT_OF_PHASE,
+    PHASE_OF_EVENT,
+    Event,
+    EventKind,
+    Phase,
+    PhaseSource,
+    finite_float,
+)
 
 _ORDER = {Phase.IDLE: 0, Phase.REACH: 1, Phase.TRANSFER: 2, Phase.RETREAT: 3, Phase.DONE: 4}
 _BETWEEN = (Phase.IDLE, Phase.DONE)
@@ -133,13 +144,6 @@ class PhaseChange:
     rule: Rule
 
 
-def _finite(x: object) -> bool:
-    try:
-        return math.isfinite(x)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        return False
-
-
 def _parse(event: Event) -> tuple[EventKind, float] | None:
     """``(kind, time)`` of an event (its ``t``, else ``detected_at``); ``None`` when the kind is
     unknown or no time is finite."""
@@ -148,8 +152,9 @@ def _parse(event: Event) -> tuple[EventKind, float] | None:
     except ValueError:
         return None
     for value in (getattr(event, "t", None), getattr(event, "detected_at", None)):
-        if _finite(value):
-            return kind, float(value)
+        t = finite_float(value)
+        if t is not None:
+            return kind, t
     return None
 
 
@@ -211,10 +216,80 @@ def machine_definition(
     }
 
 
+class HandoverView(Protocol):
+    """What the phase detector reads of the handover state (read-only; a
+    :class:`HandoverState` is one)."""
+
+    @property
+    def phase(self) -> Phase:
+        """The current phase."""
+        ...
+
+    @property
+    def phase_start(self) -> float:
+        """Its start (s; -inf before any handover)."""
+        ...
+
+    @property
+    def handover(self) -> int:
+        """Index of the current (or last) handover, -1 before the first."""
+        ...
+
+    @property
+    def handover_t0(self) -> float:
+        """Events at or after this belong to the current handover (s): the previous
+        handover's end, -inf for the first."""
+        ...
+
+    @property
+    def reach_tracked(self) -> bool:
+        """The tracking reported the current handover's reach start (False while a reach
+        only the robot started waits for the giver's: the first reach wins)."""
+        ...
+
+    @property
+    def entry(self) -> int:
+        """Grows whenever the phase the tracking follows is entered or its start moves (a
+        reach only the robot started is not one until the giver's joins it)."""
+        ...
+
+
+class PhaseFollower(Protocol):
+    """What reacts to the handover state's changes (the behavior machine)."""
+
+    def advance(self, t: float) -> None:
+        """Bring everything due by ``t`` up to date (before a phase change at ``t``)."""
+
+    def on_phase(self, change: PhaseChange) -> None:
+        """The state changed phase."""
+
+    def on_tracking(self, event: Event) -> None:
+        """``tracking_lost`` / ``tracking_restored``."""
+
+
+def apply_event(state: HandoverState, follower: PhaseFollower, event: Event) -> PhaseChange | None:
+    """Apply one event to ``state`` and tell ``follower``: tracking events go to it alone; a
+    phase or robot event that moves the phase first lets it catch up to the event's time
+    (what is due by then is the gaze that carries on), then tells it the change. Returns the
+    change, else ``None``."""
+    kind = getattr(event, "kind", None)
+    if kind is EventKind.TRACKING_LOST or kind is EventKind.TRACKING_RESTORED:
+        follower.on_tracking(event)
+        return None
+    t = state.would_move(event)
+    if t is not None:
+        follower.advance(t)
+    change = state.apply(event)
+    if change is not None:
+        follower.on_phase(change)
+    return change
+
+
 class _Model:
     """The object whose ``state`` (a phase's value) the handover machine drives."""
 
     state: str
+    trigger: Callable[..., bool]  # added by the machine: fires a trigger, True if it moved
 
 
 class HandoverState:
@@ -228,8 +303,10 @@ class HandoverState:
 
     def __init__(self) -> None:
         self._model = _Model()
+        # Each rule's condition, built once: the machine runs them, would_move asks them.
+        self._checks = {rule: self._condition(rule) for rule in RULES}
         #: The machine's definition (``transitions`` keyword arguments), live callables included.
-        self.definition = machine_definition(self._condition, self._callback)
+        self.definition = machine_definition(self._checks.__getitem__, self._callback)
         self._machine = Machine(
             model=self._model,
             **self.definition,
@@ -239,6 +316,9 @@ class HandoverState:
         #: Counts every change of what the behavior's timing reads (phase, its start, robot
         #: events); never goes back, not even on :meth:`reset`.
         self.revision = 0
+        #: Counts the entries of the phase the tracking follows (see :class:`HandoverView`);
+        #: never goes back, not even on :meth:`reset`.
+        self.entry = 0
         self.reset()
 
     def reset(self) -> None:
@@ -259,11 +339,17 @@ class HandoverState:
         self._robot: dict[EventKind, Event] = {}
         self._change: PhaseChange | None = None
         self.revision += 1
+        self.entry += 1
 
     @property
     def phase(self) -> Phase:
         """The current phase (the machine's state)."""
         return _PHASE_OF_STATE[self._model.state]
+
+    @property
+    def reach_tracked(self) -> bool:
+        """The tracking reported the current handover's reach start."""
+        return "giver" in self._reach_by
 
     # ----------------------------------------------------------------- input
     def apply(self, event: Event) -> PhaseChange | None:
@@ -296,14 +382,15 @@ class HandoverState:
     def would_move(self, event: Event) -> float | None:
         """The time (s) at which ``event`` would change the phase, ``None`` if it would not
         (nothing changes: the behavior first brings its gaze up to that time). Asks the
-        machine which of its transitions would apply."""
+        rule table, whose conditions the machine runs."""
         parsed = _parse(event)
         if parsed is None or parsed[0] not in _PHASE_TRIGGERS:
             return None
         kind, t = parsed
-        for transition in self._machine.events[kind.value].transitions[self._model.state]:
-            if all(c.func(t, event) is c.target for c in transition.conditions):
-                return t if transition.dest is not None else None
+        phase = self.phase
+        for rule in RULES:  # (the machine's transitions, in its order)
+            if rule.trigger is kind and phase in rule.sources and self._checks[rule](t, event):
+                return t if rule.dest is not None else None
         return None
 
     # ----------------------------------------------------------------- the machine's rules
@@ -362,8 +449,8 @@ class HandoverState:
         ev = self._robot.get(motion) if motion is not None else None
         if ev is None or ev.t < self.handover_t0:
             return math.nan
-        planned = ev.info.get("planned_duration")
-        return ev.t + float(planned) if _finite(planned) and planned > 0 else math.nan
+        planned = finite_float(ev.info.get("planned_duration"))
+        return ev.t + planned if planned is not None and planned > 0 else math.nan
 
     # ----------------------------------------------------------------- internals
     def _keep_robot(self, kind: EventKind, t: float, event: Event) -> bool:
@@ -379,11 +466,15 @@ class HandoverState:
         """The other party's reach start of the current handover: the reach starts with the
         first. An earlier start also takes over the phase's source: the reach is the earlier
         party's, whichever was told first."""
-        self._reach_by.add("robot" if kind is EventKind.ROBOT_REACH_STARTED else "giver")
-        if t < self.phase_start:
+        by_robot = kind is EventKind.ROBOT_REACH_STARTED
+        self._reach_by.add("robot" if by_robot else "giver")
+        moved = t < self.phase_start
+        if moved:
             self.phase_start = t
             self.source = event_source(event)
             self.revision += 1
+        if moved or not by_robot:  # the tracking follows the reach from now on
+            self.entry += 1
 
     def _enter(self, rule: Rule, t: float, event: Event) -> PhaseChange:
         """Enter ``rule.dest`` at ``t`` (called before the machine moves: :attr:`phase` is
@@ -407,14 +498,17 @@ class HandoverState:
             }
             self.handover += 1
             self._reach_by = set()
+        by_robot = rule.trigger is EventKind.ROBOT_REACH_STARTED
         if phase is Phase.REACH:
-            by_robot = rule.trigger is EventKind.ROBOT_REACH_STARTED
             self._reach_by.add("robot" if by_robot else "giver")
+        if not by_robot:  # (a reach only the robot started is none the tracking follows yet)
+            self.entry += 1
         self.phase_start = t
         self._last_change = t
         self.source = event_source(event)
         info = event.info if isinstance(event.info, dict) else {}
         expected = info.get("expected_end", math.nan)
-        self.event_end = float(expected) if _finite(expected) else math.nan
+        end = finite_float(expected)
+        self.event_end = end if end is not None else math.nan
         self.revision += 1
         return PhaseChange(phase, t, previous, self.source, new, rule)

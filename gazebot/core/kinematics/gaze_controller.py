@@ -45,7 +45,6 @@ from gazebot.core.kinematics.look_at import (
 from gazebot.core.kinematics.robot import RobotModel
 from gazebot.core.kinematics.shifts import GazeShiftConfig, MinJerkTrajectory, min_jerk_duration
 from gazebot.core.minimum_jerk import minimum_jerk
-from gazebot.core.types import filled
 
 # Goal changes below this (rad, any joint) do not re-plan the neck.
 _REPLAN_EPS = 1e-6
@@ -80,7 +79,7 @@ class HeadEyeState:
     eyes_saturated: bool = False
 
 
-class GazeCommand(NamedTuple):
+class GazeStep(NamedTuple):
     """The commands of one :meth:`GazeController.step` (rad).
 
     Attributes:
@@ -199,8 +198,7 @@ class GazeController:
         shift = self.step(t, target_point, arm).shift_amplitude
         valid, eyes_saturated = self._target_valid, self._eyes_saturated
         names = self._names
-        state = filled(
-            HeadEyeState,
+        state = HeadEyeState(
             head=dict(zip(names, self._q, strict=True)),
             eye_yaw=float(self._eyes[0]),
             eye_pitch=float(self._eyes[1]),
@@ -219,8 +217,8 @@ class GazeController:
         t: float,
         target_point: np.ndarray | None,
         arm: Mapping[str, float] | None = None,
-    ) -> GazeCommand:
-        """:meth:`update` as a :class:`GazeCommand`: the same floats without the
+    ) -> GazeStep:
+        """:meth:`update` as a :class:`GazeStep`: the same floats without the
         :class:`HeadEyeState` and its joint dicts (the engine's tick reads only these)."""
         dt = self._advance(t)
         arm_moved = self.robot.set_arm(arm) if arm is not None else False
@@ -238,7 +236,7 @@ class GazeController:
                 self._vel = [0.0] * len(self._q)
         self._target_valid = target is not None
         self._eyes_saturated = self._aim_eyes(dt) if self._target is not None else False
-        return GazeCommand(self._q, self._eyes[0], self._eyes[1], self._residual, shift)
+        return GazeStep(self._q, self._eyes[0], self._eyes[1], self._residual, shift)
 
     def _usable_target(self, point: object) -> tuple[float, float, float] | None:
         """``point`` as floats, or ``None`` when it is missing, not finite or absurdly far (a

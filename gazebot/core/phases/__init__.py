@@ -4,8 +4,10 @@ One entry point per use, every setting in :class:`PhaseConfig` (``configs/phases
 ``method`` choosing the rules:
 
 - offline, :func:`segment` splits a whole :class:`Trajectory` into :class:`Segment` s;
-- online, :func:`make_detector` gives the :class:`PhaseDetector` the engine runs
-  (``update(frame) -> Event | None``); :func:`run_online` replays a recording through it.
+- online, :func:`make_detector` gives the :class:`PhaseDetector` the engine runs (evidence:
+  ``update(frame, view, report)`` reports the boundaries the tracking shows beyond the handover
+  state's phase, which it reads through a read-only view); :class:`OnlineDetector` pairs one
+  with a handover state of its own, and :func:`run_online` replays a recording through that.
 
 Parts: :mod:`.filtering` (frozen samples, resampling, smoothing), :mod:`.rules` (one rule per
 phase boundary of the ``gazebot`` method), :mod:`.methods` (``gazebot``, ``seed-7.2.5``,
@@ -21,6 +23,7 @@ from gazebot.core.phases.config import (
 )
 from gazebot.core.phases.detector import (
     DetectorStats,
+    OnlineDetector,
     OnlineResult,
     PhaseDetector,
     make_detector,
@@ -42,6 +45,7 @@ def segment(trajectory: Trajectory, config: PhaseConfig | None = None) -> list[S
 
 __all__ = [
     "DetectorStats",
+    "OnlineDetector",
     "OnlineResult",
     "PhaseConfig",
     "PhaseDetector",

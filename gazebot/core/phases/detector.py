@@ -21,12 +21,12 @@ robot has not grasped are a giver waiting).
 
 A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
 back about as far apart as when it started (taken back before any transfer), ends as
-``handover_done`` with ``source = "aborted"`` (a reach adopted by :meth:`PhaseDetector.resync`
-that began before the first sample: once the hands are ``transfer_distance_margin`` farther
-apart than the closest seen). A reach that was an earlier movement (the giver
-lifted the object, rested ``reach_stall``, then set off toward the receiver) ends with
-``source = "stalled"`` when the final approach shows, and that approach is the reach (a new
-``reach_started``); a retreat longer
+``handover_done`` with ``source = "aborted"`` (a reach replayed into the handover state
+before the first sample, :meth:`PhaseDetector.resync`: once the hands are
+``transfer_distance_margin`` farther apart than the closest seen). A reach that was an
+earlier movement (the giver lifted the object, rested ``reach_stall``, then set off toward the
+receiver) ends with ``source = "stalled"`` when the final approach shows, and that approach is
+the reach (a new ``reach_started``); a retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
 
 Bad samples: a frame with a non-finite time, or a time not after the last accepted one
@@ -35,18 +35,23 @@ frozen repeats are bridged for up to ``max_gap_hold``; after that ``tracking_los
 (``t`` = last valid sample, ``info["missing"]`` names the points) and phase detection pauses
 until both hands are seen again (``tracking_restored``).
 
-One :meth:`PhaseDetector.update` call returns at most one event; the rest are queued and
-returned by the next calls, oldest first (:meth:`PhaseDetector.update_all` returns all).
+The phase is the handover state's (:class:`~gazebot.core.handover.HandoverState`): the detector
+reads it through a :class:`~gazebot.core.handover.HandoverView` and reports each event to
+whoever applies it to that state (the engine), then reads the state it moved.
+:class:`OnlineDetector` pairs a detector with a state of its own (the phases the tracking alone
+shows: replays, tools, tests).
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from gazebot.core.handover import HandoverState, HandoverView
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.durations import REACH_S
 from gazebot.core.phases.filtering import SignalCache, Signals, nanmax, nanmin, vector_norm
@@ -55,14 +60,11 @@ from gazebot.core.phases.methods.base import OnlineState
 from gazebot.core.phases.prediction import predict_end
 from gazebot.core.phases.segment import Segment, segments_from_events
 from gazebot.core.phases.trajectory import Trajectory
-from gazebot.core.types import EVENT_OF_PHASE as _EVENT_OF_PHASE
-from gazebot.core.types import F64, Event, EventKind, Phase, TrackingFrame, filled
-from gazebot.core.types import PHASE_OF_EVENT as _PHASE_OF_EVENT
+from gazebot.core.types import EVENT_OF_PHASE, Event, EventKind, Phase, TrackingFrame
 
 
 def _point(p: object) -> np.ndarray:
-    """A point as a float 3-vector (NaNs if it is not a numeric 3-vector): the conversion
-    for anything but the usual float64 3-vector, which the per-sample path takes as it is."""
+    """A point as a float 3-vector (NaNs if it is not a numeric 3-vector)."""
     try:
         v = np.asarray(p, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -76,10 +78,10 @@ _ROW = 7  # values of a kept sample: t, giver xyz, receiver xyz
 class _Samples:
     """The samples kept (rows ``[t, giver xyz, receiver xyz]``) in one array that grows and is
     compacted in place: the analysis reads them as views, with no per-sample conversion. A new
-    sample waits in a flat list until the rows are read (a list extend per sample; one copy of
-    the few new rows' values per analysis, in order into the rows' block: cheaper than numpy
-    converting a list of rows). The rows are read through a read-only view of the block
-    (made once per block, not per read: an analysis cannot write into the samples kept)."""
+    sample waits in a flat list until the rows are read (a list extend per sample; the new
+    rows' values are copied into the block once per analysis). The rows are read through a
+    read-only view of the block (made once per block, not per read: an analysis cannot write
+    into the samples kept)."""
 
     def __init__(self) -> None:
         self._buf = np.empty((256, _ROW))
@@ -149,8 +151,7 @@ class _Samples:
                 self._buf[:m] = buf[self._s0 : self._s1]
                 self._s0, self._s1 = 0, m
             s1 = self._s1
-            # (the new rows' block, row by row, through the flat view: a slice assignment
-            # converts the list in one go, cheaper than .flat's item by item)
+            # (the new rows' block, row by row, through the flat view)
             self._flat[s1 * _ROW : (s1 + k) * _ROW] = new
             self._s1 = s1 + k
             new.clear()
@@ -171,15 +172,18 @@ class DetectorStats:
 
 
 class PhaseDetector:
-    """Causal handover phase detector running ``config.method`` (see the module docstring).
+    """Causal handover phase evidence from the tracked hands, running ``config.method`` (see the
+    module docstring).
+
+    The detector keeps no phase: it reads the one handover state through a read-only
+    :class:`~gazebot.core.handover.HandoverView` and reports the boundaries the tracking shows
+    beyond the state's phase; whoever owns the state applies them (the engine, or
+    :class:`OnlineDetector`). What it keeps is the evidence of the phase under way (where the
+    next boundary may start, the hands' distance when a reach began, the end estimate),
+    rebuilt whenever the state enters a phase the tracking follows (:attr:`HandoverView.entry`).
 
     Attributes:
         config: The settings.
-        phase: Current phase (``idle`` -> ``reach`` -> ``transfer`` -> ``retreat`` -> ``done``,
-            then ``reach`` again for a following handover).
-        phase_start: Estimated start of the current phase (s; NaN in ``idle``).
-        expected_phase_end: Predicted end of the current phase (s; NaN when unknown).
-        handover: Index of the current (or last) handover, -1 before the first.
         tracking: False between ``tracking_lost`` and ``tracking_restored``.
         stats: Counts of ignored and bridged samples.
     """
@@ -187,13 +191,13 @@ class PhaseDetector:
     def __init__(self, config: PhaseConfig | None = None) -> None:
         self.config = config if config is not None else PhaseConfig()
         self.segmenter = make_segmenter(self.config)
-        self.phase = Phase.IDLE
-        self.phase_start = math.nan
-        self.expected_phase_end = math.nan
-        self.handover = -1
         self.tracking = True
         self.stats = DetectorStats()
-        self._queue: deque[Event] = deque()
+        self._view: HandoverView | None = None  # the state read (set by each update)
+        self._report: Callable[[Event], object] = _nowhere
+        self._entry = -1  # the state's phase entry the evidence below belongs to (-1: none)
+        self._rejoined = False  # resync(): the next phase entry joins a phase under way
+        self._expected_end = math.nan
         self._samples = _Samples()
         self._last_t = -math.inf
         self._last_analysis = -math.inf
@@ -214,10 +218,7 @@ class PhaseDetector:
         # boundary may have passed.
         self._trigger = self.segmenter.trigger()
         self._last_full = -math.inf
-        self._state_key: tuple[object, ...] = ()  # the values self._state was made of
-        self._state: OnlineState | None = None
         self._reach_missing_since = math.nan
-        self._floor = -math.inf  # the next phase never starts before this
         # The current phase began before this detector saw the hands move (resync, restart).
         self._joined_late = False
         # The hands' distance when the current reach began, as last read while the analysis
@@ -225,99 +226,110 @@ class PhaseDetector:
         self._reach_d0 = math.nan
 
     # ----------------------------------------------------------------- public API
-    @property
-    def pending(self) -> int:
-        """Number of queued events the next calls will return."""
-        return len(self._queue)
-
-    def update(self, frame: TrackingFrame) -> Event | None:
-        """Feed one frame; return the oldest new (or queued) event, else ``None``."""
+    def update(
+        self, frame: TrackingFrame, view: HandoverView, report: Callable[[Event], object]
+    ) -> None:
+        """Feed one frame. Every event it reveals (phase boundaries, ``tracking_lost`` /
+        ``tracking_restored``) goes to ``report``, oldest first; ``report`` applies it to the
+        handover state ``view`` reads before the detector looks further (a gripper closing can
+        reveal a reach and a transfer: the transfer is the one after the reach the state
+        took)."""
+        self._view, self._report = view, report
+        self._sync()
         self._step(frame)
-        return self._queue.popleft() if self._queue else None
 
-    def update_all(self, frame: TrackingFrame) -> list[Event]:
-        """Feed one frame; return every new and queued event, oldest first."""
-        self._step(frame)
-        if not self._queue:
-            return []
-        out = list(self._queue)
-        self._queue.clear()
-        return out
+    def expected_end(self, view: HandoverView) -> float:
+        """The tracking's estimate of the end of ``view``'s phase (s; NaN when unknown: idle,
+        done, or a reach only the robot has started)."""
+        self._view = view
+        self._sync()
+        return self._expected_end
 
-    def resync(self, event: Event) -> None:
-        """Adopt a phase known from elsewhere (e.g. published before an engine restart).
-
-        Phase events set the phase and its start to ``event.t``; ``robot_grasped`` counts as a
-        transfer start when the detector is idle, done or in a reach. Tracking and other robot
-        events are ignored. No event is emitted, and queued events are dropped. A new handover
-        is counted when a reach (or a transfer without a reach) follows ``idle``, ``done`` or
-        ``retreat``. The robot evidence of the next frame is a baseline, not an edge (a gripper
-        still closed after a finished handover starts no new one).
-        """
-        kind = event.kind
-        if kind is EventKind.ROBOT_GRASPED:
-            if self.phase not in (Phase.IDLE, Phase.REACH, Phase.DONE):
-                return
-            phase = Phase.TRANSFER
-        else:
-            phase = _PHASE_OF_EVENT.get(kind)
-            if phase is None:
-                return
-        between = self.phase in (Phase.IDLE, Phase.DONE, Phase.RETREAT)
-        if between and phase in (Phase.REACH, Phase.TRANSFER):
-            self.handover += 1
-        self._enter(phase, event.t)
+    def resync(self) -> None:
+        """The handover state was replayed (e.g. after an engine restart): the phase under way
+        began before this detector saw the hands move, and the robot evidence of the next frame
+        is a baseline, not an edge (a gripper still closed after a finished handover starts no
+        new one)."""
+        self._rejoined = True
         self._joined_late = True
         self._prev_evidence = None
-        self._queue.clear()
 
-    def adopt(self, phase: Phase, t0: float) -> None:
-        """Enter ``phase`` at ``t0`` because other evidence showed it (the handover state's:
-        the robot grasped or released), live: no event is emitted, queued events stay, and the
-        handover is counted as if the detector had started the phase itself. A phase that does
-        not move forward (or a time before the current phase's start) is ignored."""
-        order = (Phase.IDLE, Phase.REACH, Phase.TRANSFER, Phase.RETREAT, Phase.DONE)
-        current = Phase.IDLE if self.phase is Phase.DONE else self.phase
-        if order.index(phase) <= order.index(current) or not math.isfinite(t0):
-            return
-        if math.isfinite(self.phase_start) and t0 < self.phase_start:
-            return
-        if self.phase in (Phase.IDLE, Phase.DONE) and phase is not Phase.DONE:
-            self.handover += 1
-        self._enter(phase, t0)
+    # ----------------------------------------------------------------- the state's phase
+    @property
+    def _phase(self) -> Phase:
+        """The state's phase as far as the tracking follows it: a reach only the robot has
+        started is not yet one (the giver's own reach start is still to be reported: the
+        first reach wins), so it reads as the idle or done before it."""
+        view = self._state()
+        if view.phase is Phase.REACH and not view.reach_tracked:
+            return Phase.DONE if view.handover_t0 > -math.inf else Phase.IDLE
+        return view.phase
+
+    @property
+    def _phase_start(self) -> float:
+        """The start of :attr:`_phase` (s; NaN in idle)."""
+        view = self._state()
+        phase = self._phase
+        if phase is Phase.IDLE:
+            return math.nan
+        return view.phase_start if phase is view.phase else view.handover_t0
+
+    @property
+    def _floor(self) -> float:
+        """The next phase never starts before this (s): the current phase's start."""
+        start = self._phase_start
+        return -math.inf if math.isnan(start) else start
+
+    def _state(self) -> HandoverView:
+        if self._view is None:
+            raise RuntimeError("the phase detector reads a handover state only while updated")
+        return self._view
+
+    def _sync(self) -> None:
+        """Rebuild the phase's evidence when the state entered a phase since it was built."""
+        entry = self._state().entry
+        if entry != self._entry:
+            self._entry = entry
+            self._enter(self._phase, self._phase_start)
+            if self._rejoined:
+                self._joined_late = True
+        self._rejoined = False
+
+    def _emit(self, event: Event) -> None:
+        """Report ``event``, then follow the state it moved."""
+        self._report(event)
+        self._sync()
 
     # ----------------------------------------------------------------- internals
     def _enter(self, phase: Phase, t0: float) -> None:
         # Joined late: fewer than two samples seen before the phase's start.
         self._joined_late = len(self._samples) < 3 or self._samples.time(1) >= t0
-        self.phase = phase
-        self.phase_start = t0
-        self._floor = t0
         self._reach_missing_since = math.nan
         self._reach_d0 = math.nan
-        self.expected_phase_end = predict_end(phase, t0, self._signals, t0, self.config)
+        self._expected_end = predict_end(phase, t0, self._signals, t0, self.config)
+
+    def _handover(self, phase: Phase) -> int:
+        """The index of the handover a ``phase`` start reported now belongs to: the state's
+        next one when it is between handovers (the state counts it so), else its current."""
+        view = self._state()
+        new = phase is not Phase.DONE and view.phase in (Phase.IDLE, Phase.DONE)
+        return max(view.handover + (1 if new else 0), 0)
 
     def _start(self, phase: Phase, t0: float, now: float, source: str) -> None:
         t0 = min(t0, now)
-        if math.isfinite(self.phase_start):
-            t0 = max(t0, self.phase_start)  # phases never go back in time
-        if phase is Phase.REACH or (
-            phase is Phase.TRANSFER and self.phase in (Phase.IDLE, Phase.DONE)
-        ):
-            self.handover += 1
-        info = {"handover": max(self.handover, 0), "source": source}
-        self._queue.append(Event(_EVENT_OF_PHASE[phase], t0, now, info))
-        self._enter(phase, t0)
+        start = self._phase_start
+        if math.isfinite(start):
+            t0 = max(t0, start)  # phases never go back in time
+        info = {"handover": self._handover(phase), "source": source}
+        self._emit(Event(EVENT_OF_PHASE[phase], t0, now, info))
 
     def _step(self, frame: TrackingFrame) -> None:
         st = self.stats
-        t = frame.t
-        if type(t) is not float:  # (the usual frame's time is a float already)
-            try:
-                t = float(t)
-            except (TypeError, ValueError):
-                t = math.nan
-        if t - t != 0.0:  # (not finite: inf - inf and NaN - NaN are NaN)
+        try:
+            t = float(frame.t)
+        except (TypeError, ValueError, OverflowError):
+            t = math.nan
+        if not math.isfinite(t):
             st.bad_time += 1
             return
         if t <= self._last_t:
@@ -329,18 +341,12 @@ class PhaseDetector:
         self._last_t = t
         st.samples += 1
         c = self.config
-        g, r = frame.giver_hand, frame.receiver_hand
-        # (the usual frame's points are float 3-vectors: _point's test inline, no call)
-        g = (g if type(g) is np.ndarray and g.dtype is F64 and g.shape == (3,)
-             else _point(g)).tolist()
-        r = (r if type(r) is np.ndarray and r.dtype is F64 and r.shape == (3,)
-             else _point(r)).tolist()
+        g = _point(frame.giver_hand).tolist()
+        r = _point(frame.receiver_hand).tolist()
         gx, gy, gz = g
         rx, ry, rz = r
-        # Finite: x * 0.0 is 0 for a finite x, NaN for inf or NaN (and the zeros never
-        # overflow): math.isfinite's answer without three calls a point.
-        g_ok = gx * 0.0 + gy * 0.0 + gz * 0.0 == 0.0
-        r_ok = rx * 0.0 + ry * 0.0 + rz * 0.0 == 0.0
+        g_ok = math.isfinite(gx) and math.isfinite(gy) and math.isfinite(gz)
+        r_ok = math.isfinite(rx) and math.isfinite(ry) and math.isfinite(rz)
         samples = self._samples
         samples.append((t, gx, gy, gz, rx, ry, rz), t - c.online_window)
         if g_ok:
@@ -353,22 +359,22 @@ class PhaseDetector:
             st.held += 1
             if self.tracking:
                 first = samples.time(0)
-                last_g = self._seen_g if self._seen_g == self._seen_g else first
-                last_r = self._seen_r if self._seen_r == self._seen_r else first
+                last_g = first if math.isnan(self._seen_g) else self._seen_g
+                last_r = first if math.isnan(self._seen_r) else self._seen_r
                 last = min(last_g, last_r)
                 if t - last > c.max_gap_hold:
                     self.tracking = False
                     missing = [
                         n for n, ok in (("giver_hand", g_ok), ("receiver_hand", r_ok)) if not ok
                     ]
-                    info = {"handover": max(self.handover, 0), "missing": missing}
-                    self._queue.append(Event(EventKind.TRACKING_LOST, last, t, info))
+                    info = {"handover": max(self._state().handover, 0), "missing": missing}
+                    self._emit(Event(EventKind.TRACKING_LOST, last, t, info))
             if not self.tracking:
                 return
         elif not self.tracking:
             self.tracking = True
-            info = {"handover": max(self.handover, 0)}
-            self._queue.append(Event(EventKind.TRACKING_RESTORED, t, t, info))
+            info = {"handover": max(self._state().handover, 0)}
+            self._emit(Event(EventKind.TRACKING_RESTORED, t, t, info))
 
         if frame.gripper_closed is None and frame.load_share is None:
             self._prev_evidence = False  # no robot evidence (tracking alone, the usual frame)
@@ -392,30 +398,21 @@ class PhaseDetector:
                 self._analyse(t, predict_only=mode == "refresh")
                 return
             self.stats.skipped += 1
-            if self.phase is Phase.RETREAT and t - self.phase_start > c.max_retreat:
+            if self._phase is Phase.RETREAT and t - self._phase_start > c.max_retreat:
                 self._done(t, t, "timeout")
-        end = self.expected_phase_end
-        if end - end == 0.0 and t > end:  # (finite and passed: max(end, t) without calls)
-            self.expected_phase_end = t
+        if math.isfinite(self._expected_end) and t > self._expected_end:
+            self._expected_end = t  # an estimate already passed: the phase ends no earlier
 
     def _online_state(self) -> OnlineState:
-        """What the trigger reads of the detector: the last one while it holds (these change a
-        few times per handover; a new value costs more than comparing them)."""
-        key = (self.phase, self.phase_start, self._floor, self.tracking, self._joined_late,
-               self._last_full)
-        state = self._state
-        if state is None or key != self._state_key:  # (a NaN not the same object: rebuilt)
-            self._state_key = key
-            self._state = state = filled(
-                OnlineState,
-                phase=self.phase,
-                phase_start=self.phase_start,
-                floor=self._floor,
-                tracking=self.tracking,
-                joined_late=self._joined_late,
-                last_full=self._last_full,
-            )
-        return state
+        """What the trigger reads of the detector and the state's phase."""
+        return OnlineState(
+            phase=self._phase,
+            phase_start=self._phase_start,
+            floor=self._floor,
+            tracking=self.tracking,
+            joined_late=self._joined_late,
+            last_full=self._last_full,
+        )
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
         """Gripper / load-share evidence of a frame that carries some (the caller handles a
@@ -430,12 +427,12 @@ class PhaseDetector:
         rising = evidence and self._prev_evidence is False
         self._prev_evidence = evidence
         source = "gripper" if grip else "load_share"
-        if rising and self.phase in (Phase.IDLE, Phase.DONE, Phase.REACH):
-            if self.phase is not Phase.REACH:
+        if rising and self._phase in (Phase.IDLE, Phase.DONE, Phase.REACH):
+            if self._phase is not Phase.REACH:
                 self._start(Phase.REACH, t, t, source)
             self._start(Phase.TRANSFER, t, t, source)
             return True
-        if self.phase is Phase.TRANSFER and load_ok and load > c.load_share_robot:  # type: ignore[operator]
+        if self._phase is Phase.TRANSFER and load_ok and load > c.load_share_robot:  # type: ignore[operator]
             self._start(Phase.RETREAT, t, t, "load_share")
             return True
         return False
@@ -451,13 +448,13 @@ class PhaseDetector:
         rows = self._samples.rows()
         t = rows[:, 0]
         i0 = 0
-        if self.phase is not Phase.IDLE and math.isfinite(self.phase_start):
+        if self._phase is not Phase.IDLE and math.isfinite(self._phase_start):
             # After contact the rules need the hold and what follows, a reach (or, once done,
             # the next reach) its rest before and what follows, not the whole window (the cost
             # grows with the samples; after a handover, re-analysing it is wasted).
-            look = c.reach_lookback if self.phase in (Phase.REACH, Phase.DONE) else 1.0
+            look = c.reach_lookback if self._phase in (Phase.REACH, Phase.DONE) else 1.0
             back = REACH_S * look
-            i0 = int(t.searchsorted(self.phase_start - back))
+            i0 = int(t.searchsorted(self._phase_start - back))
             if n - i0 < 3:
                 i0 = 0
         window = rows[i0:]  # (read-only: a method writing into it would change the samples kept)
@@ -468,7 +465,7 @@ class PhaseDetector:
         )
         s = self.segmenter.online_signals(traj, cache=self._signal_cache)
         self._signals = s
-        if s is not None and self.phase is Phase.REACH:
+        if s is not None and self._phase is Phase.REACH:
             # Keep the reach's start distance while the window holds it (a reach can outlast
             # the window; the taken-back checks compare with it).
             self._reach_start_distance(s, self._finite_distances(s))
@@ -480,14 +477,14 @@ class PhaseDetector:
                 self._start(Phase.REACH, restart, now, "motion")
         if s is not None and not predict_only:
             if not self.segmenter.rules_after_contact:
-                self._advance(self.segmenter.online_segments(traj, s, now, self.phase), now)
+                self._advance(self.segmenter.online_segments(traj, s, now, self._phase), now)
             elif not self._rules_after_contact(s, now):
                 # Once the hands are in contact the method's own end rules run from the
                 # phase's start; before, the whole method finds the next handover.
-                segs = self.segmenter.online_segments(traj, s, now, self.phase)
+                segs = self.segmenter.online_segments(traj, s, now, self._phase)
                 self._advance(segs, now, True)
                 self._rules_after_contact(s, now)
-        self.expected_phase_end = predict_end(self.phase, self.phase_start, self._signals, now, c)
+        self._expected_end = predict_end(self._phase, self._phase_start, self._signals, now, c)
 
     def _unknown_block(self, n: int) -> np.ndarray:
         """An all-NaN ``(n, 5)`` block (read-only) for an analysis window's face, gripper and
@@ -505,15 +502,15 @@ class PhaseDetector:
         phase's start. True if the phase is one of these two."""
         c = self.config
         for _ in range(2):
-            if self.phase not in (Phase.TRANSFER, Phase.RETREAT):
+            if self._phase not in (Phase.TRANSFER, Phase.RETREAT):
                 return False
-            end = self.segmenter.phase_end(s, self.phase, self.phase_start, self._joined_late)
+            end = self.segmenter.phase_end(s, self._phase, self._phase_start, self._joined_late)
             if end is None:
-                if self.phase is Phase.RETREAT and now - self.phase_start > c.max_retreat:
+                if self._phase is Phase.RETREAT and now - self._phase_start > c.max_retreat:
                     self._done(now, now, "timeout")
                 return True
             t_end, source = end
-            if self.phase is Phase.TRANSFER:
+            if self._phase is Phase.TRANSFER:
                 self._start(Phase.RETREAT, t_end, now, source)
                 continue
             self._done(t_end, now, source)
@@ -531,7 +528,7 @@ class PhaseDetector:
         ``stop_at_contact``: stop once in a transfer (the caller's rules take over)."""
         c = self.config
         for _ in range(4):  # at most one full handover per analysis
-            ph = self.phase
+            ph = self._phase
             if ph in (Phase.IDLE, Phase.DONE):
                 reach = self._find(segs, Phase.REACH, self._floor)
                 if reach is not None:
@@ -560,7 +557,7 @@ class PhaseDetector:
                 )
                 if alive:
                     self._reach_missing_since = math.nan
-                elif self._reach_missing_since != self._reach_missing_since:
+                elif math.isnan(self._reach_missing_since):
                     self._reach_missing_since = now
                 elif (
                     now - self._reach_missing_since > c.online_period + c.max_refine
@@ -585,7 +582,7 @@ class PhaseDetector:
             if nxt is not None:
                 self._done(nxt.start, now, "next_reach")
                 continue
-            if now - self.phase_start > c.max_retreat:
+            if now - self._phase_start > c.max_retreat:
                 self._done(now, now, "timeout")
             return
 
@@ -599,7 +596,7 @@ class PhaseDetector:
         s = self._signals
         if s is None or s.t.shape[0] < 3:
             return None
-        i_start = int(s.t.searchsorted(self.phase_start))
+        i_start = int(s.t.searchsorted(self._phase_start))
         v = s.giver_speed[i_start:]
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
         if need < 1 or v.shape[0] <= need:
@@ -639,8 +636,8 @@ class PhaseDetector:
         """The hands' distance when the current reach began (``ok``: the finite samples of
         ``s.distance``): read from ``s`` while its window still holds that moment (and kept),
         else the value kept from the last window that held it; NaN if none did."""
-        if s.t.shape[0] and s.t[0] <= self.phase_start:
-            i0 = int(s.t.searchsorted(self.phase_start))
+        if s.t.shape[0] and s.t[0] <= self._phase_start:
+            i0 = int(s.t.searchsorted(self._phase_start))
             k = int(ok.searchsorted(i0, side="right"))  # (ok increases: those <= i0)
             self._reach_d0 = float(s.distance[ok[k - 1]]) if k else math.nan
         return self._reach_d0
@@ -653,7 +650,7 @@ class PhaseDetector:
             return False
         ok = self._finite_distances(s)
         d0 = self._reach_start_distance(s, ok)
-        if not ok.size or d0 != d0:
+        if not ok.size or math.isnan(d0):
             return False
         return float(s.distance[ok[-1]]) >= d0 + self.config.reach_confirm_distance
 
@@ -667,21 +664,102 @@ class PhaseDetector:
         ok = self._finite_distances(s)
         if ok.size == 0:
             return True
-        if self._joined_late and not (ok.size and s.t[ok[0]] < self.phase_start):
+        if self._joined_late and not (ok.size and s.t[ok[0]] < self._phase_start):
             # The reach began before the first sample seen (a resync): its start distance is
             # unknown, so taken back means the hands left the region around the closest seen.
             near = float(np.min(d[ok]))
             return float(d[ok[-1]]) >= near + self.config.transfer_distance_margin
         d0 = self._reach_start_distance(s, ok)
-        if d0 != d0:  # the start was never seen with a finite distance: the first one seen
+        if math.isnan(d0):  # the start was never seen with a finite distance: the first one seen
             d0 = float(d[ok[0]])
         return float(d[ok[-1]]) >= d0 - self.config.reach_confirm_distance
 
     def _done(self, t0: float, now: float, source: str) -> None:
-        t0 = max(min(t0, now), self.phase_start)
-        info = {"handover": max(self.handover, 0), "source": source}
-        self._queue.append(Event(EventKind.HANDOVER_DONE, t0, now, info))
-        self._enter(Phase.DONE, t0)
+        t0 = max(min(t0, now), self._phase_start)
+        info = {"handover": self._handover(Phase.DONE), "source": source}
+        self._emit(Event(EventKind.HANDOVER_DONE, t0, now, info))
+
+
+def _nowhere(event: Event) -> None:
+    """The report of a detector not yet updated (never called: updates pass their own)."""
+
+
+class OnlineDetector:
+    """A :class:`PhaseDetector` with a handover state of its own: the phase stream the tracking
+    alone shows (replays, tools, tests; the engine's detector follows the engine's state).
+
+    Attributes:
+        detector: The evidence source.
+        state: The handover state its events move.
+    """
+
+    def __init__(self, config: PhaseConfig | None = None) -> None:
+        self.detector = PhaseDetector(config)
+        self.state = HandoverState()
+        self._queue: deque[Event] = deque()
+
+    @property
+    def config(self) -> PhaseConfig:
+        """The detector's settings."""
+        return self.detector.config
+
+    @property
+    def stats(self) -> DetectorStats:
+        """The detector's sample counts."""
+        return self.detector.stats
+
+    @property
+    def tracking(self) -> bool:
+        """False between ``tracking_lost`` and ``tracking_restored``."""
+        return self.detector.tracking
+
+    @property
+    def phase(self) -> Phase:
+        """The state's phase."""
+        return self.state.phase
+
+    @property
+    def phase_start(self) -> float:
+        """The state's phase start (s; NaN in idle)."""
+        return self.state.phase_start if self.state.phase is not Phase.IDLE else math.nan
+
+    @property
+    def handover(self) -> int:
+        """Index of the current (or last) handover, -1 before the first."""
+        return self.state.handover
+
+    @property
+    def expected_phase_end(self) -> float:
+        """The tracking's estimate of the phase's end (s; NaN when unknown)."""
+        return self.detector.expected_end(self.state)
+
+    @property
+    def pending(self) -> int:
+        """Number of events the next :meth:`update` calls will return."""
+        return len(self._queue)
+
+    def update_all(self, frame: TrackingFrame) -> list[Event]:
+        """Feed one frame; every event the detector reported (queued ones first)."""
+        self.detector.update(frame, self.state, self._take)
+        out = list(self._queue)
+        self._queue.clear()
+        return out
+
+    def update(self, frame: TrackingFrame) -> Event | None:
+        """Feed one frame; the oldest event not yet returned, else ``None``."""
+        self.detector.update(frame, self.state, self._take)
+        return self._queue.popleft() if self._queue else None
+
+    def resync(self, event: Event) -> None:
+        """Replay an event published before a restart into the state (no event is returned;
+        events not yet returned are dropped)."""
+        self.state.apply(event)
+        self.detector.resync()
+        self._queue.clear()
+
+    def _take(self, event: Event) -> None:
+        self.state.apply(event)
+        self._queue.append(event)
 
 
 @dataclass
@@ -694,9 +772,9 @@ class OnlineResult:
 
 
 def run_online(trajectory: Trajectory, config: PhaseConfig | None = None) -> OnlineResult:
-    """Replay a recording through a fresh :class:`PhaseDetector`, sample by sample, in the
+    """Replay a recording through a fresh :class:`OnlineDetector`, sample by sample, in the
     stored order (out-of-order samples are ignored as they would be live)."""
-    det = PhaseDetector(config)
+    det = OnlineDetector(config)
     events: list[Event] = []
     for frame in trajectory.iter_frames():
         events.extend(det.update_all(frame))

@@ -27,7 +27,6 @@ from scipy.ndimage import correlate1d, gaussian_filter1d
 
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.trajectory import Trajectory
-from gazebot.core.types import filled
 
 # Share of the smoothing window that must hold data for a velocity to be known.
 FULL_WINDOW = 0.6
@@ -402,7 +401,7 @@ def compute_signals(
 
 def _first_rows(s: Signals, rows: int) -> Signals:
     """The first ``rows`` grid rows of ``s`` (views)."""
-    return filled(Signals, {name: a[:rows] for name, a in vars(s).items()})
+    return Signals(**{name: a[:rows] for name, a in vars(s).items()})
 
 
 # The per-row blocks a SignalCache keeps beside the grid: name -> row shape (one row per grid
@@ -676,7 +675,7 @@ class SignalCache:
         fields = {"t": grid[:keep], "giver": xv[:, :3], "receiver": xv[:, 3:]}
         for name in _IN_BLOCK:  # (in the fields' order)
             fields[name] = ro[name][:keep]
-        return filled(Signals, fields)
+        return Signals(**fields)
 
     def _reserve(self, rows: int, keep: int) -> None:
         """Blocks of at least ``rows`` rows, owned by the cache, holding the first ``keep``

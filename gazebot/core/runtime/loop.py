@@ -44,7 +44,6 @@ from gazebot.core.types import (
     Phase,
     TrackingFrame,
     TrackingState,
-    from_fields,
     is_valid_point,
 )
 
@@ -218,13 +217,7 @@ class GazeLoop:
         # Blink times never go back (the engine's t never does either).
         t = self._t = max(cmd.t, self._t)
         blink = min(max(float(self.blinks.update(t, cmd.gaze_shift)), 0.0), 1.0)
-        # cmd.replaced(...) without its field-name check (these are GazeCommand's fields); a
-        # copy, then the three fields (their places in the dict are kept).
-        fields = cmd.__dict__.copy()
-        fields["blink"] = blink
-        fields["distance"] = distance
-        fields["answers_sample"] = answers
-        return from_fields(GazeCommand, fields)
+        return cmd.replaced(blink=blink, distance=distance, answers_sample=answers)
 
     def _safe_head(self, cmd: GazeCommand) -> list[float] | None:
         """The commanded head vector (rest for a joint the command lacks), or ``None`` if the

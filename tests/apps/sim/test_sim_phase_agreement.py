@@ -15,6 +15,8 @@ That the check catches a stale origin is pinned in ``tests/core/behaviors/test_b
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from gazebot.apps.sim.scene_config import Initiator, load_scene, scene_names
@@ -28,31 +30,44 @@ SEED_BEHAVIORS = seed_behaviors()
 
 
 class _SharedDetector:
-    """The first loop's phase detector; the other loops get its answer to each sample (the
-    detector only reads frames, and costs most of a tick)."""
+    """The first loop's phase detector; the other loops get its answer to each sample (it reads
+    the frames and its loop's handover state, which every loop's equals: the same frames and
+    events; and it costs most of a tick)."""
 
     def __init__(self, detector) -> None:
         self._detector = detector
         self.last: list = []
+        self.end = math.nan
 
-    def update_all(self, frame):
-        self.last = list(self._detector.update_all(frame))
-        return list(self.last)
+    def update(self, frame, view, report) -> None:
+        self.last = []
+
+        def keep(event) -> None:
+            self.last.append(event)
+            report(event)
+
+        self._detector.update(frame, view, keep)
+
+    def expected_end(self, view) -> float:
+        self.end = self._detector.expected_end(view)
+        return self.end
 
     def __getattr__(self, name):
         return getattr(self._detector, name)
 
 
 class _Replay:
-    def __init__(self, shared: _SharedDetector, own) -> None:
+    """Stands in for a further loop's detector: the shared detector's answer to this sample."""
+
+    def __init__(self, shared: _SharedDetector) -> None:
         self._shared = shared
-        self._own = own  # keeps what adopt() tells it, like a detector of its own would
 
-    def update_all(self, frame):
-        return list(self._shared.last)
+    def update(self, frame, view, report) -> None:
+        for event in self._shared.last:
+            report(event)
 
-    def adopt(self, phase, t0) -> None:
-        self._own.adopt(phase, t0)
+    def expected_end(self, view) -> float:
+        return self._shared.end
 
     def __getattr__(self, name):
         return getattr(self._shared, name)
@@ -71,7 +86,7 @@ class _AllBehaviors:
         shared = _SharedDetector(first.engine.detector)
         first.engine.detector = shared
         for loop in rest:
-            loop.engine.detector = _Replay(shared, loop.engine.detector)
+            loop.engine.detector = _Replay(shared)
         self.ticks: dict[str, list[tuple[float, Phase, str, GazeOrigin, str, str | None]]] = {
             n: [] for n in SEED_BEHAVIORS
         }

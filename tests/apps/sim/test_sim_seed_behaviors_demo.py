@@ -11,6 +11,7 @@ most of a tick, runs once and its answers are handed to every loop (it only read
 from __future__ import annotations
 
 import itertools
+import math
 
 import pytest
 
@@ -25,16 +26,27 @@ SHIFT_TOL_S = 0.05  # the issue's "within 50 ms"
 
 
 class _SharedDetector:
-    """The first loop's phase detector; remembers each sample's events for the other loops."""
+    """The first loop's phase detector; the other loops get its answer to each sample (it reads
+    the frames and its loop's handover state, which every loop's equals: the same frames and
+    events; and it costs most of a tick)."""
 
     def __init__(self, detector) -> None:
         self._detector = detector
         self.last: list = []
+        self.end = math.nan
 
-    def update_all(self, frame):
-        events = self._detector.update_all(frame)
-        self.last = list(events)  # the engine extends the returned list with robot events
-        return events
+    def update(self, frame, view, report) -> None:
+        self.last = []
+
+        def keep(event) -> None:
+            self.last.append(event)
+            report(event)
+
+        self._detector.update(frame, view, keep)
+
+    def expected_end(self, view) -> float:
+        self.end = self._detector.expected_end(view)
+        return self.end
 
     def __getattr__(self, name):
         return getattr(self._detector, name)
@@ -46,8 +58,12 @@ class _Replay:
     def __init__(self, shared: _SharedDetector) -> None:
         self._shared = shared
 
-    def update_all(self, frame):
-        return list(self._shared.last)
+    def update(self, frame, view, report) -> None:
+        for event in self._shared.last:
+            report(event)
+
+    def expected_end(self, view) -> float:
+        return self._shared.end
 
     def __getattr__(self, name):
         return getattr(self._shared, name)

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from gazebot.core.behaviors import BehaviorMachine
+from gazebot.core.handover import PhaseChange, apply_event
 from gazebot.core.types import Event, EventKind, GazeContext, Phase
 
 FACE = np.array([1.0, 0.0, 1.6])
@@ -40,3 +42,8 @@ def ctx(
 
 def ev(kind: str, t: float, **info: float) -> Event:
     return Event(EventKind(kind), t, t, dict(info))
+
+
+def feed(machine: BehaviorMachine, event: Event) -> PhaseChange | None:
+    """Apply ``event`` to the machine's own handover state; the machine follows the change."""
+    return apply_event(machine.handover, machine, event)

@@ -9,7 +9,7 @@ from collections import Counter
 
 import numpy as np
 import pytest
-from behavior_helpers import ctx, ev, hand_at
+from behavior_helpers import ctx, ev, feed, hand_at
 
 from gazebot.core.behaviors import BehaviorMachine, list_behaviors, load_behavior
 from gazebot.core.behaviors.machine import diagram
@@ -33,7 +33,7 @@ def _counting(m: BehaviorMachine) -> Counter:
 
 def test_a_revised_earlier_end_estimate_starts_the_halfway_shift_on_that_tick():
     m = BehaviorMachine(load_behavior("face-hand-face"))
-    m.handle(ev("reach_started", 0.0))
+    feed(m, ev("reach_started", 0.0))
     assert m.target(ctx(0.1, R, 0.0, 2.0)).kind == "face"  # halfway: 1.0 s
     assert m.target(ctx(0.5, R, 0.0, 2.0)).kind == "face"
     assert m.target(ctx(0.55, R, 0.0, 1.0)).kind == "hand"  # now halfway is 0.5 s
@@ -42,7 +42,7 @@ def test_a_revised_earlier_end_estimate_starts_the_halfway_shift_on_that_tick():
 def test_the_timer_is_fed_only_when_a_segment_can_start_or_the_evidence_changed():
     m = BehaviorMachine(load_behavior("face-hand-face"))
     fired = _counting(m)
-    m.handle(ev("reach_started", 0.0))
+    feed(m, ev("reach_started", 0.0))
     assert fired == {"phase": 1}
     m.target(ctx(0.01, R, 0.0, 2.0))  # the new phase is scheduled: halfway at 1.0 s
     assert fired["timer"] == 1
@@ -51,7 +51,7 @@ def test_the_timer_is_fed_only_when_a_segment_can_start_or_the_evidence_changed(
     assert fired["timer"] == 1  # nothing could start before 1.0 s with that estimate
     m.target(ctx(0.995, R, 0.0, 2.2))  # a revised estimate: scheduled again (now 1.1 s)
     assert fired["timer"] == 2
-    m.handle(ev("robot_reach_started", 0.0, planned_duration=3.0))  # new evidence
+    feed(m, ev("robot_reach_started", 0.0, planned_duration=3.0))  # new evidence
     m.target(ctx(1.0, R, 0.0, 2.2))
     assert fired["timer"] == 3
     assert m.target(ctx(1.5, R, 0.0, 2.2)).kind == "hand"  # halfway of the robot's 3 s
@@ -66,7 +66,7 @@ def test_the_hold_ends_by_the_machines_timer_at_its_time():
     m = BehaviorMachine(spec)
     fired = _counting(m)
     m.target(ctx(0.0, Phase.IDLE, 0.0))
-    m.handle(ev("tracking_lost", 1.0))
+    feed(m, ev("tracking_lost", 1.0))
     hold = spec.tracking_lost.hold_s
     before = fired["timer"]
     m.target(ctx(1.0 + hold - 0.01, Phase.IDLE, 0.0))
@@ -107,8 +107,8 @@ def test_the_diagram_draws_every_condition_the_running_machines_evaluate(name):
 
 def test_the_handover_phase_the_machine_reads_is_its_handover_machines_state():
     m = BehaviorMachine(load_behavior("face-hand-face"))
-    m.handle(ev("reach_started", 1.0))
-    m.handle(ev("retreat_started", 0.5))  # stale: the handover machine's rule refuses it
+    feed(m, ev("reach_started", 1.0))
+    feed(m, ev("retreat_started", 0.5))  # stale: the handover machine's rule refuses it
     assert m.phase is R and m.handover._model.state == "reach" and m.ignored == 1
     assert math.isfinite(m.handover.phase_start)
 
@@ -120,11 +120,11 @@ def _script(m: BehaviorMachine, tick) -> list:
     for i in range(0, 400):
         t = i / 100
         if i == 30:
-            m.handle(ev("reach_started", 0.3))
+            feed(m, ev("reach_started", 0.3))
         if i == 150:
-            m.handle(ev("tracking_lost", 1.5))
+            feed(m, ev("tracking_lost", 1.5))
         if i == 250:
-            m.handle(ev("tracking_restored", 2.5))
+            feed(m, ev("tracking_restored", 2.5))
         out.append(tick(m, t))
     return out
 

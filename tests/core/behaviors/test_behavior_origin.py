@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from behavior_helpers import ctx, ev
+from behavior_helpers import ctx, ev, feed
 
 from gazebot.core.behaviors import BehaviorMachine, GazeOrigin, load_behavior
 from gazebot.core.types import Phase
@@ -23,14 +23,14 @@ def _look(m: BehaviorMachine, t: float) -> str:
 def test_a_segment_records_its_own_phase_and_a_carry_keeps_it():
     m = _face_hand_face()
     assert m.origin == GazeOrigin(Phase.IDLE, "before", "face")
-    m.handle(ev("reach_started", 1.0))
+    feed(m, ev("reach_started", 1.0))
     assert (m.origin.phase, m.origin.rule, m.origin.carried_into) == (Phase.REACH, "before", None)
-    m.handle(ev("robot_reach_started", 1.0, planned_duration=1.0))
+    feed(m, ev("robot_reach_started", 1.0, planned_duration=1.0))
     assert _look(m, 1.6) == "hand"
     picked = m.origin
     assert (picked.phase, picked.rule, picked.target) == (Phase.REACH, "segment 1", "hand")
     assert 1.5 <= picked.t <= 1.6
-    m.handle(ev("transfer_started", 2.0))
+    feed(m, ev("transfer_started", 2.0))
     # the transfer keeps the hand until its own segment fires: the gaze is the reach's, carried
     assert m.origin == replace(picked, carried_into=Phase.TRANSFER)
     assert m.origin_disagreement(Phase.TRANSFER, "hand") is None
@@ -39,8 +39,8 @@ def test_a_segment_records_its_own_phase_and_a_carry_keeps_it():
 
 def test_a_stale_origin_is_caught():
     m = _face_hand_face()
-    m.handle(ev("reach_started", 1.0))
-    m.handle(ev("robot_reach_started", 1.0, planned_duration=1.0))
+    feed(m, ev("reach_started", 1.0))
+    feed(m, ev("robot_reach_started", 1.0, planned_duration=1.0))
     before = m.origin  # the reach's "before" rule: the face
     assert _look(m, 1.6) == "hand"
     picked = m.origin
@@ -48,7 +48,7 @@ def test_a_stale_origin_is_caught():
     m.origin = before
     assert "target 'hand'" in m.origin_disagreement(Phase.REACH, "hand")
     m.origin = picked
-    m.handle(ev("transfer_started", 2.0))
+    feed(m, ev("transfer_started", 2.0))
     carried = m.origin
     assert carried.carried_into is Phase.TRANSFER and m.origin_disagreement(
         Phase.TRANSFER, "hand") is None

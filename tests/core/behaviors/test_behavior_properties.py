@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from behavior_helpers import points
+from behavior_helpers import feed, points
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -66,7 +66,7 @@ def test_any_event_sequence_never_raises_and_always_yields_a_valid_target(name, 
     allowed = SPECS[name].targets()
     for step in script:
         if isinstance(step, Event):
-            m.handle(step)
+            feed(m, step)
         else:
             c = _ctx(*step)
             target = m.target(c)
@@ -97,10 +97,10 @@ def test_shuffled_and_duplicated_handover_events_end_in_a_defined_state(name, or
     m = MACHINES[name]
     m.reset(0)
     for i in list(order) + list(dup):
-        m.handle(base[i])
+        feed(m, base[i])
         assert m.state in m.states
     # Whatever arrived late was ignored; the handover ends with the next (in-order) report.
-    m.handle(Event(EventKind.HANDOVER_DONE, 4.0, 4.0))
+    feed(m, Event(EventKind.HANDOVER_DONE, 4.0, 4.0))
     assert m.target(_ctx(4.0, Phase.DONE, 3.5, math.nan, None, None)).kind == SPECS[name].after
     assert m.state.startswith("done_")
 
@@ -163,8 +163,8 @@ def test_a_skipped_timer_tick_never_changes_a_decision(name, seed, script):
     skipping.reset(seed)
     for step in script:
         if isinstance(step, Event):
-            fed.handle(step)
-            skipping.handle(step)
+            feed(fed, step)
+            feed(skipping, step)
             continue
         c = _ctx(*step)
         a, b = fed.target(c), skipping.target(c)
@@ -175,8 +175,8 @@ def test_a_skipped_timer_tick_never_changes_a_decision(name, seed, script):
 
 def test_a_duplicated_reach_start_keeps_the_first_start_time():
     m = BehaviorMachine(SPECS["face-hand-face"])
-    m.handle(Event(EventKind.REACH_STARTED, 1.0, 1.0))
-    m.handle(Event(EventKind.REACH_STARTED, 1.4, 1.4))
+    feed(m, Event(EventKind.REACH_STARTED, 1.0, 1.0))
+    feed(m, Event(EventKind.REACH_STARTED, 1.4, 1.4))
     assert m.ignored == 1
     kind = m.target(GazeContext(1.55, points(1.55), tracking_end=2.0)).kind
     assert kind == "hand"  # halfway of 1.0-2.0 s, not of 1.4-2.0 s
@@ -184,16 +184,16 @@ def test_a_duplicated_reach_start_keeps_the_first_start_time():
 
 def test_a_stale_phase_event_is_ignored():
     m = BehaviorMachine(SPECS["face"])
-    m.handle(Event(EventKind.TRANSFER_STARTED, 2.0, 2.0))
-    m.handle(Event(EventKind.REACH_STARTED, 1.0, 2.1))  # happened before the transfer: stale
+    feed(m, Event(EventKind.TRANSFER_STARTED, 2.0, 2.0))
+    feed(m, Event(EventKind.REACH_STARTED, 1.0, 2.1))  # happened before the transfer: stale
     assert m.phase is Phase.TRANSFER and m.ignored == 1
 
 
 def test_a_missing_transfer_is_skipped_and_the_reach_gaze_carries_on():
     m = BehaviorMachine(SPECS["face-hand-face"])
-    m.handle(Event(EventKind.REACH_STARTED, 0.0, 0.0))
+    feed(m, Event(EventKind.REACH_STARTED, 0.0, 0.0))
     assert m.target(GazeContext(0.8, points(0.8), tracking_end=1.0)).kind == "hand"
-    m.handle(Event(EventKind.RETREAT_STARTED, 1.0, 1.0))
+    feed(m, Event(EventKind.RETREAT_STARTED, 1.0, 1.0))
     assert m.target(GazeContext(1.1, points(1.1), tracking_end=2.0)).kind == "hand"
     assert m.state == "retreat_hand"
 
@@ -210,17 +210,17 @@ def test_the_machine_reads_its_phase_only_from_the_handover_state():
 def test_a_new_reach_after_a_missed_handover_done_starts_a_new_handover():
     m = BehaviorMachine(SPECS["face-hand-face"])
     for kind, t in (("reach_started", 0.0), ("transfer_started", 1.0), ("retreat_started", 1.5)):
-        m.handle(Event(EventKind(kind), t, t))
-    m.handle(Event(EventKind.REACH_STARTED, 5.0, 5.0))
+        feed(m, Event(EventKind(kind), t, t))
+    feed(m, Event(EventKind.REACH_STARTED, 5.0, 5.0))
     assert m.phase is Phase.REACH
     assert m.target(GazeContext(5.1, points(5.1), tracking_end=6.0)).kind == "face"
 
 
 def test_garbage_events_are_ignored():
     m = BehaviorMachine(SPECS["hand"])
-    m.handle(Event("not-a-kind", 1.0, 1.0))  # type: ignore[arg-type]
-    m.handle(Event(EventKind.REACH_STARTED, math.nan, math.nan))
-    m.handle(Event(EventKind.ROBOT_REACH_STARTED, 1.0, 1.0, "oops"))  # type: ignore[arg-type]
+    feed(m, Event("not-a-kind", 1.0, 1.0))  # type: ignore[arg-type]
+    feed(m, Event(EventKind.REACH_STARTED, math.nan, math.nan))
+    feed(m, Event(EventKind.ROBOT_REACH_STARTED, 1.0, 1.0, "oops"))  # type: ignore[arg-type]
     # The malformed info is dropped; the robot's reach itself still starts the handover's reach.
     assert m.ignored == 2 and m.state == "reach_hand"
 
@@ -229,7 +229,7 @@ def test_unknown_named_target_falls_back_to_the_last_known_point(tmp_path):
     path = tmp_path / "shelf.yaml"
     path.write_text("segments:\n  - {phase: reach, at: 0.0, target: shelf}\n", encoding="utf-8")
     m = BehaviorMachine(load_behavior(path))
-    m.handle(Event(EventKind.REACH_STARTED, 0.0, 0.0))
+    feed(m, Event(EventKind.REACH_STARTED, 0.0, 0.0))
     pts = points(0.1)
     target = m.target(GazeContext(0.1, pts, tracking_end=1.0))
     assert target.kind == "shelf"
@@ -242,11 +242,11 @@ def test_unknown_named_target_falls_back_to_the_last_known_point(tmp_path):
 
 def test_robot_events_of_the_previous_handover_do_not_leak_into_the_next():
     m = BehaviorMachine(SPECS["hand-face-as-studied"])
-    m.handle(Event(EventKind.REACH_STARTED, 0.0, 0.0))
-    m.handle(Event(EventKind.RETREAT_STARTED, 1.0, 1.0))
-    m.handle(Event(EventKind.HANDOVER_DONE, 2.0, 2.0))
-    m.handle(Event(EventKind.ROBOT_RETREAT_STARTED, 2.5, 2.5))  # late: the old handover's retreat
-    m.handle(Event(EventKind.ROBOT_REACH_STARTED, 4.9, 4.9, {"planned_duration": 1.0}))
-    m.handle(Event(EventKind.REACH_STARTED, 5.0, 5.0))
-    m.handle(Event(EventKind.RETREAT_STARTED, 6.0, 6.0))
+    feed(m, Event(EventKind.REACH_STARTED, 0.0, 0.0))
+    feed(m, Event(EventKind.RETREAT_STARTED, 1.0, 1.0))
+    feed(m, Event(EventKind.HANDOVER_DONE, 2.0, 2.0))
+    feed(m, Event(EventKind.ROBOT_RETREAT_STARTED, 2.5, 2.5))  # late: the old handover's retreat
+    feed(m, Event(EventKind.ROBOT_REACH_STARTED, 4.9, 4.9, {"planned_duration": 1.0}))
+    feed(m, Event(EventKind.REACH_STARTED, 5.0, 5.0))
+    feed(m, Event(EventKind.RETREAT_STARTED, 6.0, 6.0))
     assert m.target(GazeContext(6.1, points(6.1), tracking_end=7.0)).kind == "hand"

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from gazebot.core.handover import RULES, HandoverState
+from gazebot.core.handover import RULES, HandoverState, PhaseChange, apply_event
 from gazebot.core.types import Event, EventKind, Phase
 
 
@@ -168,3 +168,44 @@ def test_every_row_of_the_table_does_what_it_says(rule, source):
     change = s.apply(ev(rule.trigger.value, 2.0))
     assert change is not None and change.rule == rule
     assert (s.phase, s.phase_start, change.previous) == (rule.dest, 2.0, source)
+
+
+def test_entry_counts_the_phases_the_tracking_follows():
+    s = HandoverState()
+    first = s.entry
+    s.apply(ev("robot_reach_started", 1.0, planned_duration=1.0))
+    # A reach only the robot started: the tracking has not shown it (its reach is still due).
+    assert (s.phase, s.reach_tracked, s.entry) == (Phase.REACH, False, first)
+    s.apply(ev("reach_started", 1.2))  # the giver's joins it (later: the start stays)
+    assert (s.phase_start, s.reach_tracked, s.entry) == (1.0, True, first + 1)
+    s.apply(ev("robot_grasped", 2.0))
+    assert (s.phase, s.entry) == (Phase.TRANSFER, first + 2)
+    s.apply(ev("transfer_started", 1.9))  # stale: nothing entered
+    assert s.entry == first + 2
+
+
+class _Follower:
+    def __init__(self) -> None:
+        self.calls: list[tuple[str, object]] = []
+
+    def advance(self, t: float) -> None:
+        self.calls.append(("advance", t))
+
+    def on_phase(self, change: PhaseChange) -> None:
+        self.calls.append(("phase", change.phase))
+
+    def on_tracking(self, event: Event) -> None:
+        self.calls.append(("tracking", event.kind))
+
+
+def test_apply_event_lets_the_follower_catch_up_then_tells_it_the_change():
+    s, f = HandoverState(), _Follower()
+    assert apply_event(s, f, ev("reach_started", 1.0)) is not None
+    assert f.calls == [("advance", 1.0), ("phase", Phase.REACH)]
+    f.calls.clear()
+    assert apply_event(s, f, ev("tracking_lost", 1.5)) is None
+    assert f.calls == [("tracking", EventKind.TRACKING_LOST)] and s.phase is Phase.REACH
+    f.calls.clear()
+    assert apply_event(s, f, ev("reach_started", 0.5)) is None  # a duplicate: nothing to tell
+    assert apply_event(s, f, ev("robot_reach_ended", 1.6)) is None  # evidence, no phase change
+    assert f.calls == []

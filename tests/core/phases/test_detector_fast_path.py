@@ -1,10 +1,9 @@
-"""The online detector's fast path (fused signals computed only where new samples change
-them, the trigger's per-period rows in plain floats with running maxima and sums, samples kept
-in one array, no reach onsets dated during a reach) emits exactly the events and counts of the
-straightforward path it replaced (tests/core/phases/signals_reference.py,
-tests/core/phases/trigger_reference.py) on the synthetic set, the issue-20 cases, a long rest, and
-on
-noisy input with NaN, frozen, duplicate, out-of-order and timeless samples."""
+"""The online detector's incremental analysis (fused signals computed only where new samples
+change them, the trigger's per-period rows with running maxima and sums, samples kept in one
+array, no reach onsets dated during a reach) emits exactly the events and counts of the
+straightforward computation it replaced (tests/core/phases/signals_reference.py,
+tests/core/phases/trigger_reference.py) on the synthetic set, the issue-20 cases, a long rest,
+and on noisy input with NaN, frozen, duplicate, out-of-order and timeless samples."""
 
 from __future__ import annotations
 
@@ -197,10 +196,10 @@ def test_a_long_one_hand_loss_keeps_the_detector_bounded():
     memory where it was, and the tick that restores tracking stays an ordinary one."""
     import tracemalloc
 
-    from gazebot.core.phases.detector import PhaseDetector
+    from gazebot.core.phases.detector import OnlineDetector
     from gazebot.core.types import TrackingFrame
 
-    det = PhaseDetector(PhaseConfig())
+    det = OnlineDetector(PhaseConfig())
     rate, t = 120.0, 0.0
     lost = np.array([np.nan, np.nan, np.nan])
 

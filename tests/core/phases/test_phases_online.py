@@ -10,8 +10,8 @@ import pytest
 from phase_truth import PHASE_KINDS, event_errors
 
 from gazebot.core.phases import (
+    OnlineDetector,
     PhaseConfig,
-    PhaseDetector,
     Trajectory,
     run_online,
     segments_from_events,
@@ -107,7 +107,7 @@ def test_hands_resting_together_are_no_transfer_while_the_robot_has_not_grasped(
                 t, giver_hand=hand, receiver_hand=grip, gripper_closed=t >= 3.0, load_share=0.0
             )
         )
-    det = PhaseDetector()
+    det = OnlineDetector()
     events = [e for f in frames for e in det.update_all(f)]
     transfer = [e for e in events if e.kind is EventKind.TRANSFER_STARTED]
     assert len(transfer) == 1
@@ -116,7 +116,7 @@ def test_hands_resting_together_are_no_transfer_while_the_robot_has_not_grasped(
 
 def test_expected_phase_end_is_nan_when_idle_and_never_in_the_past():
     case = generate(2, SyntheticOptions(handovers=2))
-    det = PhaseDetector()
+    det = OnlineDetector()
     for f in _frames(case):
         det.update(f)
         if det.phase in (Phase.IDLE, Phase.DONE):
@@ -131,7 +131,7 @@ def test_expected_reach_end_predicts_contact_halfway_through(varied_set):
     for case in varied_set[:25]:
         h = case.truth[0]
         half = h.reach_start + 0.5 * (h.transfer_start - h.reach_start)
-        det = PhaseDetector()
+        det = OnlineDetector()
         for f in _frames(case):
             det.update(f)
             if f.t >= half and det.phase is Phase.REACH:
@@ -147,7 +147,7 @@ def test_expected_reach_end_predicts_contact_halfway_through(varied_set):
 
 
 def test_several_events_in_one_sample_are_queued():
-    det = PhaseDetector()
+    det = OnlineDetector()
     base = dict(giver_hand=[1.0, 0, 0], receiver_hand=[0.85, 0, 0])
     assert det.update(TrackingFrame.make(0.0, **base, gripper_closed=False)) is None
     # The robot grasps although no reach was seen: reach_started and transfer_started at once.
@@ -207,7 +207,7 @@ def test_duplicate_and_out_of_order_samples_are_ignored_and_counted():
             messy.append(frames[i - 3])  # late sample
     bad = replace(frames[5], t=math.nan)
     messy.insert(6, bad)
-    det_clean, det_messy = PhaseDetector(), PhaseDetector()
+    det_clean, det_messy = OnlineDetector(), OnlineDetector()
     clean = [e for f in frames for e in det_clean.update_all(f)]
     got = [e for f in messy for e in det_messy.update_all(f)]
     assert got == clean
@@ -230,7 +230,7 @@ def test_jittered_sampling_gives_the_same_events_as_regular():
 
 def test_second_handover_starts_a_new_reach():
     case = generate(12, SyntheticOptions(handovers=2, rate=100))
-    det = PhaseDetector()
+    det = OnlineDetector()
     seen = []
     for f in _frames(case):
         for e in det.update_all(f):
@@ -245,7 +245,7 @@ def test_resync_continues_from_the_adopted_phase():
     case = generate(4, SyntheticOptions(rate=100))
     h = case.truth[0]
     frames = _frames(case)
-    det = PhaseDetector()
+    det = OnlineDetector()
     known = Event(EventKind.TRANSFER_STARTED, h.transfer_start, h.transfer_start + 0.05)
     later = [f for f in frames if f.t > h.transfer_start + 0.1]
     # A restarted engine sees some frames, then learns the phase published before the restart.
@@ -260,31 +260,36 @@ def test_resync_continues_from_the_adopted_phase():
     assert abs(events[0].t - h.transfer_end) <= 0.2
 
 
-def test_resync_ignores_tracking_and_other_robot_events():
-    det = PhaseDetector()
+def test_resync_follows_the_one_handover_state():
+    det = OnlineDetector()
     det.resync(Event(EventKind.TRACKING_LOST, 1.0, 1.0))
-    det.resync(Event(EventKind.ROBOT_REACH_STARTED, 1.0, 1.0, {"planned_duration": 1.2}))
     assert det.phase is Phase.IDLE
+    det.resync(Event(EventKind.ROBOT_REACH_STARTED, 1.0, 1.0, {"planned_duration": 1.2}))
+    # The robot's reach is the state's; the tracking has not shown the giver's yet (no end).
+    assert det.phase is Phase.REACH and math.isnan(det.expected_phase_end)
     det.resync(Event(EventKind.ROBOT_GRASPED, 2.0, 2.0))
     assert det.phase is Phase.TRANSFER and det.phase_start == 2.0
+    assert det.expected_phase_end >= 2.0
 
 
 def test_resync_replay_counts_one_handover():
-    det = PhaseDetector()
+    det = OnlineDetector()
     for kind, t in [
         (EventKind.REACH_STARTED, 1.0),
         (EventKind.ROBOT_GRASPED, 2.1),
         (EventKind.TRANSFER_STARTED, 2.0),
     ]:
         det.resync(Event(kind, t, t))
-    assert det.handover == 0 and det.phase is Phase.TRANSFER and det.phase_start == 2.0
+    # The grasp started the transfer; the tracking's transfer start told after it is the
+    # current phase's (ignored by the handover state's rules).
+    assert det.handover == 0 and det.phase is Phase.TRANSFER and det.phase_start == 2.1
     det.resync(Event(EventKind.HANDOVER_DONE, 4.0, 4.0))
     det.resync(Event(EventKind.REACH_STARTED, 6.0, 6.0))
     assert det.handover == 1 and det.phase is Phase.REACH
 
 
 def test_release_seen_through_load_share():
-    det = PhaseDetector()
+    det = OnlineDetector()
     p = dict(giver_hand=[1.0, 0, 0], receiver_hand=[0.9, 0, 0])
     det.resync(Event(EventKind.TRANSFER_STARTED, 0.0, 0.0))
     assert det.update(TrackingFrame.make(0.01, **p, load_share=0.5)) is None
@@ -309,7 +314,7 @@ def test_config_is_used():
 
 
 def test_malformed_points_count_as_missing_and_numpy_flags_work():
-    det = PhaseDetector()
+    det = OnlineDetector()
     bad = TrackingFrame(0.0, giver_hand=[1.0, 0.0], receiver_hand=np.array([0.5, 0, 0]))
     assert det.update(bad) is None and det.stats.held == 1
     p = dict(giver_hand=[1.0, 0, 0], receiver_hand=[0.9, 0, 0])
@@ -320,7 +325,7 @@ def test_malformed_points_count_as_missing_and_numpy_flags_work():
 
 def test_retreat_adopted_by_resync_ends_when_the_hand_is_at_rest():
     # An engine restarted late in the retreat: the giver's hand is already back at rest.
-    det = PhaseDetector()
+    det = OnlineDetector()
     det.resync(Event(EventKind.RETREAT_STARTED, 1.0, 1.0))
     events = []
     for t in np.arange(1.5, 3.0, 0.01):
@@ -334,7 +339,7 @@ def test_retreat_adopted_by_resync_ends_when_the_hand_is_at_rest():
 def test_release_seen_only_after_a_restart_still_ends_the_handover_at_rest():
     # Restarted in the transfer; the first sample already says the robot holds the object
     # alone and the giver's hand is nearly back at rest.
-    det = PhaseDetector()
+    det = OnlineDetector()
     det.resync(Event(EventKind.TRANSFER_STARTED, 3.0, 3.0))
     events = []
     for t in np.arange(4.0, 6.0, 0.01):

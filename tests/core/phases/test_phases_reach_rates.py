@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from gazebot.core.minimum_jerk import minimum_jerk
-from gazebot.core.phases import PhaseConfig, PhaseDetector, Trajectory, run_online
+from gazebot.core.phases import OnlineDetector, PhaseConfig, Trajectory, run_online
 from gazebot.core.phases.synthetic import rest_recording, synthetic_set
 from gazebot.core.types import EventKind
 
@@ -31,7 +31,7 @@ def _motions(rate: float, seconds: float, seed: int):
 def test_the_detector_decides_once_per_online_period_at_any_rate(rate):
     c = PhaseConfig()
     traj = rest_recording(rate, 0.002, 10.0, seed=1, jitter=0.0)
-    det = PhaseDetector(c)
+    det = OnlineDetector(c)
     for f in traj.frames():
         det.update(f)
     span = float(traj.t[-1] - traj.t[0])

@@ -1,4 +1,4 @@
-"""The engine's command filled without the dataclass ``__init__`` is a complete GazeCommand, and
+"""The engine's command is a complete GazeCommand, and
 the loop's one-pass safety check refuses exactly what ``GazeCommand.is_finite`` and the limits
 refuse."""
 
@@ -12,7 +12,7 @@ import pytest
 
 from gazebot import GazeEngine
 from gazebot.core.runtime import GazeLoop
-from gazebot.core.types import GazeCommand, GazeTarget, Phase, TrackingFrame, filled, from_fields
+from gazebot.core.types import GazeCommand, Phase, TrackingFrame
 
 
 def _frames(n: int = 60):
@@ -65,18 +65,3 @@ def test_the_loop_refuses_any_non_finite_value_is_finite_would(field, bad):
     unsafe = loop.unsafe
     assert loop.tick(TrackingFrame(t=2.0)) is None
     assert loop.unsafe == unsafe + 1
-
-
-def test_filled_refuses_a_fields_dict_and_keywords_together():
-    # (one of them would be dropped silently)
-    with pytest.raises(TypeError, match="not both"):
-        filled(GazeCommand, {"t": 0.0}, t=1.0)
-
-
-def test_from_fields_builds_the_value_the_constructor_builds():
-    point = np.array([1.0, 0.0, 1.5])
-    made = from_fields(GazeTarget, {"kind": "face", "point": point})
-    assert type(made) is GazeTarget
-    assert vars(made) == vars(GazeTarget("face", point))
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        made.kind = "hand"  # type: ignore[misc]
