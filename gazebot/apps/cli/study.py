@@ -478,10 +478,13 @@ def _serve(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from gazebot.apps.study.export import export_responses
+    from gazebot.apps.study.export import export_responses, participants_file
+    from gazebot.apps.study.study_file import STUDY_FILE
 
     out, n = export_responses(args.dir, args.out, args.include_practice)
     print(f"wrote {n} answered sessions to {out}")
+    if (args.dir / STUDY_FILE).is_file():  # a study file's study: its per-participant answers
+        print(f"wrote each participant's answers to {participants_file(out)}")
     return 0
 
 

@@ -26,11 +26,25 @@ Tables:
   live handover of an in-person session (s, the human's reach start minus the robot's; NULL: not
   measured), entered by the experimenter with the session's answers.
 
+A study file (:mod:`gazebot.apps.study.study_file`) adds:
+
+- ``items(participant, page, item, value, submitted_at)``: every answer to a study file's items
+  (Likert, free text, choice, number, attention check), ``page`` being a page's id or
+  ``session-K`` for the items asked after session ``K``; values are text as given.
+- ``pages(participant, page, submitted_at)``: the study file's pages a participant has done.
+- ``attention(participant, page, item, given, expected, at)``: each failed attention check.
+- ``entries(participant, external_id, at)``: the participants the public entry link assigned,
+  with the recruiting service's participant id (one plan row per external id).
+
+The file and its ``-wal``/``-shm`` hold every participant's link token and the CSRF key: they are
+readable by their owner only (0600).
+
 Times are UTC seconds since the epoch (floats).
 """
 
 from __future__ import annotations
 
+import os
 import secrets
 import sqlite3
 import threading
@@ -91,7 +105,36 @@ CREATE TABLE IF NOT EXISTS reach_starts (
     second_s REAL,
     PRIMARY KEY (participant, session)
 );
+CREATE TABLE IF NOT EXISTS items (
+    participant INTEGER NOT NULL,
+    page TEXT NOT NULL,
+    item TEXT NOT NULL,
+    value TEXT NOT NULL,
+    submitted_at REAL NOT NULL,
+    PRIMARY KEY (participant, page, item)
+);
+CREATE TABLE IF NOT EXISTS pages (
+    participant INTEGER NOT NULL,
+    page TEXT NOT NULL,
+    submitted_at REAL NOT NULL,
+    PRIMARY KEY (participant, page)
+);
+CREATE TABLE IF NOT EXISTS attention (
+    participant INTEGER NOT NULL,
+    page TEXT NOT NULL,
+    item TEXT NOT NULL,
+    given TEXT NOT NULL,
+    expected TEXT NOT NULL,
+    at REAL NOT NULL,
+    PRIMARY KEY (participant, page, item)
+);
+CREATE TABLE IF NOT EXISTS entries (
+    participant INTEGER PRIMARY KEY,
+    external_id TEXT NOT NULL UNIQUE,
+    at REAL NOT NULL
+);
 """
+PRIVATE_MODE = 0o600  # the answers file and SQLite's -wal and -shm beside it
 
 
 @dataclass(frozen=True)
@@ -123,6 +166,47 @@ class Progress:
     finished_at: float | None
     answered: tuple[int, ...]
     last_activity: float | None
+    pages: tuple[str, ...] = ()  # the study file's pages done
+    failed_items: tuple[str, ...] = ()  # the attention checks failed (item ids)
+
+
+@dataclass(frozen=True)
+class ItemAnswer:
+    """One answer to a study file's item: ``page`` is the page's id or ``session-K``."""
+
+    participant: int
+    page: str
+    item: str
+    value: str
+    submitted_at: float
+
+
+@dataclass(frozen=True)
+class AttentionFailure:
+    """An attention check answered otherwise than its required answer."""
+
+    participant: int
+    page: str
+    item: str
+    given: str
+    expected: str
+    at: float
+
+
+def _make_private(path: Path) -> None:
+    """Create ``path`` readable by its owner only, or tighten an existing one and its
+    ``-wal``/``-shm``. SQLite creates the ``-wal`` and ``-shm`` files with the database file's
+    permission bits, so a 0600 database gets 0600 companions whatever the umask."""
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, PRIVATE_MODE)
+    os.close(fd)
+    for p in (path, Path(f"{path}-wal"), Path(f"{path}-shm")):
+        if p.exists() and (p.stat().st_mode & 0o777) != PRIVATE_MODE:
+            os.chmod(p, PRIVATE_MODE)
+
+
+def session_page(session: int) -> str:
+    """The page name under which the study file's items of session ``session`` are stored."""
+    return f"session-{session}"
 
 
 class ResponseStore:
@@ -135,6 +219,7 @@ class ResponseStore:
         # Writers of this process take turns here: SQLite's own busy handler would put a
         # waiting writer to sleep for milliseconds; other processes still meet its lock.
         self._write_lock = threading.Lock()
+        _make_private(self.path)
         with self._connect() as con:
             con.execute("PRAGMA journal_mode=WAL")
             con.executescript(_SCHEMA)
@@ -210,11 +295,15 @@ class ResponseStore:
         mode: str = "video",
         last_session: int | None = None,
         now: float | None = None,
+        items: dict[str, str] | None = None,
+        failed: dict[str, tuple[str, str]] | None = None,
     ) -> bool:
         """Store one session's answers; ``True`` if stored now, ``False`` if that session was
         already answered (a double submit: the first answers stay). ``last_session``: the plan's
         last session, whose answer marks the participant finished. A participant answering in
-        another mode than their first step raises ``ValueError``."""
+        another mode than their first step raises ``ValueError``. ``items``: the study file's
+        items asked after the pair (item id -> value), stored under page ``session-K`` in the
+        same transaction; ``failed``: its attention checks failed (item -> (given, expected))."""
         values = [int(answers[q]) for q in QUESTION_KEYS]
         if any(v not in (1, 2) for v in values):
             raise ValueError(f"answers must be 1 or 2, got {answers}")
@@ -234,12 +323,109 @@ class ResponseStore:
                 (participant, session, *values, comment, mode, shown[0] if shown else None, now),
             )
             stored = cur.rowcount == 1
+            if stored:
+                self._put_items(con, participant, session_page(session), items, failed, now)
             if stored and last_session is not None and session == last_session:
                 con.execute(
                     "UPDATE participants SET finished_at = ? WHERE participant = ?",
                     (now, participant),
                 )
         return stored
+
+    @staticmethod
+    def _put_items(
+        con: sqlite3.Connection,
+        participant: int,
+        page: str,
+        items: dict[str, str] | None,
+        failed: dict[str, tuple[str, str]] | None,
+        now: float,
+    ) -> None:
+        for item, value in (items or {}).items():
+            con.execute(
+                "INSERT INTO items (participant, page, item, value, submitted_at) "
+                "VALUES (?, ?, ?, ?, ?) ON CONFLICT DO NOTHING",
+                (participant, page, item, str(value), now),
+            )
+        for item, (given, expected) in (failed or {}).items():
+            con.execute(
+                "INSERT INTO attention (participant, page, item, given, expected, at) "
+                "VALUES (?, ?, ?, ?, ?, ?) ON CONFLICT DO NOTHING",
+                (participant, page, item, given, expected, now),
+            )
+
+    def submit_page(
+        self,
+        participant: int,
+        page: str,
+        items: dict[str, str],
+        failed: dict[str, tuple[str, str]] | None = None,
+        now: float | None = None,
+    ) -> bool:
+        """Store the answers to one of the study file's pages (item id -> value) and its failed
+        attention checks, once: ``False`` if the page was already done (the first answers
+        stay). Needs the participant's consent (``ValueError`` without)."""
+        now = now or time.time()
+        with self._transaction() as con:
+            row = con.execute(
+                "SELECT consent_at FROM participants WHERE participant = ?", (participant,)
+            ).fetchone()
+            if row is None or row[0] is None:
+                raise ValueError(f"participant {participant} has not given consent")
+            cur = con.execute(
+                "INSERT INTO pages (participant, page, submitted_at) VALUES (?, ?, ?) "
+                "ON CONFLICT DO NOTHING",
+                (participant, page, now),
+            )
+            if cur.rowcount != 1:
+                return False
+            self._put_items(con, participant, page, items, failed, now)
+        return True
+
+    def assign_entry(
+        self, external_id: str, participants: list[int], now: float | None = None
+    ) -> int | None:
+        """The participant (plan row) of ``external_id``: the one it was given before, else the
+        first of ``participants`` (in order) nobody has taken (no entry, no step taken through
+        its own link), now recorded as this id's; ``None`` when every row is taken."""
+        with self._transaction() as con:
+            row = con.execute(
+                "SELECT participant FROM entries WHERE external_id = ?", (external_id,)
+            ).fetchone()
+            if row is not None:
+                return int(row[0])
+            taken = {r[0] for r in con.execute("SELECT participant FROM entries")}
+            taken |= {r[0] for r in con.execute("SELECT participant FROM participants")}
+            free = next((p for p in participants if p not in taken), None)
+            if free is not None:
+                con.execute(
+                    "INSERT INTO entries (participant, external_id, at) VALUES (?, ?, ?)",
+                    (free, external_id, now or time.time()),
+                )
+        return free
+
+    def external_ids(self) -> dict[int, str]:
+        """The recruiting service's id of each participant the entry link assigned."""
+        with self._connect() as con:
+            return dict(con.execute("SELECT participant, external_id FROM entries").fetchall())
+
+    def item_answers(self) -> list[ItemAnswer]:
+        """Every answer to a study file's item, by participant, page and item."""
+        with self._connect() as con:
+            rows = con.execute(
+                "SELECT participant, page, item, value, submitted_at FROM items "
+                "ORDER BY participant, page, item"
+            ).fetchall()
+        return [ItemAnswer(*r) for r in rows]
+
+    def attention_failures(self) -> list[AttentionFailure]:
+        """Every failed attention check, by participant and time."""
+        with self._connect() as con:
+            rows = con.execute(
+                "SELECT participant, page, item, given, expected, at FROM attention "
+                "ORDER BY participant, at, page, item"
+            ).fetchall()
+        return [AttentionFailure(*r) for r in rows]
 
     def links(self, participants: list[int], nbytes: int = 18) -> dict[int, str]:
         """Each participant's link token, a random one made (``nbytes`` random bytes) for a
@@ -277,8 +463,16 @@ class ResponseStore:
                 "SELECT session, submitted_at FROM answers WHERE participant = ? ORDER BY session",
                 (participant,),
             ).fetchall()
+            pages = con.execute(
+                "SELECT page, submitted_at FROM pages WHERE participant = ? ORDER BY submitted_at",
+                (participant,),
+            ).fetchall()
+            failed = con.execute(
+                "SELECT item FROM attention WHERE participant = ? ORDER BY at", (participant,)
+            ).fetchall()
         mode, consent, instr, finished = row if row else (None, None, None, None)
-        times = [t for t in (consent, instr, *(t for _, t in sessions)) if t is not None]
+        done = [t for _, t in sessions] + [t for _, t in pages]
+        times = [t for t in (consent, instr, *done) if t is not None]
         return Progress(
             participant=participant,
             mode=mode,
@@ -287,6 +481,8 @@ class ResponseStore:
             finished_at=finished,
             answered=tuple(s for s, _ in sessions),
             last_activity=max(times) if times else None,
+            pages=tuple(p for p, _ in pages),
+            failed_items=tuple(r[0] for r in failed),
         )
 
     def all_progress(self) -> list[Progress]:

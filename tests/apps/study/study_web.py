@@ -26,11 +26,13 @@ from gazebot.apps.study.video_times import VideoTimes, write_video_times
 REPO = Path(__file__).resolve().parents[3]
 
 
-def render_tiny_study(out: Path, behaviors=("face", "hand", "short-face-hand"), participants=6):
+def render_tiny_study(
+    out: Path, behaviors=("face", "hand", "short-face-hand"), participants=6, duration=0.4
+):
     """A rendered 6.3-style study (no condition): g (g - 1) sessions per participant, each
-    handover a 0.4 s synthetic clip at 64x48."""
+    handover a ``duration`` s (0.4 s) synthetic clip at 64x48."""
     plan = make_plan(list(behaviors), condition=None, participants=participants, seed=1)
-    fn = functools.partial(timed_synthetic_video, duration=0.4)
+    fn = functools.partial(timed_synthetic_video, duration=duration)
     render_study(plan, out, fn, 64, 48, 10, workers=1, card_seconds=0.1, progress=False)
     return plan
 

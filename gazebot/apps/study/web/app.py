@@ -13,6 +13,15 @@ head or the eyes, as the seed's captions did); the five questions are enabled on
 played to the end, and all five are required (the comment is optional, as the seed's question 6
 says).
 
+A study file (``DIR/study.yaml``, :mod:`gazebot.apps.study.study_file`) adds pages of items
+before the instructions and after the last session, items after every pair, attention checks, a
+public entry link ``/start?PARAM=ID`` for recruiting services and a completion code or redirect;
+without it the study is the seed's.
+
+The videos have no browser controls: a Play button below the video starts it (and resumes it
+if the browser paused it), a bar shows the position, and any seek (a script setting
+``currentTime``, a key) is undone, so a participant sees each handover whole and in order.
+
 The experimenter's pages under ``/admin`` (after signing in with the admin token; from the
 loopback interface without it only when ``local_admin`` is asked for) show every participant's
 progress and link and let the experimenter enter an in-person participant's answers after each
@@ -22,6 +31,7 @@ live pair, the plan telling which behavior comes first.
 from __future__ import annotations
 
 import ipaddress
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -45,11 +55,14 @@ from gazebot.apps.study.in_person import FAMILIARITY_QUESTION
 from gazebot.apps.study.plan import Session
 from gazebot.apps.study.questionnaire import (
     COMMENT_QUESTION,
+    QUESTIONS,
     attention_caption,
     instructions,
     questions,
 )
 from gazebot.apps.study.store import Progress, ResponseStore
+from gazebot.apps.study.study_file import DEFAULT, StudyFile, study_file_of
+from gazebot.apps.study.web.items import parse_items
 from gazebot.apps.study.web.security import (
     ADMIN_SESSION_MAX_AGE_S,
     LOOPBACK_HOSTS,
@@ -76,32 +89,52 @@ DEFAULT_CONSENT = (
 )
 MAX_COMMENT = 4000  # characters kept of a comment
 MAX_REACH_START_S = 60.0  # a measured reach-start time beyond +-this is a typo, not a handover
+ENTRY_PATH = "/start"  # the study file's public entry link
+EXTERNAL_ID_RE = re.compile(r"[A-Za-z0-9_.:-]{1,128}")  # a recruiting service's participant id
 
 
 @dataclass(frozen=True)
 class Step:
-    """Where a participant is: ``kind`` is ``consent``, ``instructions``, ``session`` (with
-    ``session``: 0 for the practice, else the plan's session number) or ``done``."""
+    """Where a participant is: ``kind`` is ``consent``, ``page`` (a study file's page, with
+    ``page``: its id), ``instructions``, ``session`` (with ``session``: 0 for the practice, else
+    the plan's session number), ``done`` or ``ended`` (an attention check ended the study)."""
 
     kind: str
     session: int | None = None
+    page: str | None = None
 
 
 def current_step(
-    study: StudyFolder, store: ResponseStore, participant: int, prog: Progress | None = None
+    study: StudyFolder,
+    store: ResponseStore,
+    participant: int,
+    prog: Progress | None = None,
+    study_file: StudyFile = DEFAULT,
 ) -> Step:
-    """The participant's next step, from the stored progress only (``prog``: already read)."""
+    """The participant's next step, from the stored progress only (``prog``: already read):
+    consent, the study file's ``before`` pages, instructions, the practice and the plan's
+    sessions, its ``after`` pages, done."""
     prog = prog or store.progress(participant)
     if prog.consent_at is None:
         return Step("consent")
+    if study_file.ends_on(prog.failed_items):
+        return Step("ended")
+    in_person = prog.mode == "in-person"  # the experimenter enters the sessions' answers only
+    pages_done = set(prog.pages)
+    for page in [] if in_person else study_file.pages_at("before"):
+        if page.id not in pages_done:
+            return Step("page", page=page.id)
     if prog.instructions_at is None:
         return Step("instructions")
     done = set(prog.answered)
     # In person the experimenter enters the plan's sessions only: there is no practice to wait for.
-    practice = [] if prog.mode == "in-person" else [PRACTICE]
+    practice = [] if in_person else [PRACTICE]
     for k in practice + [s.session for s in study.sessions_of(participant)]:
         if k not in done:
             return Step("session", k)
+    for page in [] if in_person else study_file.pages_at("after"):
+        if page.id not in pages_done:
+            return Step("page", page=page.id)
     return Step("done")
 
 
@@ -126,6 +159,8 @@ def _step_label(prog: Progress, step: Step) -> str:
         return "not started"
     if step.kind == "session":
         return "practice" if step.session == PRACTICE else f"session {step.session}"
+    if step.kind == "page":
+        return f"page {step.page}"
     return step.kind
 
 
@@ -138,6 +173,7 @@ class StudyWeb:
     store: ResponseStore
     links: dict[int, str]
     csrf_key: bytes
+    study_file: StudyFile = DEFAULT
 
     def link_path(self, participant: int) -> str:
         """``/p/TOKEN`` of a participant."""
@@ -166,10 +202,13 @@ def create_app(
     ``allowed_hosts``: the names a request's ``Host`` may give (an IP address is always
     accepted, see :func:`~gazebot.apps.study.web.security.host_allowed`), anything else is 400;
     ``admin_session_s``: how long a sign-in lasts (then the token is asked again); ``clock``:
-    the Unix time in s."""
+    the Unix time in s. A study file ``study_dir/study.yaml`` that is not valid raises
+    :class:`~gazebot.core.config.ConfigError` naming its line and field."""
     study = load_study(study_dir)
+    sf = study_file_of(study.root)
     store = study.store()
-    web = StudyWeb(study, store, store.links(study.participants), store.secret("csrf"))
+    web = StudyWeb(study, store, store.links(study.participants), store.secret("csrf"), sf)
+    pages = {pg.id: pg for pg in sf.pages}
     by_token = {t: p for p, t in web.links.items()}
     app = Flask(__name__)
     app.config["ADMIN_TOKEN"] = admin_token or new_token(16)
@@ -316,9 +355,36 @@ def create_app(
             caption=attention_caption(study.gaze_mode),
             questions=questions("video"),
             comment_question=COMMENT_QUESTION,
+            items=sf.session_items,
             errors=errors or [],
             values=values or {},
         )
+
+    def items_page(token: str, page_id: str, errors=None, values=None):
+        return page(
+            "page.html",
+            400 if errors else 200,
+            link=f"/p/{token}",
+            page=pages[page_id],
+            errors=errors or [],
+            values=values or {},
+        )
+
+    def end_page(screened_out: bool):
+        """The closing page: the completion code (or the screen-out one) shown, or with a
+        redirect URL the browser sent there with the code."""
+        c = sf.completion
+        url = c.url(screened_out)
+        if url is not None:
+            return redirect(url, 303)
+        code = c.screen_out_code if screened_out else c.code
+        reached = (
+            "Your answer to a check question ended the study here"
+            if screened_out
+            else "You have completed all the sessions"
+        )
+        message = f"{reached}; your answers are saved. You can close this page."
+        return page("message.html", title="Thank you", message=message, code=code)
 
     @app.get("/")
     def index():
@@ -341,7 +407,7 @@ def create_app(
         prog = store.progress(participant)
         if prog.mode == "in-person":
             return in_person_page(participant)
-        step = current_step(study, store, participant, prog)
+        step = current_step(study, store, participant, prog, sf)
         link = f"/p/{token}"
         if step.kind == "consent":
             return page("consent.html", link=link, paragraphs=consent_paragraphs)
@@ -352,6 +418,12 @@ def create_app(
                 text=instructions(study.gaze_mode),
                 total=n_sessions[participant],
             )
+        if step.kind == "page":
+            return items_page(token, step.page or "")
+        if step.kind == "ended":
+            return end_page(screened_out=True)
+        if step.kind == "done" and (sf.completion.code or sf.completion.redirect_url):
+            return end_page(screened_out=False)
         if step.kind == "done":
             return page(
                 "message.html",
@@ -381,8 +453,63 @@ def create_app(
 
     @app.post("/p/<token>/instructions")
     def instructions_read(token: str):
-        store.read_instructions(participant_of(token))
+        participant = participant_of(token)
+        # The instructions come after the study file's "before" pages: not before they are done.
+        if current_step(study, store, participant, None, sf).kind == "instructions":
+            store.read_instructions(participant)
         return to_page(token)
+
+    def not_this_step(token: str):
+        return page(
+            "message.html",
+            409,
+            title="Not this step yet",
+            message="This is not your current step.",
+            link=url_for("participant_page", token=token),
+        )
+
+    @app.post("/p/<token>/page/<page_id>")
+    def submit_page(token: str, page_id: str):
+        participant = participant_of(token)
+        prog = store.progress(participant)
+        if prog.mode == "in-person":
+            return in_person_page(participant)
+        if page_id in prog.pages:  # a double submit or a resent form: already stored, go on
+            return to_page(token)
+        step = current_step(study, store, participant, prog, sf)
+        if step.kind != "page" or step.page != page_id:
+            return not_this_step(token)
+        parsed = parse_items(pages[page_id].items, request.form)
+        if parsed.errors:
+            return items_page(token, page_id, parsed.errors, form_values())
+        store.submit_page(participant, page_id, parsed.values, parsed.failed)
+        return to_page(token)
+
+    if sf.entry is not None:
+        param = sf.entry.param
+
+        @app.get(ENTRY_PATH)
+        def entry():
+            """The public entry link: the next free plan row for a new external id, the same
+            row again for a known one."""
+            external = request.args.get(param, "").strip()
+            if not EXTERNAL_ID_RE.fullmatch(external):
+                return page(
+                    "message.html",
+                    400,
+                    title="Missing participant id",
+                    message=f"This link needs your participant id in its {param} parameter: "
+                    "open the study from the link the recruiting site gave you.",
+                )
+            participant = store.assign_entry(external, study.participants)
+            if participant is None:
+                return page(
+                    "message.html",
+                    409,
+                    title="The study is full",
+                    message="Every place in this study is taken. Thank you for your interest.",
+                )
+            return to_page(web.links[participant])
 
     def parse_answers(mode: str) -> tuple[dict[str, int], str, list[str]]:
         answers, errors = {}, []
@@ -406,7 +533,7 @@ def create_app(
             return in_person_page(participant)
         if k in prog.answered:  # a double submit or a resent form: already stored, go on
             return to_page(token)
-        step = current_step(study, store, participant, prog)
+        step = current_step(study, store, participant, prog, sf)
         if step.kind != "session" or step.session != k:
             return page(
                 "message.html",
@@ -416,9 +543,19 @@ def create_app(
                 link=url_for("participant_page", token=token),
             )
         answers, comment, errors = parse_answers("video")
-        if errors:
-            return session_page(participant, token, k, errors, form_values())
-        store.submit(participant, k, answers, comment, "video", last_session[participant])
+        extra = parse_items(sf.session_items, request.form, len(QUESTIONS) + 2)
+        if errors or extra.errors:
+            return session_page(participant, token, k, errors + extra.errors, form_values())
+        store.submit(
+            participant,
+            k,
+            answers,
+            comment,
+            "video",
+            last_session[participant],
+            items=extra.values,
+            failed=extra.failed,
+        )
         return to_page(token)
 
     @app.get("/p/<token>/video/<int:k>/<int:which>.mp4")
@@ -471,7 +608,7 @@ def create_app(
                     "mode": prog.mode or "",
                     "answered": len([k for k in prog.answered if k != PRACTICE]),
                     "total": n_sessions[p],
-                    "step": _step_label(prog, current_step(study, store, p, prog)),
+                    "step": _step_label(prog, current_step(study, store, p, prog, sf)),
                     "last": _utc(prog.last_activity),
                     "link": request.host_url.rstrip("/") + web.link_path(p),
                 }

@@ -1,13 +1,28 @@
-"""``gazebot study serve``: the study's Flask app on waitress, a production WSGI server."""
+"""``gazebot study serve``: the study's Flask app on waitress, a production WSGI server.
+
+Slow clients. waitress reads each request whole in its event loop before a worker thread sees
+it, so a connection that sends half a request (a "slowloris") holds no thread, only a socket.
+What it can exhaust is waitress's ``connection_limit`` (100 by default): with 100 such
+connections open waitress stops accepting, and every participant waits. So the server takes
+:class:`ConnectionLimits`: many more connections than one attacker's worth (1000 by default,
+watched with ``poll()``, since ``select()`` cannot watch a socket numbered 1024 or above), and
+a connection that sends nothing for ``channel_timeout_s`` is closed (checked every
+``cleanup_interval_s``). A determined attacker with thousands of connections still needs a
+reverse proxy in front (nginx's ``client_header_timeout`` and ``limit_conn``); see
+``docs/study-file.md``.
+"""
 
 from __future__ import annotations
 
 import csv
 import ipaddress
+import logging
 import os
 import re
+import resource
 import socket
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
@@ -20,6 +35,8 @@ from gazebot.apps.study.web.security import (
     new_token,
     rate_limit_logs,
 )
+
+log = logging.getLogger(__name__)
 
 LINKS_FILE = "participant-links.csv"
 ADMIN_TOKEN_FILE = "admin-token"  # written (mode 0600) when no token is given
@@ -117,6 +134,44 @@ def write_links(path: Path, base: str, links: dict[int, str]) -> None:
     os.chmod(path, 0o600)
 
 
+@dataclass(frozen=True)
+class ConnectionLimits:
+    """waitress's limits on client connections (see the module doc): ``connection_limit`` open
+    connections at most, an idle connection closed after ``channel_timeout_s`` (s) without a
+    byte, idle connections looked for every ``cleanup_interval_s`` (s)."""
+
+    connection_limit: int = 1000
+    channel_timeout_s: int = 20
+    cleanup_interval_s: int = 5
+
+    def waitress_options(self) -> dict[str, object]:
+        """The keyword arguments of ``waitress.create_server`` that set these limits."""
+        return {
+            "connection_limit": self.connection_limit,
+            "channel_timeout": self.channel_timeout_s,
+            "cleanup_interval": self.cleanup_interval_s,
+            "asyncore_use_poll": True,
+        }
+
+
+def raise_open_file_limit(wanted: int) -> int:
+    """Raise this process's soft limit on open files to ``wanted`` (at most the hard limit):
+    each connection is a file. Returns the soft limit now in force."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    target = wanted if hard == resource.RLIM_INFINITY else min(wanted, hard)
+    if soft != resource.RLIM_INFINITY and soft < target:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (target, hard))
+        soft = target
+    if soft != resource.RLIM_INFINITY and soft < wanted:
+        log.warning(
+            "only %d open files allowed (hard limit): fewer than the %d connections "
+            "the server accepts",
+            soft,
+            wanted,
+        )
+    return soft
+
+
 def serve(
     study_dir: str,
     host: str = "127.0.0.1",
@@ -126,13 +181,14 @@ def serve(
     out: TextIO | None = None,
     local_admin: bool = False,
     allowed_hosts: tuple[str, ...] = (),
+    limits: ConnectionLimits = ConnectionLimits(),
 ) -> None:
     """Serve the rendered study in ``study_dir`` until interrupted. Writes each participant's
     link to ``DIR/participant-links.csv`` and prints where the links and the admin token are
     once the socket listens (never the token itself); ``port`` 0 picks a free port. The admin
     token: see :func:`admin_token_source`; ``local_admin``: see
     :func:`~gazebot.apps.study.web.app.create_app`; ``allowed_hosts``: host names to answer to
-    besides :func:`served_host_names`."""
+    besides :func:`served_host_names`; ``limits``: on client connections (slow clients)."""
     from waitress import create_server
 
     out = out or sys.stdout
@@ -147,6 +203,8 @@ def serve(
         allowed_hosts=served_host_names(host, allowed_hosts),
     )
     rate_limit_logs()
+    # Room for every connection besides the study's files and the worker threads' own.
+    raise_open_file_limit(limits.connection_limit + 64 + threads)
     server = create_server(
         app,
         host=host,
@@ -154,6 +212,7 @@ def serve(
         threads=threads,
         ident="gazebot-study",
         max_request_body_size=MAX_BODY_BYTES,
+        **limits.waitress_options(),
     )
     base = base_url(host, server.effective_port)
     study = app.config["STUDY"]
