@@ -10,6 +10,7 @@ import signal
 import sys
 import threading
 from collections.abc import Iterator
+from typing import TYPE_CHECKING
 
 from gazebot.apps.cli.argtypes import positive, seed_value
 from gazebot.apps.cli.bus import (
@@ -19,6 +20,10 @@ from gazebot.apps.cli.bus import (
     robot_base_frame,
 )
 from gazebot.apps.cli.errors import robot_with_gaze_mode
+from gazebot.apps.cli.extras import extra_for
+
+if TYPE_CHECKING:
+    from gazebot.apps.render.eyes import LazyEyeRenderer
 
 
 class DeprecatedAlias(argparse.Action):
@@ -87,7 +92,6 @@ def handle(args: argparse.Namespace) -> int:
         standby=args.standby,
     )
     # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
-    from gazebot.apps.render import LazyEyeRenderer
     from gazebot.core.runtime import GazeLoop
 
     robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
@@ -104,7 +108,7 @@ def handle(args: argparse.Namespace) -> int:
         def warn(text: str) -> None:
             print(f"gazebot run: warning: {text} ({endpoints})", file=sys.stderr, flush=True)
 
-        eyes = None if args.no_eye_frames else LazyEyeRenderer(loop.robot.name)
+        eyes = None if args.no_eye_frames else _eye_renderer(loop.robot.name)
         node = EngineNode(loop, driver, node_cfg, warn=warn, eye_renderer=eyes)
         try:
             with _stop_on_sigterm() as stop:  # before saying it runs: SIGTERM from then on
@@ -136,6 +140,20 @@ def handle(args: argparse.Namespace) -> int:
         driver.close()
     print(json.dumps(summary) if args.json else "\n".join(f"{k}: {v}" for k, v in summary.items()))
     return 0
+
+
+def _eye_renderer(robot: str) -> LazyEyeRenderer | None:
+    """The robot's eye renderer, or ``None`` (a note on stderr) on an install without the
+    ``render`` extra: the node then publishes eye state but no eye frames."""
+    try:
+        from gazebot.apps.render.eyes import LazyEyeRenderer
+    except ModuleNotFoundError as exc:
+        if extra_for(exc.name) != "render":
+            raise
+        print("gazebot run: note: no eye frames (they need the [render] extra); eye state is "
+              "published", file=sys.stderr, flush=True)
+        return None
+    return LazyEyeRenderer(robot)
 
 
 @contextlib.contextmanager

@@ -1,0 +1,44 @@
+"""Which pip extra provides which missing package: ``pip install gazebot`` is the core install (the
+engine and the bus), every other command names the extra it needs instead of a traceback.
+
+The extras themselves (their packages and version ranges) are declared in ``pyproject.toml``;
+``tests/apps/cli/test_cli_extras.py`` checks that this table and that file agree.
+"""
+
+from __future__ import annotations
+
+#: Top-level import name of each package that only an extra installs -> that extra. Where a
+#: package is in several extras (the ``sim`` extra includes ``render``), the smallest one.
+EXTRA_OF_MODULE: dict[str, str] = {
+    "cv2": "render",
+    "pygame": "render",
+    "imageio": "render",
+    "imageio_ffmpeg": "render",
+    "matplotlib": "render",
+    "tqdm": "render",
+    "mujoco": "sim",
+    "cvxpy": "controllers",
+    "clarabel": "controllers",
+    "c3d": "recordings",
+    "openpyxl": "study",
+    "flask": "study",
+    "waitress": "study",
+    "jax": "gps",
+    "optax": "gps",
+    "sklearn": "gps",
+    "threadpoolctl": "gps",
+}
+
+
+def extra_for(module: str | None) -> str | None:
+    """The extra that installs ``module`` (a dotted name is looked up by its top level), or
+    ``None`` when no extra does (a missing core package or a bug: not ours to explain)."""
+    if not module:
+        return None
+    return EXTRA_OF_MODULE.get(module.partition(".")[0])
+
+
+def missing_extra_message(command: str, module: str, extra: str) -> str:
+    """One line: what is missing, which extra has it and the command that installs it."""
+    return (f"{command} needs the [{extra}] extra (no module {module!r}): "
+            f"pip install 'gazebot[{extra}]'")
