@@ -60,3 +60,38 @@ def bounded_memory():
         assert peak < limit_bytes, f"peak {peak / 1e6:.0f} MB over {limit_bytes / 1e6:.0f} MB"
 
     return limit
+
+
+# The core install (`make test-core`: no extras) runs the core and I/O tests; a test, or a test
+# module, that needs a package of an extra skips there with the extra's name instead of failing.
+# Only a package of an extra (gazebot.apps.cli.extras) counts: any other missing module still fails.
+def _needs_extra(text: str) -> str | None:
+    import re
+
+    from gazebot.apps.cli.extras import extra_for
+
+    match = re.search(r"No module named '([\w.]+)'", text)
+    extra = extra_for(match.group(1)) if match else None
+    return None if extra is None else f"needs the [{extra}] extra (no module {match.group(1)!r})"
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_make_collect_report(collector):
+    outcome = yield
+    report = outcome.get_result()
+    reason = _needs_extra(str(report.longrepr)) if report.failed else None
+    if reason is not None:
+        report.outcome = "skipped"
+        report.longrepr = (str(collector.path), 0, f"Skipped: {reason}")
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    report = outcome.get_result()
+    if report.failed and call.excinfo is not None and call.excinfo.errisinstance(
+            ModuleNotFoundError):
+        reason = _needs_extra(str(call.excinfo.value))
+        if reason is not None:
+            report.outcome = "skipped"
+            report.longrepr = (str(item.path), item.location[1] or 0, f"Skipped: {reason}")
