@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from tests.core.engine_stream import REFERENCE, run, scenarios
 
 ROUND_OFF = 1e-12

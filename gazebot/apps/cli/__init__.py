@@ -91,7 +91,8 @@ def main(argv: list[str] | None = None) -> int:
         extra = extra_for(exc.name)
         if extra is None:
             raise
-        print(f"gazebot: error: {missing_extra_message(command_name(parser, argv), exc.name, extra)}",
+        command = command_name(parser, argv)
+        print(f"gazebot: error: {missing_extra_message(command, exc.name, extra)}",
               file=sys.stderr)
         return 2
     except BrokenPipeError:

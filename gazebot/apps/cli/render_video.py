@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from gazebot.apps.cli.argtypes import seed_value
+from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, robot_with_gaze_mode
 
 
@@ -15,9 +16,9 @@ def register(kinds: argparse._SubParsersAction) -> None:
     parser = kinds.add_parser(
         "video", help="render a simulated handover to an MP4", description=__doc__
     )
-    parser.add_argument("--robot", default="sawyer", help="sawyer | jaco2 | robot YAML")
-    parser.add_argument("--behavior", required=True, help="gaze behavior name or YAML")
-    parser.add_argument("--scene", default="default", help="scene name or YAML (default: default)")
+    add_robot_argument(parser)
+    add_behavior_argument(parser, required=True)
+    add_scene_argument(parser)
     parser.add_argument(
         "--gaze-mode",
         default=None,

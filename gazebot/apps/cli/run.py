@@ -19,8 +19,10 @@ from gazebot.apps.cli.bus import (
     bus_config,
     robot_base_frame,
 )
+from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument
 from gazebot.apps.cli.errors import robot_with_gaze_mode
 from gazebot.apps.cli.extras import extra_for
+from gazebot.core.defaults import DEFAULT_BEHAVIOR
 
 if TYPE_CHECKING:
     from gazebot.apps.render.eyes import LazyEyeRenderer
@@ -44,8 +46,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "commands, eye state (rendered eye frames while someone subscribes), events and a "
         "heartbeat.",
     )
-    p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
-    p.add_argument("--behavior", default="face-hand-face", help="behavior name or YAML file")
+    add_robot_argument(p)
+    add_behavior_argument(p, default=DEFAULT_BEHAVIOR)
     p.add_argument(
         "--gaze-mode",
         default=None,

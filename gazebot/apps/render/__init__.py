@@ -1,6 +1,6 @@
 """Off-screen eye images for the robots' head screens.
 
-``EyeRenderer.for_robot("sawyer").render(eye_yaw, eye_pitch, blink, distance)`` returns an RGB
+``EyeRenderer.for_robot(DEFAULT_ROBOT).render(eye_yaw, eye_pitch, blink, distance)`` returns an RGB
 image.
 The blink that closes the lids comes from the runtime loop's
 :class:`~gazebot.core.runtime.blink.BlinkModel`.

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gazebot.apps.render.timeline import TickRecord
+from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 from gazebot.core.kinematics.config import RobotConfig
 from gazebot.core.runtime import GazeLoop
 from gazebot.core.types import Event, Phase
@@ -78,8 +79,8 @@ def expected_duration(sim) -> float:
 
 
 def record_handover(
-    robot: str | Path | RobotConfig = "sawyer",
-    behavior: str | Path = "face-hand-face",
+    robot: str | Path | RobotConfig = DEFAULT_ROBOT,
+    behavior: str | Path = DEFAULT_BEHAVIOR,
     scene: str | Path = "default",
     out_path: str | Path | None = None,
     seed: int = 0,

@@ -45,6 +45,7 @@ from gazebot.apps.sim.torque_arm import (
     is_torque_motor,
 )
 from gazebot.apps.sim.tracking import TrackingNoise
+from gazebot.core.defaults import DEFAULT_ROBOT
 from gazebot.core.kinematics.config import RobotConfig
 from gazebot.core.types import Event, EventKind, TrackingFrame
 
@@ -135,7 +136,7 @@ class HandoverSimulation:
 
     def __init__(
         self,
-        robot: str | Path | RobotConfig | SimRobot = "sawyer",
+        robot: str | Path | RobotConfig | SimRobot = DEFAULT_ROBOT,
         scene: str | Path | SceneConfig = "default",
         seed: int = 0,
         tracking_noise: TrackingNoiseConfig | None = None,

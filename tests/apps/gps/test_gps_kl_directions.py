@@ -171,9 +171,8 @@ def test_the_shipped_configuration_keeps_levine_et_als_directions():
 
 def test_the_seed_directions_inner_loop_sets_the_policy_covariance_from_kl_p_pi():
     pytest.importorskip("jax", reason="the global policy needs the optional extra gazebot[gps]")
-    from tests.apps.gps.test_gps_badmm import _config, _problem, _state
-
     from gazebot.apps.gps.badmm import inner_loop
+    from tests.apps.gps.test_gps_badmm import _config, _problem, _state
 
     cfg = _config(kl_directions="seed")
     Xs, dyns, expansions, ctrls = _problem()

@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests.core.phases.signals_reference import reference_signals
-from tests.core.phases.trigger_reference import ReferenceTrigger
 
 import gazebot.core.phases.methods.gazebot as gazebot_method
 from gazebot.core.phases.config import PhaseConfig
@@ -25,6 +23,8 @@ from gazebot.core.phases.synthetic import (
     synthetic_set,
 )
 from gazebot.core.phases.trajectory import Trajectory
+from tests.core.phases.signals_reference import reference_signals
+from tests.core.phases.trigger_reference import ReferenceTrigger
 
 
 def _damaged(traj: Trajectory, seed: int) -> Trajectory:

@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests.core.phases.signals_reference import reference_signals
 
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.filtering import compute_signals, gaussian_weights
 from gazebot.core.phases.synthetic import SyntheticOptions, generate, synthetic_set
 from gazebot.core.phases.trajectory import Trajectory
+from tests.core.phases.signals_reference import reference_signals
 
 
 def _assert_same(traj: Trajectory, config: PhaseConfig) -> None:
