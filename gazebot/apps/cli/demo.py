@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from gazebot.apps.cli.argtypes import seed_value
 from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, option_error, robot_with_gaze_mode
+from gazebot.apps.render.video_settings import VIDEO
 from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 
 if TYPE_CHECKING:
@@ -52,8 +53,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
     parser.add_argument("--seed", type=seed_value, default=0, help="random seed (default: 0)")
-    parser.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
-    parser.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
+    parser.add_argument("--width", type=int, default=VIDEO.width,
+                        help=f"video width, px (default: {VIDEO.width})")
+    parser.add_argument("--height", type=int, default=VIDEO.height,
+                        help=f"video height, px (default: {VIDEO.height})")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     parser.add_argument(
         "--no-inset",

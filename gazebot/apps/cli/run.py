@@ -23,6 +23,7 @@ from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument
 from gazebot.apps.cli.errors import robot_with_gaze_mode
 from gazebot.apps.cli.extras import extra_for
 from gazebot.core.defaults import DEFAULT_BEHAVIOR
+from gazebot.io.drivers.engine_node import EngineNodeConfig
 
 if TYPE_CHECKING:
     from gazebot.apps.render.eyes import LazyEyeRenderer
@@ -58,15 +59,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=seed_value, default=0, help="seed of behavior timings and blinks")
     p.add_argument("--duration", type=positive, default=None,
                    help="seconds to run (default: until Ctrl-C)")
-    p.add_argument("--silent-after", type=positive, default=0.15, metavar="S",
+    node = EngineNodeConfig()  # the node's defaults are the options' defaults
+    p.add_argument("--silent-after", type=positive, default=node.silence_after, metavar="S",
                    help="s without tracking before it counts as silent: the engine ticks "
                    "without samples, so the behavior's tracking-loss policy applies "
-                   "(default 0.15)")
+                   f"(default {node.silence_after:g})")
     # Deprecated spelling (one release): the same option as `gazebot display --silent-after`.
     p.add_argument("--silence-after", type=positive, dest="silent_after", metavar="S",
                    action=DeprecatedAlias, help=argparse.SUPPRESS)
-    p.add_argument("--no-robot-warning", type=positive, default=3.0, metavar="S",
-                   help="warn on stderr if no robot data arrived after S seconds (default 3)")
+    p.add_argument("--no-robot-warning", type=positive, default=node.no_robot_warning,
+                   metavar="S", help="warn on stderr if no robot data arrived after S seconds "
+                   f"(default {node.no_robot_warning:g})")
     p.add_argument("--no-resync", action="store_true",
                    help="do not catch up with a handover under way at start")
     p.add_argument("--standby", action="store_true",
@@ -83,7 +86,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
-    from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig, EngineRefused
+    from gazebot.io.drivers.engine_node import EngineNode, EngineRefused
     from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
 
     cfg = bus_config(args, listens_by_default=False, base_frame=robot_base_frame(args.robot))

@@ -18,6 +18,7 @@ from gazebot.apps.cli.bus import (
 )
 from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, robot_with_gaze_mode
+from gazebot.apps.render.video_settings import VIDEO
 from gazebot.core.defaults import DEFAULT_BEHAVIOR
 
 
@@ -61,7 +62,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 class PygameView:
     """A window showing the observer camera (needs a display)."""
 
-    def __init__(self, width: int = 640, height: int = 480) -> None:
+    def __init__(self, width: int = VIDEO.width, height: int = VIDEO.height) -> None:
         import os
 
         os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")

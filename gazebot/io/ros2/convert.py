@@ -26,6 +26,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 from rosbags.typesys.store import Typestore
 
+from gazebot.core.phases.trajectory import POINTS
 from gazebot.core.types import (
     PHASE_STREAM_KINDS,
     Event,
@@ -52,7 +53,7 @@ GRIPPER_STATE = "gazebot_msgs/msg/GripperState"
 LOAD_SHARE = "gazebot_msgs/msg/LoadShare"
 
 #: The tracked bodies of a :class:`~gazebot.core.types.TrackingFrame`, one topic (or TF frame) each.
-BODIES = ("giver_hand", "receiver_hand", "giver_face")
+BODIES = POINTS
 
 
 EventCategory = Literal["phase", "robot", "behavior", "fault", "node"]

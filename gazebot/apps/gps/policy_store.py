@@ -13,7 +13,7 @@ import numpy as np
 from gazebot.apps.gps.badmm import TrainResult
 from gazebot.apps.gps.config import GPSFileConfig
 from gazebot.apps.gps.policy import PolicyParams
-from gazebot.apps.gps.scene import DU
+from gazebot.apps.gps.reach_scene import DU
 from gazebot.apps.gps.state import DIMS, StateKind
 from gazebot.core.config import ConfigError, validate
 
