@@ -48,3 +48,14 @@ def test_the_embedding_example_runs_without_an_extra():
     )
     assert res.returncode == 0, res.stderr
     assert "look at hand" in res.stdout
+
+
+def test_the_wheels_copy_of_the_interface_package_names_its_types_as_the_repositorys(tmp_path):
+    import shutil
+
+    from gazebot.io.ros2.typestore import msgs_package_dir, read_msg_files
+
+    wheel_copy = tmp_path / "_gazebot_msgs"  # where pyproject.toml's force-include puts it
+    shutil.copytree(msgs_package_dir() / "msg", wheel_copy / "msg")
+    assert read_msg_files(wheel_copy) == read_msg_files(msgs_package_dir())
+    assert "gazebot_msgs/msg/HandoverEvent" in read_msg_files(wheel_copy)

@@ -11,7 +11,7 @@ import os
 import sys
 
 from gazebot.apps.cli.errors import UsageError
-from gazebot.apps.cli.extras import extra_for, missing_extra_message
+from gazebot.apps.cli.extras import extra_for_command, missing_extra_message
 from gazebot.core.config import ConfigError
 from gazebot.core.phases.trajectory import TrajectoryFormatError
 from gazebot.io.recordings import RecordingError
@@ -88,10 +88,10 @@ def main(argv: list[str] | None = None) -> int:
     except ModuleNotFoundError as exc:
         # A package of an extra the core install leaves out: say which extra, in one line.
         # A missing module of no extra is a broken install or a bug: it keeps its traceback.
-        extra = extra_for(exc.name)
+        command = command_name(parser, argv)
+        extra = extra_for_command(command.split()[1:], exc.name)
         if extra is None:
             raise
-        command = command_name(parser, argv)
         print(f"gazebot: error: {missing_extra_message(command, exc.name, extra)}",
               file=sys.stderr)
         return 2

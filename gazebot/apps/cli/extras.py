@@ -30,12 +30,37 @@ EXTRA_OF_MODULE: dict[str, str] = {
 }
 
 
+#: Commands that need a whole extra: the extra to name when any of its packages is missing, so
+#: that one install fixes the command (``gazebot sim`` needs OpenCV too, but ``[sim]`` includes
+#: ``[render]``). Keyed by the words after ``gazebot``; the longest match counts.
+EXTRA_OF_COMMAND: dict[str, str] = {
+    "sim": "sim",
+    "demo": "sim",
+    "render video": "sim",
+    "study": "study",
+    "annotations": "study",
+    "gps": "gps",
+}
+
+
 def extra_for(module: str | None) -> str | None:
     """The extra that installs ``module`` (a dotted name is looked up by its top level), or
     ``None`` when no extra does (a missing core package or a bug: not ours to explain)."""
     if not module:
         return None
     return EXTRA_OF_MODULE.get(module.partition(".")[0])
+
+
+def extra_for_command(words: list[str], module: str | None) -> str | None:
+    """The extra to name when ``module`` is missing in the command ``words`` (e.g. ``["render",
+    "video"]``): the command's own extra (:data:`EXTRA_OF_COMMAND`), else the module's; ``None``
+    when the module belongs to no extra."""
+    if extra_for(module) is None:
+        return None
+    for n in range(len(words), 0, -1):
+        if " ".join(words[:n]) in EXTRA_OF_COMMAND:
+            return EXTRA_OF_COMMAND[" ".join(words[:n])]
+    return extra_for(module)
 
 
 def missing_extra_message(command: str, module: str, extra: str) -> str:

@@ -10,8 +10,8 @@ import pytest
 
 import gazebot.apps.cli.ik as ik_command
 from gazebot.apps.cli import main
-from gazebot.apps.cli.extras import EXTRA_OF_MODULE, extra_for
-from tests.blocked_extras import REPO, gazebot_without_extras
+from gazebot.apps.cli.extras import EXTRA_OF_MODULE, extra_for, extra_for_command
+from tests.blocked_extras import REPO, gazebot_without_extras, run_without_extras
 
 
 def test_gps_train_without_the_gps_extra_names_it_in_one_line_and_exits_2(tmp_path):
@@ -28,6 +28,14 @@ def test_a_missing_module_of_an_extra_is_mapped_by_its_top_level_name():
     assert extra_for("sklearn.mixture") == "gps"
     assert extra_for("numpy") is None
     assert extra_for(None) is None
+
+
+def test_a_command_that_needs_a_whole_extra_names_it_whichever_package_is_missing_first():
+    assert extra_for_command(["sim"], "cv2") == "sim"  # [sim] includes [render]
+    assert extra_for_command(["render", "video"], "cv2") == "sim"
+    assert extra_for_command(["render", "eyes"], "cv2") == "render"
+    assert extra_for_command(["gps", "demo"], "mujoco") == "gps"
+    assert extra_for_command(["sim"], "gazebot_typo") is None
 
 
 def test_a_missing_module_of_no_extra_keeps_its_traceback(monkeypatch):
@@ -65,3 +73,23 @@ def test_the_table_of_extras_agrees_with_pyproject():
             except md.PackageNotFoundError:
                 continue  # not installed here: its import name cannot be looked up
             assert dist in mapped, f"{dist} of the [{extra}] extra has no entry in EXTRA_OF_MODULE"
+
+
+def test_demo_without_mujoco_names_the_sim_extra_not_a_gl_package(tmp_path):
+    # Without MUJOCO_GL set, the demo would otherwise probe for a GL back end first.
+    env_cleared = "import os\nos.environ.pop('MUJOCO_GL', None)\n"
+    res = run_without_extras(env_cleared + "from gazebot.apps.cli import main\n"
+                             f"raise SystemExit(main(['demo', '--out', {str(tmp_path)!r}]))\n")
+    assert res.returncode == 2, res.stderr
+    assert res.stderr.startswith("gazebot: error: gazebot demo needs the [sim] extra")
+    assert res.stderr.count("\n") == 1
+
+
+def test_every_command_of_the_table_exists_and_its_extra_is_declared():
+    from gazebot.apps.cli import build_parser, command_name
+    from gazebot.apps.cli.extras import EXTRA_OF_COMMAND
+
+    parser = build_parser()
+    for words, extra in EXTRA_OF_COMMAND.items():
+        assert command_name(parser, words.split()) == f"gazebot {words}"
+        assert extra in set(EXTRA_OF_MODULE.values())
