@@ -73,14 +73,15 @@ def _needs_extra(text: str) -> str | None:
 
     from gazebot.apps.cli.extras import extra_for
 
-    match = re.search(r"No module named '([\w.]+)'", text) or re.search(
-        r"needs the \[\w+\] extra \(no module '([\w.]+)'\)", text)
-    if match is None or extra_for(match.group(1)) is None:
+    said = re.search(r"needs the \[(\w+)\] extra \(no module '([\w.]+)'\)", text)
+    raised = re.search(r"No module named '([\w.]+)'", text)
+    module = said.group(2) if said else raised.group(1) if raised else None
+    if module is None or extra_for(module) is None:
         return None
-    module = match.group(1)
     if importlib.util.find_spec(module.partition(".")[0]) is not None:
         return None  # installed here: the failure is real (e.g. a test of that very message)
-    return f"needs the [{extra_for(module)}] extra (no module {module!r})"
+    extra = said.group(1) if said else extra_for(module)
+    return f"needs the [{extra}] extra (no module {module!r})"
 
 
 @pytest.hookimpl(hookwrapper=True)
