@@ -115,7 +115,7 @@ bench: $(TEST_STAMP)
 # the types of core and io (mypy, configured in pyproject.toml).
 lint: $(LINT_STAMP)
 	$(VENV)/bin/ruff check gazebot tests benchmarks examples
-	$(VENV)/bin/lint-imports
+	$(VENV)/bin/lint-imports --no-logo
 	$(VENV)/bin/mypy
 
 clean:
