@@ -1,4 +1,7 @@
-# The two commands a new user runs: `make demo` and `make test`. Each sets up .venv itself.
+# The two commands a new user runs: `make demo` and `make test`. Each sets up .venv itself, with
+# every extra (`pip install -e ".[all]"`; `make test` adds the test and lint tools). `make
+# test-core` tests the core install alone (no extra: what `pip install gazebot` gives a robot
+# stack) in .venv-core.
 # pyproject.toml declares version ranges; make installs the exact versions of the lock
 # constraints.txt (resolved on Python 3.11; on Python 3.10, where NumPy 2.4 and SciPy 1.17 do not
 # install, the lowest allowed versions that CI tests there). `make test-lowest` runs the suite on
@@ -14,28 +17,50 @@ LOCK := $(if $(filter 3.10,$(shell $(PYTHON) -c 'import sys; print("%d.%d" % sys
 	2>/dev/null)),$(LOWEST),constraints.txt)
 LOW_VENV := .venv-lowest
 LOW_STAMP := $(LOW_VENV)/.installed-test
+# The lowest-versions run installs every extra but gps (constraints-lowest.txt has no bounds for
+# JAX and scikit-learn).
+LOW_EXTRAS := render,sim,controllers,recordings,study,test
+CORE_VENV := .venv-core
+CORE_STAMP := $(CORE_VENV)/.installed-test
+# The core install's tests: the core and I/O layers (a test that needs an extra skips, naming it:
+# tests/conftest.py), the examples, and the checks that nothing of an extra is imported.
+CORE_TESTS := tests/core tests/io tests/test_core_install.py tests/test_examples.py \
+	tests/apps/cli/test_cli_extras.py
+LINT_STAMP := $(VENV)/.installed-lint
 # The lowest supported Python: python3.10 on PATH, else pyenv's 3.10, else $(PYTHON).
 PYTHON_LOWEST ?= $(shell for p in python3.10 $$HOME/.pyenv/versions/3.10*/bin/python3.10; do \
 	"$$p" -c "" >/dev/null 2>&1 && { echo "$$p"; exit 0; }; done; echo $(PYTHON))
 
-.PHONY: demo test test-lowest bench lint lock lock-upgrade check-gl browser-deps clean
+.PHONY: demo test test-lowest test-core bench lint lock lock-upgrade check-gl browser-deps clean
 
 $(STAMP): pyproject.toml $(LOCK)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c $(LOCK) -e .
+	$(PY) -m pip install --quiet -c $(LOCK) -e ".[all]"
 	touch $@
 
 $(TEST_STAMP): $(STAMP) pyproject.toml $(LOCK)
-	$(PY) -m pip install --quiet -c $(LOCK) -e ".[test,gps]"
+	$(PY) -m pip install --quiet -c $(LOCK) -e ".[all,test,lint]"
+	touch $@
+
+$(LINT_STAMP): $(STAMP) pyproject.toml $(LOCK)
+	$(PY) -m pip install --quiet -c $(LOCK) -e ".[lint]"
 	touch $@
 
 $(LOW_STAMP): pyproject.toml $(LOWEST)
 	rm -rf $(LOW_VENV)
 	$(PYTHON_LOWEST) -m venv $(LOW_VENV)
 	$(LOW_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(LOW_VENV)/bin/python -m pip install --quiet --prefer-binary -c $(LOWEST) -e ".[test]"
+	$(LOW_VENV)/bin/python -m pip install --quiet --prefer-binary -c $(LOWEST) -e ".[$(LOW_EXTRAS)]"
 	$(LOW_VENV)/bin/python -m pip check
+	touch $@
+
+$(CORE_STAMP): pyproject.toml $(LOWEST)
+	rm -rf $(CORE_VENV)
+	$(PYTHON_LOWEST) -m venv $(CORE_VENV)
+	$(CORE_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(CORE_VENV)/bin/python -m pip install --quiet --prefer-binary -c $(LOWEST) -e ".[test]"
+	$(CORE_VENV)/bin/python -m pip check
 	touch $@
 
 # Rewrite the lock from a scratch venv: `lock` keeps every locked version and resolves only what
@@ -46,7 +71,7 @@ lock lock-upgrade:
 	rm -rf .venv-lock
 	$(PYTHON) -m venv .venv-lock
 	.venv-lock/bin/python -m pip install --quiet --upgrade pip
-	.venv-lock/bin/python -m pip install --quiet $(if $(filter lock,$@),-c constraints.txt) ".[test,gps]"
+	.venv-lock/bin/python -m pip install --quiet $(if $(filter lock,$@),-c constraints.txt) ".[all,test,lint]"
 	{ sed -n '/^#/p;/^#/!q' constraints.txt; .venv-lock/bin/python -m pip freeze --exclude-editable \
 		| grep -v '^gazebot'; } > constraints.txt.new
 	mv constraints.txt.new constraints.txt
@@ -74,15 +99,24 @@ demo: $(STAMP) check-gl
 test: $(TEST_STAMP) check-gl browser-deps
 	$(PY) -m pytest
 
+# The lowest versions, with the extras and then the core install alone.
 test-lowest: $(LOW_STAMP) browser-deps
 	$(LOW_VENV)/bin/python -m gazebot.apps.render.gl_check
 	$(LOW_VENV)/bin/python -m pytest
+	$(MAKE) test-core
+
+test-core: $(CORE_STAMP)
+	$(CORE_VENV)/bin/python -m pytest $(CORE_TESTS)
 
 bench: $(TEST_STAMP)
 	$(PY) -m benchmarks
 
-lint: $(TEST_STAMP)
+# Style, the layers (import-linter's contracts in pyproject.toml: core < io < apps, no cycles) and
+# the types of core and io (mypy, configured in pyproject.toml).
+lint: $(LINT_STAMP)
 	$(VENV)/bin/ruff check gazebot tests benchmarks examples
+	$(VENV)/bin/lint-imports --no-logo
+	$(VENV)/bin/mypy
 
 clean:
-	rm -rf $(VENV) $(LOW_VENV) .venv-lock out .pytest_cache
+	rm -rf $(VENV) $(LOW_VENV) $(CORE_VENV) .venv-lock out .pytest_cache

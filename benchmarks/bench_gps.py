@@ -36,8 +36,8 @@ def run() -> list[Result]:
     from gazebot.apps.gps.badmm import train
     from gazebot.apps.gps.config import load_gps_config
     from gazebot.apps.gps.evaluate import evaluate
+    from gazebot.apps.gps.policy_store import load, save
     from gazebot.apps.gps.state import StateKind
-    from gazebot.apps.gps.store import load, save
 
     cfg = load_gps_config()
     out: list[Result] = []
@@ -82,9 +82,9 @@ def scene_transitions(trained, repeats: int = 3, samples: int = 5, seed: int = 0
     """Transitions (x_t, u_t, x_t+1) of the trained policy with its Gaussian action noise on each
     training target: ``repeats`` x ``samples`` trials per target, as the prior sees in training."""
     from gazebot.apps.gps.dynamics import transitions
-    from gazebot.apps.gps.rollout import run_trial
-    from gazebot.apps.gps.scene import HandoverScene
+    from gazebot.apps.gps.reach_scene import HandoverScene
     from gazebot.apps.gps.tester import motion_to
+    from gazebot.apps.gps.trial import run_trial
 
     rng = np.random.default_rng(seed)
     scene = HandoverScene(trained.cfg.scene)

@@ -1,7 +1,10 @@
 """gazebot: robot gaze behaviors for human-to-robot object handovers.
 
 Entry points: :class:`GazeEngine` (embed in a robot stack), the ``gazebot`` command line, and the
-packages ``phases``, ``behaviors``, ``kinematics``, ``render``, ``drivers``, ``sim`` and ``study``.
+layers :mod:`gazebot.core` (the engine), :mod:`gazebot.io` (the bus, recordings) and
+:mod:`gazebot.apps` (simulator, renderers, study, command line). ``pip install gazebot`` installs
+what the core and io need; the apps' extras (``gazebot[sim]``, ``[render]``, ``[study]``, ...) the
+rest, and a command whose extra is missing says which.
 """
 
 from __future__ import annotations

@@ -27,6 +27,7 @@ import numpy as np
 
 from gazebot.core.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
 from gazebot.core.config import ConfigError
+from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 from gazebot.core.handover import HandoverState, HandoverView, apply_event
 from gazebot.core.kinematics import (
     GazeController,
@@ -141,8 +142,8 @@ class GazeEngine:
     @classmethod
     def from_config(
         cls,
-        robot: str | Path | RobotConfig = "sawyer",
-        behavior: str | Path = "face-hand-face",
+        robot: str | Path | RobotConfig = DEFAULT_ROBOT,
+        behavior: str | Path = DEFAULT_BEHAVIOR,
         phases: str | Path | PhaseConfig | None = None,
         shifts: GazeShiftConfig | None = None,
         seed: int = 0,

@@ -34,7 +34,7 @@ _Array = TypeVar("_Array", bound=np.ndarray)
 def _clip_unit(s: float) -> float: ...
 @overload
 def _clip_unit(s: _Array) -> _Array: ...
-def _clip_unit(s):  # type: ignore[no-untyped-def]
+def _clip_unit(s: float | np.ndarray) -> float | np.ndarray:
     """``s`` clipped to ``[0, 1]`` (a NaN stays NaN)."""
     if isinstance(s, np.ndarray):
         return np.clip(s, 0.0, 1.0)
@@ -45,7 +45,7 @@ def _clip_unit(s):  # type: ignore[no-untyped-def]
 def minimum_jerk(s: float) -> float: ...
 @overload
 def minimum_jerk(s: _Array) -> _Array: ...
-def minimum_jerk(s):  # type: ignore[no-untyped-def]
+def minimum_jerk(s: float | np.ndarray) -> float | np.ndarray:
     """Position ``x(s) = s^3 (10 + s (-15 + 6 s))`` of the minimum-jerk move 0 -> 1 at
     normalised time ``s`` (clipped to ``[0, 1]``)."""
     s = _clip_unit(s)
@@ -56,7 +56,7 @@ def minimum_jerk(s):  # type: ignore[no-untyped-def]
 def minimum_jerk_rate(s: float) -> float: ...
 @overload
 def minimum_jerk_rate(s: _Array) -> _Array: ...
-def minimum_jerk_rate(s):  # type: ignore[no-untyped-def]
+def minimum_jerk_rate(s: float | np.ndarray) -> float | np.ndarray:
     """Rate ``dx/ds = 30 s^2 (1 - s)^2`` of :func:`minimum_jerk` (``s`` clipped to ``[0, 1]``;
     divide by the duration for a velocity)."""
     s = _clip_unit(s)

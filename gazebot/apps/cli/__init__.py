@@ -12,6 +12,7 @@ import sys
 
 from gazebot import __version__
 from gazebot.apps.cli.errors import UsageError
+from gazebot.apps.cli.extras import extra_for_command, missing_extra_message
 from gazebot.core.config import ConfigError
 from gazebot.io.recordings import RecordingError
 
@@ -68,12 +69,36 @@ def _plain(text: str | None) -> str | None:
     return None if text is None else text.replace("``", "")
 
 
+def command_name(parser: argparse.ArgumentParser, argv: list[str]) -> str:
+    """The (sub-)command ``argv`` runs, e.g. ``gazebot gps train``: its leading words that
+    name a sub-command, level by level."""
+    words = [parser.prog]
+    for token in argv:
+        subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+        if token.startswith("-") or not subs or token not in subs[0].choices:
+            break
+        words.append(token)
+        parser = subs[0].choices[token]
+    return " ".join(words)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     try:
         result = args.func(args)
         sys.stdout.flush()
+    except ModuleNotFoundError as exc:
+        # A package of an extra the core install leaves out: say which extra, in one line.
+        # A missing module of no extra is a broken install or a bug: it keeps its traceback.
+        command = command_name(parser, argv)
+        extra = extra_for_command(command.split()[1:], exc.name)
+        if extra is None:
+            raise
+        print(f"gazebot: error: {missing_extra_message(command, exc.name, extra)}",
+              file=sys.stderr)
+        return 2
     except BrokenPipeError:
         # The reader went away (e.g. `| head`): not an error of ours. Point stdout at devnull so
         # the interpreter's final flush does not complain again.

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from gazebot.apps.cli.argtypes import seed_value
+from gazebot.apps.cli.choices import add_behavior_argument
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -26,12 +27,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "replay", help="share of frames where a behavior's target matches the person's gaze"
     )
     p.add_argument("dir", type=Path, help="folder of the annotations")
-    p.add_argument(
-        "--behavior",
-        action="append",
-        required=True,
-        help="behavior name or YAML file (repeatable; 'all' = every available behavior)",
-    )
+    add_behavior_argument(p, action="append", required=True,
+                          what="behavior to replay, repeatable ('all': every one)")
     p.add_argument(
         "--role",
         choices=("receiver", "giver"),

@@ -13,7 +13,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gazebot.apps.cli.argtypes import seed_value
+from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, option_error, robot_with_gaze_mode
+from gazebot.apps.render.video_settings import VIDEO
+from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 
 if TYPE_CHECKING:
     from gazebot.core.kinematics.robot_config import RobotConfig
@@ -38,17 +41,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="simulate a handover with gaze and write a video, a timeline CSV and a plot",
         description=__doc__,
     )
-    parser.add_argument(
-        "--robot",
-        default=None,
-        help="robot name or YAML (default: panda with --controller gps, else sawyer)",
-    )
-    parser.add_argument(
-        "--behavior",
-        default="face-hand-face",
-        help="gaze behavior name or YAML (default: %(default)s)",
-    )
-    parser.add_argument("--scene", default="default", help="scene name or YAML (default: default)")
+    add_robot_argument(parser, default=None,
+                       default_help=f"panda with --controller gps, else {DEFAULT_ROBOT}")
+    add_behavior_argument(parser, default=DEFAULT_BEHAVIOR)
+    add_scene_argument(parser)
     parser.add_argument(
         "--gaze-mode",
         default=None,
@@ -57,8 +53,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
     parser.add_argument("--seed", type=seed_value, default=0, help="random seed (default: 0)")
-    parser.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
-    parser.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
+    parser.add_argument("--width", type=int, default=VIDEO.width,
+                        help=f"video width, px (default: {VIDEO.width})")
+    parser.add_argument("--height", type=int, default=VIDEO.height,
+                        help=f"video height, px (default: {VIDEO.height})")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     parser.add_argument(
         "--no-inset",
@@ -223,7 +221,7 @@ def default_robot(args: argparse.Namespace) -> str:
     controller = getattr(args, "controller", None)
     if controller is None:
         controller = load_scene(args.scene).controller.reach_controller
-    return "panda" if controller == GPS_REACH else "sawyer"
+    return "panda" if controller == GPS_REACH else DEFAULT_ROBOT
 
 
 def run_demo(args: argparse.Namespace) -> int:

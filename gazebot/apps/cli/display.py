@@ -13,6 +13,7 @@ from typing import Any
 
 from gazebot.apps.cli.argtypes import positive, seed_value
 from gazebot.apps.cli.bus import add_bus_arguments, bus_config
+from gazebot.apps.cli.choices import add_robot_argument
 from gazebot.apps.cli.errors import UsageError
 from gazebot.io.ros2 import topics
 
@@ -26,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "when the engine goes silent they return to a neutral pose, blink on their own and the "
         "status line says so. Headless with SDL_VIDEODRIVER=dummy (e.g. with --record).",
     )
-    p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
+    add_robot_argument(p)
     p.add_argument("--style", default=None, help="eye style name or YAML (default: the robot's)")
     p.add_argument("--fullscreen", action="store_true", help="fill the monitor")
     p.add_argument("--fps", type=positive, default=None,

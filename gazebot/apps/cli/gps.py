@@ -89,8 +89,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _train(args: argparse.Namespace) -> int:
     from gazebot.apps.gps.badmm import train
     from gazebot.apps.gps.config import load_gps_config
+    from gazebot.apps.gps.policy_store import save
     from gazebot.apps.gps.state import StateKind
-    from gazebot.apps.gps.store import save
 
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -146,7 +146,7 @@ def _continue(args: argparse.Namespace):
 
 def _evaluate(args: argparse.Namespace) -> int:
     from gazebot.apps.gps.evaluate import evaluate
-    from gazebot.apps.gps.store import load
+    from gazebot.apps.gps.policy_store import load
 
     trained = load(args.policy)
     try:

@@ -6,6 +6,7 @@ import argparse
 import json
 import math
 
+from gazebot.apps.cli.choices import add_robot_argument
 from gazebot.apps.cli.errors import UsageError
 
 
@@ -20,9 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "the residual pointing errors. JSON angles are in rad, residuals in degrees."
         ),
     )
-    parser.add_argument(
-        "--robot", default="sawyer", help="robot name (sawyer, jaco2) or robot YAML path"
-    )
+    add_robot_argument(parser)
     parser.add_argument(
         "--target",
         nargs=3,

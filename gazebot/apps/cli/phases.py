@@ -11,6 +11,7 @@ import sys
 from typing import TYPE_CHECKING
 
 from gazebot.apps.cli.argtypes import positive
+from gazebot.core.phases.trajectory import POINTS
 
 if TYPE_CHECKING:
     from gazebot.core.phases import Segment
@@ -174,7 +175,7 @@ def handle(args: argparse.Namespace) -> int:
             "units": {"time": "s", "length": "m", "file_length": rec.unit},
             "rate_hz": None if math.isnan(rec.rate) else round(rec.rate, 3),
             "names": dict(
-                zip(("giver_hand", "receiver_hand", "giver_face"), rec.names, strict=True)
+                zip(POINTS, rec.names, strict=True)
             ),
             "segments": [s.to_json() for s in segments],
         }

@@ -7,6 +7,7 @@ import json
 import math
 from pathlib import Path
 
+from gazebot.apps.cli.choices import add_robot_argument
 from gazebot.apps.cli.errors import UsageError
 from gazebot.core.config import ConfigError
 
@@ -20,9 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "its left (pupils move right in the image); positive pitch = looking down."
         ),
     )
-    parser.add_argument(
-        "--robot", default="sawyer", help="robot name or robot YAML (sawyer, jaco2)"
-    )
+    add_robot_argument(parser)
     parser.add_argument(
         "--style", default=None, help="eye style name or YAML (default: the robot's)"
     )

@@ -8,16 +8,18 @@ import sys
 from pathlib import Path
 
 from gazebot.apps.cli.argtypes import seed_value
+from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, robot_with_gaze_mode
+from gazebot.apps.render.video_settings import VIDEO
 
 
 def register(kinds: argparse._SubParsersAction) -> None:
     parser = kinds.add_parser(
         "video", help="render a simulated handover to an MP4", description=__doc__
     )
-    parser.add_argument("--robot", default="sawyer", help="sawyer | jaco2 | robot YAML")
-    parser.add_argument("--behavior", required=True, help="gaze behavior name or YAML")
-    parser.add_argument("--scene", default="default", help="scene name or YAML (default: default)")
+    add_robot_argument(parser)
+    add_behavior_argument(parser, required=True)
+    add_scene_argument(parser)
     parser.add_argument(
         "--gaze-mode",
         default=None,
@@ -26,8 +28,10 @@ def register(kinds: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--out", type=Path, required=True, help="output FILE.mp4")
     parser.add_argument("--seed", type=seed_value, default=0, help="random seed (default: 0)")
-    parser.add_argument("--width", type=int, default=640, help="width, px, even (default: 640)")
-    parser.add_argument("--height", type=int, default=480, help="height, px, even (default: 480)")
+    parser.add_argument("--width", type=int, default=VIDEO.width,
+                        help=f"width, px, even (default: {VIDEO.width})")
+    parser.add_argument("--height", type=int, default=VIDEO.height,
+                        help=f"height, px, even (default: {VIDEO.height})")
     parser.add_argument("--fps", type=float, default=30.0, help="frames per second (default: 30)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     parser.add_argument(

@@ -10,6 +10,7 @@ import signal
 import sys
 import threading
 from collections.abc import Iterator
+from typing import TYPE_CHECKING
 
 from gazebot.apps.cli.argtypes import positive, seed_value
 from gazebot.apps.cli.bus import (
@@ -18,7 +19,14 @@ from gazebot.apps.cli.bus import (
     bus_config,
     robot_base_frame,
 )
+from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument
 from gazebot.apps.cli.errors import robot_with_gaze_mode
+from gazebot.apps.cli.extras import extra_for
+from gazebot.core.defaults import DEFAULT_BEHAVIOR
+from gazebot.io.drivers.engine_node import EngineNodeConfig
+
+if TYPE_CHECKING:
+    from gazebot.apps.render.eyes import LazyEyeRenderer
 
 
 class DeprecatedAlias(argparse.Action):
@@ -39,8 +47,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "commands, eye state (rendered eye frames while someone subscribes), events and a "
         "heartbeat.",
     )
-    p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
-    p.add_argument("--behavior", default="face-hand-face", help="behavior name or YAML file")
+    add_robot_argument(p)
+    add_behavior_argument(p, default=DEFAULT_BEHAVIOR)
     p.add_argument(
         "--gaze-mode",
         default=None,
@@ -51,15 +59,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=seed_value, default=0, help="seed of behavior timings and blinks")
     p.add_argument("--duration", type=positive, default=None,
                    help="seconds to run (default: until Ctrl-C)")
-    p.add_argument("--silent-after", type=positive, default=0.15, metavar="S",
+    node = EngineNodeConfig()  # the node's defaults are the options' defaults
+    p.add_argument("--silent-after", type=positive, default=node.silence_after, metavar="S",
                    help="s without tracking before it counts as silent: the engine ticks "
                    "without samples, so the behavior's tracking-loss policy applies "
-                   "(default 0.15)")
+                   f"(default {node.silence_after:g})")
     # Deprecated spelling (one release): the same option as `gazebot display --silent-after`.
     p.add_argument("--silence-after", type=positive, dest="silent_after", metavar="S",
                    action=DeprecatedAlias, help=argparse.SUPPRESS)
-    p.add_argument("--no-robot-warning", type=positive, default=3.0, metavar="S",
-                   help="warn on stderr if no robot data arrived after S seconds (default 3)")
+    p.add_argument("--no-robot-warning", type=positive, default=node.no_robot_warning,
+                   metavar="S", help="warn on stderr if no robot data arrived after S seconds "
+                   f"(default {node.no_robot_warning:g})")
     p.add_argument("--no-resync", action="store_true",
                    help="do not catch up with a handover under way at start")
     p.add_argument("--standby", action="store_true",
@@ -76,7 +86,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
-    from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig, EngineRefused
+    from gazebot.io.drivers.engine_node import EngineNode, EngineRefused
     from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
 
     cfg = bus_config(args, listens_by_default=False, base_frame=robot_base_frame(args.robot))
@@ -87,7 +97,6 @@ def handle(args: argparse.Namespace) -> int:
         standby=args.standby,
     )
     # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
-    from gazebot.apps.render import LazyEyeRenderer
     from gazebot.core.runtime import GazeLoop
 
     robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
@@ -104,7 +113,7 @@ def handle(args: argparse.Namespace) -> int:
         def warn(text: str) -> None:
             print(f"gazebot run: warning: {text} ({endpoints})", file=sys.stderr, flush=True)
 
-        eyes = None if args.no_eye_frames else LazyEyeRenderer(loop.robot.name)
+        eyes = None if args.no_eye_frames else _eye_renderer(loop.robot.name)
         node = EngineNode(loop, driver, node_cfg, warn=warn, eye_renderer=eyes)
         try:
             with _stop_on_sigterm() as stop:  # before saying it runs: SIGTERM from then on
@@ -136,6 +145,20 @@ def handle(args: argparse.Namespace) -> int:
         driver.close()
     print(json.dumps(summary) if args.json else "\n".join(f"{k}: {v}" for k, v in summary.items()))
     return 0
+
+
+def _eye_renderer(robot: str) -> LazyEyeRenderer | None:
+    """The robot's eye renderer, or ``None`` (a note on stderr) on an install without the
+    ``render`` extra: the node then publishes eye state but no eye frames."""
+    try:
+        from gazebot.apps.render.eyes import LazyEyeRenderer
+    except ModuleNotFoundError as exc:
+        if extra_for(exc.name) != "render":
+            raise
+        print("gazebot run: note: no eye frames (they need the [render] extra); eye state is "
+              "published", file=sys.stderr, flush=True)
+        return None
+    return LazyEyeRenderer(robot)
 
 
 @contextlib.contextmanager

@@ -16,7 +16,10 @@ from gazebot.apps.cli.bus import (
     bus_config,
     robot_base_frame,
 )
+from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, robot_with_gaze_mode
+from gazebot.apps.render.video_settings import VIDEO
+from gazebot.core.defaults import DEFAULT_BEHAVIOR
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -26,13 +29,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Simulate a handover in MuJoCo and serve it on the bus: tracking at 120 Hz, "
         "joint states, robot events, heartbeat; obeys head, eye and arm commands.",
     )
-    p.add_argument("--robot", default="sawyer", help="sawyer or jaco2 (or a robot YAML file)")
-    p.add_argument("--scene", default="default", help="scene name in configs/scenes/ or YAML")
+    add_robot_argument(p)
+    add_scene_argument(p)
     p.add_argument(
         "--seed", type=seed_value, default=0, help="seed of the giver and the tracking noise"
     )
     p.add_argument("--with-engine", action="store_true", help="run a gaze engine in-process too")
-    p.add_argument("--behavior", default="face-hand-face", help="behavior for --with-engine")
+    add_behavior_argument(p, default=DEFAULT_BEHAVIOR, what="behavior of --with-engine")
     p.add_argument(
         "--gaze-mode",
         default=None,
@@ -59,7 +62,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 class PygameView:
     """A window showing the observer camera (needs a display)."""
 
-    def __init__(self, width: int = 640, height: int = 480) -> None:
+    def __init__(self, width: int = VIDEO.width, height: int = VIDEO.height) -> None:
         import os
 
         os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")

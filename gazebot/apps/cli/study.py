@@ -13,6 +13,7 @@ from pathlib import Path
 
 from gazebot.apps.cli.argtypes import seed_value
 from gazebot.apps.cli.errors import UsageError
+from gazebot.apps.render.video_settings import VIDEO
 from gazebot.apps.study.conditions import (
     CONDITION_LEVELS,
     DEFAULT_BEHAVIORS,
@@ -106,8 +107,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="study folder to write (videos/, pairs/, participants/, manifest.json; reused "
         "videos come from its cache)",
     )
-    r.add_argument("--width", type=int, default=640, help="video width, px (default: 640)")
-    r.add_argument("--height", type=int, default=480, help="video height, px (default: 480)")
+    r.add_argument("--width", type=int, default=VIDEO.width,
+                        help=f"video width, px (default: {VIDEO.width})")
+    r.add_argument("--height", type=int, default=VIDEO.height,
+                        help=f"video height, px (default: {VIDEO.height})")
     r.add_argument("--fps", type=int, default=30, help="frames per second (default: 30)")
     r.add_argument("--workers", type=int, default=None, help="processes (default: CPU cores)")
     r.add_argument("--card-seconds", type=float, default=1.5, help="title card duration (s)")

@@ -66,9 +66,9 @@ class GPSController:
                 "(--policy DIR, written by `gazebot gps train --out DIR`)"
             )
         try:
-            from gazebot.apps.gps.scene import HandoverScene
+            from gazebot.apps.gps.policy_store import load
+            from gazebot.apps.gps.reach_scene import HandoverScene
             from gazebot.apps.gps.state import StateKind
-            from gazebot.apps.gps.store import load
         except ImportError as exc:
             raise ValueError(
                 f"controller 'gps' needs the optional extra: pip install 'gazebot[gps]' ({exc})"
@@ -117,7 +117,7 @@ class GPSController:
         Raises:
             ValueError: the tester cannot hold its cylinder at ``p_h`` (out of its reach).
         """
-        from gazebot.apps.gps.scene import Observation
+        from gazebot.apps.gps.reach_scene import Observation
         from gazebot.apps.gps.state import state_vector
 
         p_h = np.asarray(p_h, float)

@@ -21,11 +21,11 @@ from gazebot.apps.gps.dynamics import GMMPrior, LinearDynamics, fit_dynamics, tr
 from gazebot.apps.gps.lingauss import LinearGaussian, pd_controller
 from gazebot.apps.gps.lqg import PolicyLinearization, kl_per_step, lqg_update
 from gazebot.apps.gps.policy import PolicyParams, init_policy, jacobians, train_policy
-from gazebot.apps.gps.rollout import Trial, run_trial
-from gazebot.apps.gps.scene import DU, HandoverScene
+from gazebot.apps.gps.reach_scene import DU, HandoverScene
 from gazebot.apps.gps.shell import training_targets
 from gazebot.apps.gps.state import DIMS, StateKind, gap_selector, state_vector
 from gazebot.apps.gps.tester import TesterMotion, motion_to
+from gazebot.apps.gps.trial import Trial, run_trial
 
 
 @dataclass(frozen=True)

@@ -9,11 +9,12 @@ from pathlib import Path
 import numpy as np
 
 from gazebot.apps.gps.badmm import policy_act
-from gazebot.apps.gps.scene import HandoverScene
+from gazebot.apps.gps.policy_store import load
+from gazebot.apps.gps.reach_scene import HandoverScene
 from gazebot.apps.gps.shell import shell_grid
 from gazebot.apps.gps.state import state_vector
-from gazebot.apps.gps.store import load
 from gazebot.apps.gps.tester import motion_to
+from gazebot.apps.render.video_settings import VIDEO
 
 
 @dataclass(frozen=True)
@@ -25,7 +26,8 @@ class DemoResult:
 
 
 def run_demo(policy_dir: str | Path, out: str | Path, moving: bool = True,
-             target: np.ndarray | None = None, width: int = 640, height: int = 480) -> DemoResult:
+             target: np.ndarray | None = None, width: int = VIDEO.width,
+             height: int = VIDEO.height) -> DemoResult:
     """Render the policy in ``policy_dir`` reaching for the tester's hand (default target: the
     middle of the test shell) to the MP4 file ``out``."""
     import imageio.v2 as imageio

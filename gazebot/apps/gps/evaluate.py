@@ -9,11 +9,11 @@ import numpy as np
 from scipy.stats import spearmanr
 
 from gazebot.apps.gps.badmm import policy_act
-from gazebot.apps.gps.rollout import run_trial
-from gazebot.apps.gps.scene import HandoverScene
+from gazebot.apps.gps.policy_store import TrainedPolicy
+from gazebot.apps.gps.reach_scene import HandoverScene
 from gazebot.apps.gps.shell import shell_grid
-from gazebot.apps.gps.store import TrainedPolicy
 from gazebot.apps.gps.tester import motion_to
+from gazebot.apps.gps.trial import run_trial
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from gazebot.apps.gps.evaluate import Evaluation
-from gazebot.apps.gps.store import TrainedPolicy
+from gazebot.apps.gps.policy_store import TrainedPolicy
 from gazebot.core.config import ConfigError
 
 
@@ -23,7 +23,7 @@ def _pyplot():
 def shell_plot(ev: Evaluation, trained: TrainedPolicy, out: Path) -> None:
     """Fig. 5.2: each test location (the tester hand's final position) coloured by its error,
     clamped to [0, 0.3] m; training targets as black squares, the gripper's start as a circle."""
-    from gazebot.apps.gps.scene import HandoverScene
+    from gazebot.apps.gps.reach_scene import HandoverScene
     from gazebot.apps.gps.tester import motion_to
 
     plt = _pyplot()

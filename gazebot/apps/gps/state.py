@@ -15,7 +15,7 @@ from enum import Enum
 
 import numpy as np
 
-from gazebot.apps.gps.scene import Observation
+from gazebot.apps.gps.reach_scene import Observation
 
 
 class StateKind(str, Enum):

@@ -14,6 +14,7 @@ from typing import Annotated
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
 
 from gazebot.core.config import configs_dir, load_model
+from gazebot.core.defaults import DEFAULT_ROBOT
 
 RGB = tuple[int, int, int]
 
@@ -155,14 +156,19 @@ def available_eye_styles() -> list[str]:
     return sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
 
 
-def load_eye_style(name_or_path: str | Path | EyeStyle = "sawyer") -> EyeStyle:
-    """Load an eye style by shipped name (``"sawyer"``) or from a YAML path.
+def load_eye_style(name_or_path: str | Path | EyeStyle | None = None) -> EyeStyle:
+    """Load an eye style by shipped name (``sawyer``) or from a YAML path; ``None``: the style
+    of the default robot (:data:`~gazebot.core.defaults.DEFAULT_ROBOT`).
 
     Raises ``ConfigError`` for a malformed file and ``FileNotFoundError`` (listing the shipped
     styles) for an unknown name.
     """
     if isinstance(name_or_path, EyeStyle):
         return name_or_path
+    if name_or_path is None:
+        from gazebot.apps.render.eyes_display import robot_display
+
+        name_or_path = robot_display(DEFAULT_ROBOT).style
     path = Path(name_or_path)
     if path.suffix in (".yaml", ".yml") or path.is_file():
         if not path.is_file():

@@ -36,6 +36,7 @@ import numpy as np
 
 from gazebot.apps.render.eye_style import EyeStyle, load_eye_style
 from gazebot.apps.render.eyes_display import robot_display
+from gazebot.core.defaults import DEFAULT_ROBOT
 
 if TYPE_CHECKING:
     from gazebot.core.kinematics.robot_config import RobotConfig
@@ -199,7 +200,7 @@ def _stroke(points: np.ndarray, width: float) -> np.ndarray:
 class EyeRenderer:
     """Draws a pair of eyes for a head screen of ``width`` x ``height`` pixels.
 
-    >>> r = EyeRenderer.for_robot("sawyer")
+    >>> r = EyeRenderer.for_robot(DEFAULT_ROBOT)
     >>> img = r.render(eye_yaw=0.2, eye_pitch=-0.1, blink=0.0, distance=1.0)  # (600, 1024, 3) RGB
     """
 
@@ -207,7 +208,7 @@ class EyeRenderer:
         self,
         width: int,
         height: int,
-        style: EyeStyle | str | Path = "sawyer",
+        style: EyeStyle | str | Path | None = None,
         *,
         yaw_range: float = math.radians(35.0),
         pitch_range: float = math.radians(25.0),
@@ -231,7 +232,7 @@ class EyeRenderer:
     @classmethod
     def for_robot(
         cls,
-        robot: str | Path | RobotConfig = "sawyer",
+        robot: str | Path | RobotConfig = DEFAULT_ROBOT,
         *,
         width: int | None = None,
         height: int | None = None,

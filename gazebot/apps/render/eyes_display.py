@@ -39,7 +39,7 @@ def _half_range(range_deg: tuple[float, float]) -> float:
 
 
 def robot_display(robot: str | Path | RobotConfig) -> RobotDisplay:
-    """The display of a robot given by name (``"sawyer"``), robot YAML path or parsed config.
+    """The display of a robot given by name (``sawyer``), robot YAML path or parsed config.
 
     Raises:
         FileNotFoundError: unknown robot name or missing YAML file.

@@ -7,6 +7,7 @@ when ``MUJOCO_GL`` is unset; call it before MuJoCo is imported.
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -55,12 +56,16 @@ def ensure_gl_backend(probe_first: bool = True) -> str:
     Raises:
         OffscreenRenderingError: probing found no working back end (the message names the
             packages to install).
+        ModuleNotFoundError: MuJoCo is not installed (the ``sim`` extra), which no system
+            package fixes.
     """
     chosen = os.environ.get("MUJOCO_GL")
     if chosen:
         return chosen
     if "mujoco" in sys.modules:  # too late to choose: MuJoCo picked its back end on import
         return "default"
+    if importlib.util.find_spec("mujoco") is None:
+        raise ModuleNotFoundError("No module named 'mujoco'", name="mujoco")
     if not sys.platform.startswith("linux"):  # macOS/Windows: MuJoCo's own default works
         return "default"
     errors = {}

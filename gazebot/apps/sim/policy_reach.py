@@ -165,7 +165,7 @@ class PolicyReachLog:
         self._reach: PolicyReach | None = None
 
     def on_tick(self, sim, _tick=None) -> None:
-        from gazebot.apps.sim.controller import ControllerState
+        from gazebot.apps.sim.arm_controller import ControllerState
 
         reach = sim.controller.reach
         if not isinstance(reach, PolicyReach):

@@ -18,6 +18,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gazebot.apps.render.timeline import TickRecord
+from gazebot.apps.render.video_settings import VIDEO
+from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 from gazebot.core.kinematics.robot_config import RobotConfig
 from gazebot.core.runtime import GazeLoop
 from gazebot.core.types import Event, Phase
@@ -78,14 +80,14 @@ def expected_duration(sim) -> float:
 
 
 def record_handover(
-    robot: str | Path | RobotConfig = "sawyer",
-    behavior: str | Path = "face-hand-face",
+    robot: str | Path | RobotConfig = DEFAULT_ROBOT,
+    behavior: str | Path = DEFAULT_BEHAVIOR,
     scene: str | Path = "default",
     out_path: str | Path | None = None,
     seed: int = 0,
-    width: int = 640,
-    height: int = 480,
-    fps: float = 30.0,
+    width: int = VIDEO.width,
+    height: int = VIDEO.height,
+    fps: float = VIDEO.fps,
     progress: bool = True,
     on_tick: Callable[[HandoverSimulation, TickRecord], None] | None = None,
     loop: GazeLoop | None = None,
@@ -211,9 +213,9 @@ def render_handover_video(
     scene: str | Path,
     out_path: str | Path,
     seed: int = 0,
-    width: int = 640,
-    height: int = 480,
-    fps: float = 30.0,
+    width: int = VIDEO.width,
+    height: int = VIDEO.height,
+    fps: float = VIDEO.fps,
     progress: bool = True,
     giver_factory=None,
 ) -> Path:

@@ -19,9 +19,10 @@ import numpy as np
 
 from gazebot.apps.controllers.base import INFEASIBLE_MESSAGE
 from gazebot.apps.render.offscreen import OffscreenRenderer
+from gazebot.apps.render.video_settings import VIDEO
+from gazebot.apps.sim.arm_controller import ControllerState, HandoverController, Sensed
 from gazebot.apps.sim.cartesian_reach import CartesianReach
-from gazebot.apps.sim.controller import ControllerState, HandoverController, Sensed
-from gazebot.apps.sim.display import DisplayTexture
+from gazebot.apps.sim.display_texture import DisplayTexture
 from gazebot.apps.sim.giver import GiverPlan, GiverState, SimulatedGiver
 from gazebot.apps.sim.receiver import ReceiverState, SimulatedReceiver
 from gazebot.apps.sim.robot import SimRobot, load_sim_robot
@@ -45,6 +46,7 @@ from gazebot.apps.sim.torque_arm import (
     is_torque_motor,
 )
 from gazebot.apps.sim.tracking import TrackingNoise
+from gazebot.core.defaults import DEFAULT_ROBOT
 from gazebot.core.kinematics.robot_config import RobotConfig
 from gazebot.core.types import Event, EventKind, TrackingFrame
 
@@ -135,7 +137,7 @@ class HandoverSimulation:
 
     def __init__(
         self,
-        robot: str | Path | RobotConfig | SimRobot = "sawyer",
+        robot: str | Path | RobotConfig | SimRobot = DEFAULT_ROBOT,
         scene: str | Path | SceneConfig = "default",
         seed: int = 0,
         tracking_noise: TrackingNoiseConfig | None = None,
@@ -666,8 +668,8 @@ class HandoverSimulation:
     def render(
         self,
         camera: str = OBSERVER,
-        width: int = 640,
-        height: int = 480,
+        width: int = VIDEO.width,
+        height: int = VIDEO.height,
         inset: bool | None = None,
     ) -> np.ndarray:
         """An RGB frame ((height, width, 3) uint8) from ``camera`` (default: the observer).
@@ -694,7 +696,9 @@ class HandoverSimulation:
                 frame = _feedback_banner(frame, INFEASIBLE_MESSAGE)
         return frame
 
-    def inset_rect(self, width: int = 640, height: int = 480) -> tuple[int, int, int, int]:
+    def inset_rect(
+        self, width: int = VIDEO.width, height: int = VIDEO.height
+    ) -> tuple[int, int, int, int]:
         """The screen close-up's place (x0, y0, x1, y1) px in an observer frame of that size."""
         return inset_rect(
             width, height, (self.display.width, self.display.height), self.config.camera.inset

@@ -11,10 +11,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 RenderFn = Callable[..., Path]
-"""``render_fn(robot, behavior, scene, out_path, seed=0, width=640, height=480, fps=30,
-progress=True) -> Path``: the contract of ``gazebot.apps.render.video.render_handover_video``. It
-must
-be picklable (a module-level function or a ``functools.partial`` of one) to run in workers."""
+"""``render_fn(robot, behavior, scene, out_path, seed=0, width=..., height=..., fps=...,
+progress=True) -> Path`` (size and rate default to
+:data:`gazebot.apps.render.video_settings.VIDEO`): the contract of
+``gazebot.apps.render.video.render_handover_video``. It must be
+picklable (a module-level function or a ``functools.partial`` of one) to run in workers."""
 
 
 @dataclass(frozen=True)

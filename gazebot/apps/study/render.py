@@ -39,6 +39,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from gazebot.apps.render.video_settings import VIDEO
 from gazebot.apps.study.cache import RenderFn, VideoSpec, code_version, inputs_digest
 from gazebot.apps.study.pair_video import make_pair_video
 from gazebot.apps.study.plan import Session, write_plan
@@ -84,9 +85,9 @@ def render_handover_in_gaze_mode(
     scene: str,
     out_path: str | Path,
     seed: int = 0,
-    width: int = 640,
-    height: int = 480,
-    fps: int = 30,
+    width: int = VIDEO.width,
+    height: int = VIDEO.height,
+    fps: int = VIDEO.fps,
     progress: bool = True,
     gaze_mode: str = "head-and-eyes",
 ) -> Path:
@@ -216,9 +217,9 @@ def render_study(
     plan: list[Session],
     out_dir: str | Path,
     render_fn: RenderFn | None = None,
-    width: int = 640,
-    height: int = 480,
-    fps: int = 30,
+    width: int = VIDEO.width,
+    height: int = VIDEO.height,
+    fps: int = VIDEO.fps,
     workers: int | None = None,
     card_seconds: float = 1.5,
     code_version_str: str | None = None,

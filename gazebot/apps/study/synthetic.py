@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gazebot.apps.render.video_settings import VIDEO
+
 
 def render_synthetic_video(
     robot: str,
@@ -20,9 +22,9 @@ def render_synthetic_video(
     scene: str,
     out_path: str | Path,
     seed: int = 0,
-    width: int = 640,
-    height: int = 480,
-    fps: int = 30,
+    width: int = VIDEO.width,
+    height: int = VIDEO.height,
+    fps: int = VIDEO.fps,
     progress: bool = True,
     duration: float = 1.0,
     gaze_mode: str = "head-and-eyes",

@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from gazebot.core.config import ConfigError
+from gazebot.core.defaults import DEFAULT_ROBOT
 from gazebot.core.kinematics.eyes import DisplayEyes
 from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config, resolve_mjcf
 
@@ -146,7 +147,7 @@ class RobotModel:
         self._last_frame: tuple[tuple[tuple[float, ...], int], list[list[float]]] | None = None
 
     @classmethod
-    def load(cls, name_or_yaml: str | Path | RobotConfig = "sawyer") -> RobotModel:
+    def load(cls, name_or_yaml: str | Path | RobotConfig = DEFAULT_ROBOT) -> RobotModel:
         """Load a robot by name (``configs/robots/<name>.yaml``), YAML path or config.
 
         Raises:

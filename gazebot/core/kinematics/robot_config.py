@@ -154,7 +154,7 @@ class RobotConfig(BaseModel):
 
 
 def robot_config_path(name_or_yaml: str | Path) -> Path:
-    """``"sawyer"`` -> ``configs/robots/sawyer.yaml``; a ``.yaml`` path is returned as is."""
+    """``sawyer`` -> ``configs/robots/sawyer.yaml``; a ``.yaml`` path is returned as is."""
     path = Path(name_or_yaml)
     if path.suffix in (".yaml", ".yml"):
         if not path.is_file():

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
+from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 from gazebot.core.runtime.blink import BlinkModel
 from gazebot.core.types import (
     Event,
@@ -130,8 +131,8 @@ class GazeLoop:
     @classmethod
     def from_config(
         cls,
-        robot: str | Path | RobotConfig = "sawyer",
-        behavior: str | Path = "face-hand-face",
+        robot: str | Path | RobotConfig = DEFAULT_ROBOT,
+        behavior: str | Path = DEFAULT_BEHAVIOR,
         phases: str | Path | PhaseConfig | None = None,
         seed: int = 0,
     ) -> GazeLoop:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gazebot.core.phases.trajectory import POINTS
 from gazebot.io.recordings.base import (
     PointNames,
     Recording,
@@ -22,7 +23,7 @@ from gazebot.io.recordings.base import (
 )
 
 TIME_COLUMNS = ("t", "time", "timestamp")
-DEFAULTS = ("giver_hand", "receiver_hand", "giver_face")
+DEFAULTS = POINTS
 _MISSING = {"", "nan", "-nan", "+nan"}
 
 

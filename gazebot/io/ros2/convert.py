@@ -30,6 +30,7 @@ import numpy.typing as npt
 from rosbags.typesys.store import Typestore
 from rosbags.typesys.stores import ros2_jazzy as jazzy
 
+from gazebot.core.phases.trajectory import POINTS
 from gazebot.core.types import Event, GazeCommand, Phase, PhaseSource, TrackingFrame
 from gazebot.io.ros2.errors import MessageError
 from gazebot.io.ros2.typestore import typestore
@@ -102,7 +103,7 @@ GRIPPER_STATE = "gazebot_msgs/msg/GripperState"
 LOAD_SHARE = "gazebot_msgs/msg/LoadShare"
 
 #: The tracked bodies of a :class:`~gazebot.core.types.TrackingFrame`, one topic (or TF frame) each.
-BODIES = ("giver_hand", "receiver_hand", "giver_face")
+BODIES = POINTS
 
 _SOURCES: tuple[str, ...] = get_args(PhaseSource)
 _INT32 = 2**31

@@ -37,7 +37,8 @@ def read_msg_files(package_dir: Path) -> dict[str, str]:
     files = sorted((package_dir / "msg").glob("*.msg"))
     if not files:
         raise FileNotFoundError(f"{package_dir / 'msg'}: no .msg files")
-    return {f"{package_dir.name}/msg/{f.stem}": f.read_text(encoding="utf-8") for f in files}
+    package = package_dir.name.removeprefix("_")  # the wheel ships it as gazebot/_gazebot_msgs
+    return {f"{package}/msg/{f.stem}": f.read_text(encoding="utf-8") for f in files}
 
 
 def build_typestore(package_dir: Path | None = None) -> Typestore:

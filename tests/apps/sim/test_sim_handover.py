@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gazebot.apps.sim.controller import ControllerState, HandoverController, Sensed
+from gazebot.apps.sim.arm_controller import ControllerState, HandoverController, Sensed
 from gazebot.apps.sim.giver import GiverState
 from gazebot.apps.sim.scene_config import ControllerConfig, TrackingNoiseConfig
 from gazebot.apps.sim.simulation import HandoverSimulation, nearest_equivalent

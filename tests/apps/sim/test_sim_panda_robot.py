@@ -11,7 +11,7 @@ import numpy as np
 from gazebot.apps.gps import panda
 from gazebot.apps.gps.config import load_gps_config
 from gazebot.apps.gps.handover_robot import ASSET, handover_robot_mjcf
-from gazebot.apps.sim.controller import ControllerState
+from gazebot.apps.sim.arm_controller import ControllerState
 from gazebot.apps.sim.simulation import HandoverSimulation
 from gazebot.core.kinematics import RobotModel, solve_ik
 

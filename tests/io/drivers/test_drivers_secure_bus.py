@@ -94,6 +94,7 @@ def _gazebot(*args: str) -> subprocess.Popen:
 @pytest.mark.slow
 def test_simulator_and_engine_over_mutual_tls_and_a_node_without_the_certificate_gets_nothing(
         tmp_path, pki):
+    pytest.importorskip("mujoco", reason="needs the [sim] extra (gazebot sim)")
     good, other = pki
     secure = tls_config(tmp_path / "secure.json5", good)
     foreign = tls_config(tmp_path / "foreign.json5", other)  # a certificate of another CA

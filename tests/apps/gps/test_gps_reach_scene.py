@@ -9,7 +9,7 @@ import pytest
 
 from gazebot.apps.gps import panda
 from gazebot.apps.gps.config import load_gps_config
-from gazebot.apps.gps.scene import HandoverScene
+from gazebot.apps.gps.reach_scene import HandoverScene
 from gazebot.apps.gps.shell import shell_grid, training_targets
 from gazebot.apps.gps.state import DIMS, StateKind, gap_selector, state_vector
 from gazebot.apps.gps.tester import (
@@ -163,7 +163,7 @@ def test_state_dimensions_and_gap_to_the_hand(scene, kind):
 
 
 def test_trial_error_is_the_mean_gap_over_the_last_half_second():
-    from gazebot.apps.gps.rollout import Trial
+    from gazebot.apps.gps.trial import Trial
 
     n = 41  # 2 s at 20 Hz, both ends included
     p_h = np.zeros((n, 3))

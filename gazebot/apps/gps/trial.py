@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gazebot.apps.gps.scene import HandoverScene
+from gazebot.apps.gps.reach_scene import HandoverScene
 from gazebot.apps.gps.state import StateKind, state_vector
 from gazebot.apps.gps.tester import TesterMotion
 

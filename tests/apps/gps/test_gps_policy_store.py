@@ -12,7 +12,7 @@ import pytest
 pytest.importorskip("jax", reason="gazebot gps needs the optional extra gazebot[gps]")
 pytest.importorskip("sklearn", reason="gazebot gps needs the optional extra gazebot[gps]")
 
-from gazebot.apps.gps.store import load  # noqa: E402
+from gazebot.apps.gps.policy_store import load  # noqa: E402
 from gazebot.core.config import ConfigError  # noqa: E402
 
 

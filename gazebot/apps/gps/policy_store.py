@@ -17,7 +17,7 @@ from gazebot.apps.gps.badmm import GPSState, IterationLog, TrainResult
 from gazebot.apps.gps.config import GPSFileConfig
 from gazebot.apps.gps.lingauss import LinearGaussian
 from gazebot.apps.gps.policy import PolicyParams
-from gazebot.apps.gps.scene import DU
+from gazebot.apps.gps.reach_scene import DU
 from gazebot.apps.gps.state import DIMS, StateKind
 from gazebot.core.config import ConfigError, validate
 
