@@ -6,6 +6,7 @@ plans again (receding horizon)."""
 from __future__ import annotations
 
 import math
+import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
@@ -73,6 +74,29 @@ class VelocityPlan:
     feasible: bool
     solve_ms: float
     status: str = "optimal"
+
+    @classmethod
+    def integrated(
+        cls,
+        t0: float,
+        dt: float,
+        x0: np.ndarray,
+        velocities: np.ndarray,
+        feasible: bool,
+        started: float,
+        status: str = "optimal",
+    ) -> VelocityPlan:
+        """The plan of ``velocities`` from ``x0`` (its positions by :func:`integrate`), solved
+        since ``started`` (a ``time.perf_counter()`` reading)."""
+        return cls(
+            t0=t0,
+            dt=dt,
+            velocities=velocities,
+            positions=integrate(x0, velocities, dt),
+            feasible=feasible,
+            solve_ms=(time.perf_counter() - started) * 1e3,
+            status=status,
+        )
 
     @property
     def command(self) -> np.ndarray:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
-from gazebot.apps.controllers.base import ReachController, ReachObservation, VelocityPlan, integrate
+from gazebot.apps.controllers.base import ReachController, ReachObservation, VelocityPlan
 from gazebot.apps.controllers.config import ControllersConfig, MPCConfig, SpeedLimit
 
 BIG_M = 100.0  # m or m/s: a tolerance that is no constraint
@@ -166,12 +166,4 @@ class TimedMPC(ReachController):
         U[still] = 0.0
         self._u_prev = np.vstack([self._u_prev[1], U[0]])
         self._first = False
-        return VelocityPlan(
-            t0=obs.t,
-            dt=self.dt,
-            velocities=U,
-            positions=integrate(x0, U, self.dt),
-            feasible=feasible,
-            solve_ms=(time.perf_counter() - t_start) * 1e3,
-            status=status,
-        )
+        return VelocityPlan.integrated(obs.t, self.dt, x0, U, feasible, t_start, status)

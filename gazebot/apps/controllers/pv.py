@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from gazebot.apps.controllers.base import ReachController, ReachObservation, VelocityPlan, integrate
+from gazebot.apps.controllers.base import ReachController, ReachObservation, VelocityPlan
 
 
 class PVController(ReachController):
@@ -22,11 +22,4 @@ class PVController(ReachController):
         t0 = time.perf_counter()
         goal = obs.hand if obs.target is None else np.asarray(obs.target, float)
         u = self.cap(self.config.pv.k_p * (goal - np.asarray(obs.x, float)))[None, :]
-        return VelocityPlan(
-            t0=obs.t,
-            dt=self.dt,
-            velocities=u,
-            positions=integrate(obs.x, u, self.dt),
-            feasible=True,
-            solve_ms=(time.perf_counter() - t0) * 1e3,
-        )
+        return VelocityPlan.integrated(obs.t, self.dt, obs.x, u, True, t0)

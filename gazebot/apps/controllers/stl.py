@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gazebot.apps.controllers.base import ReachController, ReachObservation, VelocityPlan, integrate
+from gazebot.apps.controllers.base import ReachController, ReachObservation, VelocityPlan
 from gazebot.apps.controllers.config import ControllersConfig, Role
 from gazebot.apps.controllers.human_model import LinearHandModel
 from gazebot.apps.controllers.stl_milp import ReachMILP, solve_reach_milp
@@ -144,12 +144,4 @@ class STLController(ReachController):
         feasible = U is not None
         if U is None:
             U = np.zeros((H, 3))  # "If no feasible control input is found, the robot stops."
-        return VelocityPlan(
-            t0=obs.t,
-            dt=self.dt,
-            velocities=U,
-            positions=integrate(x0, U, self.dt),
-            feasible=feasible,
-            solve_ms=(time.perf_counter() - t_start) * 1e3,
-            status=status,
-        )
+        return VelocityPlan.integrated(obs.t, self.dt, x0, U, feasible, t_start, status)

@@ -360,6 +360,11 @@ class HandoverSimulation:
             rel_quat = np.zeros(4)
             mujoco.mju_mulQuat(rel_quat, inv, self.data.mocap_quat[mocap].copy())
             self._object_rel = (rel_pos, rel_quat)
+        self._carry_in_gripper(mocap, g_pos, g_quat)
+
+    def _carry_in_gripper(self, mocap: int, g_pos: np.ndarray, g_quat: np.ndarray) -> None:
+        """Pose the object where it was taken in the gripper (``_object_rel``), the gripper at
+        ``g_pos``, ``g_quat``."""
         rel_pos, rel_quat = self._object_rel
         world = np.zeros(3)
         mujoco.mju_rotVecQuat(world, rel_pos, g_quat)
@@ -391,13 +396,7 @@ class HandoverSimulation:
             if self.controller.pickup is not None:  # it stays where the gripper closed on it
                 mujoco.mju_rotVecQuat(rel_pos, self.data.mocap_pos[mocap] - g_pos, inv)
             self._object_rel = (rel_pos, rel_quat)
-        rel_pos, rel_quat = self._object_rel
-        world = np.zeros(3)
-        mujoco.mju_rotVecQuat(world, rel_pos, g_quat)
-        self.data.mocap_pos[mocap] = g_pos + world
-        quat = np.zeros(4)
-        mujoco.mju_mulQuat(quat, g_quat, rel_quat)
-        self.data.mocap_quat[mocap] = quat
+        self._carry_in_gripper(mocap, g_pos, g_quat)
 
     # ----------------------------------------------------------------------------- state
     @property

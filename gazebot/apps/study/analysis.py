@@ -291,31 +291,14 @@ class StudyAnalysis:
                 for level, measures in self.per_level.items()
             },
             "bias": {
-                m: {"W": b.statistic, "S": b.s, "z": b.z, "n": b.n, "p_value": b.p_value}
-                for m, b in self.bias.items()
+                m: b.as_json(with_p_z=False) for m, b in self.bias.items()
             },
             "bias_per_question": {
-                q: {
-                    "W": b.statistic,
-                    "S": b.s,
-                    "z": b.z,
-                    "n": b.n,
-                    "p_value": b.p_value,
-                    "p_z": b.p_z,
-                }
-                for q, b in self.bias_per_question.items()
+                q: b.as_json() for q, b in self.bias_per_question.items()
             },
             "bias_by_group": {
                 g: {
-                    k: {
-                        "W": b.statistic,
-                        "S": b.s,
-                        "z": b.z,
-                        "n": b.n,
-                        "p_value": b.p_value,
-                        "p_z": b.p_z,
-                    }
-                    for k, b in tests.items()
+                    k: b.as_json() for k, b in tests.items()
                 }
                 for g, tests in self.bias_by_group.items()
             },

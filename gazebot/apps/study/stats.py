@@ -91,6 +91,13 @@ class BiasTest:
     z: float = 0.0
     p_z: float = 1.0
 
+    def as_json(self, with_p_z: bool = True) -> dict[str, float]:
+        """The test as the analysis' JSON reports it (the seed's names: W, S, z)."""
+        out = {"W": self.statistic, "S": self.s, "z": self.z, "n": self.n, "p_value": self.p_value}
+        if with_p_z:
+            out["p_z"] = self.p_z
+        return out
+
 
 def position_bias_test(differences: np.ndarray) -> BiasTest:
     """One-sample Wilcoxon signed-rank test that ``differences`` are centred on 0.
