@@ -20,13 +20,6 @@ REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("GAZEBOT_SHARED_DATA", REPO.parent / "shared" / "data"))
 
 
-def documentation_text() -> str:
-    """The README and every page of the documentation site (``docs/``), as one text: tests that
-    pin what the documentation says look here, wherever a section lives."""
-    pages = [REPO / "README.md", *sorted((REPO / "docs").rglob("*.md"))]
-    return "\n".join(p.read_text(encoding="utf-8") for p in pages)
-
-
 @pytest.fixture(scope="session")
 def annotations_dir() -> Path:
     """The human-human gaze annotations (288 handovers), or a skip saying where they were

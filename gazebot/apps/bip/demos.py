@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gazebot.apps.sim.motion import min_jerk_phase
+from gazebot.core.minimum_jerk import minimum_jerk
 from gazebot.io.recordings import RecordingError
 
 WRISTS = ("giver_left", "giver_right", "receiver_left", "receiver_right")
@@ -120,7 +120,7 @@ class DemoGenerator:
         goal = np.array(self.handover) + rng.normal(0.0, 1.0, 3) * np.array(self.handover_sd)
         yaw = rng.normal(0.0, self.yaw_sd)
         axis = np.array([-np.sin(yaw), np.cos(yaw), 0.0])  # giver's right -> left
-        s = np.asarray(min_jerk_phase(t / t_giver))[:, None]
+        s = np.asarray(minimum_jerk(t / t_giver))[:, None]
         middle = start + (goal - start) * s
         middle[:, 2] += rng.normal(self.lift_mean, self.lift_sd) * np.sin(np.pi * s[:, 0])
         giver_left = middle + 0.5 * w * axis
@@ -133,7 +133,7 @@ class DemoGenerator:
         reach_in = np.array([self.receiver_reach_in, 0.0, -0.02])
         recv_left1 = goal + reach_in - 0.5 * w * axis
         recv_right1 = goal + reach_in + 0.5 * w * axis
-        sr = np.asarray(min_jerk_phase((t - delay) / t_recv))[:, None]
+        sr = np.asarray(minimum_jerk((t - delay) / t_recv))[:, None]
         recv_left = recv_left0 + (recv_left1 - recv_left0) * sr
         recv_right = recv_right0 + (recv_right1 - recv_right0) * sr
 

@@ -4,7 +4,6 @@ from it."""
 from __future__ import annotations
 
 import pytest
-from conftest import documentation_text
 
 from gazebot.apps.cli.registries import registries
 from gazebot.apps.controllers import CONTROLLERS, make_controller
@@ -12,6 +11,7 @@ from gazebot.core.config import ConfigError
 from gazebot.core.phases import PhaseConfig, load_phase_config
 from gazebot.core.phases.methods import PHASE_METHODS
 from gazebot.core.registry import Registry
+from tests.documentation import documentation_text
 
 
 def test_every_extension_kind_has_one_registry_with_its_builtins():

@@ -126,10 +126,9 @@ def test_a_seed_behaviors_diagram_shows_every_segment_that_decides_its_targets(n
 
 
 def test_the_documented_diagram_is_the_one_the_machine_draws():
-    from conftest import documentation_text
-
     from gazebot.core.behaviors import load_behavior
     from gazebot.core.behaviors.machine import diagram
+    from tests.documentation import documentation_text
 
     assert diagram(load_behavior("face-hand-face")).strip() in documentation_text()
 
