@@ -27,11 +27,12 @@ CORE_STAMP := $(CORE_VENV)/.installed-test
 CORE_TESTS := tests/core tests/io tests/test_core_install.py tests/test_examples.py \
 	tests/apps/cli/test_cli_extras.py
 LINT_STAMP := $(VENV)/.installed-lint
+DOCS_STAMP := $(VENV)/.installed-docs
 # The lowest supported Python: python3.10 on PATH, else pyenv's 3.10, else $(PYTHON).
 PYTHON_LOWEST ?= $(shell for p in python3.10 $$HOME/.pyenv/versions/3.10*/bin/python3.10; do \
 	"$$p" -c "" >/dev/null 2>&1 && { echo "$$p"; exit 0; }; done; echo $(PYTHON))
 
-.PHONY: demo test test-lowest test-core bench lint lock lock-upgrade check-gl browser-deps clean
+.PHONY: demo test test-lowest test-core bench lint docs lock lock-upgrade check-gl browser-deps clean
 
 $(STAMP): pyproject.toml $(LOCK)
 	$(PYTHON) -m venv $(VENV)
@@ -45,6 +46,10 @@ $(TEST_STAMP): $(STAMP) pyproject.toml $(LOCK)
 
 $(LINT_STAMP): $(STAMP) pyproject.toml $(LOCK)
 	$(PY) -m pip install --quiet -c $(LOCK) -e ".[lint]"
+	touch $@
+
+$(DOCS_STAMP): $(STAMP) pyproject.toml $(LOCK)
+	$(PY) -m pip install --quiet -c $(LOCK) -e ".[all,docs]"
 	touch $@
 
 $(LOW_STAMP): pyproject.toml $(LOWEST)
@@ -117,6 +122,11 @@ lint: $(LINT_STAMP)
 	$(VENV)/bin/ruff check gazebot tests benchmarks examples
 	$(VENV)/bin/lint-imports --no-logo
 	$(VENV)/bin/mypy
+
+# The documentation site (MkDocs Material; the CLI, topic and API references generated from the
+# code at build time: docs/_hooks/generated.py) into out/site, strict: a broken link fails.
+docs: $(DOCS_STAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict
 
 clean:
 	rm -rf $(VENV) $(LOW_VENV) $(CORE_VENV) .venv-lock out .pytest_cache
