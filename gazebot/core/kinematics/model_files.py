@@ -66,8 +66,12 @@ def resolve_model_path(
     """
     if raw.startswith(PACKAGE_SCHEME):
         found = resolve_package_uri(raw, search)
-        where = ", ".join(str(f) for f in search) or "no folders: give --package-path"
-        return found, f"a package folder (searched {where})"
+        where = ", ".join(str(f) for f in search) or "no folders"
+        package = raw.removeprefix(PACKAGE_SCHEME).partition("/")[0]
+        return found, (
+            f"package {package!r} in --package-path, ROS_PACKAGE_PATH or an installed cmeel "
+            f"prefix (searched {where})"
+        )
     path = Path(raw)
     candidates = [path] if path.is_absolute() else []
     if yaml_path is not None and not path.is_absolute():

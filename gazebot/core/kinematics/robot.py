@@ -42,12 +42,38 @@ def load_full_model(path: Path, kind: str) -> pin.Model:
     """
     try:
         if kind == "urdf":
-            return pin.buildModelFromUrdf(str(path))
+            return pin.buildModelFromXML(_urdf_with_limit_gaps_marked(path))
         return pin.buildModelFromMJCF(str(path))
     except (RuntimeError, ValueError) as exc:  # Pinocchio's parser errors
         raise ConfigError(
             path, f"<{kind}>", f"a robot {kind.upper()} Pinocchio can load", str(exc)
         ) from exc
+
+
+def _urdf_with_limit_gaps_marked(path: Path) -> str:
+    """The URDF's text with what urdfdom refuses to parse marked as absent: a ``<limit>``
+    without ``velocity`` gets ``velocity="0"`` and a revolute or prismatic joint without
+    ``<limit>`` gets an empty one (lower = upper = 0), so the model loads and a head joint that
+    lacks a limit is reported by name (with its YAML override, a velocity limit may be left out).
+
+    Raises:
+        ConfigError: the file is not readable XML.
+    """
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise ConfigError(path, "<urdf>", "a readable URDF (XML)", str(exc)) from exc
+    for joint in root.iter("joint"):
+        if joint.get("type") not in ("revolute", "prismatic"):
+            continue
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ET.SubElement(joint, "limit", lower="0", upper="0", effort="0")
+        limit.attrib.setdefault("velocity", "0")
+        limit.attrib.setdefault("effort", "0")
+    return ET.tostring(root, encoding="unicode")
 
 
 def _radians(degrees: Sequence[float]) -> tuple[float, float]:
@@ -171,7 +197,11 @@ class RobotModel:
         self.eye_chains: tuple[EyeChain, ...] = ()
         if config.eye_joints is not None:
             self.eye_chains = eye_chains_of(
-                full, config.eye_joints.yaw, config.eye_joints.pitch, gaze_full, self.mjcf_path
+                full,
+                config.eye_joints.yaw,
+                config.eye_joints.pitch,
+                full.getFrameId(config.gaze_site, gaze_type),
+                self.mjcf_path,
             )
             yaw_range, pitch_range = eye_ranges(self.eye_chains, self.mjcf_path)
             eye_speed = min(self._velocity_limit(full, n) for n in self.eye_joints)
