@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from gazebot.apps.cli.argtypes import seed_value
 from gazebot.apps.cli.errors import UsageError, option_error, robot_with_gaze_mode
+from gazebot.apps.cli.robots import add_package_path, is_urdf_robot, run_kinematic_demo
 
 if TYPE_CHECKING:
     from gazebot.core.kinematics.robot_config import RobotConfig
@@ -41,8 +42,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--robot",
         default=None,
-        help="robot name or YAML (default: panda with --controller gps, else sawyer)",
+        help="robot name or YAML (default: panda with --controller gps, else sawyer); a URDF "
+        "robot runs the engine against a kinematic head (docs/your-robot.md)",
     )
+    add_package_path(parser)
     parser.add_argument(
         "--behavior",
         default="face-hand-face",
@@ -230,6 +233,8 @@ def run_demo(args: argparse.Namespace) -> int:
     from gazebot.core.kinematics.robot_config import GAZE_MODES
 
     args.robot = default_robot(args)
+    if is_urdf_robot(args.robot):
+        return run_kinematic_demo(args)
     from gazebot.apps.render.gl_check import OffscreenRenderingError
     from gazebot.apps.render.timeline import phase_spans, plot_timeline, write_timeline_csv
 

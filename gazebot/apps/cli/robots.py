@@ -200,3 +200,61 @@ def print_report(report: dict[str, Any]) -> None:
         print(f"  problem: {p}")
     print("  ok: the engine can use this robot" if not report["problems"] else
           "  the engine cannot use this robot")
+
+
+def is_urdf_robot(robot: str) -> bool:
+    """Whether the robot (name or YAML) is described by a URDF (``gazebot demo`` then runs the
+    engine against a kinematic head: the MuJoCo handover scene needs an MJCF arm and gripper).
+
+    Raises:
+        FileNotFoundError, ConfigError: unknown robot, malformed YAML.
+    """
+    from gazebot.core.kinematics.robot_config import load_robot_config
+
+    return load_robot_config(robot)[0].urdf is not None
+
+
+def run_kinematic_demo(args: argparse.Namespace) -> int:
+    """``gazebot demo --robot FILE.yaml`` for a URDF robot: the gaze engine against a kinematic
+    head in a synthetic handover; writes ``timeline.csv`` into ``--out`` and prints a summary.
+
+    Raises:
+        UsageError: ``--out`` is not a folder, or ``--gaze-mode`` unknown.
+        ConfigError, FileNotFoundError: a malformed robot YAML or model.
+    """
+    from gazebot.apps.cli.errors import robot_with_gaze_mode
+    from gazebot.apps.sim.kinematic_head import (
+        run_kinematic_head,
+        synthetic_handover,
+        write_kinematic_csv,
+    )
+    from gazebot.core.kinematics import RobotModel
+    from gazebot.core.kinematics.robot_config import with_package_path
+
+    out: Path = args.out
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {out} exists and is not a folder")
+    config = with_package_path(args.robot, tuple(getattr(args, "package_path", ())))
+    robot = RobotModel.load(robot_with_gaze_mode(config, getattr(args, "gaze_mode", None)))
+    ticks = run_kinematic_head(robot, synthetic_handover(robot), args.behavior)
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path = out / "timeline.csv"
+    write_kinematic_csv(ticks, csv_path)
+    phases = list(dict.fromkeys(t.phase for t in ticks))
+    summary: dict[str, Any] = {
+        "robot": robot.name,
+        "head": "kinematic (URDF robot: no MuJoCo handover scene)",
+        "timeline_csv": str(csv_path),
+        "duration_s": round(ticks[-1].t, 4),
+        "phases": phases,
+        "targets": list(dict.fromkeys(t.target for t in ticks)),
+        "final_miss_deg": math.degrees(ticks[-1].miss),
+    }
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        print(f"gazebot demo: {robot.name} with a kinematic head (a URDF robot has no MuJoCo "
+              f"handover scene); {len(ticks)} ticks, {summary['duration_s']:.2f} s")
+        print(f"  phases: {' -> '.join(phases)}; targets: {', '.join(summary['targets'])}")
+        print(f"  final gaze miss {summary['final_miss_deg']:.3f} deg; timeline: {csv_path}")
+    return 0

@@ -100,7 +100,8 @@ def run_kinematic_head(
         miss = angle_between(sight, point - pose.position)
         ticks.append(
             KinematicTick(
-                t=cmd.t, phase=str(cmd.phase), target=cmd.target, target_point=point,
+                t=cmd.t, phase=getattr(cmd.phase, "value", str(cmd.phase)), target=cmd.target,
+                target_point=point,
                 head=dict(cmd.head), eye_yaw=cmd.eye_yaw, eye_pitch=cmd.eye_pitch,
                 eye_joints=robot.eye_joint_positions(cmd.eye_yaw, cmd.eye_pitch), miss=miss,
             )

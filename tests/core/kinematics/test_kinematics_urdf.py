@@ -236,3 +236,18 @@ def test_eye_joint_positions_point_each_eye_along_the_eye_direction(eyehead, yaw
     want = pose.rotation @ eye_direction(yaw, pitch)
     for sight in eye_sight(eyehead, head, eyes):
         assert angle(sight, want) < 1e-9
+
+
+def test_demo_runs_a_urdf_robot_against_a_kinematic_head(tmp_path, capsys):
+    import csv
+    import json
+
+    path = write_robot(tmp_path)
+    out = tmp_path / "demo"
+    assert main(["demo", "--robot", str(path), "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["phases"] == ["idle", "reach", "transfer", "retreat", "done"]
+    assert summary["final_miss_deg"] < 0.5
+    rows = list(csv.DictReader((out / "timeline.csv").open()))
+    assert {"head_pan_deg", "left_eye_pan_deg", "eye_tilt_deg", "miss_deg"} <= set(rows[0])
+    assert {r["target"] for r in rows} == {"face", "hand"}
