@@ -11,47 +11,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from gazebot.apps.cli import main
 from gazebot.core.config import ConfigError
 from gazebot.core.kinematics import GazeController, RobotModel
 from gazebot.core.kinematics.robot_config import with_package_path
-
-HEAD_URDF = """<robot name="eyehead">
-  <link name="base"/><link name="neck"/><link name="head"/>
-  <link name="eye_tilt_link"/><link name="left_eye"/><link name="right_eye"/>
-  <joint name="head_pan" type="revolute"><parent link="base"/><child link="neck"/>
-    <origin xyz="0 0 1.2"/><axis xyz="0 0 1"/>
-    <limit lower="-1.5" upper="1.5" effort="5" velocity="{pan_velocity}"/></joint>
-  <joint name="head_tilt" type="revolute"><parent link="neck"/><child link="head"/>
-    <origin xyz="0.02 0 0.08"/><axis xyz="0 1 0"/>
-    <limit lower="-0.5" upper="0.8" effort="5" velocity="2.5"/></joint>
-  <joint name="eye_tilt" type="revolute"><parent link="head"/><child link="eye_tilt_link"/>
-    <origin xyz="0.09 0 0.05"/><axis xyz="0 1 0"/>
-    <limit lower="-0.4" upper="0.5" effort="1" velocity="8"/></joint>
-  <joint name="left_eye_pan" type="revolute"><parent link="eye_tilt_link"/>
-    <child link="left_eye"/><origin xyz="0 0.03 0"/><axis xyz="0 0 1"/>
-    <limit lower="-0.6" upper="0.6" effort="1" velocity="10"/></joint>
-  <joint name="right_eye_pan" type="revolute"><parent link="eye_tilt_link"/>
-    <child link="right_eye"/><origin xyz="0 -0.03 0"/><axis xyz="0 0 1"/>
-    <limit lower="-0.6" upper="0.6" effort="1" velocity="10"/></joint>
-</robot>
-"""
-
-ROBOT_YAML = """name: eyehead
-urdf: {urdf}
-head_joints: [head_pan, head_tilt]
-gaze_frame: {{link: head, xyz: [0.09, 0.0, 0.05]}}
-eye_joints: {{yaw: [left_eye_pan, right_eye_pan], pitch: [eye_tilt]}}
-points: {{face: [1.2, 0.0, 1.6], handover_location: [0.6, 0.0, 0.9], rest: [1.5, 0.5, 1.3]}}
-{extra}"""
-
-
-def write_robot(folder: Path, urdf_ref: str | None = None, extra: str = "",
-                pan_velocity: str = "3.0") -> Path:
-    (folder / "eyehead.urdf").write_text(HEAD_URDF.format(pan_velocity=pan_velocity))
-    path = folder / "eyehead.yaml"
-    path.write_text(ROBOT_YAML.format(urdf=urdf_ref or "eyehead.urdf", extra=extra))
-    return path
+from tests.core.kinematics.eyehead import write_robot
 
 
 @pytest.fixture
@@ -111,17 +74,6 @@ def test_a_head_joint_without_position_limits_is_an_error(tmp_path):
     urdf.write_text(text)
     with pytest.raises(ConfigError, match="head_tilt.*position limits"):
         RobotModel.load(path)
-
-
-def test_model_file_errors_name_the_yaml_and_field(tmp_path, capsys):
-    path = write_robot(tmp_path, urdf_ref="package://no_such_pkg/urdf/eyehead.urdf")
-    assert main(["robots", "check", str(path)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and str(path) in err and "'urdf'" in err and "no_such_pkg" in err
-    both = tmp_path / "both.yaml"
-    both.write_text(path.read_text() + "mjcf: x.xml\n")
-    assert main(["robots", "check", str(both)]) == 2
-    assert "exactly one model file" in capsys.readouterr().err
 
 
 def test_package_uris_resolve_from_the_package_path(tmp_path, monkeypatch):
@@ -204,25 +156,6 @@ def test_eye_joints_must_turn_about_the_gaze_frame_axes(tmp_path):
         RobotModel.load(path)
 
 
-def test_robots_check_prints_the_chain_limits_and_reach(tmp_path, capsys):
-    path = write_robot(tmp_path)
-    assert main(["robots", "check", str(path), "--radius", "1.0"]) == 0
-    out = capsys.readouterr().out
-    assert "head chain (base to gaze): head_pan -> head_tilt" in out
-    assert "[  -85.94,    85.94] deg    171.89 deg/s (model)" in out
-    assert "eyes: joints left_eye_pan, right_eye_pan, eye_tilt" in out
-    assert "head and eyes" in out and "worst miss" in out
-
-
-def test_robots_check_fails_on_a_head_joint_that_does_not_turn_the_gaze(tmp_path, capsys):
-    path = write_robot(tmp_path)
-    path.write_text(path.read_text().replace(
-        "gaze_frame: {link: head, xyz: [0.09, 0.0, 0.05]}",
-        "gaze_frame: {link: neck, xyz: [0.09, 0.0, 0.05]}"))
-    assert main(["robots", "check", str(path), "--radius", "1.0"]) == 1
-    assert "head joint 'head_tilt' does not turn the gaze frame" in capsys.readouterr().out
-
-
 @pytest.mark.parametrize(
     ("yaw_deg", "pitch_deg"), [(20.0, 0.0), (0.0, -15.0), (-25.0, 20.0), (30.0, 22.0)]
 )
@@ -236,18 +169,3 @@ def test_eye_joint_positions_point_each_eye_along_the_eye_direction(eyehead, yaw
     want = pose.rotation @ eye_direction(yaw, pitch)
     for sight in eye_sight(eyehead, head, eyes):
         assert angle(sight, want) < 1e-9
-
-
-def test_demo_runs_a_urdf_robot_against_a_kinematic_head(tmp_path, capsys):
-    import csv
-    import json
-
-    path = write_robot(tmp_path)
-    out = tmp_path / "demo"
-    assert main(["demo", "--robot", str(path), "--out", str(out), "--json"]) == 0
-    summary = json.loads(capsys.readouterr().out)
-    assert summary["phases"] == ["idle", "reach", "transfer", "retreat", "done"]
-    assert summary["final_miss_deg"] < 0.5
-    rows = list(csv.DictReader((out / "timeline.csv").open()))
-    assert {"head_pan_deg", "left_eye_pan_deg", "eye_tilt_deg", "miss_deg"} <= set(rows[0])
-    assert {r["target"] for r in rows} == {"face", "hand"}
