@@ -51,3 +51,11 @@ def test_demo_runs_a_urdf_robot_against_a_kinematic_head(tmp_path, capsys):
     rows = list(csv.DictReader((out / "timeline.csv").open()))
     assert {"head_pan_deg", "left_eye_pan_deg", "eye_tilt_deg", "miss_deg"} <= set(rows[0])
     assert {r["target"] for r in rows} == {"face", "hand"}
+
+
+def test_robots_list_names_the_shipped_robots_and_the_examples(capsys):
+    assert main(["robots", "list"]) == 0
+    out = capsys.readouterr().out
+    assert "sawyer" in out and "mjcf sawyer.xml" in out
+    assert "configs/robots/examples/tiago.yaml" in out
+    assert "urdf package://example-robot-data/robots/tiago_description/robots/tiago.urdf" in out
