@@ -34,6 +34,7 @@ COMMAND_MODULES = (
     "bip",
     "topic",
     "node",
+    "robots",
 )
 
 

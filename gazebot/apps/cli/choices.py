@@ -29,8 +29,8 @@ def add_robot_argument(
     default is decided later, e.g. from another option)."""
     parser.add_argument(
         "--robot", default=default,
-        help=f"robot name ({known_names('robots')}) or a robot YAML file "
-        f"(default: {default_help or default})",
+        help=f"robot name ({known_names('robots')}) or a robot YAML file (URDF or MJCF robots: "
+        f"docs/your-robot.md) (default: {default_help or default})",
     )
 
 

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from gazebot.apps.cli.argtypes import seed_value
 from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, option_error, robot_with_gaze_mode
+from gazebot.apps.cli.robots import add_package_path, is_urdf_robot, run_kinematic_demo
 from gazebot.apps.render.video_settings import VIDEO
 from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 
@@ -43,6 +44,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_robot_argument(parser, default=None,
                        default_help=f"panda with --controller gps, else {DEFAULT_ROBOT}")
+    add_package_path(parser)
     add_behavior_argument(parser, default=DEFAULT_BEHAVIOR)
     add_scene_argument(parser)
     parser.add_argument(
@@ -228,6 +230,8 @@ def run_demo(args: argparse.Namespace) -> int:
     from gazebot.core.kinematics.robot_config import GAZE_MODES
 
     args.robot = default_robot(args)
+    if is_urdf_robot(args.robot):
+        return run_kinematic_demo(args)
     from gazebot.apps.render.gl_check import OffscreenRenderingError
     from gazebot.apps.render.timeline import phase_spans, plot_timeline, write_timeline_csv
 

@@ -55,6 +55,10 @@ def robot_display(robot: str | Path | RobotConfig) -> RobotDisplay:
         config, path = load_robot_config(robot)
         source = str(path)
     eyes = config.eyes
+    if config.display is None or eyes is None or config.eye_style is None:
+        from gazebot.core.config import ConfigError
+
+        raise ConfigError(source, "display", "a head screen with drawn eyes (display, eyes)")
     return RobotDisplay(
         robot=config.name,
         width=config.display.width_px,

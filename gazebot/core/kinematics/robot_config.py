@@ -3,7 +3,8 @@
 The YAML is shared: the simulation reads ``mjcf``, ``head_joints``, ``arm_joints``,
 ``arm_home_deg``, ``arm_handover_deg`` and ``gripper_actuator``; the eye renderer reads
 ``display`` and ``eyes``; the gaze engine reads everything else. Joint position limits are not
-repeated here: the MJCF is their single source.
+repeated here: the model (``mjcf:`` or ``urdf:``) is their single source, and of velocity limits
+unless ``head_velocity_limits_deg_s`` overrides them (docs/your-robot.md).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from gazebot.core.config import ConfigError, configs_dir, load_model
+from gazebot.core.kinematics.model_files import package_search_path, resolve_model_path
 from gazebot.core.kinematics.shifts import GazeShiftConfig
 
 REQUIRED_POINTS = ("face", "handover_location", "rest")
@@ -60,6 +62,35 @@ class EyeConfig(BaseModel):
 Point = tuple[float, float, float]
 
 
+class GazeFrameConfig(BaseModel):
+    """The gaze frame as a fixed offset from a link of the model (``gaze_frame:``).
+
+    The frame's +x is the line of sight, +y the robot's left, +z up (the display's up).
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    link: str = Field(min_length=1)
+    xyz: Point = (0.0, 0.0, 0.0)
+    rpy_deg: Point = (0.0, 0.0, 0.0)
+
+
+class EyeJointsConfig(BaseModel):
+    """Eyes that are joints of the model (``eye_joints:``): the joints that turn them left/right
+    (one per eye) and up/down (one per eye, or one shared). Their ranges and speeds come from
+    the model."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    yaw: list[str] = Field(min_length=1)
+    pitch: list[str] = Field(min_length=1)
+
+    @property
+    def names(self) -> list[str]:
+        """All eye joints, yaw joints first."""
+        return list(self.yaw) + [n for n in self.pitch if n not in self.yaw]
+
+
 class IKSettings(BaseModel):
     """The look-at solver's settings (``ik:``), degrees and metres at the surface.
 
@@ -99,27 +130,33 @@ class IKSettings(BaseModel):
 
 
 class RobotConfig(BaseModel):
-    """A robot for gazebot: its MJCF, head and arm joints, poses, eyes and default points."""
+    """A robot for gazebot: its model (MJCF or URDF), head and arm joints, poses, eyes and
+    default points."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     name: str = Field(min_length=1)
-    mjcf: str = Field(min_length=1)
+    mjcf: str | None = Field(default=None, min_length=1)
+    urdf: str | None = Field(default=None, min_length=1)
     # The ROS frame name of the base frame every point is in (the MJCF world frame); what
     # gaze targets and tracking on the ROS 2 wire carry as ``header.frame_id``.
     base_frame: str = Field(default="world", min_length=1)
+    # The gaze frame: a frame of the model by name (an MJCF site, a URDF link), or, with
+    # ``gaze_frame``, the name given to a frame added at an offset from a link.
     gaze_site: str = "gaze"
+    gaze_frame: GazeFrameConfig | None = None
     gripper_site: str = "gripper"
     gripper_actuator: str = "gripper"
-    eye_style: str = Field(min_length=1)
-    display: DisplayConfig
+    eye_style: str | None = Field(default=None, min_length=1)
+    display: DisplayConfig | None = None  # none: no head screen
+    eye_joints: EyeJointsConfig | None = None  # eyes that are joints of the model
     head_joints: list[str] = Field(default_factory=list)  # none: a fixed head (eyes only)
     head_velocity_limits_deg_s: dict[str, float] = Field(default_factory=dict)
     head_rest_deg: dict[str, float] = Field(default_factory=dict)
-    arm_joints: list[str] = Field(min_length=1)
-    arm_home_deg: dict[str, float]
-    arm_handover_deg: dict[str, float]
-    eyes: EyeConfig
+    arm_joints: list[str] = Field(default_factory=list)  # none: a head without an arm
+    arm_home_deg: dict[str, float] = Field(default_factory=dict)
+    arm_handover_deg: dict[str, float] = Field(default_factory=dict)
+    eyes: EyeConfig | None = None  # the drawn eyes (with ``display``); none: no movable eyes
     shifts: GazeShiftConfig = Field(default_factory=lambda: GazeShiftConfig.model_validate({}))
     ik: IKSettings = Field(default_factory=lambda: IKSettings.model_validate({}))
     gaze_mode: GazeMode = "head-and-eyes"
@@ -130,14 +167,23 @@ class RobotConfig(BaseModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> RobotConfig:
+        if (self.mjcf is None) == (self.urdf is None):
+            raise ValueError("exactly one model file: 'mjcf: FILE' or 'urdf: FILE'")
+        if self.display is not None and (self.eyes is None or self.eye_style is None):
+            raise ValueError("'eyes' and 'eye_style' with a 'display' (the eyes drawn on it)")
+        if self.eye_joints is not None and (self.display is not None or self.eyes is not None):
+            raise ValueError("either eyes on a 'display' (with 'eyes') or 'eye_joints', not both")
         head = set(self.head_joints)
         if len(head) != len(self.head_joints):
             raise ValueError("head_joints without duplicates")
         if head & set(self.arm_joints):
             raise ValueError("head_joints and arm_joints to be disjoint")
-        missing = head - set(self.head_velocity_limits_deg_s)
-        if missing:
-            raise ValueError(f"head_velocity_limits_deg_s for every head joint (missing {missing})")
+        eye = set(self.eye_joints.names) if self.eye_joints is not None else set()
+        if eye & (head | set(self.arm_joints)):
+            raise ValueError("eye_joints apart from head_joints and arm_joints")
+        unknown = set(self.head_velocity_limits_deg_s) - head - eye
+        if unknown:
+            raise ValueError(f"head_velocity_limits_deg_s only for head or eye joints ({unknown})")
         if any(not v > 0.0 for v in self.head_velocity_limits_deg_s.values()):
             raise ValueError("positive head velocity limits")
         unknown = set(self.head_rest_deg) - head
@@ -196,21 +242,61 @@ def with_gaze_mode(robot: str | Path | RobotConfig, mode: str | None) -> str | P
     else:
         config, path = load_robot_config(robot)
     data = config.model_dump()
-    data.update(gaze_mode=mode, mjcf=str(resolve_mjcf(config, path).resolve()))
+    data.update(gaze_mode=mode)
+    if config.mjcf is not None:
+        data.update(mjcf=str(resolve_mjcf(config, path).resolve()))
+    else:
+        data.update(urdf=str(resolve_model_file(config, path)[0]))
     return RobotConfig.model_validate(data)
 
 
+def with_package_path(
+    robot: str | Path | RobotConfig, package_path: list[str] | tuple[str, ...] = ()
+) -> RobotConfig:
+    """``robot`` (name, YAML path or config) with its model file resolved to an absolute path
+    (``package://`` URIs looked up in ``package_path`` first, then the usual folders), so it
+    loads wherever it is passed (the CLI's ``--package-path``).
+
+    Raises:
+        FileNotFoundError: unknown robot / file.
+        ConfigError: malformed YAML, or the model file is not found.
+    """
+    if isinstance(robot, RobotConfig):
+        config, path = robot, None
+    else:
+        config, path = load_robot_config(robot)
+    found, kind = resolve_model_file(config, path, package_path)
+    return config.model_copy(update={kind: str(found)})
+
+
+def resolve_model_file(
+    config: RobotConfig, yaml_path: Path | None, package_path: list[str] | tuple[str, ...] = ()
+) -> tuple[Path, str]:
+    """The model file of ``config`` and its kind (``"mjcf"`` or ``"urdf"``).
+
+    Raises:
+        ConfigError: the file is not found (names the YAML, the field and where it looked).
+    """
+    kind = "mjcf" if config.mjcf is not None else "urdf"
+    raw = config.mjcf if config.mjcf is not None else config.urdf
+    assert raw is not None  # the validator asks for exactly one
+    search = package_search_path(package_path)
+    found, expected = resolve_model_path(raw, yaml_path, search, assets=kind == "mjcf")
+    if found is None:
+        raise ConfigError(yaml_path or "<robot config>", kind, expected, raw)
+    return found, kind
+
+
 def resolve_mjcf(config: RobotConfig, yaml_path: Path | None) -> Path:
-    """The MJCF file of ``config``: absolute, beside the YAML, or in ``gazebot/assets/robots/``."""
-    assets = Path(__file__).resolve().parents[2] / "assets" / "robots"
-    raw = Path(config.mjcf)
-    candidates = [raw] if raw.is_absolute() else []
-    if yaml_path is not None and not raw.is_absolute():
-        candidates.append(yaml_path.parent / raw)
-    candidates += [assets / raw, assets / raw.name]
-    for cand in candidates:
-        if cand.is_file():
-            return cand
-    raise ConfigError(
-        yaml_path or "<robot config>", "mjcf", f"an existing MJCF file (looked in {assets})", raw
-    )
+    """The MJCF file of ``config``: absolute, beside the YAML, or in ``gazebot/assets/robots/``.
+
+    Raises:
+        ConfigError: no such file, or the robot is described by a URDF (the MuJoCo simulation
+            of the handover scene needs an MJCF).
+    """
+    if config.mjcf is None:
+        raise ConfigError(
+            yaml_path or "<robot config>", "mjcf", "an MJCF model (this robot has a URDF)",
+            config.urdf,
+        )
+    return resolve_model_file(config, yaml_path)[0]
