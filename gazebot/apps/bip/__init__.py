@@ -10,5 +10,5 @@ robot giver, and the two ways of 7.5 to keep its hands at the object's grip widt
 - :mod:`~gazebot.apps.bip.evaluate`: prediction errors on held-out demonstrations.
 - :mod:`~gazebot.apps.bip.scene`: a kinematic robot-giver scene with the gaze engine in the loop.
 
-See ``docs/bip.md``.
+See ``docs/seed/bip.md``.
 """

@@ -22,7 +22,7 @@ The constraint set, linear in the weights ``w`` (so that both solutions are clos
 ``axis_only=True`` constrains only the separation's component along ``u`` (the distance
 linearised about the prior's axis, 9 rows instead of 27): it leaves the grip axis free, and with
 a prior from 8 demonstrations conditioning on a narrow box turned that axis by up to 30 degrees
-(spurious width-yaw correlations), 3.8 cm off the width (docs/bip.md).
+(spurious width-yaw correlations), 3.8 cm off the width (docs/seed/bip.md).
 
 :func:`project_gaussian` is the first solution: the Gaussian ``q`` that minimises ``KL(q || p)``
 among distributions whose samples satisfy ``A s = b`` is ``p`` conditioned on ``A s = b``

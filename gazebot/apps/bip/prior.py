@@ -38,7 +38,7 @@ class TrainConfig:
             a few demonstrations is singular, and conditioning needs it positive definite.
         noise_floor_m: Least measurement noise standard deviation (m). It stands for the model
             error of a new interaction (the prior cannot reproduce it exactly), not only the
-            tracker's (docs/bip.md).
+            tracker's (docs/seed/bip.md).
     """
 
     basis: GaussianBasis = GaussianBasis()
