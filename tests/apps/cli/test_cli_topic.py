@@ -225,7 +225,7 @@ def garbage_bus():
             if i % 2:
                 pub.publish_raw(b"\x00\x01\x00\x00garbage")
             else:
-                pub.publish(pub.codec.new(
+                pub.publish(node.store.types[pub.codec.type_name](
                     header=node.store.types["std_msgs/msg/Header"](
                         stamp=node.store.types["builtin_interfaces/msg/Time"](sec=i, nanosec=0),
                         frame_id="junk"),

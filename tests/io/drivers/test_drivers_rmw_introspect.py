@@ -67,7 +67,7 @@ def test_a_message_as_plain_data_has_its_fields_in_order_without_constants():
 def test_arrays_become_lists_and_long_ones_are_cut():
     codec = Codec.for_type(typestore(), cv.COMPRESSED_IMAGE)
     T = typestore().types
-    img = codec.new(header=T["std_msgs/msg/Header"](
+    img = T[cv.COMPRESSED_IMAGE](header=T["std_msgs/msg/Header"](
         stamp=T["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="f" * 10),
         format="jpeg", data=np.arange(6, dtype=np.uint8))
     decoded = codec.decode(codec.encode(img))  # as a subscription hands it over
