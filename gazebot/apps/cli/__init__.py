@@ -33,6 +33,7 @@ COMMAND_MODULES = (
     "bip",
     "topic",
     "node",
+    "view",
 )
 
 

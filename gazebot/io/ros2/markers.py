@@ -10,6 +10,7 @@ viewer never shows a stale hand.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -100,7 +101,7 @@ def _delete(scene: Scene, frame_id: str, part: str) -> RosMarker:
 def marker_array(scene: Scene, frame_id: str) -> RosMarkerArray:
     """The scene's markers in ``frame_id`` (the robot's base frame)."""
     origin, target = _finite(scene.gaze_origin), _finite(scene.target)
-    out = []
+    out: list[Any] = []  # rosbags types the field with an older distribution's Marker
     if origin is not None and target is not None:
         # An arrow from two points: scale x is the shaft diameter, y the head's, z its length.
         out.append(_marker(scene, frame_id, "gaze_ray", RosMarker.ARROW, scale=(0.01, 0.03, 0.05),

@@ -43,7 +43,8 @@ def transform_stamped(t: float, pose: Pose) -> cv.RosTransformStamped:
     finite."""
     p = np.asarray(pose.position, dtype=float)
     if p.shape != (3,) or not np.all(np.isfinite(p)) or not np.all(np.isfinite(pose.rotation)):
-        raise MessageError(f"transform {pose.parent} -> {pose.child} is not finite")
+        raise MessageError(cv.TRANSFORM_STAMPED,
+                           f"transform {pose.parent} -> {pose.child} is not finite")
     x, y, z, w = pin.Quaternion(np.asarray(pose.rotation, dtype=float)).coeffs()
     return cv.RosTransformStamped(
         header=cv.header(t, pose.parent), child_frame_id=pose.child,

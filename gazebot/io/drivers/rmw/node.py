@@ -399,7 +399,8 @@ def _declare_publisher(session: zenoh.Session, key: str, qos: QosProfile) -> Any
     if not qos.transient_local:
         return session.declare_publisher(key, reliability=reliability,
                                          congestion_control=congestion)
-    miss = zext.MissDetectionConfig(sporadic_heartbeat=HEARTBEAT_S) if qos.reliable else None
+    miss = (zext.MissDetectionConfig(heartbeat=None, sporadic_heartbeat=HEARTBEAT_S)
+            if qos.reliable else None)
     try:
         return zext.declare_advanced_publisher(
             session, key, reliability=reliability, congestion_control=congestion,
@@ -421,7 +422,7 @@ def _declare_subscriber(session: zenoh.Session, key: str, callback: Callable[[ze
         return session.declare_subscriber(key, callback)
     import zenoh.ext as zext
 
-    recovery = zext.RecoveryConfig(heartbeat=True) if qos.reliable else None
+    recovery = zext.RecoveryConfig(periodic_queries=None, heartbeat=True) if qos.reliable else None
     return zext.declare_advanced_subscriber(
         session, key, callback, subscriber_detection=True, recovery=recovery,
         history=zext.HistoryConfig(detect_late_publishers=True, max_samples=qos.depth))
