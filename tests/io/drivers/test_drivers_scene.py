@@ -58,13 +58,18 @@ def test_the_engine_publishes_tf_and_markers_during_a_handover(bus, sim):  # noq
     ns = bus.names.namespace.strip("/")
     markers = Raw(watcher, f"0/{ns}/markers/*/*")
     tf = Raw(watcher, "0/tf/*/*")
+    read_markers, read_tf = decoder(MARKER_ARRAY), decoder(topics.TF.type)
+
+    def phases() -> set[str]:
+        return {m.text for d in markers.all() for m in read_markers(d).markers
+                if m.id == IDS["phase"]}
+
     sim_thread.start()
-    assert wait_until(lambda: len(markers.all()) > 20 and tf.all(), timeout=120)
+    assert wait_until(lambda: tf.all() and "transfer" in phases(), timeout=120, poll=0.25)
     # /tf_static was sent once, before this subscriber: it is latched
     static = Raw(watcher, "0/tf_static/*/*", latched=True)
     assert wait_until(static.all, timeout=20)
 
-    read_markers, read_tf = decoder(MARKER_ARRAY), decoder(topics.TF.type)
     (gaze,) = read_tf(static.all()[0]).transforms
     assert gaze.child_frame_id == "gaze" and gaze.header.frame_id.startswith("gazebot/")
     frames = {t.child_frame_id for t in read_tf(tf.all()[-1]).transforms}
@@ -73,8 +78,7 @@ def test_the_engine_publishes_tf_and_markers_during_a_handover(bus, sim):  # noq
     last = {m.id: m for m in arrays[-1].markers}
     assert set(last) == set(IDS.values())
     assert {m.header.frame_id for m in arrays[-1].markers} == {bus.names.base_frame}
-    phases = {m.text for a in arrays for m in a.markers if m.id == IDS["phase"]}
-    assert phases & {"reach", "transfer"}, phases
+    assert {"reach", "transfer"} <= phases()
     rays = [m for a in arrays for m in a.markers if m.id == IDS["gaze_ray"] and m.action == 0]
     assert rays and all(len(r.points) == 2 for r in rays)
     assert any(m.action == 0 for a in arrays for m in a.markers if m.id == IDS["giver_hand"])

@@ -106,7 +106,8 @@ def test_a_foxglove_client_sees_the_markers_and_the_phase_of_a_running_handover(
     assert wait_until(lambda: engine_node.phase == "done", timeout=120)
     # the engine's last phase reaches the client a moment after the engine decided it
     assert wait_until(lambda: client.count(markers) > 20
-                      and [m.phase for m in client.messages(phase)][-1:] == ["done"], timeout=30)
+                      and [m.phase for m in client.messages(phase)][-1:] == ["done"],
+                      timeout=30, poll=0.25)
     # /tf_static was published once, long before: latched, it still reaches a late subscriber
     client.subscribe("/tf_static")
     assert wait_until(lambda: client.count("/tf_static"), timeout=20)
