@@ -19,7 +19,7 @@ LOW_VENV := .venv-lowest
 LOW_STAMP := $(LOW_VENV)/.installed-test
 # The lowest-versions run installs every extra but gps (constraints-lowest.txt has no bounds for
 # JAX and scikit-learn).
-LOW_EXTRAS := render,sim,controllers,recordings,study,test
+LOW_EXTRAS := render,sim,controllers,recordings,study,view,test
 CORE_VENV := .venv-core
 CORE_STAMP := $(CORE_VENV)/.installed-test
 # The core install's tests: the core and I/O layers (a test that needs an extra skips, naming it:

@@ -35,6 +35,7 @@ COMMAND_MODULES = (
     "topic",
     "node",
     "robots",
+    "view",
 )
 
 

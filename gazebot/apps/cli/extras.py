@@ -27,6 +27,7 @@ EXTRA_OF_MODULE: dict[str, str] = {
     "optax": "gps",
     "sklearn": "gps",
     "threadpoolctl": "gps",
+    "foxglove": "view",
 }
 
 
@@ -40,6 +41,7 @@ EXTRA_OF_COMMAND: dict[str, str] = {
     "study": "study",
     "annotations": "study",
     "gps": "gps",
+    "view": "view",
 }
 
 

@@ -57,9 +57,12 @@ from typing import Any, Literal, Protocol
 
 import numpy as np
 
+from gazebot.core.kinematics.robot import RobotModel
 from gazebot.core.runtime import GazeLoop, LoopCommand
 from gazebot.core.types import Event, EventKind, TrackingFrame
 from gazebot.io.drivers.base import RobotDriver
+from gazebot.io.drivers.rmw.node import RosNode
+from gazebot.io.drivers.scene_out import SceneOut
 from gazebot.io.ros2 import convert
 from gazebot.io.ros2.topics import GAZE_FRAME
 from gazebot.io.ros2.values import (
@@ -207,6 +210,11 @@ class EngineNode:
         self._last_fault_at = -math.inf
         self._callback_faults: dict[str, int] = {}
         self.ready = threading.Event()  # set once started (and resynchronised)
+        self._last_frame: TrackingFrame | None = None
+        # The scene for rviz2 / Foxglove, when the robot is on the bus (not an in-process one).
+        ros, robot = getattr(driver, "ros", None), getattr(self.engine, "robot", None)
+        self.scene = (SceneOut(ros, robot) if isinstance(ros, RosNode)
+                      and isinstance(robot, RobotModel) else None)
 
     # -- helpers ---------------------------------------------------------------------------
     def _next(self, name: str) -> int:
@@ -455,6 +463,7 @@ class EngineNode:
             self.resync()
         self._last_frame_wall = now
         self._last_t = frame.t
+        self._last_frame = frame
         # The latest measured joints: an arm joint may carry the head (Sawyer's right_j0).
         joints = self.driver.joint_state()
         cmd = self._tick_loop("tracking", frame,
@@ -524,6 +533,8 @@ class EngineNode:
         if (point := finite_point(cmd.target_point)) is not None:
             self.driver.send_gaze_target(cmd.t, point)
         self._send_phase(cmd.t)
+        if self.scene is not None:
+            self._guarded("scene", self.scene.send, cmd, self.phase, self._last_frame)
         self.driver.send_eyes(EyeState.of(cmd))
         now = self.clock()
         if (

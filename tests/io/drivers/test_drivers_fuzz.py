@@ -28,6 +28,7 @@ from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
 from gazebot.io.ros2 import convert, topics
 from gazebot.io.ros2.codec import Codec
 from gazebot.io.ros2.errors import MessageError
+from gazebot.io.ros2.markers import MARKER_ARRAY, Scene, marker_array
 from gazebot.io.ros2.typestore import typestore
 from gazebot.io.ros2.values import BusEvent, EyeState, JointGoal, NodeStatus
 
@@ -61,6 +62,7 @@ def samples() -> dict[str, object]:
         convert.GRIPPER_STATE: convert.gripper_state(1.0, True),
         convert.LOAD_SHARE: convert.load_share(1.0, 0.5),
         STRING: store.types[STRING](data="home"),
+        MARKER_ARRAY: marker_array(Scene(1.0, "reach", [0.0, 0.0, 1.2], [1.0, 0.0, 1.0]), "world"),
     }
 
 

@@ -5,6 +5,7 @@ graph from the tokens it sees appear and vanish (rmw_zenoh's graph cache). A tok
 ``@ros2_lv/<domain>/<zid>/<node id>/<entity id>/<kind>/<enclave>/<namespace>/<node>`` and, for
 publishers (``MP``) and subscriptions (``MS``), ``/<topic>/<DDS type>/<type hash>/<qos>``;
 names are mangled (``/`` -> ``%``), the default enclave and the root namespace are ``%``.
+Trailing chunks a newer rmw_zenoh adds after these are ignored.
 """
 
 from __future__ import annotations
@@ -20,6 +21,10 @@ from gazebot.io.ros2.names import ros_type_name
 ADMIN_SPACE = "@ros2_lv"
 Kind = Literal["NN", "MP", "MS", "SS", "SC"]
 _KINDS = ("NN", "MP", "MS", "SS", "SC")
+#: Chunks of an endpoint token as gazebot reads it. Newer rmw_zenoh releases append chunks
+#: (14 in all): those after the QoS are not gazebot's concern and are ignored, as are any a
+#: node token carries after its name.
+ENDPOINT_CHUNKS = 13
 
 
 @dataclass(frozen=True)
@@ -96,11 +101,10 @@ class Entity:
                      kind=cast(Kind, kind), enclave=demangle(parts[6]),
                      namespace=demangle(parts[7]), node=demangle(parts[8]))
         if kind == "NN":
-            if len(parts) != 9:
-                raise ValueError(f"node token with extra chunks: {key!r}")
             return common
-        if len(parts) != 13:
-            raise ValueError(f"{kind} token needs 13 chunks, got {len(parts)}: {key!r}")
+        if len(parts) < ENDPOINT_CHUNKS:
+            raise ValueError(
+                f"{kind} token needs {ENDPOINT_CHUNKS} chunks, got {len(parts)}: {key!r}")
         return replace(common, topic=demangle(parts[9]), dds_type=parts[10],
                        type_hash=parts[11], qos=QosProfile.decode(parts[12]))
 

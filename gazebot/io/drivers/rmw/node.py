@@ -3,6 +3,13 @@ rmw_zenoh's attachment on ``<domain>/<topic>/<DDS type>/<hash>``; subscriptions 
 every node, publisher and subscription holds its liveliness token under ``@ros2_lv``, and the
 node keeps the graph the other tokens describe.
 
+Transient local (latched) endpoints are rmw_zenoh's: a Zenoh ``AdvancedPublisher`` with a cache
+of ``depth`` samples, publisher detection (a liveliness token ``<key>/@adv/pub/...``) and, when
+reliable, a sporadic heartbeat for sample-miss detection; an ``AdvancedSubscriber`` that queries
+the caches of the publishers already there and of late-joining ones for their last ``depth``
+samples (and, when reliable, recovers a missed last sample on a heartbeat). Volatile endpoints are
+plain Zenoh publishers and subscribers with rmw_zenoh's reliability and congestion control.
+
 Subscriptions listen to their topic whatever the type (``<domain>/<topic>/*/*``) so that a
 publisher of another type or another version of the type is reported, not silently unheard.
 Zenoh runs callbacks on its own threads: a subscription callback never raises; anything
@@ -20,14 +27,19 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from gazebot.io.drivers.rmw.attachment import Attachment, AttachmentError, gid_of
+from gazebot.io.drivers.rmw.attachment import (
+    Attachment,
+    AttachmentError,
+    LegacyAttachmentError,
+    gid_of,
+)
 from gazebot.io.drivers.rmw.graph import ADMIN_SPACE, Entity, Graph, Kind
 from gazebot.io.drivers.rmw.names import Names, check_namespace, check_node_name
-from gazebot.io.drivers.rmw.qos import DEFAULT, QosProfile
+from gazebot.io.drivers.rmw.qos import HEARTBEAT_S, KEEP_ALL, QosProfile, qos_of
 from gazebot.io.ros2.codec import MAX_PAYLOAD_BYTES, Codec
 from gazebot.io.ros2.errors import MessageError, one_line
 from gazebot.io.ros2.names import ros_type_name
-from gazebot.io.ros2.topics import max_bytes_of
+from gazebot.io.ros2.topics import durability_of, max_bytes_of
 
 if TYPE_CHECKING:
     import zenoh
@@ -107,7 +119,7 @@ class Publisher:
         self.gid = gid_of(self.entity.token())
         self._seq = 0
         self._lock = threading.Lock()
-        self._pub = node.session.declare_publisher(self.key)
+        self._pub = _declare_publisher(node.session, self.key, qos)
         self._token = node.session.liveliness().declare_token(self.entity.token())
 
     def publish(self, msg: object) -> bool:
@@ -174,7 +186,8 @@ class Subscription:
         self._expected = tuple(f"{c.info.name} ({c.info.hash})" for c in codecs)
         self.entity = node.entity("MS", topic, codecs[0], qos)
         self.received = 0
-        self._sub = node.session.declare_subscriber(node.names.key_any_type(topic), self._on)
+        self._sub = _declare_subscriber(node.session, node.names.key_any_type(topic), self._on,
+                                        qos)
         self._token = node.session.liveliness().declare_token(self.entity.token())
 
     def _on(self, sample: zenoh.Sample) -> None:
@@ -201,8 +214,12 @@ class Subscription:
         if sample.attachment is not None:
             try:
                 att = Attachment.decode(sample.attachment.to_bytes())
+            except LegacyAttachmentError:
+                self.node.legacy_peer_seen(self.topic)
             except AttachmentError:
                 att = None
+            if att is not None and att.legacy:
+                self.node.legacy_peer_seen(self.topic)
         self.received += 1
         try:
             self.handler(msg, Received(self.topic, codec.info.name, att))
@@ -267,6 +284,7 @@ class RosNode:
         self._codecs: dict[tuple[str, int], Codec] = {}
         self._entities: list[Any] = []
         self._token: Any = None
+        self._legacy_warned = False
         self._graph_sub = session.liveliness().declare_subscriber(
             f"{ADMIN_SPACE}/{names.domain_id}/**", self._on_token, history=True)
 
@@ -296,6 +314,15 @@ class RosNode:
             except Exception:
                 log.exception("graph callback failed")
 
+    def legacy_peer_seen(self, topic: str) -> None:
+        """A sample with the labelled attachment of rmw_zenoh 0.2.0-0.2.3 arrived: warn once
+        per node (its message is used all the same)."""
+        if not self._legacy_warned:
+            self._legacy_warned = True
+            log.warning("a publisher on %s uses rmw_zenoh 0.2.0-0.2.3 (labelled attachment); "
+                        "gazebot reads it, but supports rmw_zenoh 0.2.4 and later (docs/bus.md)",
+                        topic)
+
     def announce(self) -> None:
         """Declare the node's own token: call after the node's endpoints, so a peer that sees
         the node also finds all its subscriptions declared."""
@@ -312,22 +339,27 @@ class RosNode:
             self._codecs[key] = Codec.for_type(self.store, ros_type, cap)
         return self._codecs[key]
 
-    def publisher(self, name: str, ros_type: str, qos: QosProfile = DEFAULT) -> Publisher:
-        """A publisher of ``ros_type`` on topic ``name`` (resolved: namespace, remapping)."""
+    def publisher(self, name: str, ros_type: str, qos: QosProfile | None = None) -> Publisher:
+        """A publisher of ``ros_type`` on topic ``name`` (resolved: namespace, remapping);
+        ``qos`` defaults to the topic's durability and depth in :mod:`gazebot.io.ros2.topics`
+        (ROS 2's default profile for a topic not in it)."""
         topic = self.names.resolve(name)
-        pub = Publisher(self, topic, self.codec(ros_type, topic, name), qos)
+        pub = Publisher(self, topic, self.codec(ros_type, topic, name), qos or qos_of(
+            *durability_of(name)))
         self._entities.append(pub)
         return pub
 
     def subscription(self, name: str, ros_types: str | Sequence[str], handler: Handler,
-                     qos: QosProfile = DEFAULT, raw: bool = False) -> Subscription:
+                     qos: QosProfile | None = None, raw: bool = False) -> Subscription:
         """Subscribe to topic ``name`` accepting ``ros_types`` (the first one is advertised);
         ``handler(msg, received)`` runs on Zenoh's thread for each well-formed message (``raw``:
-        with the CDR bytes as received instead of the message)."""
+        with the CDR bytes as received instead of the message). ``qos`` defaults as for
+        :meth:`publisher`; a transient-local one also receives the last ``depth`` messages of
+        each transient-local publisher, whenever it started."""
         topic = self.names.resolve(name)
         types = [ros_types] if isinstance(ros_types, str) else list(ros_types)
-        sub = Subscription(self, topic, [self.codec(t, topic, name) for t in types], handler, qos,
-                           raw)
+        sub = Subscription(self, topic, [self.codec(t, topic, name) for t in types], handler,
+                           qos or qos_of(*durability_of(name)), raw)
         self._entities.append(sub)
         return sub
 
@@ -351,3 +383,46 @@ class RosNode:
             except Exception:  # the session may already be closed
                 pass
         self._entities.clear()
+
+
+def _declare_publisher(session: zenoh.Session, key: str, qos: QosProfile) -> Any:
+    """The Zenoh publisher of an rmw_zenoh publisher of ``qos`` (``PublisherData::make``):
+    reliability as asked, congestion control ``BLOCK`` only for reliable keep-all; for transient
+    local an ``AdvancedPublisher`` with a cache of ``depth`` samples and publisher detection, and
+    sample-miss detection by sporadic heartbeat when reliable."""
+    import zenoh
+    import zenoh.ext as zext
+
+    reliability = zenoh.Reliability.RELIABLE if qos.reliable else zenoh.Reliability.BEST_EFFORT
+    congestion = (zenoh.CongestionControl.BLOCK if qos.reliable and qos.history == KEEP_ALL
+                  else zenoh.CongestionControl.DROP)
+    if not qos.transient_local:
+        return session.declare_publisher(key, reliability=reliability,
+                                         congestion_control=congestion)
+    miss = (zext.MissDetectionConfig(heartbeat=None, sporadic_heartbeat=HEARTBEAT_S)
+            if qos.reliable else None)
+    try:
+        return zext.declare_advanced_publisher(
+            session, key, reliability=reliability, congestion_control=congestion,
+            cache=zext.CacheConfig(max_samples=qos.depth), publisher_detection=True,
+            sample_miss_detection=miss)
+    except zenoh.ZError as exc:
+        # A best-effort cache orders by timestamp: the session needs Zenoh's ``timestamping``.
+        raise ValueError(f"cannot publish {key} transient local: {exc}") from exc
+
+
+def _declare_subscriber(session: zenoh.Session, key: str, callback: Callable[[zenoh.Sample], None],
+                        qos: QosProfile) -> Any:
+    """The Zenoh subscriber of an rmw_zenoh subscription of ``qos``
+    (``SubscriptionData::init``): plain when volatile; for transient local an
+    ``AdvancedSubscriber`` with subscriber detection and a history query of ``depth`` samples
+    per publisher that also detects late-joining publishers, and, when reliable, last-sample
+    recovery on the publishers' heartbeats."""
+    if not qos.transient_local:
+        return session.declare_subscriber(key, callback)
+    import zenoh.ext as zext
+
+    recovery = zext.RecoveryConfig(periodic_queries=None, heartbeat=True) if qos.reliable else None
+    return zext.declare_advanced_subscriber(
+        session, key, callback, subscriber_detection=True, recovery=recovery,
+        history=zext.HistoryConfig(detect_late_publishers=True, max_samples=qos.depth))

@@ -31,6 +31,15 @@ class QosProfile:
     liveliness: int = AUTOMATIC
     lease: tuple[int, int] = INFINITE
 
+    @property
+    def transient_local(self) -> bool:
+        """Whether a late subscription receives the last ``depth`` samples (latched)."""
+        return self.durability == TRANSIENT_LOCAL
+
+    @property
+    def reliable(self) -> bool:
+        return self.reliability == RELIABLE
+
     def encode(self) -> str:
         """The token chunk, values equal to :data:`RMW_ZENOH_DEFAULT` left empty."""
         d = RMW_ZENOH_DEFAULT
@@ -81,3 +90,23 @@ RMW_ZENOH_DEFAULT = QosProfile(depth=42)
 #: What gazebot's publishers and subscriptions use: ROS 2's default profile (reliable, volatile,
 #: keep last 10), so ``ros2 topic echo`` with its defaults matches.
 DEFAULT = QosProfile()
+
+#: A latched topic as ``robot_state_publisher`` publishes ``/robot_description`` and
+#: ``tf2_ros::StaticTransformBroadcaster`` ``/tf_static``: reliable, transient local, keep last 1.
+LATCHED = QosProfile(durability=TRANSIENT_LOCAL, depth=1)
+
+#: Period of the sporadic heartbeat of a reliable transient-local publisher (s): rmw_zenoh's
+#: ``SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD`` (500 ms), sent only when a sample was published
+#: since the last one, so a subscriber detects a lost last sample and fetches it from the cache.
+HEARTBEAT_S = 0.5
+
+
+def qos_of(durability: str, depth: int) -> QosProfile:
+    """The reliable keep-last profile of ``durability`` (``volatile`` or ``transient_local``)
+    and ``depth``; ``ValueError`` naming what was expected."""
+    kinds = {"volatile": VOLATILE, "transient_local": TRANSIENT_LOCAL}
+    if durability not in kinds:
+        raise ValueError(f"durability must be 'volatile' or 'transient_local', got {durability!r}")
+    if not (isinstance(depth, int) and depth > 0):
+        raise ValueError(f"QoS depth must be a positive integer, got {depth!r}")
+    return QosProfile(durability=kinds[durability], depth=depth)
