@@ -32,6 +32,7 @@ COMMAND_MODULES = (
     "gps",
     "bip",
     "topic",
+    "mcap",
     "node",
 )
 

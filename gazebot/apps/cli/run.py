@@ -19,6 +19,7 @@ from gazebot.apps.cli.bus import (
     robot_base_frame,
 )
 from gazebot.apps.cli.errors import robot_with_gaze_mode
+from gazebot.apps.cli.mcap import add_record_split_arguments, record_split
 
 
 class DeprecatedAlias(argparse.Action):
@@ -72,6 +73,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "SIGTERM)")
     add_bus_arguments(p, listens_by_default=False)
     add_record_argument(p)
+    add_record_split_arguments(p)
     p.set_defaults(func=handle)
 
 
@@ -98,7 +100,8 @@ def handle(args: argparse.Namespace) -> int:
         if args.record:
             from gazebot.io.drivers.recorder import BusRecorder
 
-            recorder = BusRecorder(driver.session, cfg.names, args.record)
+            recorder = BusRecorder(driver.session, cfg.names, args.record,
+                                   split=record_split(args))
         endpoints = f"listen {list(cfg.listen)}, connect {list(cfg.connect)}"
 
         def warn(text: str) -> None:
@@ -129,7 +132,8 @@ def handle(args: argparse.Namespace) -> int:
             "type_mismatches": {k: str(v) for k, v in driver.type_mismatches().items()},
         }
         if recorder is not None:
-            summary["recorded"] = {"file": str(recorder.close()), "messages": recorder.messages}
+            summary["recorded"] = {"file": str(recorder.close()), "messages": recorder.messages,
+                                   "files": [str(f) for f in recorder.files]}
     finally:
         if recorder is not None:
             recorder.close()

@@ -1,0 +1,151 @@
+"""The records of an MCAP file in file order, with bounded cost: every chunk's declared
+uncompressed size and compression ratio are checked before it is decompressed, and it is
+decompressed to at most its declared size (the ``mcap`` library's own readers allocate whatever
+a chunk declares: a 32 kB file declaring a 1 GiB zstd chunk, or an lz4 bomb, runs for minutes
+at gigabytes). Used by :mod:`.mcap_file` and :mod:`.mcap_recover`.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import struct
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any, BinaryIO
+
+from mcap.exceptions import McapError
+from mcap.records import Channel, Chunk, Footer, Message, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk
+
+# A chunk declaring less than this is decompressed whatever its ratio: its cost is bounded, and
+# a small chunk of repeated messages compresses far beyond any ratio a bomb is refused at.
+_RATIO_FLOOR_BYTES = 1024 * 1024
+
+
+class ChunkLimitError(ValueError):
+    """A chunk over a limit (declared size or compression ratio): hostile or damaged input,
+    never read as a recording cut short."""
+
+
+class DamagedError(ValueError):
+    """A record that does not parse (a file cut short ends with one)."""
+
+
+@dataclass
+class McapRecords:
+    """What :func:`iter_messages` found: :attr:`finished` (the file ends with its footer),
+    the schemas and channels by id, and the number of chunks read."""
+
+    schemas: dict[int, Schema] = field(default_factory=dict)
+    channels: dict[int, Channel] = field(default_factory=dict)
+    chunks: int = 0
+    finished: bool = False
+
+
+class CappedReads:
+    """A binary file whose ``read(n)`` never asks for more than is left in it: the mcap reader
+    reads a record's length field and then that many bytes, so one damaged length in a 1 kB
+    file would otherwise allocate up to gigabytes before finding the file too short."""
+
+    def __init__(self, f: BinaryIO) -> None:
+        self._f = f
+        self._size = os.fstat(f.fileno()).st_size
+
+    def read(self, n: int | None = -1) -> bytes:
+        if n is None or n < 0:
+            return self._f.read()
+        return self._f.read(max(0, min(n, self._size - self._f.tell())))
+
+    def __getattr__(self, name: str) -> Any:  # seek, tell, seekable, ... of the file
+        return getattr(self._f, name)
+
+
+def decompress_chunk(chunk: Chunk, number: int, max_bytes: int, max_ratio: float) -> bytes:
+    """The records of ``chunk`` (the ``number``-th of its file, from 1), uncompressed.
+
+    Raises:
+        ChunkLimitError: The chunk declares more than ``max_bytes``, or (declaring over 1 MiB)
+            more than ``max_ratio`` times its compressed size.
+        DamagedError: An unknown compression, data that does not decompress, or a size other
+            than declared.
+    """
+    declared, packed = chunk.uncompressed_size, len(chunk.data)
+    where = f"chunk {number}"
+    if declared > max_bytes:
+        raise ChunkLimitError(
+            f"{where} declares {declared} bytes uncompressed, over the limit of {max_bytes} "
+            "bytes (RecordingLimits.max_chunk_bytes)"
+        )
+    if declared > _RATIO_FLOOR_BYTES and declared > max_ratio * max(packed, 1):
+        raise ChunkLimitError(
+            f"{where} declares {declared} bytes from {packed} compressed "
+            f"(ratio {declared / max(packed, 1):.0f}), over the limit of {max_ratio:g} "
+            "(RecordingLimits.max_chunk_ratio)"
+        )
+    try:
+        if chunk.compression == "":
+            data = chunk.data
+        elif chunk.compression == "zstd":
+            import zstandard
+
+            # Read at most one byte past the declared size: a chunk that lies is caught there.
+            with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(chunk.data)) as r:
+                data = r.read(declared + 1)
+        elif chunk.compression == "lz4":
+            import lz4.frame
+
+            data = lz4.frame.LZ4FrameDecompressor().decompress(chunk.data, max_length=declared + 1)
+        else:
+            raise DamagedError(f"{where}: unknown compression {chunk.compression!r}")
+    except DamagedError:
+        raise
+    except Exception as exc:  # zstandard.ZstdError, RuntimeError of lz4: damaged data
+        raise DamagedError(f"{where} does not decompress ({exc})") from None
+    if len(data) != declared:
+        raise DamagedError(
+            f"{where} decompresses to {'more' if len(data) > declared else len(data)} bytes, "
+            f"declared {declared}"
+        )
+    return data
+
+
+def iter_messages(
+    f: BinaryIO, found: McapRecords, max_chunk_bytes: int, max_chunk_ratio: float
+) -> Iterator[tuple[Schema | None, Channel, Message]]:
+    """``(schema, channel, message)`` of every message of the MCAP file ``f``, in file order;
+    fills ``found`` as it goes (``finished`` once the footer is read).
+
+    Raises:
+        ChunkLimitError: A chunk over a limit (see :func:`decompress_chunk`).
+        DamagedError: A record that does not parse: where a file cut short ends, or damage.
+    """
+    reader = StreamReader(CappedReads(f), emit_chunks=True)  # type: ignore[arg-type]
+    try:
+        for record in reader.records:
+            if isinstance(record, Chunk):
+                found.chunks += 1
+                data = decompress_chunk(record, found.chunks, max_chunk_bytes, max_chunk_ratio)
+                plain = Chunk(compression="", data=data, message_start_time=0,
+                              message_end_time=0, uncompressed_crc=0,
+                              uncompressed_size=len(data))
+                inner: list[Any] = breakup_chunk(plain)
+            else:
+                inner = [record]
+            for rec in inner:
+                if isinstance(rec, Schema):
+                    found.schemas[rec.id] = rec
+                elif isinstance(rec, Channel):
+                    found.channels[rec.id] = rec
+                elif isinstance(rec, Message):
+                    channel = found.channels.get(rec.channel_id)
+                    if channel is None:
+                        raise DamagedError(f"a message on unknown channel {rec.channel_id}")
+                    yield found.schemas.get(channel.schema_id), channel, rec
+                elif isinstance(rec, Footer):
+                    found.finished = True
+    except (ChunkLimitError, DamagedError):
+        raise
+    except (McapError, struct.error, UnicodeDecodeError, ValueError, KeyError) as exc:
+        where = f"after chunk {found.chunks}" if found.chunks else "before the first chunk"
+        raise DamagedError(f"a record {where} does not parse ({exc!r})") from None
