@@ -65,12 +65,12 @@ class BusRecorder:
         self.node.announce()
 
     def _flush_loop(self, period: float) -> None:
-        # Half the period: the chunk in progress is never older than the period when written.
-        while not self._stop.wait(period / 2):
+        # Every period, whatever arrived: a message waits at most one period to be written.
+        while not self._stop.wait(period):
             with self._lock:
                 if self.mcap is not None:
                     try:
-                        self.mcap.flush_if_due()
+                        self.mcap.flush()
                     except OSError as exc:  # a full disk: said once per period, kept trying
                         log.error("recording %s: cannot write: %s", self.path, exc)
 

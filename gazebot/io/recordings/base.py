@@ -38,14 +38,15 @@ class RecordingLimits:
         max_chunk_bytes: Largest uncompressed size a compressed chunk (MCAP) may declare
             (bytes): a 32 kB file declaring 1 GiB would otherwise allocate it. rosbag2 and the
             ``mcap`` writers write chunks of 1 to 4 MiB.
-        max_chunk_ratio: Largest ratio of a chunk's uncompressed to compressed size: a
-            decompression bomb (zstd, lz4) is refused before it is decompressed.
+        max_chunk_ratio: Largest ratio of a chunk's uncompressed to compressed size (for chunks
+            declaring over 1 MiB): a decompression bomb (zstd, lz4) is refused before it is
+            decompressed. Recorded ROS 2 messages compress 3 to 20 times.
     """
 
     max_gap_s: float = 60.0
     workspace_m: float = 50.0
     max_chunk_bytes: int = 64 * 1024 * 1024
-    max_chunk_ratio: float = 1000.0
+    max_chunk_ratio: float = 100.0
 
     def __post_init__(self) -> None:
         for name in ("max_gap_s", "workspace_m", "max_chunk_bytes", "max_chunk_ratio"):

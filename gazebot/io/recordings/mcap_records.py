@@ -14,13 +14,16 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO
 
+from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
+from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Footer, Message, Schema
-from mcap.stream_reader import StreamReader, breakup_chunk
+from mcap.stream_reader import StreamReader
 
 # A chunk declaring less than this is decompressed whatever its ratio: its cost is bounded, and
 # a small chunk of repeated messages compresses far beyond any ratio a bomb is refused at.
 _RATIO_FLOOR_BYTES = 1024 * 1024
+_RECORD_HEAD = struct.Struct("<BQ")  # opcode, length
 
 
 class ChunkLimitError(ValueError):
@@ -110,6 +113,40 @@ def decompress_chunk(chunk: Chunk, number: int, max_bytes: int, max_ratio: float
     return data
 
 
+def chunk_records(data: bytes, number: int) -> Iterator[Schema | Channel | Message]:
+    """The schemas, channels and messages in a chunk's uncompressed ``data`` (other records,
+    which the MCAP specification does not put in chunks, are skipped by their length).
+
+    Raises:
+        DamagedError: A record cut short or of opcode 0 (reserved: zeros are not records, and
+            a chunk of zeros would otherwise be millions of empty records to skip).
+    """
+    size, pos = len(data), 0
+    while pos < size:
+        where = f"chunk {number}, byte {pos}"
+        if size - pos < _RECORD_HEAD.size:
+            raise DamagedError(f"{where}: a record cut short")
+        opcode, length = _RECORD_HEAD.unpack_from(data, pos)
+        body, pos = pos + _RECORD_HEAD.size, pos + _RECORD_HEAD.size + length
+        if opcode == 0:
+            raise DamagedError(f"{where}: opcode 0 is not a record")
+        if pos > size:
+            raise DamagedError(f"{where}: a record of {length} bytes past the chunk's end")
+        if opcode not in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE):
+            continue
+        stream = ReadDataStream(io.BytesIO(data[body:pos]))
+        try:
+            if opcode == Opcode.SCHEMA:
+                yield Schema.read(stream)
+            elif opcode == Opcode.CHANNEL:
+                yield Channel.read(stream)
+            else:
+                yield Message.read(stream, length)
+        except (McapError, struct.error, UnicodeDecodeError, ValueError) as exc:
+            raise DamagedError(f"{where}: {Opcode(opcode).name.lower()} does not parse "
+                               f"({exc!r})") from None
+
+
 def iter_messages(
     f: BinaryIO, found: McapRecords, max_chunk_bytes: int, max_chunk_ratio: float
 ) -> Iterator[tuple[Schema | None, Channel, Message]]:
@@ -123,15 +160,13 @@ def iter_messages(
     reader = StreamReader(CappedReads(f), emit_chunks=True)  # type: ignore[arg-type]
     try:
         for record in reader.records:
+            inner: Iterator[Any]
             if isinstance(record, Chunk):
                 found.chunks += 1
                 data = decompress_chunk(record, found.chunks, max_chunk_bytes, max_chunk_ratio)
-                plain = Chunk(compression="", data=data, message_start_time=0,
-                              message_end_time=0, uncompressed_crc=0,
-                              uncompressed_size=len(data))
-                inner: list[Any] = breakup_chunk(plain)
+                inner = chunk_records(data, found.chunks)
             else:
-                inner = [record]
+                inner = iter([record])
             for rec in inner:
                 if isinstance(rec, Schema):
                     found.schemas[rec.id] = rec

@@ -125,6 +125,7 @@ class McapRecorder:
         self.files.append(path)
         self._writer = Writer(self._file, chunk_size=self.chunk_size, compression=self.compression)
         self._writer.start(profile="ros2", library=LIBRARY)
+        self._file.flush()  # a file killed before its first chunk is an (empty) MCAP file
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, int] = {}
         self._first_ns: int | None = None
