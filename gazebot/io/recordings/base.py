@@ -45,7 +45,7 @@ class RecordingLimits:
 
     max_gap_s: float = 60.0
     workspace_m: float = 50.0
-    max_chunk_bytes: int = 64 * 1024 * 1024
+    max_chunk_bytes: int = 32 * 1024 * 1024
     max_chunk_ratio: float = 100.0
 
     def __post_init__(self) -> None:

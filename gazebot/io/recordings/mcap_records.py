@@ -24,6 +24,7 @@ from mcap.stream_reader import StreamReader
 # a small chunk of repeated messages compresses far beyond any ratio a bomb is refused at.
 _RATIO_FLOOR_BYTES = 1024 * 1024
 _RECORD_HEAD = struct.Struct("<BQ")  # opcode, length
+_PIECE = 1024 * 1024  # bytes decompressed at a time
 
 
 class ChunkLimitError(ValueError):
@@ -64,7 +65,9 @@ class CappedReads:
         return getattr(self._f, name)
 
 
-def decompress_chunk(chunk: Chunk, number: int, max_bytes: int, max_ratio: float) -> bytes:
+def decompress_chunk(
+    chunk: Chunk, number: int, max_bytes: int, max_ratio: float
+) -> bytes | bytearray:
     """The records of ``chunk`` (the ``number``-th of its file, from 1), uncompressed.
 
     Raises:
@@ -87,18 +90,17 @@ def decompress_chunk(chunk: Chunk, number: int, max_bytes: int, max_ratio: float
             "(RecordingLimits.max_chunk_ratio)"
         )
     try:
+        # Up to one piece past the declared size (a chunk that lies is caught there),
+        # appended to one buffer: the declared size is held once, not twice.
         if chunk.compression == "":
-            data = chunk.data
+            data: bytes | bytearray = chunk.data
         elif chunk.compression == "zstd":
             import zstandard
 
-            # Read at most one byte past the declared size: a chunk that lies is caught there.
             with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(chunk.data)) as r:
-                data = r.read(declared + 1)
+                data = _gather(iter(lambda: r.read(_PIECE), b""), declared)
         elif chunk.compression == "lz4":
-            import lz4.frame
-
-            data = lz4.frame.LZ4FrameDecompressor().decompress(chunk.data, max_length=declared + 1)
+            data = _gather(_lz4_pieces(chunk.data), declared)
         else:
             raise DamagedError(f"{where}: unknown compression {chunk.compression!r}")
     except DamagedError:
@@ -113,7 +115,7 @@ def decompress_chunk(chunk: Chunk, number: int, max_bytes: int, max_ratio: float
     return data
 
 
-def chunk_records(data: bytes, number: int) -> Iterator[Schema | Channel | Message]:
+def chunk_records(data: bytes | bytearray, number: int) -> Iterator[Schema | Channel | Message]:
     """The schemas, channels and messages in a chunk's uncompressed ``data`` (other records,
     which the MCAP specification does not put in chunks, are skipped by their length).
 
@@ -145,6 +147,29 @@ def chunk_records(data: bytes, number: int) -> Iterator[Schema | Channel | Messa
         except (McapError, struct.error, UnicodeDecodeError, ValueError) as exc:
             raise DamagedError(f"{where}: {Opcode(opcode).name.lower()} does not parse "
                                f"({exc!r})") from None
+
+
+def _lz4_pieces(data: bytes) -> Iterator[bytes]:
+    """The decompressed lz4 frame ``data``, ``_PIECE`` bytes at a time."""
+    import lz4.frame
+
+    lz = lz4.frame.LZ4FrameDecompressor()
+    out = lz.decompress(data, max_length=_PIECE)
+    while out:
+        yield out
+        if lz.eof or lz.needs_input:
+            return
+        out = lz.decompress(b"", max_length=_PIECE)
+
+
+def _gather(pieces: Iterator[bytes], limit: int) -> bytearray:
+    """The ``pieces`` joined, stopping once more than ``limit`` bytes came."""
+    out = bytearray()
+    for piece in pieces:
+        out += piece
+        if len(out) > limit:
+            break
+    return out
 
 
 def iter_messages(

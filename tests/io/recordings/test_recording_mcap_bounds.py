@@ -73,15 +73,15 @@ def test_a_32_kB_file_declaring_a_1_GiB_chunk_is_refused_naming_chunk_and_limit(
                          1024 * MiB)
     with bounded_memory(10e6):
         text = _one_line_error(f, "chunk 1 declares 1073741824 bytes")
-    assert "RecordingLimits.max_chunk_bytes" in text and str(64 * MiB) in text
+    assert "RecordingLimits.max_chunk_bytes" in text and str(32 * MiB) in text
 
 
 def test_a_zstd_bomb_under_the_size_limit_is_refused_by_its_ratio(tmp_path, bounded_memory):
-    data = _zeros_compressed("zstd", 32 * MiB)
-    f = _mcap_with_chunk(tmp_path / "bomb.mcap", "zstd", data, 32 * MiB)
+    data = _zeros_compressed("zstd", 30 * MiB)
+    f = _mcap_with_chunk(tmp_path / "bomb.mcap", "zstd", data, 30 * MiB)
     with bounded_memory(10e6):
         _one_line_error(f, "RecordingLimits.max_chunk_ratio")
-    # Allowed a higher ratio, it is decompressed (32 MiB, within the bound): zeros are no records.
+    # Allowed a higher ratio, it is decompressed (30 MiB, within the bound): zeros are no records.
     limits = RecordingLimits(max_chunk_ratio=1e9)
     with bounded_memory(100e6), pytest.raises(RecordingError, match="opcode 0 is not a record"):
         load_recording(f, limits=limits)
@@ -123,7 +123,7 @@ def test_any_declared_size_of_any_chunk_reads_or_fails_in_one_line_in_bounded_me
     data = _zeros_compressed(compression, size)
     n = {"true": size, "less": max(0, size - 1), "more": size + 1}.get(declared, declared)
     f = _mcap_with_chunk(tmp_path_factory.mktemp("chunk") / "c.mcap", compression, data, n)
-    # The declared cap (64 MiB) and the output bound: never more than the cap decompressed.
+    # The declared cap (32 MiB) and the output bound: never more than the cap decompressed.
     with bounded_memory(100e6):
         for read in (load_recording, recover_mcap):
             try:
