@@ -65,19 +65,13 @@ class CappedReads:
         return getattr(self._f, name)
 
 
-def decompress_chunk(
-    chunk: Chunk, number: int, max_bytes: int, max_ratio: float
-) -> bytes | bytearray:
-    """The records of ``chunk`` (the ``number``-th of its file, from 1), uncompressed.
+def check_chunk(where: str, declared: int, packed: int, max_bytes: int, max_ratio: float) -> None:
+    """Refuse a chunk (named ``where``) declaring ``declared`` bytes uncompressed from ``packed``
+    bytes over the limits (see :func:`decompress_chunk`).
 
     Raises:
-        ChunkLimitError: The chunk declares more than ``max_bytes``, or (declaring over 1 MiB)
-            more than ``max_ratio`` times its compressed size.
-        DamagedError: An unknown compression, data that does not decompress, or a size other
-            than declared.
+        ChunkLimitError: Over a limit.
     """
-    declared, packed = chunk.uncompressed_size, len(chunk.data)
-    where = f"chunk {number}"
     if declared > max_bytes:
         raise ChunkLimitError(
             f"{where} declares {declared} bytes uncompressed, over the limit of {max_bytes} "
@@ -89,6 +83,44 @@ def decompress_chunk(
             f"(ratio {declared / max(packed, 1):.0f}), over the limit of {max_ratio:g} "
             "(RecordingLimits.max_chunk_ratio)"
         )
+
+
+def check_mcap_chunks(f: BinaryIO, max_bytes: int, max_ratio: float) -> None:
+    """Check every chunk of the MCAP file ``f`` against the limits without decompressing any
+    (for readers that decompress by themselves, as rosbags does); stops quietly where the file
+    stops parsing (the reader reports that).
+
+    Raises:
+        ChunkLimitError: A chunk over a limit.
+    """
+    number = 0
+    records = StreamReader(CappedReads(f), emit_chunks=True).records  # type: ignore[arg-type]
+    try:
+        for record in records:
+            if isinstance(record, Chunk):
+                number += 1
+                check_chunk(f"chunk {number}", record.uncompressed_size, len(record.data),
+                            max_bytes, max_ratio)
+    except ChunkLimitError:
+        raise
+    except (McapError, struct.error, UnicodeDecodeError, ValueError, KeyError):
+        return
+
+
+def decompress_chunk(
+    chunk: Chunk, number: int, max_bytes: int, max_ratio: float
+) -> bytes | bytearray:
+    """The records of ``chunk`` (the ``number``-th of its file, from 1), uncompressed.
+
+    Raises:
+        ChunkLimitError: The chunk declares more than ``max_bytes``, or (declaring over 1 MiB)
+            more than ``max_ratio`` times its compressed size.
+        DamagedError: An unknown compression, data that does not decompress, or a size other
+            than declared.
+    """
+    declared = chunk.uncompressed_size
+    where = f"chunk {number}"
+    check_chunk(where, declared, len(chunk.data), max_bytes, max_ratio)
     try:
         # Up to one piece past the declared size (a chunk that lies is caught there),
         # appended to one buffer: the declared size is held once, not twice.

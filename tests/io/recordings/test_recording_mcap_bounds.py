@@ -140,3 +140,36 @@ def test_a_csv_header_of_200k_columns_is_checked_for_duplicates_linearly(tmp_pat
     with bounded_memory(200e6), pytest.raises(RecordingError) as info:
         load_recording(f)
     assert str(info.value) == f"{f}: line 1, column 'c7': duplicate column"
+
+
+def _bag1_with_chunk(path: Path, data: bytes, declared: int, compression: bytes = b"bz2"):
+    """A ROS 1 bag (format 2.0) whose first record is a chunk of ``data`` declaring
+    ``declared`` bytes uncompressed."""
+    import struct
+
+    def field(name: bytes, value: bytes) -> bytes:
+        return struct.pack("<I", len(name) + 1 + len(value)) + name + b"=" + value
+
+    header = (field(b"op", b"\x05") + field(b"compression", compression)
+              + field(b"size", struct.pack("<I", declared)))
+    path.write_bytes(b"#ROSBAG V2.0\n" + struct.pack("<I", len(header)) + header
+                     + struct.pack("<I", len(data)) + data)
+    return path
+
+
+def test_bag_readers_check_chunks_before_rosbags_decompresses_them(tmp_path, bounded_memory):
+    import bz2
+
+    from gazebot.io.recordings.rosbag import read_bag
+
+    bomb = bz2.compress(b"\0" * (8 * MiB))  # ~50 bytes declaring 8 MiB
+    ros1 = _bag1_with_chunk(tmp_path / "bomb.bag", bomb, 8 * MiB)
+    with bounded_memory(10e6):
+        _one_line_error(ros1, "chunk 1 declares 8388608 bytes from")
+    huge = _bag1_with_chunk(tmp_path / "huge.bag", bomb, 2**32 - 1)
+    with bounded_memory(10e6):
+        _one_line_error(huge, "RecordingLimits.max_chunk_bytes")
+    ros2 = _mcap_with_chunk(tmp_path / "gib.mcap", "zstd", _zeros_compressed("zstd", MiB),
+                            1024 * MiB)
+    with bounded_memory(10e6), pytest.raises(RecordingError, match="refused: chunk 1 declares"):
+        read_bag(ros2)
