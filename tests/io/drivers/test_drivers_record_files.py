@@ -136,3 +136,37 @@ def test_nothing_is_kept_per_message_beyond_the_chunk_in_progress(tmp_path):
         tracemalloc.stop()
     rec.close()
     assert grown < 300_000, f"{grown} bytes kept over 15000 messages"
+
+
+@pytest.mark.zenoh
+def test_the_bus_recorder_splits_into_finished_files(bus, tmp_path):
+    import time
+
+    from drivers_fakes import wait_until
+
+    from gazebot.io.drivers.recorder import BusRecorder
+    from gazebot.io.drivers.rmw.node import RosNode
+    from gazebot.io.ros2 import topics as tp
+
+    recorder = BusRecorder(bus.listener(), bus.names, tmp_path / "bus.mcap",
+                           split=Split(max_duration_s=0.5))
+    bus.closers.append(recorder.close)
+    node = RosNode(bus.connector(), bus.names, "publisher")
+    bus.closers.append(node.close)
+    pub = node.publisher(tp.GAZE_TARGET.name, tp.GAZE_TARGET.type)
+    node.announce()
+    i = 0
+
+    def publish_until_split() -> bool:
+        nonlocal i
+        i += 1
+        pub.publish(cv.point_stamped(0.0, [i, 0, 0], "world"))
+        time.sleep(0.02)
+        return len(recorder.files) >= 3
+
+    assert wait_until(publish_until_split, timeout=60)
+    recorder.close()
+    files = recorder.files
+    assert files[:3] == [tmp_path / f"bus_{k}.mcap" for k in range(3)]
+    assert sorted(tmp_path.iterdir()) == sorted(files)
+    assert sum(len(_indexed(f)) for f in files) == recorder.messages > 0
