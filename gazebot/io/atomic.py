@@ -1,7 +1,9 @@
-"""Atomic output files: the videos, MCAP recordings, study exports, cached study videos and
-their sidecars go to a hidden temporary file beside the target and are renamed over it only when
-writing finished without an error, so an interrupted or failing run never leaves a truncated
-file where a reader expects a whole one (and an older whole file stays until it is replaced).
+"""Atomic output files: the videos, study exports, cached study videos and their sidecars go to
+a hidden temporary file beside the target and are renamed over it only when writing finished
+without an error, so an interrupted or failing run never leaves a truncated file where a reader
+expects a whole one (and an older whole file stays until it is replaced). MCAP recordings are
+not written this way: they are written under their final name, a chunk flushed every second, so
+a killed run keeps what it recorded (:mod:`gazebot.io.ros2.mcap_writer`).
 """
 
 from __future__ import annotations

@@ -33,6 +33,7 @@ COMMAND_MODULES = (
     "gps",
     "bip",
     "topic",
+    "mcap",
     "node",
     "robots",
     "view",

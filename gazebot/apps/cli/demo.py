@@ -1,7 +1,7 @@
 """``gazebot demo``: the main job. Simulates a human-to-robot handover in MuJoCo with the gaze
 engine driving the robot's head and eyes, and writes ``handover.mp4``, ``timeline.csv``,
-``timeline.png`` and ``handover.mcap`` (every ROS 2 topic of the run, log time = simulation time)
-into the output folder."""
+``timeline.png`` and ``handover.mcap`` (every ROS 2 topic of the run, log time = wall clock,
+header stamps = simulation time) into the output folder."""
 
 from __future__ import annotations
 

@@ -22,6 +22,7 @@ from gazebot.apps.cli.bus import (
 from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument
 from gazebot.apps.cli.errors import robot_with_gaze_mode
 from gazebot.apps.cli.extras import extra_for
+from gazebot.apps.cli.mcap import add_record_split_arguments, record_split
 from gazebot.core.defaults import DEFAULT_BEHAVIOR
 from gazebot.io.drivers.engine_node import EngineNodeConfig
 
@@ -82,6 +83,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "SIGTERM)")
     add_bus_arguments(p, listens_by_default=False)
     add_record_argument(p)
+    add_record_split_arguments(p)
     p.set_defaults(func=handle)
 
 
@@ -107,7 +109,8 @@ def handle(args: argparse.Namespace) -> int:
         if args.record:
             from gazebot.io.drivers.recorder import BusRecorder
 
-            recorder = BusRecorder(driver.session, cfg.names, args.record)
+            recorder = BusRecorder(driver.session, cfg.names, args.record,
+                                   split=record_split(args))
         endpoints = f"listen {list(cfg.listen)}, connect {list(cfg.connect)}"
 
         def warn(text: str) -> None:
@@ -138,7 +141,8 @@ def handle(args: argparse.Namespace) -> int:
             "type_mismatches": {k: str(v) for k, v in driver.type_mismatches().items()},
         }
         if recorder is not None:
-            summary["recorded"] = {"file": str(recorder.close()), "messages": recorder.messages}
+            summary["recorded"] = {"file": str(recorder.close()), "messages": recorder.messages,
+                                   "files": [str(f) for f in recorder.files]}
     finally:
         if recorder is not None:
             recorder.close()

@@ -18,6 +18,7 @@ from gazebot.apps.cli.bus import (
 )
 from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
 from gazebot.apps.cli.errors import UsageError, robot_with_gaze_mode
+from gazebot.apps.cli.mcap import add_record_split_arguments, record_split
 from gazebot.apps.render.video_settings import VIDEO
 from gazebot.core.defaults import DEFAULT_BEHAVIOR
 
@@ -56,6 +57,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
     add_bus_arguments(p, listens_by_default=True)
     add_record_argument(p)
+    add_record_split_arguments(p)
     p.set_defaults(func=handle)
 
 
@@ -122,7 +124,8 @@ def handle(args: argparse.Namespace) -> int:
         if args.record:
             from gazebot.io.drivers.recorder import BusRecorder
 
-            recorder = BusRecorder(endpoint.session, cfg.names, args.record)
+            recorder = BusRecorder(endpoint.session, cfg.names, args.record,
+                                   split=record_split(args))
         node = SimNode(sim, endpoint, SimNodeConfig(speed=args.speed), view=view)
         node.publish_state()
         if args.with_engine:
@@ -173,7 +176,8 @@ def handle(args: argparse.Namespace) -> int:
         if recorder is not None:
             path = recorder.close()  # before the session closes
             if summary:
-                summary["recorded"] = {"file": str(path), "messages": recorder.messages}
+                summary["recorded"] = {"file": str(path), "messages": recorder.messages,
+                                       "files": [str(f) for f in recorder.files]}
         if engine_node is not None and summary:
             summary["engine"] = {
                 "frames": engine_node.frames_processed,

@@ -35,13 +35,21 @@ class RecordingLimits:
             step allocate gigabytes.
         workspace_m: Largest plausible coordinate magnitude (m, after the unit): a point
             beyond it (or infinite) is a missing sample, counted.
+        max_chunk_bytes: Largest uncompressed size a compressed chunk (MCAP) may declare
+            (bytes): a 32 kB file declaring 1 GiB would otherwise allocate it. rosbag2 and the
+            ``mcap`` writers write chunks of 1 to 4 MiB.
+        max_chunk_ratio: Largest ratio of a chunk's uncompressed to compressed size (for chunks
+            declaring over 1 MiB): a decompression bomb (zstd, lz4) is refused before it is
+            decompressed. Recorded ROS 2 messages compress 3 to 20 times.
     """
 
     max_gap_s: float = 60.0
     workspace_m: float = 50.0
+    max_chunk_bytes: int = 32 * 1024 * 1024
+    max_chunk_ratio: float = 100.0
 
     def __post_init__(self) -> None:
-        for name in ("max_gap_s", "workspace_m"):
+        for name in ("max_gap_s", "workspace_m", "max_chunk_bytes", "max_chunk_ratio"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v}")

@@ -64,9 +64,11 @@ def read_csv(
     time_col = next((c for c in header if c.lower() in TIME_COLUMNS), None)
     if time_col is None:
         raise RecordingError(path, f"line 1: no time column (one of {', '.join(TIME_COLUMNS)})")
+    seen: set[str] = set()
     for col in header:
-        if header.count(col) > 1:
+        if col in seen:
             raise RecordingError(path, f"line 1, column '{col}': duplicate column")
+        seen.add(col)
     values: list[list[float]] = []
     lines: list[int] = []
     for lineno, row in enumerate(rows[1:], start=2):

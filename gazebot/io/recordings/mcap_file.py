@@ -12,7 +12,6 @@ as in :mod:`.rosbag`. A coordinate that is NaN or infinite is a missing sample.
 
 from __future__ import annotations
 
-import os
 import struct
 from collections.abc import Iterator
 from pathlib import Path
@@ -28,6 +27,13 @@ from gazebot.io.recordings.base import (
     build,
     hold_values,
     sample_streams,
+)
+from gazebot.io.recordings.mcap_records import (
+    CappedReads,
+    ChunkLimitError,
+    DamagedError,
+    McapRecords,
+    iter_messages,
 )
 from gazebot.io.ros2 import convert as cv
 from gazebot.io.ros2 import topics as ros_topics
@@ -83,10 +89,11 @@ def read_mcap(
                                             float(p.z)))
 
     notes: list[str] = []
+    limits = limits or RecordingLimits()
     try:
         with open(path, "rb") as raw:
-            f = _CappedReads(raw)
-            for schema, channel, message in _messages(f, notes):  # type: ignore[arg-type]
+            f = CappedReads(raw)
+            for schema, channel, message in _messages(f, notes, limits):  # type: ignore[arg-type]
                 if schema is None or schema.encoding != "ros2msg":
                     continue
                 if channel.message_encoding != "cdr":
@@ -126,12 +133,13 @@ def read_mcap(
                         load.append((shape.stamp(share.header), float(share.share)))
     except (RecordingError, FileNotFoundError):
         raise
+    except ChunkLimitError as exc:
+        raise RecordingError(path, f"refused: {exc}") from None
     except Exception as exc:  # mcap, its decompressors (zstd, lz4), struct: a damaged file
         # McapError, MessageError, OSError, ValueError, KeyError, struct.error, ZstdError...
         raise RecordingError(path, f"not a readable MCAP file of ROS 2 messages ({exc})") from None
     if not series:
         raise RecordingError(path, "no PoseStamped, PointStamped, TransformStamped or /tf data")
-    limits = limits or RecordingLimits()
     series, beyond, namer = bound_streams(path, series, limits)
     t, points = sample_streams(series, max_gap)
     topics = sorted(points)
@@ -146,49 +154,41 @@ def read_mcap(
     return rec
 
 
-class _CappedReads:
-    """A binary file whose ``read(n)`` never asks for more than is left in it: the mcap reader
-    reads a record's length field and then that many bytes, so one damaged length in a 1 kB
-    file would otherwise allocate up to gigabytes before finding the file too short."""
-
-    def __init__(self, f: BinaryIO) -> None:
-        self._f = f
-        self._size = os.fstat(f.fileno()).st_size
-
-    def read(self, n: int | None = -1) -> bytes:
-        if n is None or n < 0:
-            return self._f.read()
-        return self._f.read(max(0, min(n, self._size - self._f.tell())))
-
-    def __getattr__(self, name: str) -> Any:  # seek, tell, seekable, ... of the file
-        return getattr(self._f, name)
-
-
-def _messages(f: BinaryIO, notes: list[str]) -> Iterator[tuple[Any, Any, Any]]:
-    """``(schema, channel, message)`` of every message: indexed reading of a finished file, else
-    (a recording cut short, e.g. by a crash) every complete chunk up to the cut, with a note."""
+def _has_footer(f: BinaryIO) -> bool:
+    """Whether ``f`` is a finished MCAP file (its footer and summary read)."""
     from mcap.exceptions import McapError
-    from mcap.reader import NonSeekingReader, make_reader
+    from mcap.reader import make_reader
 
     try:
-        reader = make_reader(f)
-        reader.get_summary()  # a finished file has its footer
-    except (McapError, struct.error):  # struct.error: shorter than the magic and a record
+        make_reader(f).get_summary()
+    except (McapError, struct.error, ValueError):  # struct.error: shorter than a record
+        return False
+    finally:
         f.seek(0)
-        count, last = 0, None
-        try:
-            # In file order (a time-ordered stream would hold everything back to sort it).
-            for item in NonSeekingReader(f).iter_messages(log_time_order=False):
-                count, last = count + 1, item[2].log_time
-                yield item
-        except (McapError, struct.error) as exc:  # the stream reader meets the cut
-            if not count:
-                raise ValueError(
-                    f"no footer, and cut short before the first complete chunk ({exc!r})"
-                ) from None
-            notes.append(
-                f"the file is cut short ({exc!r}); read the {count} messages before the cut "
-                f"(up to log time {(last or 0) * 1e-9:.3f} s)"
-            )
-        return
-    yield from reader.iter_messages()
+    return True
+
+
+def _messages(
+    f: BinaryIO, notes: list[str], limits: RecordingLimits
+) -> Iterator[tuple[Any, Any, Any]]:
+    """``(schema, channel, message)`` of every message in file order (every chunk bounded: see
+    :mod:`.mcap_records`); of a file without footer (a recording cut short, e.g. by a crash)
+    every complete chunk up to the cut, with a note."""
+    finished = _has_footer(f)
+    found = McapRecords()
+    count, last = 0, None
+    try:
+        for item in iter_messages(f, found, limits.max_chunk_bytes, limits.max_chunk_ratio):
+            count, last = count + 1, item[2].log_time
+            yield item
+    except DamagedError as exc:
+        if finished:
+            raise
+        if not count:
+            raise ValueError(
+                f"no footer, and cut short before the first complete chunk ({exc})"
+            ) from None
+        notes.append(
+            f"the file is cut short ({exc}); read the {count} messages before the cut "
+            f"(up to log time {(last or 0) * 1e-9:.3f} s)"
+        )

@@ -2,16 +2,19 @@
 file: what ``gazebot demo`` records beside its video, on the topics and types a robot running
 gazebot over ROS 2 publishes (:mod:`gazebot.io.ros2.topics`).
 
-Per tick (at the tick's robot time): the tracked bodies (``PointStamped``), gripper state and
-load share, ``/joint_states``, the robot's events, and the engine's answer (``head/command``,
-``gaze_target``, ``eyes/state``, ``handover/events``, ``handover/phase``); ``/diagnostics``
-once per ``diagnostics_period``; the eye display (``CompressedImage``, JPEG) once per
-``eye_image_period`` when an eye renderer is given.
+Log time is the run's wall clock when the tick is written, as ``ros2 bag record`` stamps what it
+receives; the robot's (simulation) time stays in the messages' header stamps, as stacks with
+``use_sim_time`` expect. Per tick (header stamps at the tick's robot time): the tracked bodies
+(``PointStamped``), gripper state and load share, ``/joint_states``, the robot's events, and
+the engine's answer (``head/command``, ``gaze_target``, ``eyes/state``, ``handover/events``,
+``handover/phase``); ``/diagnostics`` once per ``diagnostics_period``; the eye display
+(``CompressedImage``, JPEG) once per ``eye_image_period`` when an eye renderer is given.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
@@ -44,6 +47,7 @@ class HandoverMcap:
         eye_image_period: Seconds between eye images.
         diagnostics_period: Seconds between ``/diagnostics`` messages.
         node: The node name in diagnostics and as the source of events.
+        clock: The wall clock of the log times (s since the epoch).
     """
 
     def __init__(
@@ -57,6 +61,7 @@ class HandoverMcap:
         eye_image_period: float = 0.1,
         diagnostics_period: float = 1.0,
         node: str = "engine",
+        clock: Callable[[], float] = time.time,
     ) -> None:
         self.recorder = McapRecorder(path)
         self.base_frame = base_frame
@@ -67,13 +72,14 @@ class HandoverMcap:
         self.eye_image_period = eye_image_period
         self.diagnostics_period = diagnostics_period
         self.node = node
+        self.clock = clock
         self._phase: tuple[Phase, float] | None = None  # (phase, its start)
         self._next_image = -math.inf
         self._next_diag = -math.inf
         self._t0: float | None = None
 
-    def _write(self, topic: tp.Topic, msg: object, t: float) -> None:
-        self.recorder.write(topic.resolve(self.namespace), msg, t)
+    def _write(self, topic: tp.Topic, msg: object) -> None:
+        self.recorder.write(topic.resolve(self.namespace), msg, self.clock())
 
     def tick(
         self,
@@ -89,41 +95,41 @@ class HandoverMcap:
             self._t0 = t
         if frame is not None:
             for body, p in cv.tracking_points(frame).items():
-                self._write(tp.TRACKING[body], cv.point_stamped(frame.t, p, self.base_frame), t)
+                self._write(tp.TRACKING[body], cv.point_stamped(frame.t, p, self.base_frame))
             if frame.gripper_closed is not None:
-                self._write(tp.GRIPPER, cv.gripper_state(frame.t, frame.gripper_closed), t)
+                self._write(tp.GRIPPER, cv.gripper_state(frame.t, frame.gripper_closed))
             if frame.load_share is not None:
-                self._write(tp.LOAD_SHARE, cv.load_share(frame.t, frame.load_share), t)
+                self._write(tp.LOAD_SHARE, cv.load_share(frame.t, frame.load_share))
         if joints:
-            self._write(tp.JOINT_STATES, cv.joint_state(t, joints), t)
+            self._write(tp.JOINT_STATES, cv.joint_state(t, joints))
         for event in robot_events:
-            self._write(tp.ROBOT_EVENTS, cv.event_msg(event, "robot", t), t)
+            self._write(tp.ROBOT_EVENTS, cv.event_msg(event, "robot", t))
         if cmd is None:
             return
         msgs = cv.command_messages(cmd, self.base_frame, self.gaze_frame, self.time_from_start)
         if msgs.head is not None:
-            self._write(tp.HEAD_COMMAND, msgs.head, t)
+            self._write(tp.HEAD_COMMAND, msgs.head)
         if msgs.gaze_target is not None:
-            self._write(tp.GAZE_TARGET, msgs.gaze_target, t)
-        self._write(tp.EYES, msgs.eyes, t)
+            self._write(tp.GAZE_TARGET, msgs.gaze_target)
+        self._write(tp.EYES, msgs.eyes)
         for msg in msgs.events:
-            self._write(tp.EVENTS, msg, t)
+            self._write(tp.EVENTS, msg)
         phase, source = cv.command_phase(cmd)
         if self._phase is None or self._phase[0] is not phase:
             self._phase = (phase, float(cmd.t))
         self._write(tp.PHASE, cv.handover_phase(float(cmd.t), phase, self._phase[1],
-                                                source=source), t)
+                                                source=source))
         if self.eye_image is not None and t >= self._next_image:
             self._next_image = _next_slot(t, self.eye_image_period)
             img = self.eye_image(cmd.eye_yaw, cmd.eye_pitch, cmd.blink, cmd.distance)
-            self._write(tp.EYE_IMAGE, cv.compressed_image(img, t, "display"), t)
+            self._write(tp.EYE_IMAGE, cv.compressed_image(img, t, "display"))
         if t >= self._next_diag:
             self._next_diag = _next_slot(t, self.diagnostics_period)
             status = NodeStatus(
                 node=self.node, state=cmd.status, tracking=cmd.tracking, phase=phase.value,
                 uptime=t - self._t0,
             )
-            self._write(tp.DIAGNOSTICS, cv.diagnostics(status, t), t)
+            self._write(tp.DIAGNOSTICS, cv.diagnostics(status, t))
 
     def close(self) -> Path:
         """Finish the file; returns its path."""

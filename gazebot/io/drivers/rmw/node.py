@@ -204,6 +204,10 @@ class Subscription:
             mismatch = TypeMismatch(self.topic, self._expected, f"{name} ({type_hash})")
             drops.drop(self.topic, str(mismatch), mismatch)
             return
+        size = len(sample.payload)
+        if size > codec.max_bytes:  # dropped before its bytes are copied out of Zenoh's buffer
+            drops.drop(self.topic, f"oversized: {size} bytes, at most {codec.max_bytes}")
+            return
         data = sample.payload.to_bytes()
         try:
             msg = data if self.raw else codec.decode(data)
