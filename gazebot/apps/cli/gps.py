@@ -122,7 +122,7 @@ def _continue(args: argparse.Namespace):
 
     from gazebot.apps.gps.badmm import continue_training
     from gazebot.apps.gps.shell import training_targets
-    from gazebot.apps.gps.store import load_checkpoint
+    from gazebot.apps.gps.policy_store import load_checkpoint
 
     for option, value in (("--controllers", args.controllers), ("--config", args.config)):
         if value is not None:

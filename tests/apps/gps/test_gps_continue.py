@@ -16,7 +16,7 @@ pytest.importorskip("sklearn", reason="gazebot gps needs the optional extra gaze
 
 
 def test_a_run_saves_what_continuing_it_needs(trained):
-    from gazebot.apps.gps.store import load_checkpoint
+    from gazebot.apps.gps.policy_store import load_checkpoint
 
     prev, cfg = load_checkpoint(trained)
     assert len(prev.state.controllers) == 8 and prev.state.lam.shape[0] == 8
@@ -27,7 +27,7 @@ def test_a_run_saves_what_continuing_it_needs(trained):
 def test_continuing_keeps_the_eight_controllers_and_the_policy_and_adds_four_fresh_ones(trained):
     from gazebot.apps.gps.badmm import continue_training
     from gazebot.apps.gps.shell import training_targets
-    from gazebot.apps.gps.store import load_checkpoint
+    from gazebot.apps.gps.policy_store import load_checkpoint
 
     prev, cfg = load_checkpoint(trained)
     twelve = training_targets(cfg.shell, 12)
