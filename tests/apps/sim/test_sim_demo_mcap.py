@@ -171,3 +171,31 @@ def test_demo_mcap_holds_what_foxglove_draws_the_robot_hands_and_gaze_from(demo_
             np.testing.assert_allclose([start_pt.x, start_pt.y, start_pt.z], origin, atol=1e-9)
         hands += by_id[2].action == 0
     assert hands > len(got["/tf"]) // 2
+
+
+def test_the_foxglove_layout_shows_topics_and_fields_the_demo_mcap_has(demo_run):
+    import json
+    from pathlib import Path
+
+    from mcap.reader import make_reader
+
+    out, _, _ = demo_run
+    layout = json.loads((Path(__file__).parents[3] / "docs" / "foxglove-layout.json").read_text())
+    panels = layout["configById"]
+    with (out / "handover.mcap").open("rb") as f:
+        channels = {c.topic for c in make_reader(f).get_summary().channels.values()}
+    three_d = panels["3D!gazebot"]
+    shown = {t for t, cfg in three_d["topics"].items() if cfg["visible"]}
+    assert shown <= channels and {"/robot_description", "/gazebot/markers"} <= shown
+    assert three_d["followTf"] == "world"  # the shipped robots' base frame
+    paths = [p["value"] for p in panels["StateTransitions!phase"]["paths"]]
+    from gazebot.io.ros2.typestore import typestore
+
+    fields = {"/gazebot/handover/phase": set(
+        typestore().types[tp.PHASE.type].__dataclass_fields__)}
+    for path in paths:
+        topic, _, field = path.partition(".")
+        assert topic in channels and field in fields[topic]
+    for key in ("RawMessages!phase", "RawMessages!events"):
+        assert panels[key]["topicPath"] in channels
+    assert panels["Image!eyes"]["imageMode"]["imageTopic"] in channels
