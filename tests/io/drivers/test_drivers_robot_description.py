@@ -207,3 +207,34 @@ def test_a_published_description_that_is_not_a_urdf_is_a_config_error(tmp_path):
 
 
 
+
+
+def test_tiagos_urdf_as_text_gives_the_model_its_file_gives():
+    from gazebot.core.kinematics.model_files import package_search_path, resolve_package_uri
+    from gazebot.core.kinematics.robot import RobotModel
+    from gazebot.core.kinematics.robot_config import (
+        configs_dir,
+        load_robot_config,
+        resolve_model_file,
+    )
+
+    if resolve_package_uri("package://example-robot-data/package.xml",
+                           package_search_path()) is None:
+        pytest.skip("example-robot-data is not installed (pip install 'example-robot-data>=6,<7')")
+
+    path = configs_dir() / "robots" / "examples" / "tiago.yaml"
+    config, _ = load_robot_config(path)
+    urdf_file, kind = resolve_model_file(config, path)
+    assert kind == "urdf"
+    from_file = RobotModel.load(path)
+    # The YAML without its urdf: line, the URDF as the stack would publish it (its meshes are
+    # package:// URIs the kinematics never reads).
+    bare = config.model_copy(update={"urdf": None})
+    from_text = RobotModel.from_urdf_text(bare, urdf_file.read_text())
+    assert from_text.head_joints == from_file.head_joints
+    np.testing.assert_array_equal(from_text.lower, from_file.lower)
+    np.testing.assert_array_equal(from_text.velocity_limits, from_file.velocity_limits)
+    q = (from_file.lower + from_file.upper) / 3.0
+    a, b = from_text.gaze_pose(q), from_file.gaze_pose(q)
+    np.testing.assert_allclose(a.position, b.position, atol=1e-12)
+    np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-12)
