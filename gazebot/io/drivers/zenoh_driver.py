@@ -43,6 +43,9 @@ if TYPE_CHECKING:
     import zenoh
 
 log = logging.getLogger("gazebot.io.drivers")
+#: Frames counted one by one in ``untransformed``; beyond, under :data:`OTHER_FRAMES`.
+MAX_FRAMES = 100
+OTHER_FRAMES = "(other frames)"
 
 
 class ZenohRobotDriver(ZenohNode, RobotDriver):
@@ -187,14 +190,20 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
             raise MessageError(ros.__msgtype__, f"frame_id {frame!r}, expected the robot base "
                                f"frame {self.names.base_frame!r}")
         try:
-            return t, self.tf.transform_point(self.names.base_frame, frame, p, t)
+            base = self.tf.transform_point(self.names.base_frame, frame, p, t)
         except TransformError as exc:
             with self._cond:
+                if frame not in self.untransformed and len(self.untransformed) >= MAX_FRAMES:
+                    frame = OTHER_FRAMES  # a sender of ever new frame ids: stay bounded
                 n = self.untransformed[frame] = self.untransformed.get(frame, 0) + 1
             if n == 1:
                 log.warning("tracking in frame %r dropped: %s (no transform to the base frame "
                             "%r on /tf or /tf_static)", frame, exc, self.names.base_frame)
             return None
+        if not np.all(np.isfinite(base)):  # finite values far out of range
+            raise MessageError(ros.__msgtype__, f"point in {frame!r} is not finite in the base "
+                               "frame")
+        return t, base
 
     def _point_handler(
         self, body: str

@@ -238,3 +238,25 @@ def test_tiagos_urdf_as_text_gives_the_model_its_file_gives():
     a, b = from_text.gaze_pose(q), from_file.gaze_pose(q)
     np.testing.assert_allclose(a.position, b.position, atol=1e-12)
     np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-12)
+
+
+def test_tracking_in_ever_new_frames_is_counted_in_bounded_space(bus):
+    from gazebot.io.drivers.rmw.node import Received
+    from gazebot.io.drivers.tf_buffer import TfBuffer, Transform
+    from gazebot.io.drivers.zenoh_driver import MAX_FRAMES, OTHER_FRAMES, ZenohRobotDriver
+    from gazebot.io.ros2 import convert as cv
+
+    drv = ZenohRobotDriver(bus.listener(), bus.names, "engine", tf=TfBuffer())
+    bus.closers.append(drv.close)
+    rx = Received("/t/tracking/giver_face", cv.POINT_STAMPED, None)
+    for i in range(3 * MAX_FRAMES):
+        drv._on_point("giver_face", cv.point_stamped(1.0 + 0.01 * i, [1.0, 0.0, 1.0], f"f{i}"),
+                      rx)
+    assert len(drv.untransformed) == MAX_FRAMES + 1
+    assert drv.untransformed[OTHER_FRAMES] == 2 * MAX_FRAMES
+    # a frame that has a transform is used, in the base frame
+    drv.tf.add("world", "cam", 0.0, Transform(np.array([0.0, 0.0, 1.0]), np.eye(3)), static=True)
+    drv._on_point("giver_face", cv.point_stamped(5.0, [1.0, 0.0, 0.5], "cam"), rx)
+    sample = drv.wait_tracking(2.0)
+    assert sample is not None and sample.t == pytest.approx(5.0)
+    np.testing.assert_allclose(sample.giver_face, [1.0, 0.0, 1.5])
