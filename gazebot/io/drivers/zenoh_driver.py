@@ -183,12 +183,21 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         """The sample's stamp and point in the base frame; ``None`` when its frame has no
         transform to the base frame (counted, warned about once per frame)."""
         t, p = convert.point_of(ros)
-        frame = str(ros.header.frame_id)
+        base = self._to_base(str(ros.header.frame_id), t, p, ros.__msgtype__)
+        return None if base is None else (t, base)
+
+    def _to_base(self, frame: str, t: float, p: np.ndarray, what: str) -> np.ndarray | None:
+        """``p`` given in ``frame`` at time ``t``, in the base frame (through :attr:`tf`);
+        ``None`` when ``frame`` has no transform to it (counted, warned about once per frame).
+
+        Raises:
+            MessageError: another frame without a tf buffer, or a result that is not finite.
+        """
         if self.names.is_base_frame(frame):
-            return t, p
+            return p
         if self.tf is None:
-            raise MessageError(ros.__msgtype__, f"frame_id {frame!r}, expected the robot base "
-                               f"frame {self.names.base_frame!r}")
+            raise MessageError(what, f"frame_id {frame!r}, expected the robot base frame "
+                               f"{self.names.base_frame!r}")
         try:
             base = self.tf.transform_point(self.names.base_frame, frame, p, t)
         except TransformError as exc:
@@ -201,9 +210,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                             "%r on /tf or /tf_static)", frame, exc, self.names.base_frame)
             return None
         if not np.all(np.isfinite(base)):  # finite values far out of range
-            raise MessageError(ros.__msgtype__, f"point in {frame!r} is not finite in the base "
-                               "frame")
-        return t, base
+            raise MessageError(what, f"point in {frame!r} is not finite in the base frame")
+        return base
 
     def _point_handler(
         self, body: str
@@ -219,9 +227,15 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         by_child = {child.lstrip("/"): body for body, child in self.names.tf_frames.items()}
         for tf in ros.transforms:
             body = by_child.get(str(tf.child_frame_id).lstrip("/"))
-            if body is not None and self.names.is_base_frame(str(tf.header.frame_id)):
-                t, p = convert.point_of(tf)
-                self._add(body, t, p, rx)
+            if body is None:
+                continue
+            parent = str(tf.header.frame_id)
+            if self.tf is None and not self.names.is_base_frame(parent):
+                continue  # a frame of the robot's own tree, not a tracked body in the base
+            t, p = convert.point_of(tf)
+            base = self._to_base(parent, t, p, ros.__msgtype__)
+            if base is not None:
+                self._add(body, t, base, rx)
 
     def _on_gripper(self, ros: RosGripperState, rx: Received) -> None:
         self._add("gripper", convert.stamp_of(ros), bool(ros.closed), rx)

@@ -260,3 +260,26 @@ def test_tracking_in_ever_new_frames_is_counted_in_bounded_space(bus):
     sample = drv.wait_tracking(2.0)
     assert sample is not None and sample.t == pytest.approx(5.0)
     np.testing.assert_allclose(sample.giver_face, [1.0, 0.0, 1.5])
+
+
+def test_tracked_tf_frames_under_another_parent_are_transformed_into_the_base(bus):
+    from gazebot.core.types import TrackingFrame
+    from gazebot.io.drivers.rmw.names import Names
+    from gazebot.io.drivers.rmw.node import Received
+    from gazebot.io.drivers.tf_buffer import TfBuffer, Transform
+    from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
+    from gazebot.io.ros2 import convert as cv
+
+    names = Names(bus.names.namespace, tf_frames={"giver_face": "mocap/face"})
+    drv = ZenohRobotDriver(bus.listener(), names, "engine", tf=TfBuffer())
+    bus.closers.append(drv.close)
+    # the motion-capture frame: 2 m ahead of the base, turned half a turn about z
+    half_turn = np.diag([-1.0, -1.0, 1.0])
+    drv.tf.add("world", "mocap", 0.0, Transform(np.array([2.0, 0.0, 0.0]), half_turn),
+               static=True)
+    msg = cv.tracking_tf(TrackingFrame.make(3.0, giver_face=[0.5, 0.1, 1.6]), "mocap",
+                         {"giver_face": "mocap/face"})
+    drv._on_tf(msg, Received("/tf", cv.TF_MESSAGE, None))
+    sample = drv.wait_tracking(2.0)
+    assert sample is not None
+    np.testing.assert_allclose(sample.giver_face, [1.5, -0.1, 1.6])
