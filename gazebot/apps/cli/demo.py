@@ -376,6 +376,7 @@ def handover_mcap(robot: str | Path | RobotConfig, path: Path) -> HandoverMcap:
     at 5 Hz from the robot's own eye renderer (JPEG at the display's size costs milliseconds)."""
     from gazebot.apps.render import EyeRenderer
     from gazebot.apps.sim.record import CONTROL_HZ
+    from gazebot.core.kinematics.robot import RobotModel
     from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config
     from gazebot.io.ros2.handover_log import HandoverMcap
 
@@ -386,4 +387,5 @@ def handover_mcap(robot: str | Path | RobotConfig, path: Path) -> HandoverMcap:
         eye_image=lambda yaw, pitch, blink, distance: eyes.render(
             yaw, pitch, blink=blink, distance=distance),
         eye_image_period=0.2,
+        robot=RobotModel.load(robot),  # /robot_description, /tf, /tf_static, markers
     )

@@ -28,6 +28,11 @@ from gazebot.io.drivers.engine_node import EngineNodeConfig
 
 if TYPE_CHECKING:
     from gazebot.apps.render.eyes import LazyEyeRenderer
+    from gazebot.core.runtime import GazeLoop
+    from gazebot.io.drivers.rmw.node import RosNode
+
+#: The topic ``--robot-description`` reads when given without one.
+ROBOT_DESCRIPTION_TOPIC = "/robot_description"
 
 
 class DeprecatedAlias(argparse.Action):
@@ -68,6 +73,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     # Deprecated spelling (one release): the same option as `gazebot display --silent-after`.
     p.add_argument("--silence-after", type=positive, dest="silent_after", metavar="S",
                    action=DeprecatedAlias, help=argparse.SUPPRESS)
+    p.add_argument("--robot-description", nargs="?", const=ROBOT_DESCRIPTION_TOPIC,
+                   default=None, metavar="TOPIC",
+                   help="take the robot's URDF from its running stack (std_msgs/String, "
+                   f"transient local; default topic {ROBOT_DESCRIPTION_TOPIC}); the robot YAML "
+                   "then needs no urdf:/mjcf:, only what a URDF does not say")
+    p.add_argument("--description-timeout", type=positive, default=10.0, metavar="S",
+                   help="s to wait for the robot description (default 10)")
     p.add_argument("--no-robot-warning", type=positive, default=node.no_robot_warning,
                    metavar="S", help="warn on stderr if no robot data arrived after S seconds "
                    f"(default {node.no_robot_warning:g})")
@@ -98,12 +110,27 @@ def handle(args: argparse.Namespace) -> int:
         no_robot_warning=args.no_robot_warning,
         standby=args.standby,
     )
-    # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
     from gazebot.core.runtime import GazeLoop
+    from gazebot.io.drivers.tf_buffer import TfBuffer
 
     robot = robot_with_gaze_mode(args.robot, args.gaze_mode)
-    loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
-    driver = ZenohRobotDriver.open(cfg, "engine")
+    # Tracking in any frame of /tf and /tf_static is transformed into the base frame.
+    tf = TfBuffer()
+    if args.robot_description is None:
+        # Build the loop before joining the bus: samples arriving meanwhile would only go stale.
+        loop = GazeLoop.from_config(robot, args.behavior, args.phases, seed=args.seed)
+        driver = ZenohRobotDriver.open(cfg, "engine", tf=tf)
+    else:
+        driver = ZenohRobotDriver.open(cfg, "engine", tf=tf)
+        try:
+            stack_loop = _loop_from_stack(args, robot, driver.ros)
+        except BaseException:
+            driver.close()
+            raise
+        if stack_loop is None:
+            driver.close()
+            return 2
+        loop = stack_loop
     recorder = None
     try:
         if args.record:
@@ -138,6 +165,7 @@ def handle(args: argparse.Namespace) -> int:
             "warnings": node.warnings,
             "dropped": driver.dropped(),
             "tracking_skipped": driver.tracking_skipped,
+            "untransformed": dict(driver.untransformed),
             "type_mismatches": {k: str(v) for k, v in driver.type_mismatches().items()},
         }
         if recorder is not None:
@@ -149,6 +177,56 @@ def handle(args: argparse.Namespace) -> int:
         driver.close()
     print(json.dumps(summary) if args.json else "\n".join(f"{k}: {v}" for k, v in summary.items()))
     return 0
+
+
+def wait_robot_description(ros: RosNode, topic: str, timeout: float) -> str | None:
+    """The URDF text the stack publishes on ``topic`` (``std_msgs/String``, transient local as
+    ``robot_state_publisher`` latches it, so one published before this node started arrives
+    too), or ``None`` when none came within ``timeout`` s."""
+    from gazebot.io.drivers.rmw.qos import qos_of
+    from gazebot.io.ros2 import topics
+
+    got: list[str] = []
+    arrived = threading.Event()
+
+    def on(msg: object, received: object) -> None:
+        if not arrived.is_set():
+            got.append(str(getattr(msg, "data", "")))
+            arrived.set()
+
+    sub = ros.subscription(topic, topics.ROBOT_DESCRIPTION.type, on,
+                           qos=qos_of("transient_local", 1))
+    try:
+        arrived.wait(timeout)
+    finally:
+        sub.undeclare()
+    return got[0] if got else None
+
+
+def _loop_from_stack(args: argparse.Namespace, robot: object, ros: RosNode) -> GazeLoop | None:
+    """The gaze loop of the robot YAML ``robot`` with the URDF the stack publishes; ``None``
+    (a message on stderr) when it does not come in time."""
+    from gazebot.core.behaviors import load_behavior
+    from gazebot.core.engine import GazeEngine
+    from gazebot.core.kinematics.robot import RobotModel
+    from gazebot.core.kinematics.robot_config import RobotConfig, load_robot_config
+    from gazebot.core.phases import load_phase_config
+    from gazebot.core.runtime import GazeLoop
+
+    config = robot if isinstance(robot, RobotConfig) else load_robot_config(str(robot))[0]
+    topic = ros.names.resolve(args.robot_description)
+    print(f"gazebot run: waiting for the robot description on {topic} (at most "
+          f"{args.description_timeout:g} s)", file=sys.stderr, flush=True)
+    urdf = wait_robot_description(ros, args.robot_description, args.description_timeout)
+    if urdf is None:
+        print(f"gazebot run: error: no robot description on {topic} within "
+              f"{args.description_timeout:g} s: is the stack's robot_state_publisher running "
+              "on this bus (--connect, ROS_DOMAIN_ID)?", file=sys.stderr, flush=True)
+        return None
+    model = RobotModel.from_urdf_text(config, urdf, topic)
+    engine = GazeEngine(model, load_behavior(args.behavior), load_phase_config(args.phases),
+                        seed=args.seed)
+    return GazeLoop(engine, seed=args.seed)
 
 
 def _eye_renderer(robot: str) -> LazyEyeRenderer | None:

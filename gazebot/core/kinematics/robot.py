@@ -41,17 +41,51 @@ def load_full_model(path: Path, kind: str) -> pin.Model:
     Raises:
         ConfigError: Pinocchio cannot parse the file.
     """
+    if kind == "urdf":
+        import xml.etree.ElementTree as ET
+
+        try:
+            root = ET.parse(path).getroot()
+        except (ET.ParseError, OSError) as exc:
+            raise ConfigError(path, "<urdf>", "a readable URDF (XML)", str(exc)) from exc
+        return _build_urdf(root, path)
     try:
-        if kind == "urdf":
-            return pin.buildModelFromXML(_urdf_with_limit_gaps_marked(path))
         return pin.buildModelFromMJCF(str(path))
     except (RuntimeError, ValueError) as exc:  # Pinocchio's parser errors
-        raise ConfigError(
-            path, f"<{kind}>", f"a robot {kind.upper()} Pinocchio can load", str(exc)
-        ) from exc
+        raise ConfigError(path, "<mjcf>", "a robot MJCF Pinocchio can load", str(exc)) from exc
 
 
-def _urdf_with_limit_gaps_marked(path: Path) -> str:
+def load_urdf_text(text: str, source: str) -> pin.Model:
+    """The Pinocchio model (fixed base) of a URDF given as text, e.g. the ``/robot_description``
+    of a running stack; ``source`` names where it came from in errors. Meshes
+    (``package://`` URIs) are not read: the kinematics needs none.
+
+    Raises:
+        ConfigError: the text is not XML or Pinocchio cannot parse it.
+    """
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ConfigError(source, "<urdf>", "a readable URDF (XML)", str(exc)) from exc
+    return _build_urdf(root, source)
+
+
+def _build_urdf(root: object, source: str | Path) -> pin.Model:
+    """Pinocchio's model of a parsed URDF (``xml.etree`` root), limit gaps marked."""
+    import xml.etree.ElementTree as ET
+
+    assert isinstance(root, ET.Element)
+    if root.tag != "robot":
+        raise ConfigError(source, "<urdf>", "a URDF (root element <robot>)", f"<{root.tag}>")
+    try:
+        return pin.buildModelFromXML(_with_limit_gaps_marked(root))
+    except (RuntimeError, ValueError) as exc:  # Pinocchio's parser errors
+        raise ConfigError(source, "<urdf>", "a robot URDF Pinocchio can load", str(exc)) from exc
+
+
+def _with_limit_gaps_marked(root: object) -> str:
     """The URDF's text with what urdfdom refuses to parse marked as absent: a ``<limit>``
     without ``velocity`` gets ``velocity="0"`` and a revolute or prismatic joint without
     ``<limit>`` gets an empty one (lower = upper = 0), so the model loads and a head joint that
@@ -62,10 +96,7 @@ def _urdf_with_limit_gaps_marked(path: Path) -> str:
     """
     import xml.etree.ElementTree as ET
 
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as exc:
-        raise ConfigError(path, "<urdf>", "a readable URDF (XML)", str(exc)) from exc
+    assert isinstance(root, ET.Element)
     for joint in root.iter("joint"):
         if joint.get("type") not in ("revolute", "prismatic"):
             continue
@@ -132,13 +163,15 @@ class RobotModel:
         arm_joints: Arm joint names; ``arm_home``/``arm_handover``: poses (rad) by joint.
     """
 
-    def __init__(self, config: RobotConfig, mjcf_path: Path) -> None:
+    def __init__(self, config: RobotConfig, mjcf_path: Path, full: pin.Model | None = None) -> None:
         self.name = config.name
         self.config = config
-        # The model file (MJCF or URDF; the attribute keeps its historical name).
+        # The model file (MJCF or URDF; the attribute keeps its historical name), or where the
+        # model came from when ``full`` is given (a topic).
         self.mjcf_path = Path(mjcf_path)
         self.model_kind = "mjcf" if config.mjcf is not None else "urdf"
-        full = load_full_model(self.mjcf_path, self.model_kind)
+        if full is None:
+            full = load_full_model(self.mjcf_path, self.model_kind)
         self.head_joints = list(config.head_joints)
         self.arm_joints = list(config.arm_joints)
         self.eye_joints = list(config.eye_joints.names) if config.eye_joints is not None else []
@@ -245,6 +278,19 @@ class RobotModel:
             return cls(name_or_yaml, resolve_model_file(name_or_yaml, None)[0])
         config, path = load_robot_config(name_or_yaml)
         return cls(config, resolve_model_file(config, path)[0])
+
+    @classmethod
+    def from_urdf_text(cls, config: RobotConfig, urdf: str,
+                       source: str = "/robot_description") -> RobotModel:
+        """A robot whose model is the URDF text ``urdf`` (the stack's ``/robot_description``,
+        named ``source`` in errors) and whose YAML ``config`` gives what a URDF does not say
+        (head joints, gaze frame, display, points); the YAML's ``urdf:``/``mjcf:`` is ignored.
+
+        Raises:
+            ConfigError: the URDF is not readable or does not match the YAML.
+        """
+        config = config.model_copy(update={"mjcf": None, "urdf": source})
+        return cls(config, Path(source), load_urdf_text(urdf, source))
 
     def _check_revolute(self, full: pin.Model, name: str, field: str = "head_joints") -> None:
         kind = self.model_kind.upper()

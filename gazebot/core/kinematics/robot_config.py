@@ -4,7 +4,9 @@ The YAML is shared: the simulation reads ``mjcf``, ``head_joints``, ``arm_joints
 ``arm_home_deg``, ``arm_handover_deg`` and ``gripper_actuator``; the eye renderer reads
 ``display`` and ``eyes``; the gaze engine reads everything else. Joint position limits are not
 repeated here: the model (``mjcf:`` or ``urdf:``) is their single source, and of velocity limits
-unless ``head_velocity_limits_deg_s`` overrides them (docs/your-robot.md).
+unless ``head_velocity_limits_deg_s`` overrides them (docs/your-robot.md). A YAML without
+``mjcf:`` and ``urdf:`` describes a robot whose URDF comes from its running stack
+(``gazebot run --robot-description``, :meth:`RobotModel.from_urdf_text`).
 """
 
 from __future__ import annotations
@@ -167,8 +169,9 @@ class RobotConfig(BaseModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> RobotConfig:
-        if (self.mjcf is None) == (self.urdf is None):
-            raise ValueError("exactly one model file: 'mjcf: FILE' or 'urdf: FILE'")
+        if self.mjcf is not None and self.urdf is not None:
+            raise ValueError("exactly one model file: 'mjcf: FILE' or 'urdf: FILE' (or neither, "
+                             "for the URDF of a running stack: gazebot run --robot-description)")
         if self.display is not None and (self.eyes is None or self.eye_style is None):
             raise ValueError("'eyes' and 'eye_style' with a 'display' (the eyes drawn on it)")
         if self.eye_joints is not None and (self.display is not None or self.eyes is not None):
@@ -245,7 +248,7 @@ def with_gaze_mode(robot: str | Path | RobotConfig, mode: str | None) -> str | P
     data.update(gaze_mode=mode)
     if config.mjcf is not None:
         data.update(mjcf=str(resolve_mjcf(config, path).resolve()))
-    else:
+    elif config.urdf is not None:
         data.update(urdf=str(resolve_model_file(config, path)[0]))
     return RobotConfig.model_validate(data)
 
@@ -265,6 +268,8 @@ def with_package_path(
         config, path = robot, None
     else:
         config, path = load_robot_config(robot)
+    if config.mjcf is None and config.urdf is None:
+        return config  # its URDF comes from the running stack
     found, kind = resolve_model_file(config, path, package_path)
     return config.model_copy(update={kind: str(found)})
 
@@ -275,11 +280,15 @@ def resolve_model_file(
     """The model file of ``config`` and its kind (``"mjcf"`` or ``"urdf"``).
 
     Raises:
-        ConfigError: the file is not found (names the YAML, the field and where it looked).
+        ConfigError: the file is not found (names the YAML, the field and where it looked), or
+            the YAML names none (its URDF comes from the stack).
     """
     kind = "mjcf" if config.mjcf is not None else "urdf"
     raw = config.mjcf if config.mjcf is not None else config.urdf
-    assert raw is not None  # the validator asks for exactly one
+    if raw is None:
+        raise ConfigError(
+            yaml_path or "<robot config>", "urdf", "a model file ('urdf: FILE' or 'mjcf: FILE'); "
+            "without one, the URDF comes from the stack: gazebot run --robot-description")
     search = package_search_path(package_path)
     found, expected = resolve_model_path(raw, yaml_path, search, assets=kind == "mjcf")
     if found is None:

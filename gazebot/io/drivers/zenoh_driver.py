@@ -3,6 +3,7 @@ rmw_zenoh wire (:mod:`gazebot.io.ros2.topics`), e.g. ``gazebot sim`` or a ROS 2 
 
 from __future__ import annotations
 
+import logging
 import math
 import threading
 import time
@@ -19,6 +20,7 @@ from gazebot.io.drivers.rmw.attachment import gid_of
 from gazebot.io.drivers.rmw.graph import Entity
 from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.rmw.node import Received
+from gazebot.io.drivers.tf_buffer import TfBuffer, TransformError, listen
 from gazebot.io.drivers.tracking_assembly import IDLE_FLUSH, REORDER, Part, SampleAssembler
 from gazebot.io.drivers.tracking_source import Rival, SourceArbiter, group_of
 from gazebot.io.drivers.zenoh_node import HISTORY_BYTES, ZenohNode
@@ -39,6 +41,11 @@ from gazebot.io.ros2.values import ArmCommand, EyeState, JointGoal, JointState, 
 
 if TYPE_CHECKING:
     import zenoh
+
+log = logging.getLogger("gazebot.io.drivers")
+#: Frames counted one by one in ``untransformed``; beyond, under :data:`OTHER_FRAMES`.
+MAX_FRAMES = 100
+OTHER_FRAMES = "(other frames)"
 
 
 class ZenohRobotDriver(ZenohNode, RobotDriver):
@@ -63,6 +70,10 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         source_timeout: A tracking source silent this long (s) gives way to the next one
             (see :mod:`gazebot.io.drivers.tracking_source`); until then another source's samples
             are dropped, counted by topic and reported as rivals.
+        tf: A transform buffer to feed from ``/tf`` and ``/tf_static``: tracking in another
+            frame than the base frame is transformed into it at the sample's stamp; a frame
+            with no transform is dropped, counted in ``untransformed`` and warned about once.
+            ``None``: tracking in another frame is dropped as malformed.
     """
 
     default_node: ClassVar[str] = "engine"
@@ -82,6 +93,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         max_bytes: dict[str, int] | None = None,
         history_bytes: int = HISTORY_BYTES,
         source_timeout: float = 1.0,
+        tf: TfBuffer | None = None,
     ) -> None:
         super().__init__(session, names, node, owns_session=owns_session,
                          peer_timeout=peer_timeout, clock=clock, max_bytes=max_bytes,
@@ -97,6 +109,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self._gid_labels: dict[bytes, str] = {}
         self._assembler = SampleAssembler(self._expected_parts, assemble_idle,
                                           assemble_reorder, clock=clock)
+        self.tf = tf
+        self.untransformed: dict[str, int] = {}  # tracking dropped for want of a transform
         ros = self.ros
         self._head_pub = ros.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
         self._target_pub = ros.publisher(topics.GAZE_TARGET.name, topics.GAZE_TARGET.type)
@@ -105,6 +119,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self._phase_pub = ros.publisher(topics.PHASE.name, topics.PHASE.type)
         self._arm_pub = ros.publisher(topics.ARM_COMMAND.name, topics.ARM_COMMAND.type)
         self._arm_mode_pub = ros.publisher(topics.ARM_MODE.name, topics.ARM_MODE.type)
+        if tf is not None:  # first: the latched frames may come before the first sample
+            listen(ros, tf)
         self._part_topics: dict[str, str] = {}
         for body, t in topics.TRACKING.items():
             sub = ros.subscription(t.name, (t.type, convert.POSE_STAMPED),
@@ -163,13 +179,39 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         """Sources whose tracking was ignored lately (``new_only``: not returned before)."""
         return self._sources.new_rivals() if new_only else self._sources.rivals()
 
-    def _point(self, ros: RosPointStamped | RosPoseStamped) -> tuple[float, np.ndarray]:
+    def _point(self, ros: RosPointStamped | RosPoseStamped) -> tuple[float, np.ndarray] | None:
+        """The sample's stamp and point in the base frame; ``None`` when its frame has no
+        transform to the base frame (counted, warned about once per frame)."""
         t, p = convert.point_of(ros)
-        frame = str(ros.header.frame_id)
-        if not self.names.is_base_frame(frame):
-            raise MessageError(ros.__msgtype__, f"frame_id {frame!r}, expected the robot base "
-                               f"frame {self.names.base_frame!r}")
-        return t, p
+        base = self._to_base(str(ros.header.frame_id), t, p, ros.__msgtype__)
+        return None if base is None else (t, base)
+
+    def _to_base(self, frame: str, t: float, p: np.ndarray, what: str) -> np.ndarray | None:
+        """``p`` given in ``frame`` at time ``t``, in the base frame (through :attr:`tf`);
+        ``None`` when ``frame`` has no transform to it (counted, warned about once per frame).
+
+        Raises:
+            MessageError: another frame without a tf buffer, or a result that is not finite.
+        """
+        if self.names.is_base_frame(frame):
+            return p
+        if self.tf is None:
+            raise MessageError(what, f"frame_id {frame!r}, expected the robot base frame "
+                               f"{self.names.base_frame!r}")
+        try:
+            base = self.tf.transform_point(self.names.base_frame, frame, p, t)
+        except TransformError as exc:
+            with self._cond:
+                if frame not in self.untransformed and len(self.untransformed) >= MAX_FRAMES:
+                    frame = OTHER_FRAMES  # a sender of ever new frame ids: stay bounded
+                n = self.untransformed[frame] = self.untransformed.get(frame, 0) + 1
+            if n == 1:
+                log.warning("tracking in frame %r dropped: %s (no transform to the base frame "
+                            "%r on /tf or /tf_static)", frame, exc, self.names.base_frame)
+            return None
+        if not np.all(np.isfinite(base)):  # finite values far out of range
+            raise MessageError(what, f"point in {frame!r} is not finite in the base frame")
+        return base
 
     def _point_handler(
         self, body: str
@@ -177,16 +219,23 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         return lambda ros, rx: self._on_point(body, ros, rx)
 
     def _on_point(self, body: str, ros: RosPointStamped | RosPoseStamped, rx: Received) -> None:
-        t, p = self._point(ros)
-        self._add(body, t, p, rx)
+        point = self._point(ros)
+        if point is not None:
+            self._add(body, *point, rx)
 
     def _on_tf(self, ros: RosTFMessage, rx: Received) -> None:
         by_child = {child.lstrip("/"): body for body, child in self.names.tf_frames.items()}
         for tf in ros.transforms:
             body = by_child.get(str(tf.child_frame_id).lstrip("/"))
-            if body is not None and self.names.is_base_frame(str(tf.header.frame_id)):
-                t, p = convert.point_of(tf)
-                self._add(body, t, p, rx)
+            if body is None:
+                continue
+            parent = str(tf.header.frame_id)
+            if self.tf is None and not self.names.is_base_frame(parent):
+                continue  # a frame of the robot's own tree, not a tracked body in the base
+            t, p = convert.point_of(tf)
+            base = self._to_base(parent, t, p, ros.__msgtype__)
+            if base is not None:
+                self._add(body, t, base, rx)
 
     def _on_gripper(self, ros: RosGripperState, rx: Received) -> None:
         self._add("gripper", convert.stamp_of(ros), bool(ros.closed), rx)

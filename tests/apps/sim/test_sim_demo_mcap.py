@@ -11,6 +11,7 @@ import io
 import json
 import time
 
+import numpy as np
 import pytest
 
 from gazebot.apps.cli import demo, main
@@ -60,8 +61,8 @@ def test_demo_mcap_decodes_with_mcap_ros2_support_on_every_topic(demo_run):
                 # Log time = the run's wall clock (rosbag2's); simulation time in the header.
                 assert summary["wall_ns"][0] <= message.log_time <= summary["wall_ns"][1]
                 assert stamp < 10**12  # seconds of simulation, not an epoch
-    # The demo's tracking is per body (no /tf), and no operator sends arm goals in a demo.
-    expected = {t.resolve() for t in tp.ALL} - {"/tf"} - {
+    # Every topic (/tf: the head's frames) but the arm goals no operator sends in a demo.
+    expected = {t.resolve() for t in tp.ALL} - {
         t.resolve() for t in (tp.ARM_COMMAND, tp.ARM_MODE)}
     assert set(counts) == expected
     ticks = len(rows)
@@ -105,3 +106,96 @@ def test_gazebot_phases_finds_the_timelines_phases_in_the_demo_mcap(demo_run, ca
     assert main(["phases", str(out / "handover.mcap")]) == 0
     lines = capsys.readouterr().out.splitlines()[2:]
     assert [line.split()[1] for line in lines] == ["reach", "transfer", "retreat"]
+
+
+def _decoded(path, topics: set[str]) -> dict[str, list]:
+    decoder = pytest.importorskip("mcap_ros2.decoder", reason="mcap-ros2-support not installed")
+    from mcap.reader import make_reader
+
+    out: dict[str, list] = {t: [] for t in topics}
+    with path.open("rb") as f:
+        reader = make_reader(f, decoder_factories=[decoder.DecoderFactory()])
+        for _, channel, message, msg in reader.iter_decoded_messages(topics=sorted(topics)):
+            out[channel.topic].append((message.log_time, msg))
+    return out
+
+
+def _pose(tf) -> tuple[np.ndarray, np.ndarray]:
+    """A TransformStamped as (rotation, translation), with Pinocchio's quaternion."""
+    import pinocchio as pin
+
+    q, p = tf.transform.rotation, tf.transform.translation
+    return pin.Quaternion(q.w, q.x, q.y, q.z).toRotationMatrix(), np.array([p.x, p.y, p.z])
+
+
+def test_demo_mcap_holds_what_foxglove_draws_the_robot_hands_and_gaze_from(demo_run):
+    import pinocchio as pin
+
+    out, rows, summary = demo_run
+    topics = {"/tf", "/tf_static", "/robot_description", "/gazebot/markers"}
+    got = _decoded(out / "handover.mcap", topics)
+    start, end = summary["wall_ns"]
+    for topic in topics:
+        assert got[topic], topic
+        # Log time: the run's wall clock (within the run, so within a minute of it).
+        assert all(start <= t <= end for t, _ in got[topic]), topic
+    (_, desc), = got["/robot_description"]
+    (_, static), = got["/tf_static"]
+    # The description is a URDF Pinocchio loads; its links are the frames on /tf and /tf_static.
+    model = pin.buildModelFromXML(desc.data)
+    links = {f.name for f in model.frames if f.type == pin.FrameType.BODY}
+    moving = {tf.child_frame_id for tf in got["/tf"][0][1].transforms}
+    assert {tf.header.frame_id for tf in got["/tf"][0][1].transforms} == {"world"}
+    assert moving | {"gaze", "world"} == links
+    (gaze_tf,) = static.transforms
+    assert gaze_tf.child_frame_id == "gaze" and gaze_tf.header.frame_id in moving
+    # /tf and markers at 30 Hz of simulation time.
+    seconds = float(rows[-1]["t"])
+    assert len(got["/tf"]) == pytest.approx(30 * seconds + 1, abs=2)
+    assert len(got["/gazebot/markers"]) == len(got["/tf"])
+    # Each scene's gaze ray starts at the gaze origin the frames put it at, and the hands are
+    # there once tracked.
+    hands = 0
+    parents = {}
+    for (_, tf_msg), (_, markers) in zip(got["/tf"], got["/gazebot/markers"], strict=True):
+        for tf in tf_msg.transforms:
+            parents[tf.child_frame_id] = _pose(tf)
+        R, p = parents[gaze_tf.header.frame_id]
+        Rg, pg = _pose(gaze_tf)
+        origin = R @ pg + p
+        by_id = {m.id: m for m in markers.markers}
+        ray = by_id[0]
+        assert ray.header.frame_id == "world"
+        if ray.action == 0:  # ADD
+            start_pt = ray.points[0]
+            np.testing.assert_allclose([start_pt.x, start_pt.y, start_pt.z], origin, atol=1e-9)
+        hands += by_id[2].action == 0
+    assert hands > len(got["/tf"]) // 2
+
+
+def test_the_foxglove_layout_shows_topics_and_fields_the_demo_mcap_has(demo_run):
+    import json
+    from pathlib import Path
+
+    from mcap.reader import make_reader
+
+    out, _, _ = demo_run
+    layout = json.loads((Path(__file__).parents[3] / "docs" / "foxglove-layout.json").read_text())
+    panels = layout["configById"]
+    with (out / "handover.mcap").open("rb") as f:
+        channels = {c.topic for c in make_reader(f).get_summary().channels.values()}
+    three_d = panels["3D!gazebot"]
+    shown = {t for t, cfg in three_d["topics"].items() if cfg["visible"]}
+    assert shown <= channels and {"/robot_description", "/gazebot/markers"} <= shown
+    assert three_d["followTf"] == "world"  # the shipped robots' base frame
+    paths = [p["value"] for p in panels["StateTransitions!phase"]["paths"]]
+    from gazebot.io.ros2.typestore import typestore
+
+    fields = {"/gazebot/handover/phase": set(
+        typestore().types[tp.PHASE.type].__dataclass_fields__)}
+    for path in paths:
+        topic, _, field = path.partition(".")
+        assert topic in channels and field in fields[topic]
+    for key in ("RawMessages!phase", "RawMessages!events"):
+        assert panels[key]["topicPath"] in channels
+    assert panels["Image!eyes"]["imageMode"]["imageTopic"] in channels

@@ -22,6 +22,7 @@ from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.rmw.node import Received
 from gazebot.io.drivers.rmw.qos import QosProfile
 from gazebot.io.drivers.session import EPHEMERAL_ENDPOINT, BusConfig, open_session
+from gazebot.io.drivers.tf_buffer import TfBuffer, add_tf_message
 from gazebot.io.drivers.zenoh_display import ZenohDisplayNode
 from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
 from gazebot.io.drivers.zenoh_robot import ZenohRobotEndpoint
@@ -107,7 +108,7 @@ def nodes():
     session = open_session(BusConfig(Names("/fuzz"), listen=(EPHEMERAL_ENDPOINT,)))
     names = Names("/fuzz", tf_frames={"giver_face": "mocap/face"})
     ep = ZenohRobotEndpoint(session, names, "sim", eye_frames=True)
-    drv = ZenohRobotDriver(session, names, "engine")
+    drv = ZenohRobotDriver(session, names, "engine", tf=TfBuffer())
     display = ZenohDisplayNode(session, names, "display")
     yield ep, drv, display
     for n in (display, drv, ep):
@@ -121,7 +122,7 @@ def handlers(ep, drv, display) -> dict[str, list]:
         convert.POINT_STAMPED: [lambda m, rx, b=b: drv._on_point(b, m, rx)
                                 for b in topics.TRACKING],
         convert.POSE_STAMPED: [lambda m, rx: drv._on_point("giver_hand", m, rx)],
-        convert.TF_MESSAGE: [drv._on_tf],
+        convert.TF_MESSAGE: [drv._on_tf, lambda m, rx: add_tf_message(drv.tf, m, static=True)],
         convert.JOINT_STATE: [drv._on_joints],
         convert.JOINT_TRAJECTORY: [ep._on_head, ep._on_arm],
         convert.DIAGNOSTIC_ARRAY: [drv._on_status, ep._on_status],
@@ -132,6 +133,7 @@ def handlers(ep, drv, display) -> dict[str, list]:
         convert.GRIPPER_STATE: [drv._on_gripper],
         convert.LOAD_SHARE: [drv._on_share],
         STRING: [ep._on_arm_mode],
+        MARKER_ARRAY: [],  # only viewers subscribe (gazebot view forwards the bytes)
     }
 
 
