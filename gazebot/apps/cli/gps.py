@@ -121,8 +121,8 @@ def _continue(args: argparse.Namespace):
     import numpy as np
 
     from gazebot.apps.gps.badmm import continue_training
-    from gazebot.apps.gps.shell import training_targets
     from gazebot.apps.gps.policy_store import load_checkpoint
+    from gazebot.apps.gps.shell import training_targets
 
     for option, value in (("--controllers", args.controllers), ("--config", args.config)):
         if value is not None:

@@ -26,8 +26,8 @@ def test_a_run_saves_what_continuing_it_needs(trained):
 
 def test_continuing_keeps_the_eight_controllers_and_the_policy_and_adds_four_fresh_ones(trained):
     from gazebot.apps.gps.badmm import continue_training
-    from gazebot.apps.gps.shell import training_targets
     from gazebot.apps.gps.policy_store import load_checkpoint
+    from gazebot.apps.gps.shell import training_targets
 
     prev, cfg = load_checkpoint(trained)
     twelve = training_targets(cfg.shell, 12)
