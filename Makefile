@@ -114,7 +114,7 @@ test-core: $(CORE_STAMP)
 	$(CORE_VENV)/bin/python -m pytest $(CORE_TESTS)
 
 bench: $(TEST_STAMP)
-	$(PY) -m benchmarks
+	$(PY) -m benchmarks --markdown docs/benchmark-results.md
 
 # Style, the layers (import-linter's contracts in pyproject.toml: core < io < apps, no cycles) and
 # the types of core and io (mypy, configured in pyproject.toml).

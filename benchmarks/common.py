@@ -100,3 +100,14 @@ def print_results(results: list[Result]) -> None:
         ratio = f"x{r.ratio:.2f} vs peer" if r.ratio is not None else ""
         note = f"  [{r.note}]" if r.note else ""
         print(f"- {r.name}: {r.ours:.4g} {r.unit} | peer {peer} | {ratio}{note}")
+
+
+def markdown_rows(results: list[Result]) -> list[str]:
+    """``results`` as the rows of a Markdown table (benchmark, ours, peer, ratio, note)."""
+    rows = []
+    for r in results:
+        peer = f"{r.peer:.4g} {r.unit} ({r.peer_name})" if r.peer is not None else "-"
+        ratio = f"x{r.ratio:.2f}" if r.ratio is not None else ""
+        rows.append(f"| {r.name} | {r.ours:.4g} {r.unit} | {peer} | {ratio} | {r.note} |")
+    return rows
+
