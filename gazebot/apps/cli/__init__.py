@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "run",
     "display",
     "router",
+    "bus_init",
     "study",
     "gps",
     "bip",
