@@ -186,8 +186,11 @@ class ZenohRobotEndpoint(ZenohNode):
             report = len(claims) > 1 and frozenset(claims) != self._reported_claims
             self._reported_claims = frozenset(claims) if len(claims) > 1 else frozenset()
         if report:
-            self._publish_fault("competing_engine", engines=[str(c) for c in claims],
-                                owner=str(claims[0]))
+            ordered = self.owners.claims()  # the owner first (not the earliest stated start)
+            owner = self.owners.owner()
+            self._publish_fault("competing_engine", engines=[str(c) for c in ordered],
+                                owner=str(owner) if owner is not None else None,
+                                forged=[str(c) for c in self.owners.forged()])
 
     def _publisher_of(self, gid: bytes, topic: str | None = None) -> tuple[str, str] | None:
         """``(zid, node)`` of the live publisher of ``topic`` (default: head commands) whose
