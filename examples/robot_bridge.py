@@ -8,6 +8,11 @@ rmw_zenoh needs no bridge at all: its own nodes publish and subscribe to these t
 Here the "robot" is a stand-in that applies head goals instantly and the "motion capture"
 replays a synthetic handover; swap both for your hardware interfaces.
 
+The endpoint obeys only the engine that owns the robot (its ownership claim, its live publisher,
+its GID in each command's attachment); anything else is dropped and counted (docs/bus.md, "What
+the robot trusts"). For a lab, ``gazebot bus init DIR`` makes certificates and configurations:
+run this bridge with ``--zenoh-config DIR/robot.json5 --listen tls/HOST:7447``.
+
 Terminal 1:  python examples/robot_bridge.py --duration 10
 Terminal 2:  gazebot run --robot sawyer --behavior face-hand-face --duration 10
 """
@@ -52,7 +57,8 @@ def main(argv: list[str] | None = None) -> int:
             time.sleep(max(0.0, frame.t - frames[0].t - (time.monotonic() - start)))
     finally:
         robot.close()
-    print(f"applied {applied} head commands")
+    dropped = sum(robot.unidentified().values())
+    print(f"applied {applied} head commands, dropped {dropped} from no identified owner")
     return 0
 
 

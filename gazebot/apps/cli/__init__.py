@@ -29,6 +29,7 @@ COMMAND_MODULES = (
     "run",
     "display",
     "router",
+    "bus_init",
     "study",
     "gps",
     "bip",

@@ -22,7 +22,11 @@ Faults (each pinned by ``tests/drivers``):
   ``warn`` callback (``gazebot run`` prints it on stderr), status ``state: degraded`` with
   ``info.robot_seen: false`` until the robot shows up.
 * robot clock restart (a sample older than the last by ``clock_reset``): event
-  ``tracking_clock_reset``, then the same resynchronisation as at start.
+  ``tracking_clock_reset``, then the same resynchronisation as at start. A restart is taken
+  only once ``clock_reset_confirm`` samples in a row went back, each later than the one before
+  (a restarted clock runs on; stamps interleaved with the old clock's are not a restart), and at
+  most once per ``clock_reset_holdoff`` s (issue 30: no stream of stamps restarts handovers);
+  the samples meanwhile are dropped (``tracking_backwards``).
 * malformed messages (garbage, truncated CDR, oversized, NaN or infinite values): dropped by
   the driver, counted by topic in the status' ``dropped``.
 * a robot speaking another message type (or another version of it) on a topic: dropped, and
@@ -111,6 +115,9 @@ class EngineNodeConfig:
         eye_frame_rate: Maximum rate of rendered eye frames (only while someone subscribes).
         clock_reset: A sample this much older than the previous one (s) means the robot's
             clock restarted: the engine is reset and resynchronised.
+        clock_reset_confirm: Samples in a row (each later than the one before) that must go
+            back before the clock counts as restarted.
+        clock_reset_holdoff: Least time (s) between two clock resets.
         no_robot_warning: Warn once when no tracking sample or joint state arrived this long
             (s) after the start.
         fault_hold: The status stays ``degraded`` this long (s) after a caught fault.
@@ -125,6 +132,8 @@ class EngineNodeConfig:
     resync_timeout: float = 1.0
     eye_frame_rate: float = 30.0
     clock_reset: float = 0.5
+    clock_reset_confirm: int = 3
+    clock_reset_holdoff: float = 5.0
     no_robot_warning: float = 3.0
     fault_hold: float = 5.0
     standby: bool = False
@@ -133,6 +142,7 @@ class EngineNodeConfig:
     def __post_init__(self) -> None:
         for name in ("silence_after", "silence_rate", "heartbeat_period", "resync_timeout",
                      "eye_frame_rate", "clock_reset", "no_robot_warning", "fault_hold",
+                     "clock_reset_confirm", "clock_reset_holdoff",
                      "claim_timeout"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
@@ -192,6 +202,9 @@ class EngineNode:
         self._seq = {"event": 0, "status": 0}
         self._last_frame_wall = math.nan
         self._last_t = math.nan
+        self._back_run: list[float] = []  # stamps of samples in a row going back
+        self._last_reset_at = -math.inf
+        self.tracking_backwards = 0  # samples dropped while a clock restart was unconfirmed
         self._last_silence_tick = -math.inf
         self._last_beat = -math.inf
         self._last_eye_frame = -math.inf
@@ -456,11 +469,15 @@ class EngineNode:
         """Tick the loop with one sample and send the command."""
         now = self.clock()
         if frame.t < self._last_t - self.config.clock_reset:
+            if not self._clock_restarted(frame.t, now):
+                return
             # The robot's clock went back (e.g. the simulator restarted): the engine would
             # ignore every sample as out of order, so start over from the robot's state.
             self.emit("tracking_clock_reset", t=frame.t, previous_t=self._last_t)
             self._last_t = math.nan
             self.resync()
+        else:
+            self._back_run.clear()
         self._last_frame_wall = now
         self._last_t = frame.t
         self._last_frame = frame
@@ -471,6 +488,22 @@ class EngineNode:
         self.frames_processed += 1
         if cmd is not None:
             self._send(cmd)
+
+    def _clock_restarted(self, t: float, now: float) -> bool:
+        """Whether a sample at ``t``, going back, confirms a clock restart (else it is
+        dropped and counted)."""
+        run = self._back_run
+        if run and t < run[-1]:  # not one clock running on: start the run again
+            run.clear()
+        run.append(t)
+        if (len(run) < self.config.clock_reset_confirm
+                or now - self._last_reset_at < self.config.clock_reset_holdoff):
+            self.tracking_backwards += 1
+            del run[:-self.config.clock_reset_confirm]  # bounded
+            return False
+        run.clear()
+        self._last_reset_at = now
+        return True
 
     def on_silence(self) -> None:
         """No sample arrived: after ``silence_after``, tick the loop without one (its

@@ -24,9 +24,16 @@ from gazebot.io.drivers.rmw.names import Names, check_node_name, demangle, mangl
 if TYPE_CHECKING:
     import zenoh
 
+    from gazebot.io.drivers.rmw.graph import Graph
+
 log = logging.getLogger("gazebot.io.drivers")
 
 OWNER_SPACE = "@gazebot_owner"
+#: A claim seen within this many seconds of the owner being settled on is ordered by its start
+#: (engines starting together agree); a later one never pre-empts the owner.
+SETTLE = 1.0
+#: A claim whose engine node is not in the graph this long after it was seen is forged.
+GRACE = 1.0
 
 
 @dataclass(frozen=True, order=True)
@@ -72,22 +79,37 @@ class Claim:
 
 
 class OwnershipWatch:
-    """The claims alive on a robot's namespace, from a liveliness subscriber (thread-safe).
+    """The claims alive on a robot's namespace, from a liveliness subscriber, and the owner they
+    settle on (thread-safe).
 
     Args:
         session: An open Zenoh session.
         names: The robot's namespace and domain.
         on_change: Called with the claims alive after each change (on Zenoh's thread).
+        graph: The ROS graph a claim's engine node must be in to count (``None``: every claim
+            counts, as before issue 30).
+        settle: See :data:`SETTLE`.
+        grace: See :data:`GRACE`.
+        clock: Monotonic clock (s).
     """
 
     def __init__(self, session: zenoh.Session, names: Names,
-                 on_change: Callable[[list[Claim]], None] | None = None) -> None:
+                 on_change: Callable[[list[Claim]], None] | None = None, *,
+                 graph: Graph | None = None, settle: float = SETTLE, grace: float = GRACE,
+                 clock: Callable[[], float] = time.monotonic) -> None:
         self.names = names
         self.on_change = on_change
+        self.graph = graph
+        self.settle = float(settle)
+        self.grace = float(grace)
+        self.clock = clock
         self.bad_tokens = 0
         self._lock = threading.Lock()
         self._claims: dict[str, Claim] = {}
+        self._seen: dict[str, float] = {}  # claim key -> when first seen (monotonic)
         self._gone: set[str] = set()  # keys seen vanishing (a late query answer is stale)
+        self._owner: Claim | None = None
+        self._owner_since = 0.0
         self.prefix = f"{OWNER_SPACE}/{names.domain_id}/{mangle(names.namespace)}"
         self._sub = session.liveliness().declare_subscriber(
             f"{self.prefix}/**", self._on_token, history=True)
@@ -104,26 +126,78 @@ class OwnershipWatch:
             return
         with self._lock:
             if sample.kind == zenoh.SampleKind.PUT:
-                self._claims[key] = claim
+                self._add(key, claim)
                 self._gone.discard(key)
             else:
                 self._claims.pop(key, None)
+                self._seen.pop(key, None)
                 self._gone.add(key)
             claims = sorted(self._claims.values())
+        self.owner()  # settle on an owner as claims come and go, not only when asked
         if self.on_change is not None:
             try:
                 self.on_change(claims)
             except Exception:
                 log.exception("ownership callback failed")
 
+    def _add(self, key: str, claim: Claim) -> None:
+        """Record a claim alive (under the lock)."""
+        self._claims[key] = claim
+        self._seen.setdefault(key, self.clock())
+
+    def _backed(self, claim: Claim) -> bool:
+        """Whether the claim's engine node is in the graph."""
+        if self.graph is None or self._is_own(claim):
+            return True
+        return any(e.zid == claim.zid and e.node == claim.node
+                   for e in self.graph.nodes(claim.namespace))
+
+    def _is_own(self, claim: Claim) -> bool:
+        """Whether ``claim`` is this party's own (its node is known to exist)."""
+        return False
+
     def claims(self) -> list[Claim]:
         """Claims alive, the owner first."""
+        owner = self.owner()
         with self._lock:
-            return sorted(self._claims.values())
+            rest = sorted(c for c in self._claims.values() if c != owner)
+        return [owner, *rest] if owner is not None else rest
+
+    def forged(self) -> list[Claim]:
+        """Claims alive whose engine node has not been in the graph within ``grace`` s."""
+        now = self.clock()
+        with self._lock:
+            items = [(c, self._seen.get(k, now)) for k, c in self._claims.items()]
+        return sorted(c for c, seen in items if now - seen > self.grace and not self._backed(c))
 
     def owner(self) -> Claim | None:
-        claims = self.claims()
-        return claims[0] if claims else None
+        """The claim that owns the robot: the owner settled on while its claim lives (a claim
+        seen within ``settle`` s of that choice and starting earlier takes its place), else the
+        earliest claim whose engine is in the graph; ``None`` while none is, or while an
+        earlier claim still waits for its node (up to ``grace`` s)."""
+        now = self.clock()
+        with self._lock:
+            items = [(c, self._seen.get(k, now)) for k, c in self._claims.items()]
+            owner, since = self._owner, self._owner_since
+        live = sorted(items)
+        if owner is not None and any(c == owner for c, _ in live):
+            earlier = [c for c, seen in live if c < owner and seen <= since + self.settle
+                       and self._backed(c)]
+            if not earlier:
+                return owner
+            new: Claim | None = earlier[0]
+        else:
+            new = None
+            for c, seen in live:
+                if self._backed(c):
+                    new = c
+                    break
+                if now - seen <= self.grace:  # its node may still be on its way
+                    return None
+        with self._lock:
+            if new != self._owner:
+                self._owner, self._owner_since = new, now
+            return self._owner
 
     def undeclare(self) -> None:
         try:
@@ -143,8 +217,10 @@ class Ownership(OwnershipWatch):
     """
 
     def __init__(self, session: zenoh.Session, names: Names, node: str,
-                 clock_ns: Callable[[], int] = time.time_ns) -> None:
-        super().__init__(session, names)
+                 clock_ns: Callable[[], int] = time.time_ns, *, graph: Graph | None = None,
+                 settle: float = SETTLE, grace: float = GRACE,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(session, names, graph=graph, settle=settle, grace=grace, clock=clock)
         self.session = session
         self.claim = Claim(clock_ns(), str(session.info.zid()), check_node_name(node),
                            names.namespace, names.domain_id)
@@ -165,21 +241,27 @@ class Ownership(OwnershipWatch):
                 continue
         with self._lock:
             for claim in found:
-                if claim.key() not in self._gone:
-                    self._claims.setdefault(claim.key(), claim)
+                if claim.key() not in self._gone and claim.key() not in self._claims:
+                    self._add(claim.key(), claim)
+        # An earlier claim whose node is not seen yet: wait (up to ``grace``) to know whether
+        # it is an engine or a forgery.
+        end = self.clock() + self.grace + 0.1
+        while self.owner() is None and self.clock() < end:
+            time.sleep(0.02)
         return self.claims()
 
+    def _is_own(self, claim: Claim) -> bool:
+        # Zenoh may call back before __init__ has set the claim
+        return claim == getattr(self, "claim", None) and getattr(self, "_token", None) is not None
+
     def rivals(self) -> list[Claim]:
-        """The other engines' claims alive, the earliest first."""
+        """The other engines' claims alive, the owner first."""
         return [c for c in self.claims() if c != self.claim]
 
     def is_owner(self) -> bool:
-        """Whether this engine's claim is the earliest alive (``False`` before
-        :meth:`declare`)."""
-        if self._token is None:
-            return False
-        rivals = self.rivals()
-        return not rivals or self.claim < rivals[0]
+        """Whether this engine's claim owns the robot (:meth:`OwnershipWatch.owner`;
+        ``False`` before :meth:`declare`)."""
+        return self._token is not None and self.owner() == self.claim
 
     def undeclare(self) -> None:
         """Withdraw the claim and stop watching; idempotent."""

@@ -5,9 +5,11 @@ restart).
 
 Sources are told apart by the publisher GID in each sample's attachment, resolved to the
 publishing node (name and Zenoh session) through the ROS graph, so the hands and the face of one
-tracker are one source. An implementation whose GIDs are not rmw_zenoh's hash of the token
-(e.g. random ones) is identified by the topic's only publisher; failing that, its samples count
-as one unidentified source. Each part (``giver_hand``, ``receiver_hand``, ``giver_face``,
+tracker are one source. A sample that cannot be resolved so (no attachment, a GID that no live
+publisher of the topic announced, or a GID whose sequence numbers go back: a second stream
+copying it) never owns a part: it is refused (:meth:`SourceArbiter.refuse`) and reported as a
+rival like a second tracker (issue 30: such samples were taken for the simulator's own).
+Each part (``giver_hand``, ``receiver_hand``, ``giver_face``,
 ``gripper``, ``load_share``, from their topics or ``/tf``) is arbitrated on its own: a
 motion-capture node may publish the hands while a separate face tracker publishes the face and a
 robot bridge the gripper and the load share; only a second publisher of the same part is a rival.
@@ -76,6 +78,20 @@ class SourceArbiter:
             _, n, _ = self._rivals.get((group, source), (owner.source, 0, now))
             self._rivals[(group, source)] = (owner.source, n + 1, now)
             return owner.source
+
+    def refuse(self, part: str, source: str) -> str:
+        """Record a sample of ``part`` from ``source`` that is never to be used (an
+        unidentified publisher): a rival of the part's owner (or of ``"the announced
+        publishers"`` while none owns it). Returns that owner."""
+        group = group_of(part)
+        now = self.clock()
+        with self._lock:
+            owner = self._owners.get(group)
+            name = (owner.source if owner is not None and now - owner.last_seen <= self.timeout
+                    else "the announced publishers")
+            _, n, _ = self._rivals.get((group, source), (name, 0, now))
+            self._rivals[(group, source)] = (name, n + 1, now)
+            return name
 
     def owners(self) -> dict[str, str]:
         """Part -> the source that owns it now (silent owners left out)."""

@@ -9,17 +9,19 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, NoReturn, cast
 
 import numpy as np
 
 from gazebot.core.types import Phase, TrackingFrame
 from gazebot.io.drivers.base import RobotDriver
+from gazebot.io.drivers.bounds import check_joint_state, check_tf
 from gazebot.io.drivers.ownership import Ownership
 from gazebot.io.drivers.rmw.attachment import gid_of
 from gazebot.io.drivers.rmw.graph import Entity
 from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.rmw.node import Received
+from gazebot.io.drivers.streams import SequenceGuard
 from gazebot.io.drivers.tf_buffer import TfBuffer, TransformError, listen
 from gazebot.io.drivers.tracking_assembly import IDLE_FLUSH, REORDER, Part, SampleAssembler
 from gazebot.io.drivers.tracking_source import Rival, SourceArbiter, group_of
@@ -106,7 +108,10 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         self._joints: JointState | None = None
         self._ownership: Ownership | None = None
         self._sources = SourceArbiter(source_timeout, clock)
-        self._gid_labels: dict[bytes, str] = {}
+        self._gid_lock = threading.Lock()
+        self._gid_labels: dict[bytes, str] = {}  # publisher GID -> its source label
+        self._bound: dict[str, bytes] = {}  # publisher token -> the GID it sends with
+        self._streams = SequenceGuard(source_timeout, clock)
         self._assembler = SampleAssembler(self._expected_parts, assemble_idle,
                                           assemble_reorder, clock=clock)
         self.tf = tf
@@ -126,14 +131,19 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
             sub = ros.subscription(t.name, (t.type, convert.POSE_STAMPED),
                                    self._point_handler(body))
             self._part_topics[body] = sub.topic
-        if names.tf_frames:
-            sub = ros.subscription(topics.TF.name, topics.TF.type, self._on_tf)
+        self._tf_codec = ros.codec(topics.TF.type, names.resolve(topics.TF.name), topics.TF.name)
+        self._joints_codec = ros.codec(topics.JOINT_STATES.type,
+                                       names.resolve(topics.JOINT_STATES.name),
+                                       topics.JOINT_STATES.name)
+        if names.tf_frames:  # raw: the element count is checked before decoding
+            sub = ros.subscription(topics.TF.name, topics.TF.type, self._on_tf, raw=True)
             for body in names.tf_frames:
                 self._part_topics.setdefault(body, sub.topic)
         for part, t, fn in (("gripper", topics.GRIPPER, self._on_gripper),
                             ("load_share", topics.LOAD_SHARE, self._on_share)):
             self._part_topics[part] = ros.subscription(t.name, t.type, fn).topic
-        ros.subscription(topics.JOINT_STATES.name, topics.JOINT_STATES.type, self._on_joints)
+        ros.subscription(topics.JOINT_STATES.name, topics.JOINT_STATES.type, self._on_joints,
+                         raw=True)
         self.announce()
 
     # -- tracking in -----------------------------------------------------------------------
@@ -152,24 +162,58 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                 out.add(part)
         return out
 
-    def _source(self, rx: Received) -> str:
-        """The node that published a received part: the publisher whose token hashes to the
-        GID of the attachment (as rmw_zenoh computes GIDs), else the topic's only publisher
-        (implementations with random GIDs), else one unidentified source."""
-        gid = rx.attachment.gid if rx.attachment is not None else None
-        label = self._gid_labels.get(gid) if gid is not None else None
-        if label is not None:
-            return label
-        publishers = self.ros.graph.endpoints(rx.topic, "MP")
-        for e in publishers:
-            if gid is not None and gid_of(e.token()) == gid:
-                if len(self._gid_labels) > 1000:  # publishers come and go: stay bounded
-                    self._gid_labels.clear()
+    def _source(self, part: str, rx: Received) -> str:
+        """The node that published a received part: the live publisher of the topic whose
+        token hashes to the GID of the attachment (as rmw_zenoh computes GIDs). An
+        implementation with GIDs of its own (random ones, e.g. zenoh-ros2-sdk) is bound to the
+        topic's only publisher by the first GID it sends, and only that GID is that publisher's
+        while its token lives. A part from no such publisher, or of a GID carrying two streams
+        (:mod:`~gazebot.io.drivers.streams`), is refused (a rival, counted and dropped:
+        :class:`MessageError`)."""
+        att = rx.attachment
+        if att is None:
+            self._refuse(part, UNANNOUNCED, rx, "no attachment")
+        with self._gid_lock:
+            label = self._gid_labels.get(att.gid)
+        if label is None:
+            label = self._bind(rx.topic, att.gid)
+        if label is None:
+            self._refuse(part, UNANNOUNCED, rx,
+                         f"GID {att.gid.hex()} announced by no live publisher of {rx.topic}")
+        why = self._streams.check(att.gid, att.sequence_number)
+        if why is not None:
+            self._refuse(part, f"a copy of the GID of {label}", rx, why)
+        return label
+
+    def _bind(self, topic: str, gid: bytes) -> str | None:
+        """The label of the publisher of ``topic`` that ``gid`` is (see :meth:`_source`)."""
+        publishers = self.ros.graph.endpoints(topic, "MP")
+        with self._gid_lock:
+            for e in publishers:
+                own = gid_of(e.token())
+                if own == gid:
+                    self._bound[e.token()] = gid
+                    label = self._gid_labels[gid] = source_label(e)
+                    return label
+            if len(publishers) == 1 and publishers[0].token() not in self._bound:
+                e = publishers[0]
+                self._bound[e.token()] = gid
                 label = self._gid_labels[gid] = source_label(e)
                 return label
-        if len({source_label(e) for e in publishers}) == 1:
-            return source_label(publishers[0])
-        return "unidentified publisher"
+        return None
+
+    def _refuse(self, part: str, source: str, rx: Received, why: str) -> NoReturn:
+        owner = self._sources.refuse(part, source)
+        raise MessageError(rx.type, f"tracking from {source} ignored ({why}); {owner} "
+                           f"publishes the {group_of(part)}")
+
+    def _on_graph(self, entity: Entity, alive: bool) -> None:
+        super()._on_graph(entity, alive)
+        if entity.kind == "MP" and not alive:  # its GID identifies nothing any more
+            with self._gid_lock:
+                gid = self._bound.pop(entity.token(), gid_of(entity.token()))
+                self._gid_labels.pop(gid, None)
+            self._streams.forget(gid)
 
     def tracking_sources(self) -> dict[str, str]:
         """Tracking part (``giver_hand``, ``giver_face``, ``gripper``, ...) -> its source now."""
@@ -223,7 +267,9 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         if point is not None:
             self._add(body, *point, rx)
 
-    def _on_tf(self, ros: RosTFMessage, rx: Received) -> None:
+    def _on_tf(self, data: bytes, rx: Received) -> None:
+        check_tf(data, rx.type)
+        ros = cast(RosTFMessage, self._tf_codec.decode(data))
         by_child = {child.lstrip("/"): body for body, child in self.names.tf_frames.items()}
         for tf in ros.transforms:
             body = by_child.get(str(tf.child_frame_id).lstrip("/"))
@@ -247,7 +293,7 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
     def _add(self, part: str, t: float, value: Part, rx: Received) -> None:
         if not math.isfinite(t):
             raise MessageError(part, f"stamp is not finite: {t}")
-        source = self._source(rx)
+        source = self._source(part, rx)
         owner = self._sources.admit(part, source)
         if owner is not None:
             raise MessageError(rx.type, f"second tracking source {source} ignored: {owner} "
@@ -265,8 +311,9 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         if samples:
             self._cond.notify_all()
 
-    def _on_joints(self, ros: RosJointState, rx: Received) -> None:
-        self._joints = convert.joint_positions(ros)
+    def _on_joints(self, data: bytes, rx: Received) -> None:
+        check_joint_state(data, rx.type)
+        self._joints = convert.joint_positions(cast(RosJointState, self._joints_codec.decode(data)))
 
     @property
     def tracking_late(self) -> int:
@@ -276,7 +323,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
     # -- ownership -------------------------------------------------------------------------
     def claim(self, timeout: float = 0.5) -> None:
         if self._ownership is None and not self.closed:
-            self._ownership = self.ros.declare(Ownership(self.session, self.names, self.node))
+            self._ownership = self.ros.declare(Ownership(self.session, self.names, self.node,
+                                                         graph=self.ros.graph))
             self._ownership.declare(timeout)
 
     def owns_robot(self) -> bool:
@@ -339,6 +387,10 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
         super().close()
         with self._cond:
             self._cond.notify_all()  # wake a wait_tracking() in progress
+
+
+#: The source of tracking samples no live publisher announced.
+UNANNOUNCED = "an unannounced publisher"
 
 
 def source_label(entity: Entity) -> str:

@@ -3,26 +3,42 @@ publishes tracking, joint states, gripper, load share and robot events; receives
 arm commands. All as ROS 2 messages on the rmw_zenoh wire (:mod:`gazebot.io.ros2.topics`).
 
 One engine per robot (:mod:`gazebot.io.drivers.ownership`): the endpoint watches the engines'
-claims and reports ``competing_engine`` (``info.engines``, the owner first) when more than one
-claims the robot; head commands from a publisher it identifies (by the GID in the attachment)
-as an engine that does not own the robot are dropped and counted. Head commands from two
-publishers within ``compete_window`` s (GIDs in the attachments, claims or not, e.g. a ROS 2
-node beside gazebot) are reported as ``competing_engine`` with ``info.publishers`` and
-``info.gids``. The heartbeat carries ``info.engines`` and ``info.head_publishers`` and is
-``degraded`` while engines compete."""
+claims, settles on one owner (a later claim never pre-empts a live owner; a claim whose engine
+is not in the ROS graph never owns) and reports ``competing_engine`` (``info.engines``, the
+owner first) when more than one claims the robot.
+
+Identity on every command (issue 30): a head, eye or arm command is applied only when its
+attachment's GID is the GID of a publisher of that topic alive in the ROS graph (its liveliness
+token), that publisher is the owner's node (same session and name) and its sequence number
+goes forward. Anything else (no attachment, a GID no live publisher announced, another node, a
+GID carrying two streams: :mod:`~gazebot.io.drivers.streams`) is dropped, counted by topic
+(:meth:`ZenohRobotEndpoint.unidentified`) and reported as a ``unidentified_command`` fault
+(rate-limited). On an open bus this is all that can be checked: an attacker who copies the
+owner's GID and stays ahead of its sequence numbers has one command obeyed before the owner's
+next one shows the copy (then both are refused while it lasts); to rule that out takes the
+authenticated bus (``gazebot bus init``, docs/bus.md), where only the engine's certificate may
+publish commands at all.
+
+Head commands from two publishers within ``compete_window`` s (GIDs in the attachments, e.g. a
+ROS 2 node beside gazebot) are reported as ``competing_engine`` with ``info.publishers`` and
+``info.gids``. The heartbeat carries ``info.engines``, ``info.head_publishers`` and
+``info.unidentified_commands`` and is ``degraded`` while engines compete."""
 
 from __future__ import annotations
 
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, ClassVar, Generic, TypeVar
+from typing import TYPE_CHECKING, ClassVar, Generic, NoReturn, TypeVar, cast
 
 from gazebot.core.types import Event, TrackingFrame
+from gazebot.io.drivers.bounds import check_trajectory
 from gazebot.io.drivers.ownership import Claim, OwnershipWatch
 from gazebot.io.drivers.rmw.attachment import gid_of
+from gazebot.io.drivers.rmw.graph import Entity
 from gazebot.io.drivers.rmw.names import Names
 from gazebot.io.drivers.rmw.node import Received
+from gazebot.io.drivers.streams import SequenceGuard
 from gazebot.io.drivers.zenoh_node import HISTORY_BYTES, ZenohNode, checked
 from gazebot.io.ros2 import convert, topics
 from gazebot.io.ros2.convert import RosCompressedImage, RosEyeState, RosJointTrajectory, RosString
@@ -113,19 +129,30 @@ class ZenohRobotEndpoint(ZenohNode):
         self._gid_publishers: dict[bytes, tuple[str, str]] = {}
         self._reported_gids: frozenset[bytes] = frozenset()
         self._reported_claims: frozenset[Claim] = frozenset()
+        self._unidentified: dict[str, int] = {}  # topic -> commands dropped as unidentified
+        self._unidentified_reported: dict[str, float] = {}  # topic -> when last reported
+        self._streams = SequenceGuard(compete_window, clock)
         ros = self.ros
         self._point_pubs = {b: ros.publisher(t.name, t.type) for b, t in topics.TRACKING.items()}
         self._gripper_pub = ros.publisher(topics.GRIPPER.name, topics.GRIPPER.type)
         self._share_pub = ros.publisher(topics.LOAD_SHARE.name, topics.LOAD_SHARE.type)
         self._joints_pub = ros.publisher(topics.JOINT_STATES.name, topics.JOINT_STATES.type)
-        ros.subscription(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type, self._on_head)
+        # Commands arrive raw: who sent them and their element counts are checked before
+        # they are decoded.
+        self._trajectory = ros.codec(topics.HEAD_COMMAND.type,
+                                     names.resolve(topics.HEAD_COMMAND.name),
+                                     topics.HEAD_COMMAND.name)
+        ros.subscription(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type, self._on_head,
+                         raw=True)
         ros.subscription(topics.EYES.name, topics.EYES.type, self._on_eyes)
         if eye_frames:
             ros.subscription(topics.EYE_IMAGE.name, topics.EYE_IMAGE.type, self._on_frame)
-        ros.subscription(topics.ARM_COMMAND.name, topics.ARM_COMMAND.type, self._on_arm)
+        ros.subscription(topics.ARM_COMMAND.name, topics.ARM_COMMAND.type, self._on_arm,
+                         raw=True)
         ros.subscription(topics.ARM_MODE.name, topics.ARM_MODE.type, self._on_arm_mode)
         self._head_topic = self.names.resolve(topics.HEAD_COMMAND.name)
-        self.owners = ros.declare(OwnershipWatch(session, names, self._on_claims))
+        self.owners = ros.declare(OwnershipWatch(session, names, self._on_claims,
+                                                 graph=ros.graph))
         self.announce()
 
     # -- out -------------------------------------------------------------------------------
@@ -159,31 +186,81 @@ class ZenohRobotEndpoint(ZenohNode):
             report = len(claims) > 1 and frozenset(claims) != self._reported_claims
             self._reported_claims = frozenset(claims) if len(claims) > 1 else frozenset()
         if report:
-            self._publish_fault("competing_engine", engines=[str(c) for c in claims],
-                                owner=str(claims[0]))
+            ordered = self.owners.claims()  # the owner first (not the earliest stated start)
+            owner = self.owners.owner()
+            self._publish_fault("competing_engine", engines=[str(c) for c in ordered],
+                                owner=str(owner) if owner is not None else None,
+                                forged=[str(c) for c in self.owners.forged()])
 
-    def _publisher_of(self, gid: bytes) -> tuple[str, str] | None:
-        """``(zid, node)`` of the head command publisher with ``gid`` (from the graph)."""
-        known = self._gid_publishers.get(gid)
+    def _publisher_of(self, gid: bytes, topic: str | None = None) -> tuple[str, str] | None:
+        """``(zid, node)`` of the live publisher of ``topic`` (default: head commands) whose
+        liveliness token hashes to ``gid``, from the graph."""
+        topic = topic or self._head_topic
+        with self._compete_lock:
+            known = self._gid_publishers.get(gid)
         if known is not None:
             return known
-        for e in self.ros.graph.endpoints(self._head_topic, "MP"):
+        for e in self.ros.graph.endpoints(topic, "MP"):
             if gid_of(e.token()) == gid:
-                if len(self._gid_publishers) > 1000:  # publishers come and go: stay bounded
-                    self._gid_publishers.clear()
-                self._gid_publishers[gid] = (e.zid, e.node)
+                with self._compete_lock:
+                    self._gid_publishers[gid] = (e.zid, e.node)
                 return e.zid, e.node
         return None
 
-    def _check_head_publisher(self, gid: bytes) -> None:
-        """Drop a command from an engine that does not own the robot; report two
-        publishers commanding within ``compete_window``."""
-        publisher = self._publisher_of(gid)
+    def _on_graph(self, entity: Entity, alive: bool) -> None:
+        super()._on_graph(entity, alive)
+        if entity.kind == "MP" and not alive:
+            # A publisher gone: its GID identifies nothing any more.
+            gid = gid_of(entity.token())
+            with self._compete_lock:
+                self._gid_publishers.pop(gid, None)
+            self._streams.forget(gid)
+
+    def _identify(self, rx: Received, what: str) -> tuple[str, str] | None:
+        """Drop (raise :class:`MessageError`, counted and reported as
+        ``unidentified_command``) a command not from the owner's live publisher of the topic;
+        returns the publisher, ``None`` when the publisher is identified but no owner is."""
+        att = rx.attachment
+        if att is None:
+            self._unidentified_drop(rx, what, "no attachment: the publisher cannot be identified")
+        publisher = self._publisher_of(att.gid, rx.topic)
+        if publisher is None:
+            self._unidentified_drop(rx, what, f"GID {att.gid.hex()} is announced by no live "
+                                    f"publisher of {rx.topic}")
+        why = self._streams.check(att.gid, att.sequence_number)
+        if why is not None:
+            self._publish_fault("competing_engine", copied_gid=att.gid.hex(), topic=rx.topic,
+                                publishers=[f"{publisher[1]} (session {publisher[0]})"])
+            self._unidentified_drop(rx, what, f"{why} (of {publisher[1]})")
         owner = self.owners.owner()
-        if owner is not None and publisher is not None and publisher != (owner.zid, owner.node):
-            raise MessageError(convert.JOINT_TRAJECTORY, f"head command from {publisher[1]} "
-                               f"(session {publisher[0]}), which does not own the robot "
-                               f"(owner: {owner})")
+        if owner is None:
+            self._unidentified_drop(rx, what, f"from {publisher[1]} (session {publisher[0]}), "
+                                    "but no engine owns the robot")
+        if publisher != (owner.zid, owner.node):
+            self._unidentified_drop(rx, what, f"from {publisher[1]} (session {publisher[0]}), "
+                                    f"which does not own the robot (owner: {owner})")
+        return publisher
+
+    def _unidentified_drop(self, rx: Received, what: str, reason: str) -> NoReturn:
+        now = self.clock()
+        with self._compete_lock:
+            n = self._unidentified[rx.topic] = self._unidentified.get(rx.topic, 0) + 1
+            last = self._unidentified_reported.get(rx.topic)
+            report = last is None or now - last > self.compete_window
+            if report:
+                self._unidentified_reported[rx.topic] = now
+        if report:  # once per topic and window: a flood cannot flood the events
+            self._publish_fault("unidentified_command", topic=rx.topic, reason=reason,
+                                count=n)
+        raise MessageError(what, f"unidentified command dropped: {reason}")
+
+    def unidentified(self) -> dict[str, int]:
+        """Commands dropped as unidentified, by topic."""
+        with self._compete_lock:
+            return dict(self._unidentified)
+
+    def _check_head_publisher(self, gid: bytes) -> None:
+        """Report two publishers commanding the head within ``compete_window``."""
         now = self.clock()
         with self._compete_lock:
             self._head_gids[gid] = now
@@ -223,14 +300,21 @@ class ZenohRobotEndpoint(ZenohNode):
         ``info.head_publishers``; ``degraded`` while engines compete."""
         engines = [str(c) for c in self.owners.claims()]
         publishers = self.head_publishers()
-        info = {**(info or {}), "engines": engines, "head_publishers": publishers}
+        info = {**(info or {}), "engines": engines, "head_publishers": publishers,
+                "unidentified_commands": sum(self.unidentified().values())}
         return super().heartbeat(tracking, phase, info, stopping,
                                  degraded or len(engines) > 1 or publishers > 1)
 
     # -- in --------------------------------------------------------------------------------
-    def _on_head(self, ros: RosJointTrajectory, rx: Received) -> None:
-        if rx.attachment is not None:
-            self._check_head_publisher(rx.attachment.gid)
+    def _decode_trajectory(self, data: bytes) -> RosJointTrajectory:
+        check_trajectory(data, convert.JOINT_TRAJECTORY)
+        return cast(RosJointTrajectory, self._trajectory.decode(data))
+
+    def _on_head(self, data: bytes, rx: Received) -> None:
+        if rx.attachment is not None and self._publisher_of(rx.attachment.gid) is not None:
+            self._check_head_publisher(rx.attachment.gid)  # a second publisher is reported
+        self._identify(rx, convert.JOINT_TRAJECTORY)
+        ros = self._decode_trajectory(data)
         goal = convert.trajectory_goal(ros)
         if not goal.time_from_start > 0.0:
             raise MessageError(convert.JOINT_TRAJECTORY, "time_from_start must be > 0, got "
@@ -238,17 +322,22 @@ class ZenohRobotEndpoint(ZenohNode):
         self.head.put(goal)
 
     def _on_eyes(self, ros: RosEyeState, rx: Received) -> None:
+        self._identify(rx, rx.type)
         self.eyes.put(convert.eyes_of(ros))
 
     def _on_frame(self, ros: RosCompressedImage, rx: Received) -> None:
+        self._identify(rx, rx.type)
         self.eye_frame.put(ros)  # decoded (and its size checked) where it is shown
 
-    def _on_arm(self, ros: RosJointTrajectory, rx: Received) -> None:
+    def _on_arm(self, data: bytes, rx: Received) -> None:
+        self._identify(rx, convert.JOINT_TRAJECTORY)
+        ros = self._decode_trajectory(data)
         goal = convert.trajectory_goal(ros)  # a ``gripper`` joint (0..1) may be among them
         self.arm.put(checked(convert.JOINT_TRAJECTORY,
                              lambda: ArmCommand(goal.t, positions=goal.positions)))
 
     def _on_arm_mode(self, ros: RosString, rx: Received) -> None:
+        self._identify(rx, convert.STRING)
         mode = str(ros.data)
         if mode == "resume":
             cmd = ArmCommand(resume=True)

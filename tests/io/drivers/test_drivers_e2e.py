@@ -235,6 +235,7 @@ def test_simulator_node_obeys_arm_commands(bus, sim):
     sim_node, ep, _, _ = start_sim_node(bus, sim)
     drv = ZenohRobotDriver(bus.connector(), bus.names, "operator")
     bus.closers.append(drv.close)
+    drv.claim()  # the robot obeys only the node that owns it (issue 30)
     assert wait_until(lambda: drv.peers().get("sim"))
     goal = {j: 0.1 * i for i, j in enumerate(sim.robot.arm_joints)}
     drv.send_arm(ArmCommand(positions=goal))

@@ -61,6 +61,9 @@ def engine_side(bus, engine=None, config=FAST, peer_timeout=2.0, clock=None):
     kw = {"clock": clock} if clock is not None else {}
     drv = ZenohRobotDriver(bus.connector(), bus.names, "engine", peer_timeout=peer_timeout,
                            **kw)
+    # The robot obeys only the engine that owns it (issue 30): claim as ``start()`` does, so
+    # tests that tick the node directly are obeyed too (``start()`` claims only once).
+    drv.claim()
     node = EngineNode(GazeLoop(engine or FakeEngine()), drv, config)
     stop = threading.Event()
     th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
@@ -341,6 +344,7 @@ def test_eye_frames_are_rendered_only_while_someone_subscribes(bus):
     ep = robot_side(bus)  # draws its own eyes: does not ask for frames
     drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
     bus.closers.append(drv.close)
+    drv.claim()  # displays, too, draw only the owner's eyes
     renderer = CountingRenderer()
     node = EngineNode(GazeLoop(FakeEngine()), drv, FAST, eye_renderer=renderer)
     assert wait_until(lambda: connected(ep, drv))
@@ -379,9 +383,12 @@ def test_robot_clock_going_back_resets_and_resyncs_the_engine(bus):
     ep.publish_joint_state(0.0, {"head_pan": -0.3})
     # keys keep their own order only: the new joint state first, then the sample
     assert wait_until(lambda: drv.joint_state().position["head_pan"] == -0.3)
-    ep.publish_tracking(frame(0.0))  # the simulator restarted
+    for i in range(3):  # the simulator restarted (a restart is taken from 3 samples in a row)
+        ep.publish_tracking(frame(i / 120))
     assert wait_until(lambda: events.where(kind="tracking_clock_reset"))
-    assert wait_until(lambda: node.engine.frames and node.engine.frames[-1].t == 0.0)
+    assert wait_until(lambda: node.engine.frames
+                      and node.engine.frames[-1].t == pytest.approx(2 / 120))
+    assert node.tracking_backwards == 2
     assert node.engine.reset_heads == [{"head_pan": 0.2}, {"head_pan": -0.3}]
 
 

@@ -132,7 +132,9 @@ def test_zenoh_drops_a_message_beyond_the_nodes_limit_before_it_is_reassembled(b
     drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
     for n in (ep, drv):
         bus.closers.append(n.close)
+    drv.claim()  # the robot obeys only the engine that owns it (issue 30)
     assert wait_until(lambda: ep.peers().get("engine"))
+
     def route_up() -> bool:
         # Seeing the peer does not mean a put already reaches its subscription: a command,
         # sent until one arrives, shows the route is in place.

@@ -13,7 +13,7 @@ from test_drivers_faults import FAST, connected, engine_side, events_of, frame, 
 
 from gazebot.core.runtime import GazeLoop
 from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig, EngineRefused
-from gazebot.io.drivers.ownership import Claim
+from gazebot.io.drivers.ownership import Claim, Ownership
 from gazebot.io.drivers.rmw.node import RosNode
 from gazebot.io.drivers.zenoh_driver import ZenohRobotDriver
 from gazebot.io.ros2 import convert, topics
@@ -119,13 +119,22 @@ def test_the_robot_reports_head_commands_from_two_publishers_by_their_gids(bus):
     bus.closers += [a.close, b.close]
     pa = a.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
     pb = b.publisher(topics.HEAD_COMMAND.name, topics.HEAD_COMMAND.type)
+    a.announce()
+    b.announce()
+    # a claims the robot as an engine does (issue 30: the robot obeys only its owner)
+    claim = Ownership(a.session, bus.names, a.name, graph=a.graph)
+    bus.closers.append(claim.undeclare)
+    claim.declare()
+    assert wait_until(lambda: ep.owners.owner() is not None)
     assert wait_until(lambda: pa.subscribed() and pb.subscribed())
     assert wait_until(lambda: len(ep.ros.graph.endpoints(ep._head_topic, "MP")) == 2)
     pa.publish(head_command(0.0, 0.1))
     assert wait_until(lambda: ep.head.count == 1)
     assert not events.where(kind="competing_engine")  # one publisher is no competition
-    pb.publish(head_command(0.0, -0.1))
+    pb.publish(head_command(0.0, -0.1))  # not the owner: dropped, and the pair reported
     assert wait_until(lambda: events.where(kind="competing_engine"))
+    assert wait_until(lambda: ep.unidentified() == {ep._head_topic: 1})
+    assert ep.head.count == 1
     [report] = events.where(kind="competing_engine")
     assert sorted(report.info["gids"]) == sorted([pa.gid.hex(), pb.gid.hex()])
     assert {p.split(" ")[0] for p in report.info["publishers"]} == {"ros_engine_a",
