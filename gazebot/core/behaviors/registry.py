@@ -17,7 +17,7 @@ from typing import Any
 
 import yaml
 
-from gazebot.core.behaviors.segment import TRACKED_TARGETS
+from gazebot.core.behaviors.segment import TRACKED_TARGETS, check_target_name
 from gazebot.core.behaviors.spec import BehaviorSpec
 from gazebot.core.config import (
     ConfigError,
@@ -197,8 +197,13 @@ def _check(
         except ConfigError as exc:
             return None, [exc]
         spec, errors = config_errors(BehaviorSpec, merged, path, doc.node)
-    if spec is not None and points is not None:
-        errors = _target_errors(spec, path, doc.node, points)
+    if points is not None:
+        # Targets too when the rest has errors: every error of the file at once.
+        uses = _target_uses(spec) if spec is not None else _raw_target_uses(data)
+        errors = sorted(
+            [*errors, *_target_errors(uses, path, doc.node, points)],
+            key=lambda e: e.line if e.line is not None else 0,
+        )
     return (None if errors else spec), errors
 
 
@@ -250,12 +255,12 @@ def _load_base(name: str, dirs: Sequence[Path] | None, seen: tuple[str, ...]) ->
     return spec
 
 
-def _target_errors(
-    spec: BehaviorSpec, path: Path, node: yaml.Node | None, points: Collection[str]
-) -> list[ConfigError]:
-    """An error for every target of ``spec`` that is neither tracked nor one of ``points``."""
-    known = known_targets(points)
-    uses: list[tuple[tuple[Any, ...], str]] = [
+_TargetUse = tuple[tuple[Any, ...], str]
+
+
+def _target_uses(spec: BehaviorSpec) -> list[_TargetUse]:
+    """Every target ``spec`` names, with where (pydantic's location)."""
+    uses: list[_TargetUse] = [
         (("before",), spec.before),
         (("after",), spec.after),
         (("tracking_lost", "target"), spec.tracking_lost.target),
@@ -263,18 +268,50 @@ def _target_errors(
     ]
     if spec.human is not None:
         uses.extend((("human",), name) for name in sorted(spec.human.targets()))
+    return uses
+
+
+def _raw_target_uses(data: dict[str, Any]) -> list[_TargetUse]:
+    """The target names a file that did not validate writes where they can be read."""
+    uses: list[_TargetUse] = [((k,), data[k]) for k in ("before", "after") if k in data]
+    lost = data.get("tracking_lost")
+    if isinstance(lost, dict) and "target" in lost:
+        uses.append((("tracking_lost", "target"), lost["target"]))
+    segments = data.get("segments")
+    if isinstance(segments, list):
+        for i, seg in enumerate(segments):
+            if isinstance(seg, dict) and "target" in seg:
+                uses.append((("segments", i, "target"), seg["target"]))
+    return [(loc, t) for loc, t in uses if isinstance(t, str)]
+
+
+def _target_errors(
+    uses: list[_TargetUse], path: Path, node: yaml.Node | None, points: Collection[str]
+) -> list[ConfigError]:
+    """An error for every target in ``uses`` that is neither tracked nor one of ``points``
+    (a malformed name is the model's error, not reported again)."""
+    known = known_targets(points)
     errors = []
     for loc, target in uses:
-        if target not in known:
-            field, line = locate(node, loc)
-            errors.append(
-                ConfigError(
-                    path,
-                    field,
-                    f"a target ({', '.join(known)})",
-                    target,
-                    line=line,
-                    problem=f"{target!r} is not a target (known: {', '.join(known)})",
-                )
+        if target in known or not _is_target_name(target):
+            continue
+        field, line = locate(node, loc)
+        errors.append(
+            ConfigError(
+                path,
+                field,
+                f"a target ({', '.join(known)})",
+                target,
+                line=line,
+                problem=f"{target!r} is not a target (known: {', '.join(known)})",
             )
+        )
     return errors
+
+
+def _is_target_name(name: str) -> bool:
+    try:
+        check_target_name(name)
+    except ValueError:
+        return False
+    return True

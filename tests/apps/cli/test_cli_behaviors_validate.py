@@ -74,13 +74,15 @@ def test_every_error_of_every_file_is_printed(tmp_path, capsys):
     assert main(["behaviors", "validate", str(bad), str(missing), str(good)]) == 2
     out, err = capsys.readouterr()
     lines = err.splitlines()
-    assert lines[:3] == [
+    assert lines[:4] == [
         f"{bad}:2: segments[0].at: expected a fraction of the phase between 0 and 1, got 1.5",
         f"{bad}:3: segments[1].at: expected a defined parameter (known: []), got '$later'",
+        f"{bad}:3: segments[1].target: 'hnad' is not a target (known: dropoff, face, hand, "
+        "handover_location, object, receiver_hand, rest)",
         f"{bad}:4: segments[2].at.delay: expected greater than or equal to 0, got -1",
     ]
-    assert lines[3].startswith(f"{missing}: ") and "not found" in lines[3]
-    assert lines[4] == "2 of 3 behavior files have errors"
+    assert lines[4].startswith(f"{missing}: ") and "not found" in lines[4]
+    assert lines[5] == "2 of 3 behavior files have errors"
     assert out == f"{good}: ok\n"
 
 

@@ -87,6 +87,9 @@ def test_sim_and_engine_complete_the_handover_whichever_starts_first(bus, hub, c
     assert status == [0], capsys.readouterr().err
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert summary["handover_done"] and summary["applied"]["head"] > 0
+    # the engine started before any tracking sample: its node event says it has no clock yet
+    started = events.where(source="engine", kind="node_started")
+    assert len(started) == 1 and started[0].t == 0.0 and started[0].info["clock"] == "none"
     # the engine saw the handover from its start: every phase, in order, ending handover_done
     assert wait_until(
         lambda: [m.kind for m in events.where(source="engine", category="phase")] == PHASES,
