@@ -184,10 +184,13 @@ def _is_tag(part: str) -> bool:
     )
 
 
-def locate(node: yaml.Node | None, loc: tuple[Any, ...]) -> tuple[str, int | None]:
+def locate(
+    node: yaml.Node | None, loc: tuple[Any, ...], missing: bool = True
+) -> tuple[str, int | None]:
     """The field of pydantic's error location ``loc`` as a user wrote it (``segments[1].at``)
     and its line in the file (1-based; the deepest part of ``loc`` the file has), ``None``
-    without a node tree."""
+    without a node tree. ``missing``: a last part the file lacks is a missing key (kept), not
+    the tag of a union member (dropped)."""
     field = ""
     line = None
     for i, part in enumerate(loc):
@@ -200,6 +203,8 @@ def locate(node: yaml.Node | None, loc: tuple[Any, ...]) -> tuple[str, int | Non
                 continue
             if i + 1 < len(loc) and str(loc[i + 1]) in keys:
                 continue  # a union member's tag (``likert``): the next part is the key
+            if i + 1 == len(loc) and not missing:
+                break  # a union member's tag: the error is the whole mapping's
         if isinstance(node, yaml.SequenceNode) and isinstance(part, int):
             if 0 <= part < len(node.value):
                 node = node.value[part]
@@ -275,7 +280,7 @@ def _error(
     model: type[BaseModel], err: Any, source: str | Path, node: yaml.Node | None
 ) -> ConfigError:
     loc = tuple(err["loc"])
-    field, line = locate(node, loc)
+    field, line = locate(node, loc, missing=err["type"] == "missing")
     if node is None:  # no file to point into: pydantic's dotted location, as callers knew it
         field = ".".join(str(p) for p in loc) or "<root>"
     kind = err["type"]
