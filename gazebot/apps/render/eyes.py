@@ -18,10 +18,11 @@ outside 0..1 is clamped. The disc narrows along the direction it turns (foreshor
 
 Speed: everything static (background, gradient, cheeks, eye outlines and the antialiased sclera
 coverage masks) is drawn once. Per frame only each eye's box is redrawn with OpenCV's antialiased
-primitives at 1/16-px precision (iris, pupil, highlights, lids), then composited over the copied
-background through the precomputed sclera coverage, which also clips pupil and lids to the eye
-(a masked copy outside, an integer blend on the 1-2 px rim); then the brows are filled as stroke
-polygons (much faster than thick antialiased polylines).
+primitives at 1/16-px precision (iris, pupil, highlights), then composited over the copied
+background through the precomputed sclera coverage, which also clips the pupil to the eye
+(a masked copy outside, an integer blend on the 1-2 px rim); the lids are drawn over that and
+clipped the same way to the eye with its outline, so a lowered lid hides the outline above it;
+then the brows are filled as stroke polygons (much faster than thick antialiased polylines).
 """
 
 from __future__ import annotations
