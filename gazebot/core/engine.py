@@ -26,6 +26,7 @@ from typing import Protocol
 import numpy as np
 
 from gazebot.core.behaviors import BehaviorMachine, BehaviorSpec, load_behavior
+from gazebot.core.behaviors.segment import TRACKED_TARGETS
 from gazebot.core.config import ConfigError
 from gazebot.core.defaults import DEFAULT_BEHAVIOR, DEFAULT_ROBOT
 from gazebot.core.handover import HandoverState, HandoverView, apply_event
@@ -51,7 +52,7 @@ from gazebot.core.types import (
 )
 
 # Targets the engine fills from tracking each tick; all others come from the robot config.
-_TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
+_TRACKED_TARGETS = TRACKED_TARGETS
 
 
 class PhaseDetectorLike(Protocol):

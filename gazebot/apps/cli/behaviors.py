@@ -1,16 +1,18 @@
-"""``gazebot behaviors``: list the available gaze behaviors or show one."""
+"""``gazebot behaviors``: list the available gaze behaviors, show one or validate files."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
+from gazebot.apps.cli.choices import add_robot_argument
 from gazebot.apps.cli.errors import UsageError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    parser = sub.add_parser("behaviors", help="list or show gaze behaviors")
+    parser = sub.add_parser("behaviors", help="list, show or validate gaze behaviors")
     cmds = parser.add_subparsers(dest="behaviors_command", metavar="ACTION")
     cmds.required = True
 
@@ -36,7 +38,21 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="write the behavior's state machine diagram as Mermaid text (FILE.md: in a fenced "
         "mermaid block; any other name, e.g. FILE.mmd: the bare diagram)",
     )
+    add_robot_argument(p)
     p.set_defaults(func=_show)
+
+    p = cmds.add_parser(
+        "validate",
+        help="check behavior files as the engine would (exit 2 on any error)",
+        description="Check every file as the engine would load it on --robot: YAML syntax, "
+        "keys, types, phases, at: fractions, $parameter and after: event references, durations "
+        "and targets (tracked ones or the robot's points). Every error is printed as "
+        "FILE:LINE: FIELD: PROBLEM; the exit status is 2 if any file has one, else 0.",
+    )
+    p.add_argument("files", nargs="+", metavar="FILE", help="behavior YAML file (or name)")
+    p.add_argument("--dir", action="append", type=Path, default=None, help="user behavior folder")
+    add_robot_argument(p)
+    p.set_defaults(func=_validate)
 
 
 def _list(args: argparse.Namespace) -> int:
@@ -54,10 +70,40 @@ def _list(args: argparse.Namespace) -> int:
     return 0
 
 
+def robot_points(robot: str | Path) -> list[str]:
+    """The point names of ``robot`` (a name or YAML file): the targets a behavior may name
+    besides the tracked ones."""
+    from gazebot.core.kinematics.robot_config import load_robot_config
+
+    return sorted(load_robot_config(robot)[0].points)
+
+
+def _validate(args: argparse.Namespace) -> int:
+    from gazebot.core.behaviors import behavior_errors
+
+    points = robot_points(args.robot)
+    failed = 0
+    for name in args.files:
+        try:
+            errors = [str(e) for e in behavior_errors(name, args.dir, points)]
+        except FileNotFoundError as exc:
+            errors = [f"{name}: {exc}"]
+        for line in errors:
+            print(line, file=sys.stderr)
+        if errors:
+            failed += 1
+        else:
+            print(f"{name}: ok")
+    if failed:
+        print(f"{failed} of {len(args.files)} behavior files have errors", file=sys.stderr)
+        return 2
+    return 0
+
+
 def _show(args: argparse.Namespace) -> int:
     from gazebot.core.behaviors import load_behavior
 
-    spec = load_behavior(args.behavior, args.dir)
+    spec = load_behavior(args.behavior, args.dir, robot_points(args.robot))
     if args.diagram is not None:
         from gazebot.core.behaviors.machine import write_diagram
 

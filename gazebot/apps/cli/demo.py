@@ -230,6 +230,11 @@ def run_demo(args: argparse.Namespace) -> int:
     from gazebot.core.kinematics.robot_config import GAZE_MODES
 
     args.robot = default_robot(args)
+    from gazebot.apps.cli.behaviors import robot_points
+    from gazebot.core.behaviors import load_behavior
+
+    # Before any simulation: a wrong behavior file fails now, naming its file and line.
+    load_behavior(args.behavior, None, robot_points(args.robot))
     if is_urdf_robot(args.robot):
         return run_kinematic_demo(args)
     from gazebot.apps.render.gl_check import OffscreenRenderingError

@@ -1,5 +1,6 @@
-"""``gazebot render video``: an off-screen MuJoCo render of a full handover (observer camera at the
-side, eyes on the head display) to an H.264 MP4, deterministic for a seed."""
+"""``gazebot render video``: an off-screen MuJoCo render of a full handover to an H.264 MP4,
+deterministic for a seed. The observer camera stands in front of the robot, where its head
+screen (the eyes) faces it, with a close-up of the screen in a corner (docs/observer-view.md)."""
 
 from __future__ import annotations
 

@@ -22,6 +22,9 @@ from gazebot.apps.cli.mcap import add_record_split_arguments, record_split
 from gazebot.apps.render.video_settings import VIDEO
 from gazebot.core.defaults import DEFAULT_BEHAVIOR
 
+#: How long (s) ``gazebot sim`` waits by default for an engine to own the robot.
+WAIT_TIMEOUT_S = 60.0
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
@@ -54,6 +57,20 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="simulated seconds to run (default: until Ctrl-C)")
     p.add_argument("--speed", type=positive, default=1.0,
                    help="simulated seconds per real second (default 1: real time)")
+    p.add_argument(
+        "--no-wait",
+        action="store_true",
+        help="start the scene at once (default: its clock starts once an engine owns the "
+        "robot, so an engine started later still sees the whole handover)",
+    )
+    p.add_argument(
+        "--wait-timeout",
+        type=positive,
+        default=WAIT_TIMEOUT_S,
+        metavar="S",
+        help=f"seconds to wait for an engine before giving up with status 2 "
+        f"(default {WAIT_TIMEOUT_S:g})",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON summary at the end")
     add_bus_arguments(p, listens_by_default=True)
     add_record_argument(p)
@@ -108,6 +125,7 @@ def handle(args: argparse.Namespace) -> int:
     stop = threading.Event()
     summary: dict[str, Any] = {}
     engine_error: list[str] = []  # why the in-process engine stopped, if it did
+    waited_out = False  # no engine came within --wait-timeout
 
     def run_engine(node: Any) -> None:
         # The engine node survives what its inputs cause; if it stops anyway, the simulation
@@ -154,8 +172,12 @@ def handle(args: argparse.Namespace) -> int:
             + (f", engine '{args.behavior}' in-process" if args.with_engine else ""),
             file=sys.stderr,
         )
+        if not (args.with_engine or args.no_wait):
+            print(f"gazebot sim: waiting up to {args.wait_timeout:g} s for a gaze engine "
+                  "(gazebot run) to own the robot; the scene starts then", file=sys.stderr)
+            waited_out = not node.wait_for_engine(args.wait_timeout, stop)
         try:
-            rtf = node.run(duration=args.duration, stop=stop)
+            rtf = float("nan") if waited_out else node.run(duration=args.duration, stop=stop)
         except KeyboardInterrupt:
             rtf = float("nan")
         summary = {
@@ -187,6 +209,11 @@ def handle(args: argparse.Namespace) -> int:
         for closable in (driver, endpoint, sim, view):  # sim before the window: shared GL
             if closable is not None:
                 closable.close()
+    if waited_out:
+        print(f"gazebot sim: error: no gaze engine owned the robot under {cfg.names.namespace} "
+              f"within {args.wait_timeout:g} s: start `gazebot run` on the same bus (or use "
+              "--with-engine, or --no-wait to start the scene anyway)", file=sys.stderr)
+        return 2
     if engine_error:
         print(f"gazebot sim: error: the in-process engine stopped ({engine_error[0]}); "
               "the simulation stopped with it", file=sys.stderr)

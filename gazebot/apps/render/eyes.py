@@ -18,10 +18,11 @@ outside 0..1 is clamped. The disc narrows along the direction it turns (foreshor
 
 Speed: everything static (background, gradient, cheeks, eye outlines and the antialiased sclera
 coverage masks) is drawn once. Per frame only each eye's box is redrawn with OpenCV's antialiased
-primitives at 1/16-px precision (iris, pupil, highlights, lids), then composited over the copied
-background through the precomputed sclera coverage, which also clips pupil and lids to the eye
-(a masked copy outside, an integer blend on the 1-2 px rim); then the brows are filled as stroke
-polygons (much faster than thick antialiased polylines).
+primitives at 1/16-px precision (iris, pupil, highlights), then composited over the copied
+background through the precomputed sclera coverage, which also clips the pupil to the eye
+(a masked copy outside, an integer blend on the 1-2 px rim); the lids are drawn over that and
+clipped the same way to the eye with its outline, so a lowered lid hides the outline above it;
+then the brows are filled as stroke polygons (much faster than thick antialiased polylines).
 """
 
 from __future__ import annotations
@@ -110,6 +111,7 @@ class _EyeLayer:
         frame_shape: tuple[int, int],
         exponent: float,
         sclera_color: tuple[int, int, int],
+        outline: float = 0.0,
     ):
         h, w = frame_shape
         self.geom = geom
@@ -131,6 +133,17 @@ class _EyeLayer:
         self.layer = self.template.copy()
         self.bg = np.zeros((bh, bw, 3), np.uint8)
         self.rim_bg = np.zeros((self.rim.size, 3), np.uint16)
+        # The eye with its outline: lids cover the outline too (a lowered lid hides the ring),
+        # to a pixel beyond it, so the ring's antialiased edge does not show as a faint line.
+        grow = outline + 1.0 if outline > 0 else 0.0
+        outer = superellipse_coverage(
+            (bh, bw), (self.ex, self.ey), (geom.a + grow, geom.b + grow), exponent
+        )
+        o8 = np.rint(outer * 256.0).astype(np.uint16).ravel()
+        self.outer_outside = (o8 == 0).reshape(bh, bw).astype(np.uint8)
+        self.outer_rim = np.nonzero((o8 > 0) & (o8 < 256))[0]
+        self.outer_rim_a = o8[self.outer_rim][:, None]
+        self.lidded = self.template.copy()
 
     def set_background(self, frame_bg: np.ndarray) -> None:
         if self.empty:  # the eye lies outside the frame: nothing to composite
@@ -145,6 +158,16 @@ class _EyeLayer:
         mixed = flat[self.rim].astype(np.uint16) * self.rim_a + self.rim_bg
         flat[self.rim] = (mixed >> 8).astype(np.uint8)
         return self.layer
+
+    def clip_outer(self, drawn: np.ndarray, under: np.ndarray) -> np.ndarray:
+        """``drawn`` (lids drawn over ``under``) clipped to the eye and its outline, over
+        ``under`` (``drawn`` in place, returned)."""
+        cv2.copyTo(under, self.outer_outside, drawn)
+        a = self.outer_rim_a
+        top, low = drawn.reshape(-1, 3), under.reshape(-1, 3)
+        mixed = top[self.outer_rim].astype(np.uint16) * a + low[self.outer_rim] * (256 - a)
+        top[self.outer_rim] = (mixed >> 8).astype(np.uint8)
+        return drawn
 
 
 class _Sprite:
@@ -290,7 +313,7 @@ class EyeRenderer:
             self._paint_blush(bg, H)
         pad = self._outline + 3.0
         self._layers = [
-            _EyeLayer(g, pad, (self.height, W), s.sclera.exponent, s.sclera.color)
+            _EyeLayer(g, pad, (self.height, W), s.sclera.exponent, s.sclera.color, self._outline)
             for g in self.eyes
         ]
         if self._outline > 0:
@@ -417,8 +440,7 @@ class EyeRenderer:
             u, v = self._offset(yaw - lay.geom.side * verg, pitch)
             v_mean += 0.5 * v
             if not lay.empty:
-                self._draw_eye(lay, u, v, blink)
-                frame[lay.y0 : lay.y1, lay.x0 : lay.x1] = lay.composite()
+                frame[lay.y0 : lay.y1, lay.x0 : lay.x1] = self._draw_eye(lay, u, v, blink)
         if self._brows:
             br = self.style.brows
             dy = int(round(br.follow * v_mean + br.blink_drop * self.height * blink))
@@ -450,8 +472,10 @@ class EyeRenderer:
         lower = np.column_stack([ex + xs, y_lo - lids.lower_curve * b * rel])
         return upper, lower
 
-    def _draw_eye(self, lay: _EyeLayer, u: float, v: float, blink: float) -> None:
-        s, H, g = self.style, float(self.height), lay.geom
+    def _draw_eye(self, lay: _EyeLayer, u: float, v: float, blink: float) -> np.ndarray:
+        """The eye's box: iris and pupil clipped to the sclera, lids clipped to the eye and
+        its outline (so a lowered lid hides the outline above it)."""
+        s, H = self.style, float(self.height)
         img = lay.layer
         np.copyto(img, lay.template)
         px, py = lay.ex + u, lay.ey + v
@@ -477,6 +501,16 @@ class EyeRenderer:
             if radius > 0.25:
                 c = (_fixed(px + ox * r_p * squash), _fixed(py + oy * r_p))
                 cv2.circle(img, c, _fixed(radius), s.pupil.highlight_color, -1, cv2.LINE_AA, _SHIFT)
+        if self._outline <= 0:  # the eye is the sclera: one clip for pupil and lids
+            self._draw_lids(img, lay, v, blink)
+            return lay.composite()
+        eye = lay.composite()
+        np.copyto(lay.lidded, eye)
+        self._draw_lids(lay.lidded, lay, v, blink)
+        return lay.clip_outer(lay.lidded, eye)
+
+    def _draw_lids(self, img: np.ndarray, lay: _EyeLayer, v: float, blink: float) -> None:
+        s, H, g = self.style, float(self.height), lay.geom
         lids = s.lids
         upper, lower = self.lid_curves(g, lay.ex, lay.ey, v, blink)
         top, bottom = -8.0, img.shape[0] + 8.0

@@ -63,20 +63,14 @@ def check_video_size(width: int, height: int, fps: float) -> None:
         raise ValueError(f"fps must be between 1 and {CONTROL_HZ:g}, got {fps}")
 
 
-def expected_duration(sim) -> float:
-    """Rough length (s) of the handover ``sim`` will run, for the progress bar: the giver's start,
-    the slower of the two reaches, the grasp, the transfer, the slower retreat and the tail."""
-    plan, ctl, cfg = sim.giver.plan, sim.controller, sim.config.controller
-    robot_reach = ctl.planned_duration(ctl.home, ctl.handover, cfg.reach_min_duration_s)
-    robot_back = ctl.planned_duration(ctl.handover, ctl.home, cfg.retreat_min_duration_s)
-    reach = max(plan.reach_s, 0.25 * plan.reach_s + robot_reach) + cfg.gripper_close_s
-    return (
-        plan.start_t
-        + reach
-        + plan.transfer_s
-        + max(plan.retreat_s, 0.25 * plan.retreat_s + robot_back)
-        + sim.config.tail_s
-    )
+def simulated_end(sim: HandoverSimulation, dt: float) -> float:
+    """When (s) the handover of ``sim``, a fresh simulation, ends: ``sim`` stepped by ``dt``
+    without gaze (the head does not change when the giver and the arm act) until it is done,
+    at most :data:`MAX_DURATION_S`. The progress bar's total comes from it: a few tenths of a
+    second of simulation, where an estimate from the giver's plan was a few frames off."""
+    while not sim.done and sim.t < MAX_DURATION_S:
+        sim.step(dt)
+    return float(sim.t)
 
 
 def record_handover(
@@ -119,10 +113,22 @@ def record_handover(
 
     check_video_size(width, height, fps)
     sim_robot = load_sim_robot(robot)
-    sim = HandoverSimulation(robot=sim_robot, scene=scene, seed=seed, giver_factory=giver_factory)
+    def new_sim() -> HandoverSimulation:
+        return HandoverSimulation(
+            robot=sim_robot, scene=scene, seed=seed, giver_factory=giver_factory
+        )
+
+    dt = 1.0 / CONTROL_HZ
+    end_s = None
+    if progress and out_path is not None:
+        dry = new_sim()
+        try:
+            end_s = simulated_end(dry, dt) + dry.config.tail_s
+        finally:
+            dry.close()
+    sim = new_sim()
     if loop is None:
         loop = GazeLoop.from_config(robot=sim_robot.spec, behavior=behavior, seed=seed)
-    dt = 1.0 / CONTROL_HZ
     tail = sim.config.tail_s
     ticks: list[TickRecord] = []
     events: list[Event] = []
@@ -137,9 +143,7 @@ def record_handover(
         )
         with (
             writer_ctx as writer,
-            FrameProgress(
-                fps, expected_duration(sim), desc=label, enabled=progress and writer is not None
-            ) as bar,
+            FrameProgress(fps, end_s or 0.0, desc=label, enabled=end_s is not None) as bar,
         ):
             while True:
                 frame = sim.tracking()

@@ -25,10 +25,9 @@ from pathlib import Path
 from typing import Annotated, Literal
 from urllib.parse import quote, urlsplit
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from gazebot.core.config import ConfigError, read_yaml, validate
+from gazebot.core.config import load_model
 
 STUDY_FILE = "study.yaml"  # in the study folder, beside consent.txt
 ITEM_ID = r"^[a-z][a-z0-9_]{0,39}$"
@@ -221,45 +220,13 @@ class StudyFile(BaseModel):
         return bool(ending & set(failed_items))
 
 
-_KINDS = frozenset(("likert", "text", "choice", "number", "attention"))
 DEFAULT = StudyFile()  # no study file: the seed's study
-
-
-def _line_of(path: Path, loc: str) -> int | None:
-    """The line (1-based) of the dotted field ``loc`` in the YAML file, as deep as it exists."""
-    try:
-        node = yaml.compose(path.read_text(encoding="utf-8"), Loader=yaml.SafeLoader)
-    except (OSError, yaml.YAMLError):
-        return None
-    line = None
-    for part in loc.split("."):
-        if part in _KINDS:
-            continue  # the union's tag pydantic puts in the path: not a YAML key
-        if isinstance(node, yaml.MappingNode):
-            pair = next(((k, v) for k, v in node.value if k.value == part), None)
-            if pair is None:
-                break
-            line, node = pair[0].start_mark.line + 1, pair[1]
-        elif isinstance(node, yaml.SequenceNode) and part.isdigit() and int(part) < len(node.value):
-            node = node.value[int(part)]
-            line = node.start_mark.line + 1
-        else:
-            break
-    return line
 
 
 def load_study_file(path: str | Path) -> StudyFile:
     """Read and validate a study file; a bad one raises :class:`ConfigError` naming the file,
-    the line and the field."""
-    path = Path(path)
-    try:
-        return validate(StudyFile, read_yaml(path), path)
-    except ConfigError as exc:
-        line = _line_of(path, exc.field)
-        if line is None:
-            raise
-        field = ".".join(p for p in exc.field.split(".") if p not in _KINDS)
-        raise ConfigError(f"{path}: line {line}", field, exc.expected, exc.got) from None
+    the line and the field (``study.yaml:5: pages[0].items[0]: ...``)."""
+    return load_model(StudyFile, path)
 
 
 def study_file_of(study_root: str | Path) -> StudyFile:

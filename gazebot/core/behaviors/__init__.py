@@ -18,7 +18,9 @@ machine
 from gazebot.core.behaviors.machine import BehaviorMachine, GazeOrigin
 from gazebot.core.behaviors.registry import (
     BehaviorInfo,
+    behavior_errors,
     behavior_path,
+    known_targets,
     list_behaviors,
     load_behavior,
     seed_behaviors,
@@ -34,7 +36,9 @@ __all__ = [
     "GazeOrigin",
     "BehaviorSpec",
     "Segment",
+    "behavior_errors",
     "behavior_path",
+    "known_targets",
     "list_behaviors",
     "load_behavior",
     "seed_behaviors",

@@ -18,14 +18,18 @@ users.
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 
 from gazebot.core.types import EVENT_OF_PHASE, EventKind, Phase
 
 #: Targets every robot provides (``GazeContext.points``); other names are robot-named points.
 STANDARD_TARGETS = ("face", "hand", "object", "handover_location", "rest")
+#: Targets the engine follows from the tracking (the giver's face and hand, the object, the
+#: receiver's hand); any other target must be a point the robot defines (``points:``).
+TRACKED_TARGETS = frozenset({"face", "hand", "object", "receiver_hand"})
 #: Phases a segment can belong to (idle and done use ``before`` and ``after``).
 SEGMENT_PHASES = (Phase.REACH, Phase.TRANSFER, Phase.RETREAT)
 #: The event that starts each phase; ``{after: <that event>}`` is measured from the phase start.
@@ -70,8 +74,9 @@ class AtNever(_Strict):
 At = AtFraction | AtEvent | AtNever
 
 
-def parse_at(value: Any, parameters: dict[str, At] | None = None) -> At | str:
-    """Turn a YAML ``at`` value into an :data:`At` (or keep a ``$parameter`` reference)."""
+def parse_at(value: Any, parameters: Collection[str] | None = None) -> At | str:
+    """Turn a YAML ``at`` value into an :data:`At` (or keep a ``$parameter`` reference; with
+    ``parameters``, the names defined, a reference to another name is an error)."""
     if isinstance(value, AtFraction | AtEvent | AtNever):
         return value
     if isinstance(value, bool):
@@ -108,8 +113,10 @@ class Segment(_Strict):
 
     @field_validator("at", mode="before")
     @classmethod
-    def _parse_at(cls, value: Any) -> Any:
-        return parse_at(value)
+    def _parse_at(cls, value: Any, info: ValidationInfo) -> Any:
+        # A loader that knows the behavior's parameter names passes them (``context``), so a
+        # wrong ``$name`` is reported at its segment.
+        return parse_at(value, (info.context or {}).get("parameters"))
 
     @field_validator("target")
     @classmethod

@@ -117,7 +117,7 @@ class BehaviorSpec(_Strict):
         human: Data-driven timing model (``human-receiver``): segments are drawn per handover.
     """
 
-    name: str
+    name: str = Field(json_schema_extra={"internal": True})  # the loader sets the file's stem
     description: str = ""
     source: str = ""
     extends: str | None = None

@@ -236,12 +236,17 @@ class EngineNode:
 
     def emit(self, kind: str, t: float | None = None, category: EventCategory | None = None,
              **info: object) -> BusEvent:
-        """Publish one of the node's own events (fault, behavior, node)."""
+        """Publish one of the node's own events (fault, behavior, node). Without ``t``: the
+        tracking clock now; a node event's ``info.clock`` says ``tracking``, or ``none`` (``t``
+        0) before the first sample (docs/cli.md)."""
+        category = category or category_of(kind)
+        if t is None and category == "node":
+            info.setdefault("clock", "tracking" if math.isfinite(self._last_t) else "none")
         t = self._now_t() if t is None else t
         t = t if math.isfinite(t) else 0.0
         msg = BusEvent(
             source=self.driver.node,
-            category=category or category_of(kind),
+            category=category,
             kind=kind,
             t=t,
             detected_at=t,

@@ -143,6 +143,34 @@ class SimNode:
         self.endpoint.publish_joint_state(self.sim.t, self.sim.joint_state())
         self.heartbeat()
 
+    def wait_for_engine(
+        self, timeout: float, stop: threading.Event | None = None, poll: float = 0.1
+    ) -> bool:
+        """Wait, the scene's clock stopped, until an engine owns the robot (its ownership
+        claim is alive on the bus), so that an engine started after the simulator still sees
+        the whole handover. Meanwhile the joint state and the heartbeat go out as usual (an
+        engine that is starting takes the head pose from them).
+
+        Returns:
+            ``True`` once an engine owns the robot; ``False`` after ``timeout`` s or on
+            ``stop``.
+        """
+        deadline = self.clock() + timeout
+        while not (stop is not None and stop.is_set()):
+            if self.endpoint.owners.owner() is not None:
+                return True
+            now = self.clock()
+            if now >= deadline:
+                return False
+            if now - self._last_beat >= self.config.heartbeat_period:
+                self._last_beat = now
+                self.publish_state()
+            if stop is None:
+                time.sleep(poll)
+            else:
+                stop.wait(poll)
+        return False
+
     def heartbeat(self, stopping: bool = False) -> None:
         self.endpoint.heartbeat(
             info={

@@ -249,3 +249,18 @@ def test_pupil_x_never_decreases_with_yaw_at_any_pitch(y1, y2, pitch):
         _R.pupil_offsets(lo, pitch), _R.pupil_offsets(hi, pitch), strict=True
     ):
         assert u_lo <= u_hi + 1e-9
+
+
+@pytest.mark.parametrize("style", ["sawyer", "jaco2-head", "cartoon"])
+def test_a_lowered_lid_covers_the_eye_outline_above_it(style):
+    # Issue 32: looking down, a grey arc of the outline showed above the lowered upper lid.
+    r = EyeRenderer(384, 224, style)
+    s = load_eye_style(style)
+    lid, outline = np.asarray(s.lids.color), np.asarray(s.sclera.outline_color)
+    assert np.abs(lid - outline).max() > 30  # the two are told apart below
+    for g in r.eyes:
+        x, y = int(round(g.cx)), int(round(g.cy - g.b - 0.5 * r._outline))  # the ring's top
+        up = r.render(0.0, -math.radians(40)).astype(int)[y, x]
+        down = r.render(0.0, math.radians(40)).astype(int)[y, x]
+        assert np.abs(up - outline).max() <= 12  # open lid: the outline is there
+        assert np.abs(down - lid).max() <= 12  # lowered lid: the lid, not the outline

@@ -82,16 +82,16 @@ def test_at_accepts_fraction_mapping_event_offset_never_and_parameters(tmp_path)
 @pytest.mark.parametrize(
     ("body", "field"),
     [
-        ("segments:\n  - {phase: reach, at: 1.5, target: face}\n", "segments.0.at"),
+        ("segments:\n  - {phase: reach, at: 1.5, target: face}\n", "segments[0].at"),
         (
             "segments:\n  - {phase: reach, at: {after: lunch}, target: face}\n",
-            "segments.0.at.after",
+            "segments[0].at.after",
         ),
-        ("segments:\n  - {phase: reach, at: 0.1, target: 'Face!'}\n", "segments.0.target"),
-        ("segments:\n  - {phase: idle, at: 0.1, target: face}\n", "segments.0.phase"),
-        ("segments:\n  - {phase: reach, at: $nope, target: face}\n", "segments"),
+        ("segments:\n  - {phase: reach, at: 0.1, target: 'Face!'}\n", "segments[0].target"),
+        ("segments:\n  - {phase: idle, at: 0.1, target: face}\n", "segments[0].phase"),
+        ("segments:\n  - {phase: reach, at: $nope, target: face}\n", "segments[0].at"),
         ("segments: []\n", "<root>"),
-        ("segments:\n  - {phase: reach, target: face, when: 2}\n", "segments.0.when"),
+        ("segments:\n  - {phase: reach, target: face, when: 2}\n", "segments[0].when"),
         ("before: 3\nsegments:\n  - {phase: reach, target: face}\n", "before"),
     ],
 )

@@ -101,7 +101,9 @@ def test_simulator_and_engine_over_mutual_tls_and_a_node_without_the_certificate
     port = free_port()
     ns = f"/tls{port}"
     robot = f"tls/localhost:{port}"
-    sim = _gazebot("sim", "--headless", "--duration", "120", "--json", "--namespace", ns,
+    # --no-wait: the robot's tracking is read below before any engine runs.
+    sim = _gazebot("sim", "--headless", "--no-wait", "--duration", "120", "--json",
+                   "--namespace", ns,
                    "--zenoh-config", str(secure), "--listen", robot)
     sessions = []
     try:
