@@ -83,6 +83,9 @@ class PhaseConfig(BaseModel):
             unknown (online: ``tracking_lost``).
         frozen_speed: A sample repeating the last position exactly while the hand was moving
             faster than this (m/s) is a frozen (stale) sample: it counts as missing.
+        glitch_jump: A sample farther than this (m) beyond where the hand's last speed could
+            take it from the last valid sample is a one-sample glitch (a marker swapped for a
+            frame): it counts as missing, unless the next stays near it (a real step). 0: off.
         online_period: Online, the detector decides whether to re-analyse the recent samples
             on a fixed grid of this period (s): at the first sample at or after each tick (the
             ``gazebot`` trigger runs then); between ticks it only stores samples.
@@ -190,6 +193,7 @@ class PhaseConfig(BaseModel):
     analysis_rate: float = Field(100.0, gt=0, le=2000)
     max_gap_hold: float = Field(0.25, ge=0)
     frozen_speed: float = Field(0.05, ge=0)
+    glitch_jump: float = Field(0.03, ge=0)
     online_period: float = Field(0.02, ge=0)
     online_window: float = Field(5.0, gt=1)
     online_refresh: float = Field(0.1, ge=0)

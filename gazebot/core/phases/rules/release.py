@@ -111,10 +111,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
             seen = np.isfinite(s.rel_speed[j + 1 :]).nonzero()[0] + j + 1
             # Seen still together a smoothing window after the gap (its edge is smoothed
             # one-sided): the giver's motion in it was the pair's.
-            k = int(seen[min(window, seen.size - 1)]) if seen.size else -1
+            k = int(seen[window]) if seen.size > window else -1
             if k >= 0 and not parted(k):
                 j = k
                 continue
+            if 0 < seen.size <= window:
+                return float(s.t[-1]), True  # too little seen after the gap yet
             if k < 0 and (coupled or swing(j)):
                 # The hands moved together into a gap that lasts to the data end: the
                 # giver's motion is the pair's, a hand unseen (a frozen or lost marker) no
