@@ -438,6 +438,8 @@ def case_set(kind: CaseKind, n: int = 12, seed: int = 0) -> list[SyntheticHandov
             hold=hold,
             hold_time=hold_time,
             marker_offset=offset + float(rng.uniform(-0.03, 0.03)) * (0.3 if coupled else 1.0),
+            # (issue 33's receivers are people in the same mocap suit: the same marker noise)
+            gripper_noise=noise if coupled else SyntheticOptions.gripper_noise,
             frozen_per_s=_COUPLED_FROZEN_PER_S if coupled else 0.0,
             glitches_per_s=_COUPLED_GLITCHES_PER_S if coupled else 0.0,
         )

@@ -66,13 +66,22 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)
-    common = s.common_speed[i0 : i_h + 1]
-    common = common[np.isfinite(common)]
-    coupled = bool(common.size) and float(np.median(common)) >= c.coupled_speed
     dists = s.distance[idx]
     dists = dists[np.isfinite(dists)]
     held_d = np.asarray(np.median(dists) if dists.size else np.nan)
     band = release_threshold(s, c, idx, held_d)
+    # Coupled: the pair moved the object together through a hold of at least min_transfer,
+    # their distance held (within twice its band: the approach is over).
+    common = s.common_speed[i0 : i_h + 1]
+    common = common[np.isfinite(common)]
+    hold_d = s.distance[i0 : i_h + 1]
+    hold_d = hold_d[np.isfinite(hold_d)]
+    coupled = (
+        bool(common.size)
+        and float(s.t[i_h] - s.t[i0]) >= c.min_transfer
+        and float(np.median(common)) >= c.coupled_speed
+        and float(hold_d.max() - hold_d.min()) <= 2.0 * band
+    )
     if coupled:
         held, sep_min = held_d, band
     else:
@@ -134,7 +143,10 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         j += 1
     if j == n - 1 and not parted(j):
         return float(s.t[-1]), True
-    sep = max(separation(j), vector_norm(s.rel[j] - s.rel[i_h])) if coupled else separation(j)
+    if coupled:
+        sep = max(separation(j), vector_norm(s.rel[j] - s.rel[i_h]))
+    else:
+        sep = separation(j)
     back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
     return max(float(s.t[j]) - back, t_start, float(s.t[i_h])), False
 
