@@ -55,6 +55,14 @@ class PhaseConfig(BaseModel):
         release_distance: gazebot: the release needs the hands' relative position this far from
             the held pose (m) ...
         release_noise_factor: ... and at least this many times the held pose's RMS jitter.
+        coupled_speed: gazebot: hands whose common motion over the hold has a median speed of
+            at least this (m/s) carry the object together (issue 33's careful handovers: 0.06-
+            0.21 m/s): the pair may turn with it, so their relative position swings at a
+            constant distance, and the release is the distance leaving its noise band (or a
+            hand moving against the other faster than ``transfer_speed_max``).
+        coupled_share: gazebot: ... and at any moment of a hold, a departure from the held
+            pose while both hands move (the slower at least this share of the faster's speed)
+            and their distance stays in its band is the pair turning, not a release.
         reach_onset_speed: gazebot: giver hand speed marking a reach onset or retreat end (m/s).
         reach_confirm_distance: gazebot: a reach under way is reported once the hands have
             closed by this much (m) ...
@@ -75,6 +83,9 @@ class PhaseConfig(BaseModel):
             unknown (online: ``tracking_lost``).
         frozen_speed: A sample repeating the last position exactly while the hand was moving
             faster than this (m/s) is a frozen (stale) sample: it counts as missing.
+        glitch_jump: A sample farther than this (m) beyond where the hand's last speed could
+            take it from the last valid sample is a one-sample glitch (a marker swapped for a
+            frame): it counts as missing, unless the next stays near it (a real step). 0: off.
         online_period: Online, the detector decides whether to re-analyse the recent samples
             on a fixed grid of this period (s): at the first sample at or after each tick (the
             ``gazebot`` trigger runs then); between ticks it only stores samples.
@@ -167,6 +178,8 @@ class PhaseConfig(BaseModel):
     stop_extrapolation: float = Field(1.0, ge=0, le=2)
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
+    coupled_speed: float = Field(0.06, gt=0)
+    coupled_share: float = Field(0.25, gt=0, le=1)
     reach_onset_speed: float = Field(0.15, gt=0)
     reach_confirm_distance: float = Field(0.02, gt=0)
     approach_ratio: float = Field(0.5, ge=0, le=1)
@@ -180,6 +193,7 @@ class PhaseConfig(BaseModel):
     analysis_rate: float = Field(100.0, gt=0, le=2000)
     max_gap_hold: float = Field(0.25, ge=0)
     frozen_speed: float = Field(0.05, ge=0)
+    glitch_jump: float = Field(0.03, ge=0)
     online_period: float = Field(0.02, ge=0)
     online_window: float = Field(5.0, gt=1)
     online_refresh: float = Field(0.1, ge=0)

@@ -3,6 +3,11 @@
 1. Frozen samples: a tracker that loses a marker often repeats its last position. A sample
    equal to the previous one while the hand was moving (faster than ``frozen_speed``) is stale
    and counts as missing (a resting hand may repeat its position: that is kept).
+   A one-sample glitch (a marker swapped for a frame: 1.5-7 cm on a mocap suit, issue 33), a
+   sample farther than ``glitch_jump`` beyond where the hand's last speed could take it from
+   the last valid sample, counts as missing too; a sample that stays near it is a real step
+   of the marker and is kept from there on. Both are decided in time order, from the samples
+   before only (online, the newest sample is judged at once).
 2. Resampling onto a uniform grid (``analysis_rate``), bridging gaps up to ``max_gap_hold``
    (longer gaps stay unknown, NaN).
 3. Zero-lag Gaussian smoothing (``smoothing``, never narrower than two input samples) and
@@ -105,6 +110,55 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float, ok: np.ndarra
         if v > moving_speed:
             stale[idx[k]] = True
     return stale
+
+
+#: The most a hand accelerates (m/s^2; reaching peaks at 5-15): the part of a glitch's bar
+#: that grows with the sample interval (7 cm at 8 Hz, 1 cm at 30 Hz, 0.7 mm at 120 Hz).
+HAND_ACCELERATION = 20.0
+
+
+def drop_glitches(t: np.ndarray, p: np.ndarray, jump: float, ok: np.ndarray) -> np.ndarray:
+    """Which rows of ``p`` are one-sample glitches (a bool mask) among the valid rows ``ok``:
+    farther from the last valid sample than ``jump`` plus where the hand could have gone in the
+    interval ``dt`` (its speed between the two valid samples before times ``dt``, plus
+    :data:`HAND_ACCELERATION` ``dt^2 / 2``), unless the sample before was such a glitch and
+    this one lies within that bar of it (the marker really moved: kept, and the speed is
+    measured afresh from there). ``jump`` <= 0: none."""
+    bad = np.zeros(p.shape[0], dtype=bool)
+    idx = ok.nonzero()[0]
+    if not jump > 0 or idx.size < 2:
+        return bad
+    pv = p[idx]
+    if not (np.linalg.norm(pv[1:] - pv[:-1], axis=1) > jump).any():
+        return bad  # (no step beyond the bar's least value: no glitch)
+    def bar(speed: float, dt: float) -> float:
+        return jump + speed * dt + 0.5 * HAND_ACCELERATION * dt * dt
+
+    last, prev, flagged = int(idx[0]), -1, -1
+    for i in idx[1:].tolist():
+        speed = 0.0
+        if prev >= 0 and t[last] > t[prev]:
+            speed = vector_norm(p[last] - p[prev]) / float(t[last] - t[prev])
+        if vector_norm(p[i] - p[last]) <= bar(speed, float(t[i] - t[last])):
+            prev, last, flagged = last, i, -1
+        elif flagged >= 0 and vector_norm(p[i] - p[flagged]) <= bar(
+            speed, float(t[i] - t[flagged])
+        ):
+            prev, last, flagged = -1, i, -1  # a step: kept from here on
+        else:
+            bad[i] = True
+            flagged = i
+    return bad
+
+
+def _steps_beyond(rows: np.ndarray, jump: float) -> bool:
+    """Whether any hand's position (rows: N x 6, both hands) moves more than ``jump`` from one
+    row to the next (NaN rows never do)."""
+    if not jump > 0 or rows.shape[0] < 2:
+        return False
+    d = (rows[1:] - rows[:-1]).reshape(rows.shape[0] - 1, 2, 3)
+    with np.errstate(invalid="ignore"):
+        return bool((np.einsum("ijk,ijk->ij", d, d) > jump * jump).any())
 
 
 def _far_from_samples(tv: np.ndarray, grid: np.ndarray, bar: float) -> np.ndarray:
@@ -355,6 +409,13 @@ def compute_signals(
         ok_g &= ~drop_frozen(t, p[:, :3], config.frozen_speed, ok_g)
         ok_r &= ~drop_frozen(t, p[:, 3:], config.frozen_speed, ok_r)
         all_seen = False
+    if _steps_beyond(p, config.glitch_jump) or not all_seen:
+        bad_g = drop_glitches(t, p[:, :3], config.glitch_jump, ok_g)
+        bad_r = drop_glitches(t, p[:, 3:], config.glitch_jump, ok_r)
+        if bad_g.any() or bad_r.any():
+            ok_g &= ~bad_g
+            ok_r &= ~bad_r
+            all_seen = False
     if all_seen:
         x = resample(t, p, None, grid, config.max_gap_hold)
     elif np.array_equal(ok_g, ok_r):  # both hands seen at the same samples
@@ -533,11 +594,13 @@ class SignalCache:
         )
 
     def _new_valid(
-        self, t: np.ndarray, p: np.ndarray, hand: int, frozen_speed: float
+        self, t: np.ndarray, p: np.ndarray, hand: int, config: PhaseConfig
     ) -> tuple[np.ndarray, np.ndarray]:
         """Which of the new samples of one hand (``p``: all its samples) are seen, and which
-        of those are not stale repeats (:func:`drop_frozen`, whose decisions run in time
-        order: run on the whole window only when a new seen sample repeats the one before)."""
+        of those are neither stale repeats (:func:`drop_frozen`) nor glitches
+        (:func:`drop_glitches`), whose decisions run in time order: run on the whole window
+        only when a new seen sample repeats the one before or steps more than
+        ``glitch_jump`` from it."""
         n0 = self._n
         fin = np.isfinite(p[n0:])
         seen_new = fin[:, 0] & fin[:, 1] & fin[:, 2]
@@ -546,11 +609,17 @@ class SignalCache:
         if before >= 0:
             rows = np.concatenate(([before], rows))
         q = p[rows]
-        if rows.size < 2 or not (q[1:] == q[:-1]).all(axis=1).any():
+        if rows.size < 2:
+            return seen_new, seen_new
+        repeats = bool((q[1:] == q[:-1]).all(axis=1).any())
+        jump = config.glitch_jump
+        steps = jump > 0 and bool((np.linalg.norm(q[1:] - q[:-1], axis=1) > jump).any())
+        if not (repeats or steps):
             return seen_new, seen_new
         seen_all = np.concatenate((self._masks()[0][:, hand], seen_new))
-        stale = drop_frozen(t, p, frozen_speed, seen_all)[n0:]
-        return seen_new, seen_new & ~stale
+        ok_all = seen_all & ~drop_frozen(t, p, config.frozen_speed, seen_all)
+        ok_all &= ~drop_glitches(t, p, jump, ok_all)
+        return seen_new, ok_all[n0:]
 
     def extend(
         self, trajectory: Trajectory, config: PhaseConfig, until: float = math.inf
@@ -569,11 +638,14 @@ class SignalCache:
         # repeating a coordinate of the one before, needs no per-hand search.
         tail = np.concatenate((g_in[n0 - 1 :], r_in[n0 - 1 :]), axis=1)
         clean = (
-            self._clean and bool(np.isfinite(tail).all()) and not (tail[1:] == tail[:-1]).any()
+            self._clean
+            and bool(np.isfinite(tail).all())
+            and not (tail[1:] == tail[:-1]).any()
+            and not _steps_beyond(tail, config.glitch_jump)
         )
         if not clean:
-            sg, og = self._new_valid(t, g_in, 0, config.frozen_speed)
-            sr, orr = self._new_valid(t, r_in, 1, config.frozen_speed)
+            sg, og = self._new_valid(t, g_in, 0, config)
+            sr, orr = self._new_valid(t, r_in, 1, config)
             seen_new, ok_new = np.stack((sg, sr), axis=1), np.stack((og, orr), axis=1)
         max_dt = max(self._max_dt, float(np.diff(t[n0 - 1 :]).max()))
         dt = 1.0 / config.analysis_rate

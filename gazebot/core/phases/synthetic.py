@@ -19,7 +19,12 @@ The hold (``SyntheticOptions.hold``) is one of the kinds seen on real handovers 
 - ``carry``: a heavy full container: the hands meet, then move *together* for about 1 s (common
   speed 0.1-0.3 m/s) while their relative position wobbles (relative speed 0.02-0.10 m/s,
   distance within +-1 cm) before they separate;
-- ``still``: a full cup: both hands steady (relative speed under 0.03 m/s) for about 1.3 s.
+- ``still``: a full cup: both hands steady (relative speed under 0.03 m/s) for about 1.3 s;
+- ``coupled``: a careful handover of a full pitcher or cup (issue 33): the hands meet 0.31-0.37
+  m apart (segment origins of a mocap suit, the object between) and for 1.1-1.5 s move the
+  object together (common speed 0.06-0.21 m/s, in two legs of different directions, so the
+  common motion slows and turns mid-hold) while the pair turns, so their relative position
+  swings at 0.04-0.10 m/s with the distance held within 1 cm; then the receiver pulls away.
 
 :func:`case_set` makes those and the quick light-cup handover (30 Hz, 5 mm noise);
 :func:`early_lift_set` makes givers who lift the object early and wait before the final approach;
@@ -40,8 +45,8 @@ from gazebot.core.phases.trajectory import Trajectory
 from gazebot.core.types import Phase
 
 Posture = Literal["standing", "sitting"]
-Hold = Literal["pull", "carry", "still"]
-CaseKind = Literal["carry", "still", "quick30", "quick_noisy"]
+Hold = Literal["pull", "carry", "still", "coupled"]
+CaseKind = Literal["carry", "still", "quick30", "quick_noisy", "coupled", "coupled30"]
 
 
 def _bump(s: np.ndarray) -> np.ndarray:
@@ -112,14 +117,16 @@ class SyntheticOptions:
             each frame sits half of it behind the contact point, along the giver-robot line.
         frozen_per_s: Rate of frozen stretches (the tracker repeats its last sample for 2-8
             samples with new times) per point.
+        glitches_per_s: Rate of one-sample glitches per hand: the sample jumps 1.5-7 cm in a
+            random direction and is back at the next one (a marker swapped for a frame).
         robot_lead: When > 0, the robot sets off this long (s) *before* the giver (a
             robot-initiated handover, seed 6.3: the receiver's hand moves first); 0: the robot
             reacts to the giver 0.05-0.4 s after its onset.
-        hold: What the hands do while both hold the object: ``pull``, ``carry`` or ``still``
-            (see the module docstring).
+        hold: What the hands do while both hold the object: ``pull``, ``carry``, ``still`` or
+            ``coupled`` (see the module docstring).
         hold_time: ``(low, high)`` range the hold's duration is drawn from (s, before the
             ``speed`` scaling); ``None``: the hold kind's own (pull 0.3-1.2, carry 0.9-1.1,
-            still 1.2-1.4).
+            still 1.2-1.4, coupled 1.1-1.5).
         early_lift: When > 0, before each reach the giver lifts the object (10-15 cm up, a
             few cm toward the robot) and waits this long (s) before the final approach, which
             is the reach (issue 20: a giver who lifted the cup early, then waited).
@@ -138,6 +145,7 @@ class SyntheticOptions:
     robot_evidence: bool = False
     marker_offset: float = 0.0
     frozen_per_s: float = 0.0
+    glitches_per_s: float = 0.0
     robot_lead: float = 0.0
     hold: Hold = "pull"
     hold_time: tuple[float, float] | None = None
@@ -163,7 +171,7 @@ class SyntheticOptions:
 
 # Hold durations per hold kind (s, before the speed scaling): the seed's 0.25-1.75 s transfers,
 # about 1 s of joint carrying and about 1.3 s of a still hold (issue 20's held-out recordings).
-_HOLD_TIME = {"pull": (0.3, 1.2), "carry": (0.9, 1.1), "still": (1.2, 1.4)}
+_HOLD_TIME = {"pull": (0.3, 1.2), "carry": (0.9, 1.1), "still": (1.2, 1.4), "coupled": (1.1, 1.5)}
 
 
 @dataclass
@@ -240,6 +248,10 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
         lag += opts.robot_delay
         g_dur = u(0.8, 1.5)
         offset = np.array([-u(0.04, 0.15), u(-0.01, 0.01), u(-0.01, 0.01)])
+        if opts.hold == "coupled":
+            # The receiver's hand frame meets the object's other side: with the marker
+            # offset of a mocap suit's segment origins, 0.31-0.37 m apart in all.
+            offset[0] = -u(0.06, 0.10)
         grip.move(onset + lag, g_dur, target + offset)
         contact = max(onset + reach, onset + lag + g_dur)
         t_close = contact + u(0.05, 0.25)
@@ -262,9 +274,29 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
             axis = rng.normal(size=3)
             wobble = u(0.003, 0.006) * axis / np.linalg.norm(axis)
             wobbles.append((pull_t0, release - pull_t0, cycles, wobble, u(0.03, 0.09)))
+        elif opts.hold == "coupled":
+            # Both move it together in two legs (mean common speed 0.06-0.21 m/s each, a new
+            # direction each), the pair turning so the relative position swings at 0.04-0.10
+            # m/s (marker offset x turn rate; mean |turn rate| = 2 A cycles / duration).
+            half_t = 0.5 * (release - pull_t0)
+            legs = []
+            for _ in range(2):
+                way = rng.normal(size=3) * [1.0, 1.0, 0.5]
+                legs.append(u(0.06, 0.21) * half_t * way / np.linalg.norm(way))
+            for k, leg in enumerate(legs):
+                to = target + legs[0] + (leg if k else 0.0)
+                hand.move(pull_t0 + k * half_t, half_t, to)
+                grip.move(pull_t0 + k * half_t, half_t, to + offset)
+            pull = legs[0] + legs[1]
+            cycles = max(1, round(u(0.8, 1.3) * (release - pull_t0)))
+            arm = max(opts.marker_offset, 0.05)
+            turn_amp = u(0.04, 0.10) * (release - pull_t0) / (2.0 * arm * cycles)
+            axis = rng.normal(size=3)
+            wobble = 0.002 * axis / np.linalg.norm(axis)
+            wobbles.append((pull_t0, release - pull_t0, cycles, wobble, turn_amp))
         else:
             pull = np.zeros(3)  # still: both hands steady
-        if release - pull_t0 > 0.1 and opts.hold != "still":
+        if release - pull_t0 > 0.1 and opts.hold not in ("still", "coupled"):
             hand.move(pull_t0, release - pull_t0, target + pull)
             grip.move(pull_t0, release - pull_t0, target + offset + pull)
         back = rest + np.array([u(-0.03, 0.03), u(-0.03, 0.03), u(-0.02, 0.02)])
@@ -307,6 +339,13 @@ def generate(seed: int = 0, options: SyntheticOptions | None = None) -> Syntheti
                 k = int(rng.integers(2, 9))
                 if 0 < i < n - k:
                     arr[i : i + k] = arr[i - 1]
+    if opts.glitches_per_s > 0:
+        for arr in (gh, rh):
+            for t0 in rng.uniform(0, t_end, rng.poisson(opts.glitches_per_s * t_end)):
+                i = int(np.searchsorted(ts, t0))
+                if i < n:
+                    way = rng.normal(size=3)
+                    arr[i] = arr[i] + u(0.015, 0.07) * way / np.linalg.norm(way)
     if opts.dropouts_per_s > 0:
         for arr in (gh, gf, rh):
             k = rng.poisson(opts.dropouts_per_s * t_end * (0.3 if arr is rh else 1.0))
@@ -353,7 +392,8 @@ def synthetic_set(n: int = 40, seed: int = 0, **overrides: object) -> list[Synth
     return out
 
 
-# The issue-20 cases: (hold kind, rate Hz, noise m, speed factor, hold_time, marker offset m).
+# The issue-20 cases: (hold kind, rate Hz, noise m, speed factor, hold_time, marker offset m),
+# and issue 33's careful coupled handovers with a mocap suit's artefacts.
 _CASES: dict[str, tuple[Hold, float, float, float, tuple[float, float] | None, float]] = {
     # A heavy full container carried together; hand frames 0.3-0.4 m apart at contact.
     "carry": ("carry", 120.0, 0.0015, 1.0, None, 0.25),
@@ -363,17 +403,29 @@ _CASES: dict[str, tuple[Hold, float, float, float, tuple[float, float] | None, f
     "quick30": ("pull", 30.0, 0.0015, 1.5, (0.25, 0.4), 0.3),
     # ... and at 120 Hz with 5 mm of marker noise.
     "quick_noisy": ("pull", 120.0, 0.005, 1.5, (0.25, 0.4), 0.3),
+    # A full pitcher moved together for 1.1-1.5 s at 120 Hz ...
+    "coupled": ("coupled", 120.0, 0.0015, 1.0, None, 0.26),
+    # ... and at 30 Hz with 5 mm of marker noise.
+    "coupled30": ("coupled", 30.0, 0.005, 1.0, None, 0.26),
 }
-CASE_KINDS: tuple[str, ...] = tuple(_CASES)
+CASE_KINDS: tuple[str, ...] = tuple(k for k in _CASES if not k.startswith("coupled"))
+COUPLED_KINDS: tuple[str, ...] = ("coupled", "coupled30")
+# The mocap suit's artefacts in the coupled cases (per hand, per s): frozen stretches (the
+# tracker repeating its last sample) and one-sample glitches of 1.5-7 cm.
+_COUPLED_FROZEN_PER_S = 0.5
+_COUPLED_GLITCHES_PER_S = 0.3
 
 
 def case_set(kind: CaseKind, n: int = 12, seed: int = 0) -> list[SyntheticHandover]:
     """``n`` recordings of one of issue 20's failing cases (:data:`CASE_KINDS`): ``carry``,
-    ``still``, ``quick30`` or ``quick_noisy`` (see the module docstring), both postures, with
-    the marker offsets of real motion capture."""
+    ``still``, ``quick30`` or ``quick_noisy``, or of issue 33's (:data:`COUPLED_KINDS`):
+    ``coupled`` (120 Hz) or ``coupled30`` (30 Hz, 5 mm noise), these with frozen samples and
+    one-sample glitches (see the module docstring); both postures, with the marker offsets of
+    real motion capture."""
     if kind not in _CASES:
         raise ValueError(f"kind must be one of {list(_CASES)}, got {kind!r}")
     hold, rate, noise, speed, hold_time, offset = _CASES[kind]
+    coupled = kind in COUPLED_KINDS
     rng = np.random.default_rng(seed)
     out = []
     for i in range(n):
@@ -385,7 +437,11 @@ def case_set(kind: CaseKind, n: int = 12, seed: int = 0) -> list[SyntheticHandov
             speed=speed * float(rng.uniform(0.9, 1.1)),
             hold=hold,
             hold_time=hold_time,
-            marker_offset=offset + float(rng.uniform(-0.03, 0.03)),
+            marker_offset=offset + float(rng.uniform(-0.03, 0.03)) * (0.3 if coupled else 1.0),
+            # (issue 33's receivers are people in the same mocap suit: the same marker noise)
+            gripper_noise=noise if coupled else SyntheticOptions.gripper_noise,
+            frozen_per_s=_COUPLED_FROZEN_PER_S if coupled else 0.0,
+            glitches_per_s=_COUPLED_GLITCHES_PER_S if coupled else 0.0,
         )
         out.append(generate(int(rng.integers(2**31)), opts))
     return out

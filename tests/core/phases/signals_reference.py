@@ -9,7 +9,7 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import FULL_WINDOW, Signals
+from gazebot.core.phases.filtering import FULL_WINDOW, HAND_ACCELERATION, Signals
 from gazebot.core.phases.trajectory import Trajectory
 
 
@@ -36,6 +36,38 @@ def drop_frozen(t: np.ndarray, p: np.ndarray, moving_speed: float) -> np.ndarray
         v = float(np.linalg.norm(p[i1] - p[i0]) / dt) if dt > 0 else 0.0
         if v > moving_speed:
             out[ok[k]] = np.nan
+    return out
+
+
+def drop_glitches(t: np.ndarray, p: np.ndarray, jump: float) -> np.ndarray:
+    """``p`` with one-sample glitches set to NaN, one sample at a time in time order: a valid
+    sample farther from the last valid one than ``jump`` + speed x dt + HAND_ACCELERATION x
+    dt^2 / 2 (speed: between the two valid samples before), unless the one before was such a
+    glitch and this one is within that bar of it (a step: kept, speed measured afresh)."""
+    out = p.copy()
+    if jump <= 0:
+        return out
+    last = prev = flagged = -1
+    for i in range(p.shape[0]):
+        if not np.isfinite(p[i]).all():
+            continue
+        if last < 0:
+            last = i
+            continue
+        speed = 0.0
+        if prev >= 0 and t[last] > t[prev]:
+            speed = float(np.linalg.norm(p[last] - p[prev]) / (t[last] - t[prev]))
+
+        def bar(dt: float, speed: float = speed) -> float:
+            return jump + speed * dt + 0.5 * HAND_ACCELERATION * dt * dt
+
+        if np.linalg.norm(p[i] - p[last]) <= bar(t[i] - t[last]):
+            prev, last, flagged = last, i, -1
+        elif flagged >= 0 and np.linalg.norm(p[i] - p[flagged]) <= bar(t[i] - t[flagged]):
+            prev, last, flagged = -1, i, -1
+        else:
+            out[i] = np.nan
+            flagged = i
     return out
 
 
@@ -87,6 +119,8 @@ def reference_signals(trajectory: Trajectory, config: PhaseConfig) -> Signals:
     grid = t.copy() if t.shape[0] < 2 else np.arange(t[0], t[-1] + 0.5 * dt, dt)
     g = drop_frozen(t, trajectory.giver_hand, config.frozen_speed)
     r = drop_frozen(t, trajectory.receiver_hand, config.frozen_speed)
+    g = drop_glitches(t, g, config.glitch_jump)
+    r = drop_glitches(t, r, config.glitch_jump)
     g = resample(t, g, grid, config.max_gap_hold)
     r = resample(t, r, grid, config.max_gap_hold)
     # Smooth at least over a couple of input samples: 8 Hz data interpolated to 100 Hz has

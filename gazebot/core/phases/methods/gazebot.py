@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.filtering import SignalCache, Signals, compute_signals
 from gazebot.core.phases.methods.base import OnlineTrigger, Segmenter
 from gazebot.core.phases.methods.gazebot_trigger import GazebotTrigger
@@ -133,9 +134,11 @@ class GazebotSegmenter(Segmenter):
         def at_end(x: float) -> float:
             return t_last if x >= grid_end - 1e-9 else x
 
-        cores = find_cores(s, c)
+        cores = find_cores(s, c, pieces=not partial)
         out: list[Segment] = []
         prev_end_idx = 0
+        if not partial and cores and not cores[0].piece:
+            prev_end_idx = _after_leading_retreat(s, c, cores[0].start)
         n = s.t.shape[0]
         trailing_ok = True
         for k, core in enumerate(cores):
@@ -163,7 +166,8 @@ class GazebotSegmenter(Segmenter):
             onset = onset_before(prev_end_idx, max(i_start - 1, prev_end_idx))
             if out:
                 onset = max(onset, out[-1].end)
-            out.append(Segment(Phase.REACH, min(onset, t_start), t_start, k))
+            if not core.piece:  # (a piece's reach is before the recording)
+                out.append(Segment(Phase.REACH, min(onset, t_start), t_start, k))
             t_end, open_end = transfer_end(s, c, core)
             if open_end:
                 out.append(Segment(Phase.TRANSFER, t_start, t_last, k, open=True))
@@ -173,7 +177,8 @@ class GazebotSegmenter(Segmenter):
                 # A refinement that collapses a short transfer (fast giver, sparse samples):
                 # the seed rule's own run stands.
                 t_start, t_end = float(s.t[core.start]), float(s.t[core.end])
-                out[-1] = Segment(Phase.REACH, out[-1].start, t_start, k)
+                if not core.piece:
+                    out[-1] = Segment(Phase.REACH, out[-1].start, t_start, k)
             i_end = min(int(s.t.searchsorted(t_end)), n - 1)
             nxt = cores[k + 1].start if k + 1 < len(cores) else n - 1
             t_rest, seen = rest_after(s, c, i_end, max(nxt, i_end))
@@ -203,3 +208,16 @@ class GazebotSegmenter(Segmenter):
                         Phase.REACH, fixed, nxt_reach.end, nxt_reach.handover, open=nxt_reach.open
                     )
         return out
+
+
+def _after_leading_retreat(s: Signals, c: PhaseConfig, a: int) -> int:
+    """Where the first reach may start before the first core at grid index ``a``: a recording
+    that starts with the hands together and parting (cut from inside a previous handover, issue
+    33) has that handover's retreat first; the hands are farthest apart before the next
+    approach, ``min_approach`` above the first distance seen. 0 otherwise."""
+    d = s.distance[: a + 1]
+    seen = np.isfinite(d).nonzero()[0]
+    if seen.size == 0:
+        return 0
+    top = int(seen[int(d[seen].argmax())])
+    return top if d[top] - d[seen[0]] >= c.min_approach else 0

@@ -13,6 +13,15 @@ start (:func:`~gazebot.core.phases.rules.onset.min_jerk_span`, at most ``max_ref
 hidden in a tracking gap is dated from the separation seen before the gap, else from the
 giver's own motion onset after it. If the hands never part before the data end, the transfer
 is still open.
+
+Hands that move the object together through the hold (their common motion's median speed over
+it at least ``coupled_speed``: a full pitcher carried carefully, issue 33) may turn with it:
+the marker frames, 0.3 m apart behind the hands, then swing their relative position by
+centimetres at a constant distance. For such a coupled hold the release is the hands'
+*distance* leaving the held distance by ``release_distance`` (or ``release_noise_factor``
+times its jitter), or one hand moving against the other faster than the seed's
+``transfer_speed_max`` beyond their common motion (``hold_speed``: a hand withdrawn sideways);
+a turn of the pair, a fidget or a pause of one hand within the band is no release.
 """
 
 from __future__ import annotations
@@ -28,8 +37,12 @@ from gazebot.core.phases.rules.transfer import TransferCore, hold_floor
 
 
 def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np.ndarray) -> float:
-    """Separation from the held pose that marks the release (m)."""
-    dev = np.linalg.norm(s.rel[held_idx] - held, axis=1)
+    """Separation from the held pose (a relative position, or a distance for a coupled hold)
+    that marks the release (m)."""
+    if held.ndim == 0:
+        dev = s.distance[held_idx] - held
+    else:
+        dev = np.linalg.norm(s.rel[held_idx] - held, axis=1)
     dev = dev[np.isfinite(dev)]
     jitter = float(np.sqrt(np.mean(dev**2))) if dev.size else 0.0
     return max(c.release_distance, c.release_noise_factor * jitter)
@@ -53,16 +66,74 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)
-    rows = s.rel[idx]
-    rows = rows[np.isfinite(rows).all(axis=1)]
-    held = np.median(rows, axis=0) if rows.size else np.full(3, np.nan)
-    sep_min = release_threshold(s, c, idx, held)
+    dists = s.distance[idx]
+    dists = dists[np.isfinite(dists)]
+    held_d = np.asarray(np.median(dists) if dists.size else np.nan)
+    band = release_threshold(s, c, idx, held_d)
+    # Coupled: the pair moved the object together through a hold of at least min_transfer,
+    # their distance held (within twice its band: the approach is over).
+    common = s.common_speed[i0 : i_h + 1]
+    common = common[np.isfinite(common)]
+    hold_d = s.distance[i0 : i_h + 1]
+    hold_d = hold_d[np.isfinite(hold_d)]
+    coupled = (
+        bool(common.size)
+        and float(s.t[i_h] - s.t[i0]) >= c.min_transfer
+        and float(np.median(common)) >= c.coupled_speed
+        and float(hold_d.max() - hold_d.min()) <= 2.0 * band
+    )
+    if coupled:
+        held, sep_min = held_d, band
+    else:
+        rows = s.rel[idx]
+        rows = rows[np.isfinite(rows).all(axis=1)]
+        held = np.median(rows, axis=0) if rows.size else np.full(3, np.nan)
+        sep_min = release_threshold(s, c, idx, held)
     n = s.t.shape[0]
+
+    def separation(i: int) -> float:
+        if coupled:
+            return abs(float(s.distance[i] - held))
+        return vector_norm(s.rel[i] - held)
+
+    def swing(i: int) -> bool:
+        # Both hands moving (the slower at least coupled_share of the faster), their relative
+        # motion mostly across their line (less than half of it along) and their distance in
+        # its band: the pair turning with the object, not a release.
+        g, r = float(s.giver_speed[i]), float(s.receiver_speed[i])
+        return bool(
+            min(g, r) >= c.coupled_share * max(g, r)
+            and abs(s.closing[i]) < 0.5 * s.rel_speed[i]
+            and abs(s.distance[i] - held_d) < band
+        )
+
+    def parted(i: int) -> bool:
+        if s.hold_speed[i] >= c.transfer_speed_max and (coupled or separation(i) >= sep_min):
+            return True
+        if not separation(i) >= sep_min:
+            return False
+        return coupled or not swing(i)
+
     j = i_h
-    while j + 1 < n and not vector_norm(s.rel[j] - held) >= sep_min:
+    while j + 1 < n and not parted(j):
         if not np.isfinite(s.rel_speed[j + 1]):
-            sep = vector_norm(s.rel[j] - held)
-            if sep >= 0.5 * sep_min and s.rel_speed[j] > 1e-6:
+            seen = np.isfinite(s.rel_speed[j + 1 :]).nonzero()[0] + j + 1
+            # Seen still together a smoothing window after the gap (its edge is smoothed
+            # one-sided): the giver's motion in it was the pair's.
+            k = int(seen[window]) if seen.size > window else -1
+            if k >= 0 and not parted(k):
+                j = k
+                continue
+            if 0 < seen.size <= window:
+                return float(s.t[-1]), True  # too little seen after the gap yet
+            if k < 0 and (coupled or swing(j)):
+                # The hands moved together into a gap that lasts to the data end: the
+                # giver's motion is the pair's, a hand unseen (a frozen or lost marker) no
+                # release.
+                return float(s.t[-1]), True
+            sep = separation(j)
+            # (a gap to the data end: only the giver's own motion tells, below)
+            if k >= 0 and sep >= 0.5 * sep_min and s.rel_speed[j] > 1e-6:
                 back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
                 return max(float(s.t[j]) - back, t_start), False
             onset = giver_onset_after(s, c, j)
@@ -70,9 +141,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
                 return float(s.t[-1]), True  # tracking lost until the end, nothing moved
             return max(float(s.t[j]) if onset is None else onset, t_start), False
         j += 1
-    if j == n - 1 and not vector_norm(s.rel[j] - held) >= sep_min:
+    if j == n - 1 and not parted(j):
         return float(s.t[-1]), True
-    sep = vector_norm(s.rel[j] - held)
+    if coupled:
+        sep = max(separation(j), vector_norm(s.rel[j] - s.rel[i_h]))
+    else:
+        sep = separation(j)
     back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
     return max(float(s.t[j]) - back, t_start, float(s.t[i_h])), False
 

@@ -46,6 +46,8 @@ class TransferCore:
         end: Last grid index of the core.
         hi: Last grid index of the dip.
         t_start: Transfer start (s), or NaN when the approach has not yet settled in the data.
+        piece: The transfer was under way at the recording's first sample (a window cut from
+            inside a handover): its reach is not in the data.
     """
 
     lo: int
@@ -53,6 +55,7 @@ class TransferCore:
     end: int
     hi: int
     t_start: float
+    piece: bool = False
 
 
 def runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -138,8 +141,12 @@ def dips(d: np.ndarray, depth: float) -> list[tuple[int, int, int]]:
         left = hi
 
 
-def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
-    """Every handover's transfer core, in time order (see the module docstring)."""
+def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[TransferCore]:
+    """Every handover's transfer core, in time order (see the module docstring).
+
+    ``pieces``: a first dip that is a handover already under way at the first sample
+    (:func:`is_leading_piece`) gives a core too, marked ``piece`` (offline: a recording cut
+    from inside a handover; online the analysis window's start slides through holds)."""
     d = s.distance
     n = d.shape[0]
     if n < 3 or not np.isfinite(d).any():
@@ -175,6 +182,8 @@ def find_cores(s: Signals, c: PhaseConfig) -> list[TransferCore]:
         if b - a + 1 < min_len:
             continue
         if not is_handover_dip(s, c, lo, p, a):
+            if pieces and not out and is_leading_piece(s, c, a, b, p, hi):
+                out.append(TransferCore(lo, a, b, hi, float(s.t[a]), piece=True))
             continue  # a pause far apart, or only the receiver moved: not a handover
         if out and a <= out[-1].end:
             continue  # the same transfer seen from a neighbouring dip
@@ -190,6 +199,16 @@ def is_handover_dip(s: Signals, c: PhaseConfig, lo: int, p: int, a: int) -> bool
     if top - d[p] < c.approach_fraction * top:
         return False  # the hands paused while still far apart (relative to where they started)
     return bool(nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed)
+
+
+def is_leading_piece(s: Signals, c: PhaseConfig, a: int, b: int, p: int, hi: int) -> bool:
+    """The seed-rule core ``[a, b]`` of the recording's first dip is a handover already under
+    way at the first sample (a window cut from inside one, issue 33): the core starts at the
+    first sample seen, and the hands are seen parting after it (``min_approach``)."""
+    seen = np.isfinite(s.distance).nonzero()[0]
+    if seen.size == 0 or a > int(seen[0]) + 1:
+        return False
+    return bool(nanmax(s.distance[b : hi + 1], initial=-np.inf) >= s.distance[p] + c.min_approach)
 
 
 def pass_core(

@@ -1,0 +1,94 @@
+"""Issue 33's careful handovers: the hands meet 0.31-0.37 m apart (segment origins of a mocap
+suit, the object between), move the object together for 1.1-1.5 s (common motion 0.06-0.21
+m/s) while the pair turns (relative speed 0.04-0.10 m/s at a distance held within 1 cm), then
+part; frozen repeated samples and one-sample glitches of 1.5-7 cm. Pins the generator's shape of
+those cases, the coupled transfer found on them offline and online, and the glitch filter."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gazebot.core.phases import PhaseConfig, compute_signals, run_online, segment
+from gazebot.core.phases.filtering import drop_glitches
+from gazebot.core.phases.synthetic import COUPLED_KINDS, case_set
+from gazebot.core.types import EventKind, Phase
+
+WITHIN = 0.2  # s, the issue's bar at both ends of the transfer
+
+
+@pytest.fixture(scope="module")
+def cases():
+    return {kind: case_set(kind, 12, seed=1) for kind in COUPLED_KINDS}
+
+
+def test_coupled_cases_look_like_the_issues_numbers(cases):
+    for case in cases["coupled"]:
+        h = case.truth[0]
+        s = compute_signals(case.trajectory, PhaseConfig())
+        i = int(np.searchsorted(s.t, h.transfer_start))
+        m = (s.t > h.transfer_start + 0.1) & (s.t < h.transfer_end - 0.05)
+        common = np.linalg.norm(s.giver_v + s.receiver_v, axis=1)[m] / 2
+        assert 1.1 <= h.transfer_end - h.transfer_start <= 1.7
+        assert 0.30 <= s.distance[i] <= 0.38  # segment origins, the object between
+        assert np.nanmax(s.distance[m]) - np.nanmin(s.distance[m]) < 0.01
+        assert 0.06 <= np.nanmedian(common) <= 0.22
+        assert 0.04 <= np.nanmedian(s.rel_speed[m]) <= 0.11
+        assert case.options.frozen_per_s > 0 and case.options.glitches_per_s > 0
+    for case in cases["coupled30"]:
+        assert np.median(np.diff(case.trajectory.t)) == pytest.approx(1 / 30, rel=0.15)
+        assert case.options.noise == case.options.gripper_noise == 0.005
+
+
+def _hits(group):
+    """How many cases give one transfer within WITHIN of the truth at both ends, offline and
+    online (the transfer_started / retreat_started events)."""
+    offline = online = 0
+    for case in group:
+        h, tr = case.truth[0], case.trajectory
+        segs = [s for s in segment(tr, PhaseConfig()) if s.phase is Phase.TRANSFER]
+        offline += len(segs) == 1 and (
+            abs(segs[0].start - h.transfer_start) <= WITHIN
+            and abs(segs[0].end - h.transfer_end) <= WITHIN
+        )
+        events = run_online(tr).events
+        start = [e.t for e in events if e.kind is EventKind.TRANSFER_STARTED]
+        end = [e.t for e in events if e.kind is EventKind.RETREAT_STARTED]
+        online += len(start) == len(end) == 1 and (
+            abs(start[0] - h.transfer_start) <= WITHIN and abs(end[0] - h.transfer_end) <= WITHIN
+        )
+    return offline, online
+
+
+def test_the_coupled_transfer_spans_the_whole_hold_at_120_hz(cases):
+    # Measured 11 / 11 of 12 offline / online (seeds 2, 3: 10 / 9 and 11 / 11); the issue's
+    # target is 12 of 12: not reached (the misses end 0.2-0.25 s late: a giver's slow
+    # minimum-jerk start reads as still). Pinned against regressions.
+    offline, online = _hits(cases["coupled"])
+    assert offline >= 11 and online >= 11
+
+
+def test_the_coupled_transfer_at_30_hz_with_5_mm_noise(cases):
+    # Measured 6 / 5 of 12 offline / online (seeds 2, 3: 6 / 6 and 5 / 6); the issue's target
+    # is 12 of 12: not reached. Pinned against regressions.
+    offline, online = _hits(cases["coupled30"])
+    assert offline >= 6 and online >= 5
+
+
+def test_a_one_sample_glitch_is_dropped_and_a_real_step_kept():
+    t = np.arange(0.0, 1.0, 1 / 120)
+    p = np.zeros((t.size, 3))
+    p[:, 0] = 0.1 * t  # a hand moving at 0.1 m/s
+    p[40, 1] += 0.05  # a glitch of 5 cm for one sample
+    p[80:, 2] += 0.06  # the marker slips 6 cm for good
+    bad = drop_glitches(t, p, 0.03, np.ones(t.size, dtype=bool))
+    assert bad.nonzero()[0].tolist() == [40, 80]  # the step's first sample only
+
+
+def test_noise_alone_is_no_glitch():
+    rng = np.random.default_rng(3)
+    for rate, noise in ((30.0, 0.005), (120.0, 0.005), (8.0, 0.003)):
+        t = np.arange(0.0, 20.0, 1 / rate)
+        p = 0.3 * np.sin(t)[:, None] * [1.0, 0.5, 0.2] + rng.normal(0, noise, (t.size, 3))
+        bad = drop_glitches(t, p, PhaseConfig().glitch_jump, np.ones(t.size, dtype=bool))
+        assert bad.sum() <= 0.002 * t.size, (rate, noise, int(bad.sum()))
