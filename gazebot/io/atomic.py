@@ -14,6 +14,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from types import TracebackType
+from typing import TypeVar
 
 
 def part_path(path: Path) -> Path:
@@ -36,7 +37,37 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         tmp.unlink(missing_ok=True)
 
 
-class AtomicWriter:
+_Self = TypeVar("_Self", bound="FinishOrAbort")
+
+
+class FinishOrAbort:
+    """A writer used as a context manager: :meth:`close` when the block ends normally,
+    :meth:`abort` when it ends by an exception."""
+
+    def close(self) -> object:
+        """Finish the output."""
+        raise NotImplementedError
+
+    def abort(self) -> None:
+        """Drop the output."""
+        raise NotImplementedError
+
+    def __enter__(self: _Self) -> _Self:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+
+
+class AtomicWriter(FinishOrAbort):
     """Base of the streaming writers: :attr:`path` is the target, :attr:`part` the temporary
     file being written. Subclasses finish their stream in :meth:`close` and then call
     :meth:`_commit`, and drop it in :meth:`abort`. As a context manager the file is committed
@@ -62,16 +93,3 @@ class AtomicWriter:
         """Stop writing and delete the temporary file; the target is left untouched."""
         raise NotImplementedError
 
-    def __enter__(self) -> AtomicWriter:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()

@@ -23,12 +23,12 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
 from typing import BinaryIO
 
 from mcap.writer import CompressionType, Writer
 from rosbags.typesys.store import Typestore
 
+from gazebot.io.atomic import FinishOrAbort
 from gazebot.io.ros2.codec import Codec
 from gazebot.io.ros2.errors import MessageError
 from gazebot.io.ros2.typestore import typestore
@@ -71,7 +71,7 @@ def split_path(path: Path, index: int) -> Path:
     return path.with_name(f"{path.stem}_{index}{path.suffix}")
 
 
-class McapRecorder:
+class McapRecorder(FinishOrAbort):
     """Writes messages of any registered type to one MCAP file (or a split series of them).
 
     Args:
@@ -247,16 +247,3 @@ class McapRecorder:
         for path in self.files:
             path.unlink(missing_ok=True)
 
-    def __enter__(self) -> McapRecorder:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
