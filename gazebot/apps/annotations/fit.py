@@ -3,8 +3,7 @@
 to the annotated human-human handovers.
 
 The fitting lives here, beside the annotations it reads, so that ``gazebot.core.behaviors`` only
-reads
-the fitted YAML and never imports ``gazebot.apps.annotations`` (the dependency is one way:
+reads the fitted YAML and never imports ``gazebot.apps.annotations`` (the dependency is one way:
 annotations -> behaviors). Regenerate the shipped model with::
 
     gazebot annotations fit-human path/to/handover-gaze-annotations --role receiver \\

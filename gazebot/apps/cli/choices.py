@@ -57,3 +57,13 @@ def scene_help(default: str | None = "default") -> str:
 def add_scene_argument(parser: argparse.ArgumentParser, *, default: str = "default") -> None:
     """``--scene NAME|YAML`` (default: the ``default`` scene)."""
     parser.add_argument("--scene", default=default, help=scene_help(default))
+
+
+def add_gaze_mode_argument(parser: argparse.ArgumentParser) -> None:
+    """``--gaze-mode``: how the robot points its gaze (default: the robot YAML's)."""
+    parser.add_argument(
+        "--gaze-mode",
+        default=None,
+        help="how the robot points its gaze: head-and-eyes, head-only "
+        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
+    )

@@ -13,7 +13,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gazebot.apps.cli.argtypes import seed_value
-from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
+from gazebot.apps.cli.choices import (
+    add_behavior_argument,
+    add_gaze_mode_argument,
+    add_robot_argument,
+    add_scene_argument,
+)
 from gazebot.apps.cli.errors import UsageError, option_error, robot_with_gaze_mode
 from gazebot.apps.cli.robots import add_package_path, is_urdf_robot, run_kinematic_demo
 from gazebot.apps.render.video_settings import VIDEO
@@ -47,12 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_package_path(parser)
     add_behavior_argument(parser, default=DEFAULT_BEHAVIOR)
     add_scene_argument(parser)
-    parser.add_argument(
-        "--gaze-mode",
-        default=None,
-        help="how the robot points its gaze: head-and-eyes, head-only "
-        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
-    )
+    add_gaze_mode_argument(parser)
     parser.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
     parser.add_argument("--seed", type=seed_value, default=0, help="random seed (default: 0)")
     parser.add_argument("--width", type=int, default=VIDEO.width,

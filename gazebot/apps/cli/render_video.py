@@ -9,7 +9,12 @@ import sys
 from pathlib import Path
 
 from gazebot.apps.cli.argtypes import seed_value
-from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
+from gazebot.apps.cli.choices import (
+    add_behavior_argument,
+    add_gaze_mode_argument,
+    add_robot_argument,
+    add_scene_argument,
+)
 from gazebot.apps.cli.errors import UsageError, robot_with_gaze_mode
 from gazebot.apps.render.video_settings import VIDEO
 
@@ -21,12 +26,7 @@ def register(kinds: argparse._SubParsersAction) -> None:
     add_robot_argument(parser)
     add_behavior_argument(parser, required=True)
     add_scene_argument(parser)
-    parser.add_argument(
-        "--gaze-mode",
-        default=None,
-        help="how the robot points its gaze: head-and-eyes, head-only "
-        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
-    )
+    add_gaze_mode_argument(parser)
     parser.add_argument("--out", type=Path, required=True, help="output FILE.mp4")
     parser.add_argument("--seed", type=seed_value, default=0, help="random seed (default: 0)")
     parser.add_argument("--width", type=int, default=VIDEO.width,

@@ -19,7 +19,11 @@ from gazebot.apps.cli.bus import (
     bus_config,
     robot_base_frame,
 )
-from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument
+from gazebot.apps.cli.choices import (
+    add_behavior_argument,
+    add_gaze_mode_argument,
+    add_robot_argument,
+)
 from gazebot.apps.cli.errors import robot_with_gaze_mode
 from gazebot.apps.cli.extras import extra_for
 from gazebot.apps.cli.mcap import add_record_split_arguments, record_split
@@ -55,12 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_robot_argument(p)
     add_behavior_argument(p, default=DEFAULT_BEHAVIOR)
-    p.add_argument(
-        "--gaze-mode",
-        default=None,
-        help="how the robot points its gaze: head-and-eyes, head-only "
-        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
-    )
+    add_gaze_mode_argument(p)
     p.add_argument("--phases", default=None, help="phase config YAML (default configs/phases.yaml)")
     p.add_argument("--seed", type=seed_value, default=0, help="seed of behavior timings and blinks")
     p.add_argument("--duration", type=positive, default=None,

@@ -16,7 +16,12 @@ from gazebot.apps.cli.bus import (
     bus_config,
     robot_base_frame,
 )
-from gazebot.apps.cli.choices import add_behavior_argument, add_robot_argument, add_scene_argument
+from gazebot.apps.cli.choices import (
+    add_behavior_argument,
+    add_gaze_mode_argument,
+    add_robot_argument,
+    add_scene_argument,
+)
 from gazebot.apps.cli.errors import UsageError, robot_with_gaze_mode
 from gazebot.apps.cli.mcap import add_record_split_arguments, record_split
 from gazebot.apps.render.video_settings import VIDEO
@@ -40,12 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--with-engine", action="store_true", help="run a gaze engine in-process too")
     add_behavior_argument(p, default=DEFAULT_BEHAVIOR, what="behavior of --with-engine")
-    p.add_argument(
-        "--gaze-mode",
-        default=None,
-        help="how the robot points its gaze: head-and-eyes, head-only "
-        "(fixed display eyes) or eyes-only (head held still); default: the robot YAML",
-    )
+    add_gaze_mode_argument(p)
     p.add_argument("--headless", action="store_true", help="no window")
     p.add_argument(
         "--eye-frames",

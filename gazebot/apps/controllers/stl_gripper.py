@@ -10,8 +10,7 @@ Each control step solves the reach's MILP (:mod:`gazebot.apps.controllers.stl_mi
 state:
 min ``sum |u_g|`` (eq. 4.4) with ``|u_g| <= gripper_speed_per_s``; a window opened by the trigger
 and not yet met needs a near step, as in :class:`~gazebot.apps.controllers.stl.STLController`; "If
-no
-feasible control input is found, the robot stops" (the gripper holds its openness).
+no feasible control input is found, the robot stops" (the gripper holds its openness).
 """
 
 from __future__ import annotations

@@ -1,6 +1,5 @@
 """The ``panda`` robot of the handover scene: the chapter-5 learner (:mod:`gazebot.apps.gps.panda`,
-the
-one MJCF source of its arm) on a pedestal, with a pan-tilt display head beside it, written to
+the one MJCF source of its arm) on a pedestal, with a pan-tilt display head beside it, written to
 ``gazebot/assets/robots/panda.xml`` so the gaze engine (Pinocchio IK), the eye renderer and the
 simulation load it like the other robots.
 

@@ -1,8 +1,7 @@
 """Off-screen eye images for the robots' head screens.
 
 ``EyeRenderer.for_robot(DEFAULT_ROBOT).render(eye_yaw, eye_pitch, blink, distance)`` returns an RGB
-image.
-The blink that closes the lids comes from the runtime loop's
+image. The blink that closes the lids comes from the runtime loop's
 :class:`~gazebot.core.runtime.blink.BlinkModel`.
 The eye state travels on the bus as ``gazebot_msgs/EyeState`` (tens of bytes;
 :class:`gazebot.io.ros2.values.EyeState`); ``gazebot display`` draws it on the robot's head

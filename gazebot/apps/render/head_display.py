@@ -12,8 +12,7 @@ updates, neutral when the engine goes silent.
   same drift; when eye states return, the eyes follow the engine again.
 
 :class:`HeadScreen` draws the chosen pose with :class:`~gazebot.apps.render.eyes.EyeRenderer` (the
-one
-eye drawing, also used for the simulator's display texture and ``gazebot render eyes``) onto a
+one eye drawing, also used for the simulator's display texture and ``gazebot render eyes``) onto a
 pygame-ce window (or SDL's dummy/offscreen driver, headless), with a status line.
 """
 
@@ -70,8 +69,7 @@ class EyeAnimator:
 
     ``state`` is the newest eye state (anything with ``yaw``, ``pitch``, ``blink``, ``distance``)
     or ``None``; ``age`` how long ago (s) it arrived; ``now`` the screen's clock (s, never going
-    back).
-    """
+    back). """
 
     def __init__(self, config: EyeAnimatorConfig | None = None, seed: int = 0) -> None:
         self.config = config or EyeAnimatorConfig()

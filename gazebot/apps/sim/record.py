@@ -95,8 +95,7 @@ def record_handover(
     when given, sees the simulation after each control tick's head and eye commands (e.g. to
     inspect or render it); it must not step the simulation. ``loop`` replaces the default
     :class:`~gazebot.core.runtime.GazeLoop` (``behavior`` and ``seed`` for its engine and blinks);
-    it
-    must be built for the same robot. ``giver_factory`` replaces the simulated giver (see
+    it must be built for the same robot. ``giver_factory`` replaces the simulated giver (see
     :class:`HandoverSimulation`; e.g. recorded motion, ``--giver-motion``). ``on_step(t,
     frame, joints, robot_events, cmd)``, when given, sees every control tick's input and the
     loop's command (``None`` when none was safe to send), e.g. to record them as ROS 2 messages.

@@ -5,8 +5,7 @@
    (robot, behavior, scene, seed, resolution, fps, code version), so a rerun renders only what
    changed (a cached file is reused; a crashed render leaves no file behind). Beside each video,
    ``NAME.json`` holds its times (:mod:`gazebot.apps.study.video_times`: the seed's reach-start
-   time,
-   the robot's events and the phase starts); a cached video without one is rendered again.
+   time, the robot's events and the phase starts); a cached video without one is rendered again.
 2. Every distinct session (first behavior, second behavior, scene) becomes one pair video in
    ``DIR/pairs/``: a "Handover 1" title card, the first handover, a "Handover 2" title card, the
    second handover (H.264, yuv420p). Each participant's session files in

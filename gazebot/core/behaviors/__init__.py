@@ -4,8 +4,7 @@
 forms.
 - :mod:`~gazebot.core.behaviors.spec`: the YAML format (:class:`BehaviorSpec`).
 - :mod:`~gazebot.core.behaviors.machine`: :class:`BehaviorMachine`, the ``transitions`` state
-machine
-  whose states are the gaze decisions (phase events and timers in, gaze target out), and
+machine whose states are the gaze decisions (phase events and timers in, gaze target out), and
   :func:`~gazebot.core.behaviors.machine.diagram` (its Mermaid drawing).
 - :mod:`~gazebot.core.behaviors.registry`: :func:`load_behavior` and :func:`list_behaviors`
 (built-ins in

@@ -3,17 +3,14 @@
 ``at`` is one of:
 
 - a number or ``{fraction: f}``: that fraction (0..1) of the phase's expected duration;
-- ``{after: EVENT, delay: s}``: ``s`` seconds after an event (``gazebot.core.types.EventKind``) of
-the
-  current handover, e.g. ``robot_reach_ended`` or ``retreat_started``;
+- ``{after: EVENT, delay: s}``: ``s`` seconds after an event (``gazebot.core.types.EventKind``)
+  of the current handover, e.g. ``robot_reach_ended`` or ``retreat_started``;
 - ``never``: the segment never starts (lets a variant switch a shift off);
 - ``$name``: the value of the behavior's parameter ``name``.
 
 Both :mod:`gazebot.core.behaviors.spec` (the behavior YAML) and :mod:`gazebot.core.behaviors.human`
-(the
-data-driven model, which draws segments) build on this module, so neither imports the other's
-users.
-"""
+(the data-driven model, which draws segments) build on this module, so neither imports the other's
+users. """
 
 from __future__ import annotations
 

@@ -12,16 +12,10 @@ phase and lasts until the next segment of that phase starts (or the phase ends):
       - {phase: reach, at: $reach_shift, target: hand}
       - {phase: retreat, at: {after: retreat_started, delay: 0.3}, target: face}
 
-``at`` is one of:
-
-- a number or ``{fraction: f}``: that fraction (0..1) of the phase's expected duration;
-- ``{after: EVENT, delay: s}``: ``s`` seconds after an event (``gazebot.core.types.EventKind``) of
-the
-  current handover, e.g. ``robot_reach_ended`` or ``retreat_started``;
-- ``never``: the segment never starts (lets a variant switch a shift off);
-- ``$name``: the value of the behavior's parameter ``name``. Variants (``extends: BASE``) change
-  only parameters, so a variant like ``face-hand-face-as-studied`` is the same behavior with other
-  timings, not a copy.
+``at`` takes the forms :mod:`gazebot.core.behaviors.segment` lists (a fraction of the phase, a
+delay after an event, ``never``, or ``$name``, a behavior parameter). Variants
+(``extends: BASE``) change only parameters, so a variant like ``face-hand-face-as-studied`` is the
+same behavior with other timings, not a copy.
 
 Before the first segment of a phase starts, the gaze of the previous phase carries on.
 """

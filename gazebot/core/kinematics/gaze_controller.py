@@ -62,8 +62,7 @@ class HeadEyeState:
         head_goal: Where the neck is heading (IK solution for the target).
         head_velocity: Commanded head joint velocities.
         shift_amplitude: Angle of a gaze shift started at this update (0 if none) — e.g. for a
-            blink model.
-        target_valid: The target given to this update was a finite point.
+            blink model. target_valid: The target given to this update was a finite point.
         eyes_saturated: The eyes are at their range.
     """
 

@@ -147,8 +147,7 @@ class RobotModel:
         head_joints: Head joint names, in the order of every head vector.
         lower, upper: Head joint position limits (rad), from the model.
         velocity_limits: Head joint velocity limits (rad/s): the YAML's overrides, else the
-            model's.
-        eye_joints: Eye joint names (empty for eyes drawn on a display or no eyes).
+            model's. eye_joints: Eye joint names (empty for eyes drawn on a display or no eyes).
         eye_chains: One :class:`EyeChain` per eye whose eyes are joints.
         rest: Head rest posture (rad).
         eye_yaw_range, eye_pitch_range: Eye ranges (rad) as ``(min, max)``.

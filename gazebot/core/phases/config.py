@@ -107,8 +107,7 @@ class PhaseConfig(BaseModel):
             before the reach's start (the rest before it dates the onset).
         predict_window: Online, ``gazebot``'s predictive reach rule
             (:mod:`~gazebot.core.phases.rules.directed`) fits the giver's hand over this long (s)
-            ...
-        predict_min_samples: ... and over at least this many samples (low rates widen it).
+            ... predict_min_samples: ... and over at least this many samples (low rates widen it).
         predict_gap_factor: ... with no gap in the window longer than this many sampling
             intervals (the newest sample seen) ...
         predict_rest_window: ... against its mean position over this long (s) before that.

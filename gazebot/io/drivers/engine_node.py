@@ -107,8 +107,7 @@ class EngineNodeConfig:
     Attributes:
         silence_after: Silence of the tracking (s) after which the node ticks the loop without
             a sample (the tracking-loss timings themselves are the phase detector's and the
-            behavior's).
-        silence_rate: Rate (Hz) of those ticks while the silence lasts.
+            behavior's). silence_rate: Rate (Hz) of those ticks while the silence lasts.
         heartbeat_period: Period of the status heartbeat.
         resync: Catch up with a handover under way at start (events + joint state).
         resync_timeout: How long to wait at start for the joint state and the event history.

@@ -38,8 +38,7 @@ class BusRecorder:
         session: An open Zenoh session (left open).
         names: Namespace, remapping and domain id of the topics.
         path: The ``.mcap`` file (with a splitting ``split``: ``NAME_0.mcap``, ``NAME_1.mcap``,
-            ...).
-        eye_images: Also record ``eyes/image/compressed``.
+            ...). eye_images: Also record ``eyes/image/compressed``.
         split: When to go on to the next file (default: never).
         flush_period: Seconds between flushes of the file (what a kill loses at most).
     """

@@ -61,8 +61,7 @@ class ZenohNode:
 
     Args:
         session: An open Zenoh session (closed by :meth:`close` only if ``owns_session``: it may
-            be shared).
-        names: Namespace, remapping, domain id and frame names.
+            be shared). names: Namespace, remapping, domain id and frame names.
         node: This node's ROS name (``engine``, ``sim``, ...): its liveliness token, the
             ``source`` of its events and the name of its ``/diagnostics`` status.
         owns_session: Close ``session`` in :meth:`close` (set by :meth:`open`).

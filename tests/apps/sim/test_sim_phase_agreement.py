@@ -3,8 +3,7 @@ target comes from a phase's rule while the command reports another phase.
 
 Each (scene, initiator) is one simulated handover; every seed behavior's own
 :class:`~gazebot.core.runtime.GazeLoop` sees the same frames and robot events tick for tick (the
-gaze
-moves neither the giver nor the arm). The behavior records the rule that picked its gaze state
+gaze moves neither the giver nor the arm). The behavior records the rule that picked its gaze state
 when it picked it (:attr:`~gazebot.core.behaviors.BehaviorMachine.origin`: a segment of a phase, the
 ``before``/``after`` target, with that rule's phase; a gaze carried unchanged into a later phase
 says so). Every tick with tracking ok must agree with it

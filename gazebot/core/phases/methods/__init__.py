@@ -1,7 +1,6 @@
 """Phase methods, one per file, each a :class:`Segmenter` (offline: whole recording in,
 segments out). The online :class:`~gazebot.core.phases.detector.PhaseDetector` runs any of them on
-the
-samples seen so far.
+the samples seen so far.
 
 - ``gazebot`` (:class:`GazebotSegmenter`): the robust default;
 - ``seed-7.2.5`` (:class:`Seed725Segmenter`): the seed's annotation rule as published;
