@@ -42,6 +42,7 @@ def test_the_readme_has_its_command_blocks():
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(BLOCK_TIMEOUT_S + 60)
 @pytest.mark.parametrize("block", readme_blocks(), ids=_block_id)
 def test_a_readme_command_block_runs_as_written(block, tmp_path):
     if Path(sys.prefix).resolve() != (REPO / ".venv").resolve():
