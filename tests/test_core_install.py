@@ -34,7 +34,13 @@ def test_the_command_line_and_its_help_start_without_an_extra():
 
 @pytest.mark.zenoh
 def test_gazebot_run_without_the_render_extra_runs_with_eye_state_only():
-    res = gazebot_without_extras("run", "--duration", "0.5", "--json")
+    import socket
+
+    with socket.socket() as s:  # a port nothing listens on: no other bus is joined
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    res = gazebot_without_extras("run", "--duration", "0.5", "--json", "--listen",
+                                 "tcp/127.0.0.1:0", "--connect", f"tcp/127.0.0.1:{port}")
     assert res.returncode == 0, res.stderr
     assert "no eye frames (they need the [render] extra)" in res.stderr
     assert '"robot_seen": false' in res.stdout
