@@ -219,11 +219,20 @@ def locate(
     return field or "<root>", line
 
 
+def _is_model(annotation: Any) -> bool:
+    """Whether ``annotation`` is a pydantic model class (on Python 3.10 a ``list[X]`` alias passes
+    ``isinstance(_, type)`` but is no class ``issubclass`` takes)."""
+    try:
+        return isinstance(annotation, type) and issubclass(annotation, BaseModel)
+    except TypeError:
+        return False
+
+
 def _sub_model(model: type[BaseModel], loc: tuple[Any, ...]) -> type[BaseModel] | None:
     """The model that holds the last key of ``loc`` (for an unknown key: whose keys to list)."""
     current: Any = model
     for part in loc[:-1]:
-        if not (isinstance(current, type) and issubclass(current, BaseModel)):
+        if not _is_model(current):
             return None
         if isinstance(part, int) or part not in current.model_fields:
             continue
@@ -231,12 +240,12 @@ def _sub_model(model: type[BaseModel], loc: tuple[Any, ...]) -> type[BaseModel] 
         models = [
             a
             for a in (annotation, *_flat_args(annotation))
-            if isinstance(a, type) and issubclass(a, BaseModel)
+            if _is_model(a)
         ]
         if not models:
             return None
         current = models[0]
-    return current if isinstance(current, type) and issubclass(current, BaseModel) else None
+    return current if _is_model(current) else None
 
 
 def _flat_args(annotation: Any) -> list[Any]:

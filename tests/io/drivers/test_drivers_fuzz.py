@@ -235,6 +235,8 @@ def test_decoding_a_payload_at_its_cap_stays_within_bounded_memory():
     cap: each decode allocates at most a few times the cap."""
     by_type = {t.type: t.max_bytes for t in topics.ALL}
     for type_name, raw in VALID.items():
+        if type_name == MARKER_ARRAY:
+            continue  # published only: no gazebot node decodes markers (view forwards the bytes)
         cap = by_type.get(type_name, 1024)
         codec = Codec.for_type(typestore(), type_name, cap)
         for offset in range(4, len(raw) - 3, 4):
