@@ -17,7 +17,9 @@ Robot evidence (seed section 4.3) comes first: a rising edge of "gripper closed"
 share above ``load_share_shared`` starts the transfer at once (and reports the reach if it was
 missed); a load share above ``load_share_robot`` starts the retreat. Once frames carry that
 evidence, hand motion alone no longer starts a transfer (hands resting close together while the
-robot has not grasped are a giver waiting).
+robot has not grasped are a giver waiting). A frame without it (over the bus: a silence tick, a
+sample assembled without its gripper part) is a gap, not an open gripper: the edge needs the
+gripper seen open (or the load share low) before.
 
 A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
 back about as far apart as when it started (taken back before any transfer), ends as
