@@ -17,7 +17,9 @@ Robot evidence (seed section 4.3) comes first: a rising edge of "gripper closed"
 share above ``load_share_shared`` starts the transfer at once (and reports the reach if it was
 missed); a load share above ``load_share_robot`` starts the retreat. Once frames carry that
 evidence, hand motion alone no longer starts a transfer (hands resting close together while the
-robot has not grasped are a giver waiting).
+robot has not grasped are a giver waiting). A frame without it (over the bus: a silence tick, a
+sample assembled without its gripper part) is a gap, not an open gripper: the edge needs the
+gripper seen open (or the load share low) before.
 
 A reach the analysis no longer shows for ``online_period`` + ``max_refine``, with the hands
 back about as far apart as when it started (taken back before any transfer), ends as
@@ -376,9 +378,8 @@ class PhaseDetector:
             info = {"handover": max(self._state().handover, 0)}
             self._emit(Event(EventKind.TRACKING_RESTORED, t, t, info))
 
-        if frame.gripper_closed is None and frame.load_share is None:
-            self._prev_evidence = False  # no robot evidence (tracking alone, the usual frame)
-        elif self._robot_evidence(frame, t):
+        has_evidence = frame.gripper_closed is not None or frame.load_share is not None
+        if has_evidence and self._robot_evidence(frame, t):
             return
         if t - self._last_analysis >= c.online_period - 1e-9:
             # On a fixed grid of online_period (the first sample at or after each tick), not
@@ -415,14 +416,19 @@ class PhaseDetector:
         )
 
     def _robot_evidence(self, frame: TrackingFrame, t: float) -> bool:
-        """Gripper / load-share evidence of a frame that carries some (the caller handles a
-        frame with neither, the usual one); True if it started a phase on this frame."""
+        """Gripper / load-share evidence of a frame; True if it started a phase on this frame.
+
+        A frame that carries neither (tracking alone; over the bus also a silence tick, or a
+        sample assembled without its gripper part) says nothing of the gripper: it keeps the
+        baseline the last frame with evidence set, so a gripper that stayed closed through
+        the gap is no grasp when it is seen again (issue 30's phantom handover)."""
         c = self.config
-        grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
         load = frame.load_share
         load_ok = load is not None and math.isfinite(load)
-        if frame.gripper_closed is not None or load_ok:
-            self._robot_reports = True
+        if frame.gripper_closed is None and not load_ok:
+            return False
+        self._robot_reports = True
+        grip = frame.gripper_closed is not None and bool(frame.gripper_closed)
         evidence = grip or (load_ok and load > c.load_share_shared)  # type: ignore[operator]
         rising = evidence and self._prev_evidence is False
         self._prev_evidence = evidence

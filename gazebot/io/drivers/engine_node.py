@@ -85,6 +85,10 @@ log = logging.getLogger("gazebot.io.drivers")
 TrackingState = Literal["waiting", "ok", "hold", "lost"]
 Role = Literal["owner", "standby", "refused"]
 
+#: Warnings the node keeps (and its status carries): the latest ones. A long run warns again
+#: at each restart of a tracker or each rival, and every heartbeat carries the list.
+MAX_WARNINGS = 20
+
 
 class EyeImages(Protocol):
     """Renders the display's eyes (:class:`gazebot.apps.render.EyeRenderer`)."""
@@ -192,7 +196,7 @@ class EngineNode:
         self.warn = warn
         self.clock = clock
         self.robot_seen = False
-        self.warnings: list[str] = []
+        self.warnings: list[str] = []  # the latest MAX_WARNINGS
         self.tracking: TrackingState = "waiting"
         self.commands_sent = 0
         self.frames_processed = 0
@@ -638,6 +642,7 @@ class EngineNode:
 
     def _warn(self, kind: str, text: str, **info: object) -> None:
         self.warnings.append(text)
+        del self.warnings[:-MAX_WARNINGS]
         self.emit(kind, None, None, **info)
         if self.warn is not None:
             self.warn(text)
