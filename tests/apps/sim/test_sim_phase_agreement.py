@@ -14,9 +14,8 @@ That the check catches a stale origin is pinned in ``tests/core/behaviors/test_b
 
 from __future__ import annotations
 
-import math
-
 import pytest
+from shared_detector import Replay, SharedDetector
 
 from gazebot.apps.sim.scene_config import Initiator, load_scene, scene_names
 from gazebot.core.behaviors import GazeOrigin, seed_behaviors
@@ -26,50 +25,6 @@ pytest.importorskip("mujoco")
 
 #: The seed's gaze behaviors (chapter 6): the built-ins whose YAML says ``source: seed``.
 SEED_BEHAVIORS = seed_behaviors()
-
-
-class _SharedDetector:
-    """The first loop's phase detector; the other loops get its answer to each sample (it reads
-    the frames and its loop's handover state, which every loop's equals: the same frames and
-    events; and it costs most of a tick)."""
-
-    def __init__(self, detector) -> None:
-        self._detector = detector
-        self.last: list = []
-        self.end = math.nan
-
-    def update(self, frame, view, report) -> None:
-        self.last = []
-
-        def keep(event) -> None:
-            self.last.append(event)
-            report(event)
-
-        self._detector.update(frame, view, keep)
-
-    def expected_end(self, view) -> float:
-        self.end = self._detector.expected_end(view)
-        return self.end
-
-    def __getattr__(self, name):
-        return getattr(self._detector, name)
-
-
-class _Replay:
-    """Stands in for a further loop's detector: the shared detector's answer to this sample."""
-
-    def __init__(self, shared: _SharedDetector) -> None:
-        self._shared = shared
-
-    def update(self, frame, view, report) -> None:
-        for event in self._shared.last:
-            report(event)
-
-    def expected_end(self, view) -> float:
-        return self._shared.end
-
-    def __getattr__(self, name):
-        return getattr(self._shared, name)
 
 
 class _AllBehaviors:
@@ -82,10 +37,10 @@ class _AllBehaviors:
 
         self.loops = {n: GazeLoop.from_config(robot=robot, behavior=n) for n in SEED_BEHAVIORS}
         first, *rest = self.loops.values()
-        shared = _SharedDetector(first.engine.detector)
+        shared = SharedDetector(first.engine.detector)
         first.engine.detector = shared
         for loop in rest:
-            loop.engine.detector = _Replay(shared)
+            loop.engine.detector = Replay(shared)
         self.ticks: dict[str, list[tuple[float, Phase, str, GazeOrigin, str, str | None]]] = {
             n: [] for n in SEED_BEHAVIORS
         }

@@ -11,9 +11,9 @@ most of a tick, runs once and its answers are handed to every loop (it only read
 from __future__ import annotations
 
 import itertools
-import math
 
 import pytest
+from shared_detector import Replay, SharedDetector
 
 from gazebot.core.behaviors import seed_behaviors
 from gazebot.core.types import EventKind
@@ -25,50 +25,6 @@ SEED_BEHAVIORS = seed_behaviors()
 SHIFT_TOL_S = 0.05  # the issue's "within 50 ms"
 
 
-class _SharedDetector:
-    """The first loop's phase detector; the other loops get its answer to each sample (it reads
-    the frames and its loop's handover state, which every loop's equals: the same frames and
-    events; and it costs most of a tick)."""
-
-    def __init__(self, detector) -> None:
-        self._detector = detector
-        self.last: list = []
-        self.end = math.nan
-
-    def update(self, frame, view, report) -> None:
-        self.last = []
-
-        def keep(event) -> None:
-            self.last.append(event)
-            report(event)
-
-        self._detector.update(frame, view, keep)
-
-    def expected_end(self, view) -> float:
-        self.end = self._detector.expected_end(view)
-        return self.end
-
-    def __getattr__(self, name):
-        return getattr(self._detector, name)
-
-
-class _Replay:
-    """Stands in for a further loop's detector: the shared detector's answer to this sample."""
-
-    def __init__(self, shared: _SharedDetector) -> None:
-        self._shared = shared
-
-    def update(self, frame, view, report) -> None:
-        for event in self._shared.last:
-            report(event)
-
-    def expected_end(self, view) -> float:
-        return self._shared.end
-
-    def __getattr__(self, name):
-        return getattr(self._shared, name)
-
-
 class _AllBehaviors:
     """A ``record_handover`` loop that ticks one GazeLoop per behavior and commands the robot
     with the first; keeps every behavior's (t, target) per tick."""
@@ -78,10 +34,10 @@ class _AllBehaviors:
 
         self.loops = {n: GazeLoop.from_config(robot=robot, behavior=n, seed=seed) for n in names}
         first, *rest = self.loops.values()
-        shared = _SharedDetector(first.engine.detector)
+        shared = SharedDetector(first.engine.detector)
         first.engine.detector = shared
         for loop in rest:
-            loop.engine.detector = _Replay(shared)
+            loop.engine.detector = Replay(shared)
         self.targets: dict[str, list[tuple[float, str]]] = {n: [] for n in names}
 
     def notify(self, events) -> None:
