@@ -319,7 +319,7 @@ def echo_topic(args: argparse.Namespace) -> int:
                 print(format_message(msg, args.json, truncate), flush=True)
                 printed += 1
         except KeyboardInterrupt:
-            pass
+            pass  # Ctrl-C is how a user stops it: the closing lines below still run
         finally:
             drops.summary()
             if skipped:
@@ -366,7 +366,7 @@ def topic_hz(args: argparse.Namespace) -> int:
                 drops.poll()
                 time.sleep(0.02)
         except KeyboardInterrupt:
-            pass
+            pass  # Ctrl-C is how a user stops it: the closing lines below still run
         finally:
             drops.summary()
     return 0

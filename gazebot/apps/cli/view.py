@@ -157,7 +157,7 @@ def handle(args: argparse.Namespace) -> int:
         try:
             stop.wait(args.duration)
         except KeyboardInterrupt:
-            pass
+            pass  # Ctrl-C is how a user stops it: the closing lines below still run
         summary = {"forwarded": dict(sorted(view.forwarded.items())),
                    "dropped": view.ros.drops.counts()}
     finally:
