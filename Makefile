@@ -32,7 +32,7 @@ DOCS_STAMP := $(VENV)/.installed-docs
 PYTHON_LOWEST ?= $(shell for p in python3.10 $$HOME/.pyenv/versions/3.10*/bin/python3.10; do \
 	"$$p" -c "" >/dev/null 2>&1 && { echo "$$p"; exit 0; }; done; echo $(PYTHON))
 
-.PHONY: demo test test-lowest test-core bench lint docs lock lock-upgrade check-gl browser-deps clean
+.PHONY: demo test test-lowest test-core bench soak lint docs lock lock-upgrade check-gl browser-deps clean
 
 $(STAMP): pyproject.toml $(LOCK)
 	$(PYTHON) -m venv $(VENV)
@@ -115,6 +115,12 @@ test-core: $(CORE_STAMP)
 
 bench: $(TEST_STAMP)
 	$(PY) -m benchmarks --markdown docs/benchmark-results.md
+
+# The bus soak (ten minutes: a router, a recording engine, 29 simulator runs, a 50-participant
+# study load, then a SIGKILL of the engine): prints what it measured, exit 1 on a phantom
+# handover, a lost event or message, or a participant who could not finish.
+soak: $(TEST_STAMP)
+	$(PY) -m benchmarks.soak
 
 # Style, the layers (import-linter's contracts in pyproject.toml: core < io < apps, no cycles) and
 # the types of core and io (mypy, configured in pyproject.toml).

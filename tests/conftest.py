@@ -5,8 +5,12 @@ Off-screen back ends are chosen here so tests run on a machine without a screen.
 
 from __future__ import annotations
 
+import gc
 import importlib.util
 import os
+import sys
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -103,3 +107,42 @@ def pytest_runtest_makereport(item, call):
         if reason is not None:
             report.outcome = "skipped"
             report.longrepr = (str(item.path), item.location[1] or 0, f"Skipped: {reason}")
+
+
+# A thread that is not a daemon keeps the interpreter alive after the last test: a Zenoh callback
+# thread whose subscriber outlives its session does (eclipse-zenoh 1.5: an advanced subscriber
+# left to the session's close), and the run then never exits. Any such thread still running
+# at the end fails the run instead of hanging it, naming the test module that started it.
+#: How long the threads left at the end may take to finish (s).
+THREAD_GRACE_S = 5.0
+#: Thread -> the test module during which it was first seen running.
+_THREAD_ORIGIN: dict[threading.Thread, str] = {}
+
+
+def _live_threads() -> set[threading.Thread]:
+    return {t for t in threading.enumerate()
+            if not t.daemon and t is not threading.main_thread() and t.is_alive()}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _note_threads_started(request):
+    """Remembers which module started the threads still running after it (for the report)."""
+    before = _live_threads()
+    yield
+    for t in _live_threads() - before:
+        _THREAD_ORIGIN.setdefault(t, request.module.__name__)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config):
+    gc.collect()  # a Zenoh callback thread ends once its subscriber object is freed
+    deadline = time.monotonic() + THREAD_GRACE_S
+    for t in _live_threads():
+        t.join(max(0.0, deadline - time.monotonic()))
+    left = _live_threads()
+    if left:
+        names = sorted(f"{t.name} (from {_THREAD_ORIGIN.get(t, 'unknown')})" for t in left)
+        sys.stderr.write(f"tests left threads running, so the run would never exit: {names}; "
+                         "undeclare Zenoh subscribers before closing their session\n")
+        sys.stderr.flush()
+        os._exit(3)

@@ -69,10 +69,11 @@ def test_the_coupled_transfer_spans_the_whole_hold_at_120_hz(cases):
 
 
 def test_the_coupled_transfer_at_30_hz_with_5_mm_noise(cases):
-    # Measured 6 / 5 of 12 offline / online (seeds 2, 3: 6 / 6 and 5 / 6); the target
-    # is 12 of 12: not reached. Pinned against regressions.
+    # Measured 6 / 8 of 12 offline / online (seeds 2, 3: 6 / 7 and 5 / 6); before the hold's
+    # band was measured over the whole hold and a fast sample needed the distance to move
+    # too, 6 / 5. The target is 12 of 12: not reached. Pinned against regressions.
     offline, online = _hits(cases["coupled30"])
-    assert offline >= 6 and online >= 5
+    assert offline >= 6 and online >= 8
 
 
 def test_a_one_sample_glitch_is_dropped_and_a_real_step_kept():
