@@ -69,11 +69,12 @@ def test_the_coupled_transfer_spans_the_whole_hold_at_120_hz(cases):
 
 
 def test_the_coupled_transfer_at_30_hz_with_5_mm_noise(cases):
-    # Measured 6 / 8 of 12 offline / online (seeds 2, 3: 6 / 7 and 5 / 6); before the hold's
-    # band was measured over the whole hold and a fast sample needed the distance to move
-    # too, 6 / 5. The target is 12 of 12: not reached. Pinned against regressions.
+    # Measured 7 / 8 of 12 offline / online (seeds 2, 3: 9 / 7 and 7 / 6); before the hold's
+    # band was measured over the whole hold, a fast sample needed the distance to move too and
+    # the pair turning together joined the seed-rule runs, 6 / 5. The target is 12 of
+    # 12: not reached. Pinned against regressions.
     offline, online = _hits(cases["coupled30"])
-    assert offline >= 6 and online >= 8
+    assert offline >= 7 and online >= 8
 
 
 def test_a_one_sample_glitch_is_dropped_and_a_real_step_kept():

@@ -7,8 +7,10 @@ distance" (section 7.2.5), whatever it is: on real motion capture the hand frame
 back of the hand or at the wrist and the object has size, so they never come closer than
 0.3-0.5 m; no absolute contact distance is assumed. Within the dip, the seed's rule (within
 ``transfer_distance_margin`` of the minimum, relative speed under ``transfer_speed_max``)
-gives the transfer's core; runs split by short blips under ``transfer_exit_speed`` or by
-tracking gaps merge. The giver's hand must have moved (``reach_onset_speed``) before the core:
+gives the transfer's core; runs split by short blips under ``transfer_exit_speed``, by
+tracking gaps, or by the pair turning with the object (under ``transfer_exit_speed`` with
+their relative speed against their common motion under ``transfer_speed_max``, however long)
+merge. The giver's hand must have moved (``reach_onset_speed``) before the core:
 a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
 more than the giver.
 
@@ -165,13 +167,18 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
                 out.append(TransferCore(lo, passed[0], passed[1], hi, float(s.t[passed[0]])))
             continue
         soft = near & (rs < c.transfer_exit_speed)
+        # The pair turning with the object: their relative speed against their common motion
+        # stays under the seed's speed (issue 33's careful carries swing the marker frames'
+        # relative position at 0.15-0.2 m/s for longer than a blip).
+        together = near & (np.nan_to_num(s.hold_speed, nan=np.inf) < c.transfer_speed_max)
         merged: list[list[int]] = [list(rule_runs[0])]
         for a, b in rule_runs[1:]:
             gap = slice(merged[-1][1] + 1, a)
             # A short blip under the exit speed, or a tracking gap with nothing but such
-            # samples, does not end a transfer.
+            # samples, does not end a transfer; nor does the pair turning together.
             ok = soft[gap] | unknown[gap]
-            if ok.all() and np.count_nonzero(~unknown[gap]) < min_len:
+            if (ok.all() and np.count_nonzero(~unknown[gap]) < min_len) or (
+                    (soft[gap] & together[gap]).all()):
                 merged[-1][1] = b
             else:
                 merged.append([a, b])
