@@ -60,11 +60,16 @@ class PhaseDetectorLike(Protocol):
 
     def update(
         self, frame: TrackingFrame, view: HandoverView, report: Callable[[Event], object]
-    ) -> None: ...
+    ) -> None:
+        """Feed one frame; report every event it reveals to ``report``, which applies it to the
+        state ``view`` reads."""
 
-    def expected_end(self, view: HandoverView) -> float: ...
+    def expected_end(self, view: HandoverView) -> float:
+        """The estimated end of ``view``'s phase (s; NaN when unknown)."""
 
-    def resync(self) -> None: ...
+    def resync(self) -> None:
+        """The handover state was replayed (e.g. after an engine restart): join the phase under
+        way."""
 
 
 @dataclass

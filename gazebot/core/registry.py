@@ -48,6 +48,7 @@ class Entry(Generic[T]):
     description: str = ""
 
     def load(self) -> Callable[..., T]:
+        """The factory, importing ``"module:attribute"`` on first use."""
         if isinstance(self.factory, str):
             module, _, attr = self.factory.partition(":")
             obj: object = importlib.import_module(module)
@@ -62,9 +63,11 @@ class NameRegistry(Protocol):
 
     kind: str
 
-    def names(self) -> tuple[str, ...]: ...
+    def names(self) -> tuple[str, ...]:
+        """Every name the registry knows."""
 
-    def check(self, name: str) -> str: ...
+    def check(self, name: str) -> str:
+        """``name`` if known, else the one ``ValueError`` listing the known names."""
 
 
 def unknown(kind: str, name: object, known: tuple[str, ...]) -> ValueError:
@@ -147,6 +150,7 @@ class Registry(Generic[T]):
         return name
 
     def entry(self, name: str) -> Entry[T]:
+        """The :class:`Entry` of ``name`` (``ValueError`` if unknown)."""
         return self._entries[self.check(name)]
 
     def make(self, name: str, *args: object, **kwargs: object) -> T:
@@ -180,9 +184,11 @@ class FolderRegistry:
         self._lister = lister
 
     def names(self) -> tuple[str, ...]:
+        """The names the folder lists now."""
         return tuple(self._lister())
 
     def check(self, name: str) -> str:
+        """``name`` if the folder lists it, else the one ``ValueError`` listing the known names."""
         if name not in self.names():
             raise unknown(self.kind, name, self.names())
         return name

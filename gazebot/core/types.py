@@ -135,6 +135,7 @@ class Event:
     info: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
+        """The event as a JSON object: ``kind``, ``t``, ``detected_at`` and the ``info`` keys."""
         return {"kind": self.kind.value, "t": self.t, "detected_at": self.detected_at, **self.info}
 
 

@@ -1,7 +1,7 @@
 """The engine's full command stream on a fixed set of scenarios, flattened for comparison.
 
 ``tests/core/test_engine_stream_reference.py`` compares what the current code gives against the
-stream in ``tests/data/engine_stream.npz``, so a speed-up that changes any command by more than
+stream in ``tests/core/data/engine_stream.npz``, so a speed-up that changes any command by more than
 float round-off fails. It was first recorded from the code before the issue-19 speed-ups and
 re-recorded only for changes of the engine's output made on purpose (each one reviewed against
 the stream it replaced):

@@ -2,7 +2,7 @@
 damaged ones (NaN points and times, out-of-order frames, an implausible point, silent ticks, a
 tracking loss) with robot events (a robot-first reach, grasp, retreat, a moving arm joint under
 Sawyer's head), the loop's full command stream equals the recorded one
-(tests/data/engine_stream.npz, written by tests/core/engine_stream.py, which lists the deliberate
+(tests/core/data/engine_stream.npz, written by tests/core/engine_stream.py, which lists the deliberate
 output changes it was re-recorded for): every label and event exactly, every number to float
 round-off (1e-12)."""
 

@@ -98,9 +98,11 @@ class HumanGazeModel(_Strict):
         return self
 
     def targets(self) -> set[str]:
+        """Every target any pattern looks at in any phase."""
         return {t for p in self.patterns for ph in PHASES for t in getattr(p, ph)}
 
     def probabilities(self) -> np.ndarray:
+        """The patterns' probabilities, normalised to sum 1."""
         w = np.array([p.probability for p in self.patterns], dtype=float)
         return w / w.sum()
 

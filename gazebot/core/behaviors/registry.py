@@ -46,6 +46,7 @@ class BehaviorInfo:
     extends: str | None
 
     def to_json(self) -> dict[str, Any]:
+        """The entry as a JSON object (``gazebot behaviors list --json``)."""
         return {
             "name": self.name,
             "path": str(self.path),

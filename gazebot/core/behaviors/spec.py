@@ -91,6 +91,7 @@ class PhaseDurations(_Strict):
     retreat: float = Field(default=RETREAT_S, gt=0.0, allow_inf_nan=False)
 
     def of(self, phase: Phase) -> float:
+        """The fallback duration of ``phase`` (s); the reach's for a phase without one."""
         return float(getattr(self, phase.value, self.reach))
 
 

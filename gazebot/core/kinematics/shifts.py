@@ -153,9 +153,12 @@ class MinJerkTrajectory(Trajectory):
 
     @property
     def end_time(self) -> float:
+        """When the motion ends (s): ``t0 + duration``."""
         return self.t0 + self.duration
 
     def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity and acceleration at time ``t``, clamped to the motion (before ``t0``
+        its start, after its end at rest on the goal)."""
         s = min(max(t - self.t0, 0.0), self.duration)
         if s >= self.duration:
             # Exactly at rest on the goal afterwards (no round-off creep).
@@ -165,6 +168,8 @@ class MinJerkTrajectory(Trajectory):
         return pos, vel, acc
 
     def position(self, t: float) -> np.ndarray:
+        """Position at time ``t``, clamped to the motion (before ``t0`` its start, after its end
+        the goal)."""
         s = min(max(t - self.t0, 0.0), self.duration)
         if s >= self.duration:
             return self._goal.copy()

@@ -60,9 +60,6 @@ class PhaseConfig(BaseModel):
             0.21 m/s): the pair may turn with it, so their relative position swings at a
             constant distance, and the release is the distance leaving its noise band (or a
             hand moving against the other faster than ``transfer_speed_max``).
-        coupled_share: gazebot: ... and at any moment of a hold, a departure from the held
-            pose while both hands move (the slower at least this share of the faster's speed)
-            and their distance stays in its band is the pair turning, not a release.
         reach_onset_speed: gazebot: giver hand speed marking a reach onset or retreat end (m/s).
         reach_confirm_distance: gazebot: a reach under way is reported once the hands have
             closed by this much (m) ...
@@ -178,7 +175,6 @@ class PhaseConfig(BaseModel):
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     coupled_speed: float = Field(0.06, gt=0)
-    coupled_share: float = Field(0.25, gt=0, le=1)
     reach_onset_speed: float = Field(0.15, gt=0)
     reach_confirm_distance: float = Field(0.02, gt=0)
     approach_ratio: float = Field(0.5, ge=0, le=1)

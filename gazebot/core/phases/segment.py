@@ -35,9 +35,11 @@ class Segment:
 
     @property
     def duration(self) -> float:
+        """``end - start`` (s)."""
         return self.end - self.start
 
     def to_json(self) -> dict[str, Any]:
+        """The segment as a JSON object (times rounded to 1 us; ``detected_at`` only when set)."""
         out: dict[str, Any] = {
             "phase": self.phase.value,
             "start": round(self.start, 6),

@@ -91,6 +91,7 @@ class HandoverTruth:
     grasp: float = float("nan")  # the gripper closes (robot evidence), after the contact
 
     def segments(self, handover: int = 0) -> list[Segment]:
+        """The true reach, transfer and retreat segments, numbered ``handover``."""
         return [
             Segment(Phase.REACH, self.reach_start, self.transfer_start, handover),
             Segment(Phase.TRANSFER, self.transfer_start, self.transfer_end, handover),
@@ -190,6 +191,7 @@ class SyntheticHandover:
     giver_motion: np.ndarray
 
     def truth_segments(self) -> list[Segment]:
+        """The true segments of every handover in the recording, in order."""
         return [s for i, h in enumerate(self.truth) for s in h.segments(i)]
 
 

@@ -61,43 +61,64 @@ __all__ = ["EngineLike", "GazeLoop", "LoopCommand", "RobotLike", "TrackingState"
 
 
 class EyesLike(Protocol):
-    def clip(self, yaw: float, pitch: float) -> tuple[float, float, bool]: ...
+    """What the loop uses of the eyes (:class:`gazebot.core.kinematics.eyes.DisplayEyes`)."""
+
+    def clip(self, yaw: float, pitch: float) -> tuple[float, float, bool]:
+        """Clip yaw and pitch (rad) to the eye range; the flag: whether anything was clipped."""
 
 
 class RobotLike(Protocol):
     """What the loop reads of the robot (:class:`gazebot.core.kinematics.RobotModel`)."""
 
     @property
-    def head_joints(self) -> Sequence[str]: ...
-    @property
-    def lower(self) -> np.ndarray: ...
-    @property
-    def upper(self) -> np.ndarray: ...
-    @property
-    def rest(self) -> np.ndarray: ...
-    @property
-    def eyes(self) -> EyesLike: ...
+    def head_joints(self) -> Sequence[str]:
+        """Head joint names, in the order of every head vector."""
 
-    def gaze_frame_lists(self, q_head: Sequence[float]) -> list[list[float]]: ...
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower head joint limits (rad)."""
+
+    @property
+    def upper(self) -> np.ndarray:
+        """Upper head joint limits (rad)."""
+
+    @property
+    def rest(self) -> np.ndarray:
+        """The head's rest position (rad)."""
+
+    @property
+    def eyes(self) -> EyesLike:
+        """The display eyes, which clip eye angles to their range."""
+
+    def gaze_frame_lists(self, q_head: Sequence[float]) -> list[list[float]]:
+        """Gaze frame pose for head vector ``q_head``: three rows ``[R_i0, R_i1, R_i2, p_i]``."""
 
 
 class EngineLike(Protocol):
     """What the loop drives (:class:`gazebot.core.engine.GazeEngine`)."""
 
     @property
-    def robot(self) -> RobotLike: ...
+    def robot(self) -> RobotLike:
+        """The robot model."""
+
     @property
-    def phase(self) -> Phase: ...
+    def phase(self) -> Phase:
+        """The current handover phase."""
 
     def step(
         self, frame: TrackingFrame, arm: Mapping[str, float] | None = None
-    ) -> GazeCommand: ...
+    ) -> GazeCommand:
+        """Advance one tick with ``frame`` (``arm``: measured arm joints, rad) and return the
+        command."""
 
-    def notify(self, events: Event | Iterable[Event]) -> None: ...
+    def notify(self, events: Event | Iterable[Event]) -> None:
+        """Queue one robot event or several for the next step."""
 
-    def reset(self, head: Mapping[str, float] | None = None) -> None: ...
+    def reset(self, head: Mapping[str, float] | None = None) -> None:
+        """Forget the current handover and optionally the head pose."""
 
-    def resync(self, events: Iterable[Event]) -> None: ...
+    def resync(self, events: Iterable[Event]) -> None:
+        """Catch up with a handover under way from the events published before a restart."""
 
 
 class GazeLoop:
@@ -144,10 +165,12 @@ class GazeLoop:
 
     @property
     def robot(self) -> RobotLike:
+        """The engine's robot model."""
         return self.engine.robot
 
     @property
     def phase(self) -> Phase:
+        """The engine's current handover phase."""
         return self.engine.phase
 
     def notify(self, events: Event | Iterable[Event]) -> None:

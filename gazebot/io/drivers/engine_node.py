@@ -269,6 +269,7 @@ class EngineNode:
 
     @property
     def phase(self) -> str:
+        """The engine's current phase as a string (``idle`` without one)."""
         phase = getattr(self.engine, "phase", None)
         return str(getattr(phase, "value", phase)) if phase is not None else "idle"
 

@@ -200,6 +200,8 @@ class OwnershipWatch:
             return self._owner
 
     def undeclare(self) -> None:
+        """Stop watching the claims (undeclare the liveliness subscriber; quiet if the session is
+        closed)."""
         try:
             self._sub.undeclare()
         except Exception:  # the session may already be closed

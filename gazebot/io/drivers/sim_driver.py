@@ -36,32 +36,61 @@ class SimArm(Protocol):
     """The simulated robot's arm: its joints and named poses (rad, in ``arm_joints`` order)."""
 
     @property
-    def arm_joints(self) -> Sequence[str]: ...
+    def arm_joints(self) -> Sequence[str]:
+        """Arm joint names."""
+
     @property
-    def home(self) -> np.ndarray: ...
+    def home(self) -> np.ndarray:
+        """The home pose (rad)."""
+
     @property
-    def handover(self) -> np.ndarray: ...
+    def handover(self) -> np.ndarray:
+        """The handover pose (rad)."""
 
 
 class Simulation(Protocol):
     """What the drivers use of a simulation (:class:`gazebot.apps.sim.HandoverSimulation`)."""
 
     @property
-    def robot(self) -> SimArm: ...
+    def robot(self) -> SimArm:
+        """The simulated robot's arm."""
+
     @property
-    def t(self) -> float: ...
+    def t(self) -> float:
+        """Simulated time (s)."""
+
     @property
-    def done(self) -> bool: ...
-    def step(self, dt: float) -> None: ...
-    def tracking(self) -> TrackingFrame: ...
-    def joint_state(self) -> Mapping[str, float]: ...
-    def robot_events(self) -> list[Event]: ...
-    def apply_head(self, joints: Mapping[str, float]) -> None: ...
-    def apply_arm(self, joints: Mapping[str, float]) -> None: ...
-    def release_arm(self) -> None: ...
+    def done(self) -> bool:
+        """Whether the run is over (handover finished, or the robot stopped after an infeasible
+        reach)."""
+
+    def step(self, dt: float) -> None:
+        """Advance the simulation by ``dt`` s."""
+
+    def tracking(self) -> TrackingFrame:
+        """The current tracking sample."""
+
+    def joint_state(self) -> Mapping[str, float]:
+        """The joint positions (rad or m) by name."""
+
+    def robot_events(self) -> list[Event]:
+        """The robot controller's events since the last call, oldest first."""
+
+    def apply_head(self, joints: Mapping[str, float]) -> None:
+        """Set head joint goals (rad); ``ValueError`` for an unknown joint or a non-finite value."""
+
+    def apply_arm(self, joints: Mapping[str, float]) -> None:
+        """Command arm joint goals (rad), taking the arm from its handover controller."""
+
+    def release_arm(self) -> None:
+        """Hand the arm back to its handover controller."""
+
     def apply_eyes(self, yaw: float, pitch: float, blink: float = 0.0,
-                   distance: float | None = None) -> None: ...
-    def set_display(self, image: np.ndarray) -> None: ...
+                   distance: float | None = None) -> None:
+        """Set the display eyes: yaw, pitch (rad), blink (0..1) and the target distance (m)."""
+
+    def set_display(self, image: np.ndarray) -> None:
+        """Show ``image`` on the robot's head screen."""
 
 
 def apply_arm_command(sim: Simulation, cmd: ArmCommand) -> None:
@@ -116,6 +145,8 @@ class SimRobotDriver(RobotDriver):
         log.warning("simulation rejected a %s command: %s", what, exc)
 
     def wait_tracking(self, timeout: float) -> TrackingFrame | None:
+        """Step the simulation by one tracking period and return its new sample (``timeout`` is not
+        waited)."""
         self.sim.step(self.dt)
         for event in self.sim.robot_events():
             msg = BusEvent.of(event, "sim", time.time(), self._event_seq)
@@ -125,9 +156,11 @@ class SimRobotDriver(RobotDriver):
         return self.sim.tracking()
 
     def joint_state(self) -> JointState | None:
+        """The simulation's joint state now."""
         return JointState(float(self.sim.t), dict(self.sim.joint_state()))
 
     def send_head(self, goal: JointGoal) -> None:
+        """Apply head joint goals; a goal the simulation refuses is counted in ``rejected``."""
         try:
             self.sim.apply_head(goal.positions)
             self.head_commands += 1
@@ -135,33 +168,43 @@ class SimRobotDriver(RobotDriver):
             self._reject("head", exc)
 
     def send_eyes(self, eyes: EyeState) -> None:
+        """Set the simulated display's eyes."""
         self.sim.apply_eyes(eyes.yaw, eyes.pitch, eyes.blink, distance=eyes.distance)
 
     def send_eye_frame(self, image: RosCompressedImage) -> None:
+        """Show a rendered eye frame on the simulated display; an unreadable one is counted in
+        ``rejected``."""
         try:
             self.sim.set_display(convert.image_of(image))
         except MessageError as exc:
             self._reject("eye_frame", exc)
 
     def send_arm(self, cmd: ArmCommand) -> None:
+        """Apply an arm command (:func:`apply_arm_command`); a refused one is counted in
+        ``rejected``."""
         try:
             apply_arm_command(self.sim, cmd)
         except ValueError as exc:
             self._reject("arm", exc)
 
     def poll_events(self) -> list[BusEvent]:
+        """The simulation's robot events since the last call, oldest first."""
         out = list(self._inbox)
         self._inbox.clear()
         return out
 
     def publish_event(self, event: BusEvent) -> None:
+        """Keep one of the engine's events in :attr:`events`."""
         self.events.append(event)
 
     def event_history(self, timeout: float = 1.0) -> list[BusEvent]:
+        """Every event published so far (the robot's and the engine's), oldest first."""
         return list(self.events)
 
     def publish_status(self, status: NodeStatus) -> None:
+        """Keep the engine's heartbeat in :attr:`statuses`."""
         self.statuses.append(status)
 
     def peers(self) -> dict[str, bool]:
+        """The one peer, the simulation (``sim``), always alive."""
         return {"sim": True}

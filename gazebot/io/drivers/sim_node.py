@@ -172,6 +172,8 @@ class SimNode:
         return False
 
     def heartbeat(self, stopping: bool = False) -> None:
+        """Publish the simulator's heartbeat (simulated time, done, ticks, commands applied and
+        rejected)."""
         self.endpoint.heartbeat(
             info={
                 "t": float(self.sim.t),

@@ -322,19 +322,25 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
 
     # -- ownership -------------------------------------------------------------------------
     def claim(self, timeout: float = 0.5) -> None:
+        """Declare this engine's claim on the robot (once), waiting up to ``timeout`` s to learn
+        the other engines' claims."""
         if self._ownership is None and not self.closed:
             self._ownership = self.ros.declare(Ownership(self.session, self.names, self.node,
                                                          graph=self.ros.graph))
             self._ownership.declare(timeout)
 
     def owns_robot(self) -> bool:
+        """Whether this engine's claim is the one the claims settle on."""
         return self._ownership is not None and self._ownership.is_owner()
 
     def rival_engines(self) -> list[str]:
+        """The other engines claiming the robot (none before :meth:`claim`)."""
         return [] if self._ownership is None else [str(c) for c in self._ownership.rivals()]
 
     # -- RobotDriver -----------------------------------------------------------------------
     def wait_tracking(self, timeout: float) -> TrackingFrame | None:
+        """The oldest assembled tracking sample, waiting up to ``timeout`` s (a closed driver does
+        not wait); ``None`` if there is none."""
         end = self.clock() + max(0.0, timeout)
         with self._cond:
             while not self._queue and not self.closed:
@@ -348,28 +354,38 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
             return self._queue.popleft() if self._queue else None
 
     def joint_state(self) -> JointState | None:
+        """The latest joint state received, ``None`` before the first one."""
         return self._joints
 
     def send_head(self, goal: JointGoal) -> None:
+        """Publish head joint goals on ``head/command`` (``JointTrajectory``)."""
         self._head_pub.publish(convert.joint_trajectory(goal))
 
     def send_gaze_target(self, t: float, point: Point) -> None:
+        """Publish the point looked at on ``gaze_target`` (``PointStamped`` in the base frame)."""
         self._target_pub.publish(convert.point_stamped(t, point, self.names.base_frame))
 
     def send_phase(self, t: float, phase: str, phase_start: float) -> None:
+        """Publish the phase on the latched ``handover/phase``."""
         self._phase_pub.publish(convert.handover_phase(t, Phase(phase), phase_start))
 
     def send_eyes(self, eyes: EyeState) -> None:
+        """Publish the eye state on ``eyes/state``."""
         self._eyes_pub.publish(convert.eye_state(eyes, GAZE_FRAME, self.ros.store))
 
     def send_eye_frame(self, image: RosCompressedImage) -> None:
+        """Publish a rendered eye frame on ``eyes/image/compressed``."""
         self._frame_pub.publish(image)
 
     def wants_eye_frames(self) -> bool:
+        """Whether a subscription of ``eyes/image/compressed`` exists (frames are costly to
+        render)."""
         # Rendering and encoding frames is costly: only while someone subscribes to them.
         return not self.closed and self._frame_pub.subscribed()
 
     def send_arm(self, cmd: ArmCommand) -> None:
+        """Publish joint goals on ``arm/command``, or a named pose or ``resume`` on ``arm/mode``;
+        a gripper goal goes on ``arm/command``."""
         if cmd.positions is not None:
             goal = dict(cmd.positions)
             if cmd.gripper is not None:
@@ -382,6 +398,8 @@ class ZenohRobotDriver(ZenohNode, RobotDriver):
                 JointGoal(cmd.t, {"gripper": cmd.gripper}, {}, 1.0)))
 
     def close(self) -> None:
+        """Close the node (see :meth:`ZenohNode.close`) and wake a :meth:`wait_tracking` in
+        progress."""
         if self.closed:
             return
         super().close()

@@ -261,6 +261,7 @@ class ZenohNode:
         return out
 
     def dropped(self) -> dict[str, int]:
+        """Malformed messages dropped so far, by topic."""
         return self.drops.counts()
 
     def callback_faults(self) -> dict[str, int]:
@@ -307,12 +308,14 @@ class ZenohNode:
         return msg
 
     def publish_status(self, status: NodeStatus) -> None:
+        """Publish a heartbeat on ``/diagnostics`` (nothing once closed)."""
         if not self._closed:
             self._status_pub.publish(convert.diagnostics(status, status.stamp))
 
     # -- lifetime --------------------------------------------------------------------------
     @property
     def closed(self) -> bool:
+        """Whether :meth:`close` was called."""
         return self._closed
 
     def close(self) -> None:

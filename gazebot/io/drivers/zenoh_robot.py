@@ -70,6 +70,7 @@ class Latest(Generic[M]):
         self.count = 0
 
     def put(self, msg: M) -> None:
+        """Keep ``msg`` as the newest, not yet taken."""
         with self._lock:
             self._msg, self._fresh = msg, True
             self.count += 1
@@ -83,6 +84,7 @@ class Latest(Generic[M]):
             return self._msg
 
     def peek(self) -> M | None:
+        """The newest message, taken or not (``None`` before the first)."""
         with self._lock:
             return self._msg
 

@@ -57,6 +57,8 @@ class CappedReads:
         self._size = os.fstat(f.fileno()).st_size
 
     def read(self, n: int | None = -1) -> bytes:
+        """Up to ``n`` bytes, never more than are left in the file (all that is left for ``None``
+        or a negative ``n``)."""
         if n is None or n < 0:
             return self._f.read()
         return self._f.read(max(0, min(n, self._size - self._f.tell())))

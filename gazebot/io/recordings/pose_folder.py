@@ -22,6 +22,8 @@ from gazebot.io.recordings.base import (
 
 
 def body_name(path: Path) -> str:
+    """The body a pose file is named for: its file name without ``_pose_saved.csv``, ``_pose.csv``
+    or ``.csv``."""
     name = path.name
     for suffix in ("_pose_saved.csv", "_pose.csv", ".csv"):
         if name.endswith(suffix):

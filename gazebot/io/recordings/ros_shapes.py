@@ -9,76 +9,127 @@ from typing import Protocol
 
 
 class Time(Protocol):
+    """A ROS time stamp (``builtin_interfaces/Time``)."""
+
     @property
-    def sec(self) -> int: ...
+    def sec(self) -> int:
+        """Whole seconds."""
+
     @property
-    def nanosec(self) -> int: ...
+    def nanosec(self) -> int:
+        """Nanoseconds past ``sec``."""
 
 
 class Header(Protocol):
+    """A ``std_msgs/Header``: only its stamp is read."""
+
     @property
-    def stamp(self) -> Time: ...
+    def stamp(self) -> Time:
+        """Time of the message's data."""
 
 
 class XYZ(Protocol):
+    """A point or vector with ``x``, ``y`` and ``z`` (m)."""
+
     @property
-    def x(self) -> float: ...
+    def x(self) -> float:
+        """x coordinate."""
+
     @property
-    def y(self) -> float: ...
+    def y(self) -> float:
+        """y coordinate."""
+
     @property
-    def z(self) -> float: ...
+    def z(self) -> float:
+        """z coordinate."""
 
 
 class PointStamped(Protocol):
+    """A ``geometry_msgs/PointStamped``."""
+
     @property
-    def header(self) -> Header: ...
+    def header(self) -> Header:
+        """Stamp of the point."""
+
     @property
-    def point(self) -> XYZ: ...
+    def point(self) -> XYZ:
+        """The point."""
 
 
 class Pose(Protocol):
+    """A ``geometry_msgs/Pose``: only its position is read."""
+
     @property
-    def position(self) -> XYZ: ...
+    def position(self) -> XYZ:
+        """The position."""
 
 
 class PoseStamped(Protocol):
+    """A ``geometry_msgs/PoseStamped``."""
+
     @property
-    def header(self) -> Header: ...
+    def header(self) -> Header:
+        """Stamp of the pose."""
+
     @property
-    def pose(self) -> Pose: ...
+    def pose(self) -> Pose:
+        """The pose."""
 
 
 class Transform(Protocol):
+    """A ``geometry_msgs/Transform``: only its translation is read."""
+
     @property
-    def translation(self) -> XYZ: ...
+    def translation(self) -> XYZ:
+        """The translation."""
 
 
 class TransformStamped(Protocol):
+    """A ``geometry_msgs/TransformStamped`` (one entry of a ``/tf`` message)."""
+
     @property
-    def header(self) -> Header: ...
+    def header(self) -> Header:
+        """Stamp of the transform."""
+
     @property
-    def child_frame_id(self) -> str: ...
+    def child_frame_id(self) -> str:
+        """The frame the transform places."""
+
     @property
-    def transform(self) -> Transform: ...
+    def transform(self) -> Transform:
+        """The transform."""
 
 
 class TFMessage(Protocol):
+    """A ``tf2_msgs/TFMessage``: the transforms of ``/tf`` or ``/tf_static``."""
+
     @property
-    def transforms(self) -> Sequence[TransformStamped]: ...
+    def transforms(self) -> Sequence[TransformStamped]:
+        """The message's transforms."""
 
 
 class GripperState(Protocol):
+    """A ``gazebot_msgs/GripperState``: whether the robot's gripper is closed."""
+
     @property
-    def header(self) -> Header: ...
+    def header(self) -> Header:
+        """Time of the measurement."""
+
     @property
-    def closed(self) -> bool: ...
+    def closed(self) -> bool:
+        """Whether the gripper is closed (on the object)."""
 
 
 class LoadShare(Protocol):
+    """A ``gazebot_msgs/LoadShare``: the share of the object's weight the robot carries."""
+
     @property
-    def header(self) -> Header: ...
+    def header(self) -> Header:
+        """Time of the measurement."""
+
     @property
-    def share(self) -> float: ...
+    def share(self) -> float:
+        """0 (the giver holds all of it) .. 1 (the robot holds all of it)."""
 
 
 def stamp(header: Header) -> float:

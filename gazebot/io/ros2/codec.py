@@ -44,6 +44,7 @@ class Codec:
 
     @property
     def type_name(self) -> str:
+        """The type's ROS name, ``pkg/msg/Name``."""
         return self.info.name
 
     def encode(self, msg: object) -> bytes:

@@ -117,7 +117,8 @@ class Stamped(Protocol):
     """A message with a ``std_msgs/Header``."""
 
     @property
-    def header(self) -> Header: ...
+    def header(self) -> Header:
+        """The message's header."""
 
 
 class RosEyeState(Protocol):

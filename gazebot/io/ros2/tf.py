@@ -81,6 +81,7 @@ class HeadFrames:
         self._frames.setdefault(self._gaze_parent, self._gaze_joint)
 
     def frame_of(self, joint: str) -> str:
+        """The ``/tf`` frame name of ``joint``'s frame (``gazebot/<joint>``)."""
         return f"{JOINT_PREFIX}{joint}"
 
     def static(self) -> list[Pose]:

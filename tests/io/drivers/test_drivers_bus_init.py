@@ -176,3 +176,51 @@ def test_a_handover_runs_on_the_authenticated_bus(lab):
     finally:
         for fn in closers:
             fn()
+
+
+def test_a_whole_simulated_handover_runs_on_the_authenticated_bus(lab):
+    """The MuJoCo simulator with the sim role's credentials and the real engine with the
+    engine's, over mutual TLS and the access control of ``gazebot bus init``: every phase of
+    the handover is detected and published, and the simulated head obeys the engine."""
+    pytest.importorskip("mujoco", reason="the [sim] extra (mujoco) is not installed")
+    from test_drivers_e2e import PHASES, SPEED, Log, head_pan
+
+    from gazebot.apps.sim import HandoverSimulation
+    from gazebot.core.engine import GazeEngine
+    from gazebot.io.drivers.engine_node import EngineNodeConfig
+    from gazebot.io.drivers.sim_node import SimNode, SimNodeConfig
+
+    names = Names("/lab")
+    port = free_port()
+    sim = HandoverSimulation("sawyer", "default", seed=0)
+    closers = [sim.close]
+    try:
+        ep = ZenohRobotEndpoint.open(_cfg(lab, "sim", names, port, listen=True), "sim")
+        closers.insert(0, ep.close)
+        # wide reassembly windows, as in test_drivers_e2e: a loaded machine's stalls are not
+        # what this test is about
+        drv = ZenohRobotDriver.open(_cfg(lab, "engine", names, port), "engine",
+                                    assemble_reorder=round(120 * SPEED), assemble_idle=5.0)
+        closers.insert(0, drv.close)
+        events = Log(ep)
+        cfg = EngineNodeConfig(silence_after=1e3, resync_timeout=10.0)
+        engine = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", "face-hand-face")), drv, cfg)
+        sim_node = SimNode(sim, ep, SimNodeConfig(speed=SPEED))
+        stop = threading.Event()
+        threads = [threading.Thread(target=engine.run, kwargs={"stop": stop}, daemon=True),
+                   threading.Thread(target=sim_node.run,
+                                    kwargs={"stop": stop, "duration": 12.0}, daemon=True)]
+        closers.insert(0, lambda: (stop.set(), [th.join(timeout=10) for th in threads]))
+        assert wait_until(lambda: ep.peers().get("engine") and drv.peers().get("sim"))
+        threads[0].start()
+        assert engine.ready.wait(30) and engine.role == "owner"
+        pan0 = head_pan(sim)
+        threads[1].start()
+        assert wait_until(lambda: sim.done, timeout=120)
+        assert wait_until(lambda: "handover_done" in events.kinds("engine"), timeout=120)
+        assert events.kinds("engine") == PHASES
+        assert sim_node.applied["head"] > 0 and abs(head_pan(sim) - pan0) > 0.05
+        assert ep.unidentified() == {} and drv.dropped() == {} and ep.dropped() == {}
+    finally:
+        for fn in closers:
+            fn()

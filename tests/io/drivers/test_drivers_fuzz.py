@@ -15,7 +15,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gazebot.core.types import Phase, TrackingFrame
-from gazebot.io.drivers.bounds import check_trajectory
+from gazebot.io.drivers.bounds import (
+    MAX_JOINTS,
+    MAX_POINTS,
+    check_joint_state,
+    check_trajectory,
+)
 from gazebot.io.drivers.ownership import Claim
 from gazebot.io.drivers.rmw.attachment import Attachment, AttachmentError
 from gazebot.io.drivers.rmw.graph import Entity, Graph
@@ -254,3 +259,48 @@ def test_decoding_a_payload_at_its_cap_stays_within_bounded_memory():
                     tracemalloc.stop()
                 assert peak <= 8 * cap + 1_000_000, (type_name, offset, value, peak)
     assert math.isfinite(sum(by_type.values()))
+
+
+def _element_message(kind: str, names: int, points: int, name_len: int) -> tuple[str, bytes]:
+    """A ``JointState`` or ``JointTrajectory`` with ``names`` joint names of ``name_len``
+    characters (and ``points`` points for a trajectory), as CDR bytes."""
+    if kind == "joint_state":
+        msg = convert.joint_state(0.0, {"head_pan": 0.1})
+        msg.name = ["j" * name_len] * names
+        msg.position = np.zeros(0)
+        type_name = topics.JOINT_STATES.type
+    else:
+        msg = convert.joint_trajectory(JointGoal(0.0, {"head_pan": 0.1}, {}, 0.1))
+        msg.joint_names = ["j" * name_len] * names
+        msg.points = [msg.points[0]] * points
+        type_name = convert.JOINT_TRAJECTORY
+    return type_name, Codec.for_type(typestore(), type_name, 1 << 24).encode(msg)
+
+
+@FUZZ
+@given(kind=st.sampled_from(["joint_state", "trajectory"]),
+       names=st.integers(0, 4 * MAX_JOINTS), points=st.integers(0, 2 * MAX_POINTS),
+       name_len=st.integers(0, 12))
+def test_element_counts_decide_before_decoding_within_bounded_memory(kind, names, points,
+                                                                     name_len):
+    """A message with more elements than a topic needs is refused from its CDR prefix (a
+    MessageError naming the field), one within the counts decodes; either way the work's peak
+    memory stays within a few times the message's own size."""
+    type_name, raw = _element_message(kind, names, points, name_len)
+    check = check_joint_state if kind == "joint_state" else check_trajectory
+    too_many = names > MAX_JOINTS or (kind == "trajectory" and points > MAX_POINTS)
+    tracemalloc.start()
+    try:
+        try:
+            check(raw)
+            refused = False
+            Codec.for_type(typestore(), type_name, 1 << 24).decode(raw)
+        except MessageError as exc:
+            refused = True
+            assert "elements in" in str(exc)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert refused == too_many
+    bound = 64_000 if refused else 8 * len(raw) + 1_000_000  # refused: the prefix only
+    assert peak <= bound, (kind, names, points, peak)

@@ -26,9 +26,9 @@ from gazebot.io.ros2 import convert, topics
 
 pytestmark = pytest.mark.zenoh
 
-GAP = 5.0  # s of wall time between the two starts
-# SPEED (3, the simulator's pace, as in the other end-to-end tests): GAP * SPEED = 15 simulated
-# s, more than the default scene's handover (about 7 s).
+GAP = 20.0  # s of wall time between the two starts (the gap)
+# SPEED (3, the simulator's pace, as in the other end-to-end tests): GAP * SPEED = 60 simulated
+# s, far more than the default scene's handover (about 7 s).
 
 
 def start_sim(bus, capsys_out: list, *extra: str) -> threading.Thread:

@@ -43,9 +43,13 @@ class OnlineState:
 class OnlineTrigger(Protocol):
     """A method's cheap per-period check of whether its analysis needs to run."""
 
-    def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None: ...
+    def add(self, g: Sequence[float], g_ok: bool, r: Sequence[float], r_ok: bool) -> None:
+        """Add one sample's giver (``g``) and receiver (``r``) hand positions; ``*_ok``: that hand
+        was seen."""
 
-    def decide(self, now: float, state: OnlineState) -> TriggerMode: ...
+    def decide(self, now: float, state: OnlineState) -> TriggerMode:
+        """Close the period at ``now``: ``full`` (run the analysis), ``refresh`` (update the
+        prediction only) or ``skip``."""
 
 
 class Segmenter(ABC):

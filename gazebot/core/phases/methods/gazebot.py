@@ -112,6 +112,8 @@ class GazebotSegmenter(Segmenter):
         raise ValueError(f"phase_end is for a transfer or retreat, not {phase.value}")
 
     def segment_sorted(self, trajectory: Trajectory, partial: bool = False) -> list[Segment]:
+        """Segments of a time-sorted trajectory by the default method's rules (see
+        :meth:`Segmenter.segment_sorted`)."""
         s = self.signals(trajectory, partial)
         if s is None:
             return []

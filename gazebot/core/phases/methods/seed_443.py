@@ -48,6 +48,8 @@ class Seed443Segmenter(Segmenter):
     name = "seed-4.4.3"
 
     def segment_sorted(self, trajectory: Trajectory, partial: bool = False) -> list[Segment]:
+        """Segments of a time-sorted trajectory by the seed's section 4.4.3 split (see
+        :meth:`Segmenter.segment_sorted`)."""
         c = self.config
         ok = np.isfinite(trajectory.giver_hand).all(axis=1)
         t = trajectory.t[ok]

@@ -79,6 +79,8 @@ class Seed725Segmenter(Segmenter):
     name = "seed-7.2.5"
 
     def segment_sorted(self, trajectory: Trajectory, partial: bool = False) -> list[Segment]:
+        """Segments of a time-sorted trajectory by the seed's section 7.2.5 rule (see
+        :meth:`Segmenter.segment_sorted`)."""
         c = self.config
         ok = np.isfinite(trajectory.giver_hand).all(axis=1) & np.isfinite(
             trajectory.receiver_hand

@@ -22,7 +22,10 @@ centimetres at a constant distance. For such a coupled hold the release is the h
 times its jitter over the whole hold), or one hand moving against the other faster than the
 seed's ``transfer_speed_max`` beyond their common motion (``hold_speed``: a hand withdrawn
 sideways) once the distance has left half that band; a turn of the pair, a fidget or a pause
-of one hand within the band is no release, nor a sample or two of marker noise at 30 Hz.
+of one hand within the band is no release, nor a sample or two of marker noise at 30 Hz. When
+the giver leads that parting (letting go and withdrawing, not pulled by the receiver), the
+release may precede the last sample still together by the hold speed, by as much as that
+sample's own minimum-jerk span.
 """
 
 from __future__ import annotations
@@ -100,15 +103,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         return vector_norm(s.rel[i] - held)
 
     def swing(i: int) -> bool:
-        # Both hands moving (the slower at least coupled_share of the faster), their relative
-        # motion mostly across their line (less than half of it along) and their distance in
-        # its band: the pair turning with the object, not a release.
-        g, r = float(s.giver_speed[i]), float(s.receiver_speed[i])
-        return bool(
-            min(g, r) >= c.coupled_share * max(g, r)
-            and abs(s.closing[i]) < 0.5 * s.rel_speed[i]
-            and abs(s.distance[i] - held_d) < band
-        )
+        # Relative motion mostly across the hands' line (less than half of it along) with
+        # their distance in its band: the pair turning with the object (about either hand, so
+        # one may stay put), not a release. A hand withdrawn faster than the seed's speed is
+        # judged by parted() first.
+        return bool(abs(s.closing[i]) < 0.5 * s.rel_speed[i]
+                    and abs(s.distance[i] - held_d) < band)
 
     def parted(i: int) -> bool:
         # A hand moving against the other faster than the seed's speed: in a coupled hold, once
@@ -155,7 +155,24 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     else:
         sep = separation(j)
     back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
-    return max(float(s.t[j]) - back, t_start, float(s.t[i_h])), False
+    # The release is not before the last sample still together, unless the giver leads the
+    # parting of a coupled hold: a giver who lets go and withdraws starts slowly (minimum
+    # jerk), under the hold's speed bar for a while after the release, so that sample is dated
+    # back by its own separation and speed; a receiver pulling the object takes it only once
+    # the giver feels the pull (the KTH sample's force truth: the giver lets go 0.05-0.08 s
+    # after the distance starts to grow).
+    floor = float(s.t[i_h])
+    if coupled and giver_leads(s, j):
+        floor -= min_jerk_span(separation(i_h), float(s.hold_speed[i_h]), c.max_refine)
+    floor = max(t_start, floor)
+    return max(float(s.t[j]) - back, floor), False
+
+
+def giver_leads(s: Signals, i: int) -> bool:
+    """Whether the giver's hand moves away from the receiver's faster than the receiver's
+    moves away from the giver's at grid index ``i`` (each velocity along their line)."""
+    line = s.rel[i]  # from the giver's hand to the receiver's
+    return float(-(s.giver_v[i] @ line)) > float(s.receiver_v[i] @ line)
 
 
 def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:

@@ -40,6 +40,7 @@ class Attachment:
     legacy: bool = False
 
     def encode(self) -> bytes:
+        """The 33 bytes rmw_zenoh attaches: sequence number, source timestamp, GID length, GID."""
         if len(self.gid) != GID_SIZE:
             raise ValueError(f"a GID has {GID_SIZE} bytes, got {len(self.gid)}")
         return _HEAD.pack(self.sequence_number, self.source_timestamp, GID_SIZE) + self.gid

@@ -71,6 +71,7 @@ class Entity:
 
     @property
     def node_fqn(self) -> str:
+        """The node's fully qualified name, ``<namespace>/<node>``."""
         return f"{self.namespace.rstrip('/')}/{self.node}"
 
     def token(self) -> str:
@@ -137,6 +138,7 @@ class Graph:
         return entity
 
     def entities(self) -> list[Entity]:
+        """Every entity alive in the graph."""
         with self._lock:
             return list(self._entities.values())
 

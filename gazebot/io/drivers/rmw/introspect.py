@@ -94,6 +94,7 @@ class Inspector:
 
     @property
     def graph(self) -> Graph:
+        """The ROS graph as the inspector's node sees it."""
         return self.node.graph
 
     @property
@@ -170,6 +171,7 @@ class Inspector:
         return sub
 
     def close(self) -> None:
+        """Close the inspector's node (its subscriptions and token); the session stays open."""
         self.node.close()
 
 

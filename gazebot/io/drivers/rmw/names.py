@@ -46,6 +46,7 @@ def mangle(name: str) -> str:
 
 
 def demangle(chunk: str) -> str:
+    """A key chunk back to a name: every ``%`` becomes ``/`` (the inverse of :func:`mangle`)."""
     return chunk.replace("%", "/")
 
 

@@ -79,6 +79,8 @@ class DropCounter:
         self._lock = threading.Lock()
 
     def drop(self, topic: str, reason: str, mismatch: TypeMismatch | None = None) -> None:
+        """Count one message dropped on ``topic`` for ``reason`` (and the type mismatch, if that
+        was it); logs rate-limited."""
         reason = one_line(reason)
         with self._lock:
             n = self._counts[topic] = self._counts.get(topic, 0) + 1
@@ -89,6 +91,7 @@ class DropCounter:
             log.warning("dropped message #%d on %s: %s", n, topic, reason)
 
     def counts(self) -> dict[str, int]:
+        """Messages dropped so far, by topic."""
         with self._lock:
             return dict(self._counts)
 
@@ -98,11 +101,13 @@ class DropCounter:
             return dict(self._reasons)
 
     def mismatches(self) -> dict[str, TypeMismatch]:
+        """The type mismatches seen, by topic."""
         with self._lock:
             return dict(self._mismatches)
 
     @property
     def total(self) -> int:
+        """Messages dropped so far on all topics."""
         with self._lock:
             return sum(self._counts.values())
 
@@ -152,6 +157,8 @@ class Publisher:
                    for e in self.node.graph.endpoints(self.topic, "MS"))
 
     def undeclare(self) -> None:
+        """Undeclare the publisher's token and its Zenoh publisher (quiet if the session is
+        closed)."""
         for entity in (self._token, self._pub):
             try:
                 entity.undeclare()
@@ -238,6 +245,8 @@ class Subscription:
             self.node.faults.drop(self.topic, reason)
 
     def undeclare(self) -> None:
+        """Undeclare the subscription's token and its Zenoh subscriber (quiet if the session is
+        closed)."""
         for entity in (self._token, self._sub):
             try:
                 entity.undeclare()
@@ -305,6 +314,7 @@ class RosNode:
 
     @property
     def node_entity(self) -> Entity:
+        """The node's own graph entity (kind ``NN``)."""
         return self.entity("NN")
 
     def _on_token(self, sample: zenoh.Sample) -> None:

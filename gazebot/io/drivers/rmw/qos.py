@@ -38,6 +38,7 @@ class QosProfile:
 
     @property
     def reliable(self) -> bool:
+        """Whether the reliability is reliable (else best effort)."""
         return self.reliability == RELIABLE
 
     def encode(self) -> str:
