@@ -118,7 +118,7 @@ bench: $(TEST_STAMP)
 
 # The bus soak (ten minutes: a router, a recording engine, 29 simulator runs, a 50-participant
 # study load, then a SIGKILL of the engine): prints what it measured, exit 1 on a phantom
-# handover, a lost event or message, or a participant who could not finish.
+# handover, a lost event or message, a participant who could not finish, or 5 MB of engine growth.
 soak: $(TEST_STAMP)
 	$(PY) -m benchmarks.soak
 

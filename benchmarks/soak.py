@@ -10,7 +10,8 @@ the last simulated handover it SIGKILLs the recording engine. Then it prints:
   runs that completed a handover (phantoms: reaches beyond one per run);
 - lost events: robot and engine events the witness saw that the engine's own recording lacks,
   and simulator runs whose handover is not whole (reach, transfer, retreat, done, in order);
-- the engine's resident memory over the last ``--rss-window`` s before the kill (growth);
+- the engine's resident memory over the last ``--rss-window`` s before the kill (growth; 5 MB
+  or more fails the soak);
 - what the SIGKILLed recording holds: ``mcap``'s default reader on it (or on the output of
   ``gazebot mcap recover``), and every message the witness received more than 1 s before the kill
   that is missing from it;
@@ -50,6 +51,7 @@ ROBOT_EVENTS = f"{NAMESPACE}/robot/events"
 #: The recorder flushes once a second; what the witness received this long before the kill must
 #: be in the killed file (the flush period plus delivery).
 KILL_ALLOWANCE_S = 1.0
+RSS_GROWTH_MAX_MB = 5.0  # the issue's bar on the engine's growth over the last window
 
 
 def _free_port() -> int:
@@ -384,10 +386,12 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     result = soak(args)
     print(json.dumps(result, indent=2))
+    rss = result.get("engine_rss_mb")
     bad = (result["phantom_handovers"] or result["events_lost"]
            or result["runs_without_a_whole_handover"]
            or result["killed_recording"]["missing"]
-           or result["study"]["participants_done"] < args.participants)
+           or result["study"]["participants_done"] < args.participants
+           or rss is None or rss["growth"] >= RSS_GROWTH_MAX_MB)
     return 1 if bad else 0
 
 

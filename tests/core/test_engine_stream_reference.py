@@ -2,9 +2,9 @@
 damaged ones (NaN points and times, out-of-order frames, an implausible point, silent ticks, a
 tracking loss) with robot events (a robot-first reach, grasp, retreat, a moving arm joint under
 Sawyer's head), the loop's full command stream equals the recorded one
-(tests/core/data/engine_stream.npz, written by tests/core/engine_stream.py, which lists the deliberate
-output changes it was re-recorded for): every label and event exactly, every number to float
-round-off (1e-12)."""
+(tests/core/data/engine_stream.npz, written by tests/core/engine_stream.py, which lists the
+deliberate output changes it was re-recorded for): every label and event exactly, every number
+to float round-off (1e-12)."""
 
 from __future__ import annotations
 

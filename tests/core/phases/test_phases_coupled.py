@@ -70,7 +70,7 @@ def test_the_coupled_transfer_spans_the_whole_hold_at_120_hz(cases):
 
 
 def test_the_coupled_transfer_at_30_hz_with_5_mm_noise(cases):
-    # Measured 8 / 9 of 12 offline / online (seeds 2, 3: 10 / 9 and 8 / 8); 7 / 8 before the
+    # Measured 8 / 9 of 12 offline / online (seeds 2, 3: 10 / 9 and 8 / 9); 7 / 8 before the
     # giver's lead counted, 6 / 5 before the hold's band was measured over the whole hold. The
     # issue's target is 12 of 12: not reached. Pinned against regressions.
     offline, online = _hits(cases["coupled30"])

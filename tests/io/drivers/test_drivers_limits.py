@@ -150,3 +150,37 @@ def test_zenoh_drops_a_message_beyond_the_nodes_limit_before_it_is_reassembled(b
     drv.send_head(JointGoal(0.0, {"head_pan": 0.3}))
     assert wait_until(lambda: ep.head.peek().positions == {"head_pan": 0.3})
     assert head not in ep.dropped()  # never reached the subscription
+
+
+class _Payload:
+    """A received payload whose bytes must not be copied (an oversized message)."""
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+
+    def __len__(self) -> int:
+        return self.size
+
+    def to_bytes(self) -> bytes:
+        raise AssertionError("an oversized payload was copied out of Zenoh's buffer")
+
+
+def test_an_oversized_message_is_dropped_without_copying_its_bytes(bus):
+    """Issue 30: memory stayed 43 MB higher after oversized messages were dropped, because each
+    was copied out of Zenoh's buffer before its size was checked. The size is read first."""
+    from types import SimpleNamespace
+
+    from gazebot.io.drivers.rmw.node import RosNode
+
+    node = RosNode(bus.listener(), bus.names, "probe")
+    bus.closers.append(node.close)
+    got = []
+    sub = node.subscription(topics.GIVER_HAND.name, topics.GIVER_HAND.type,
+                            lambda msg, rx: got.append(msg))
+    codec = next(iter(sub._by_dds.values()))
+    key = node.names.key(sub.topic, codec.info.dds_name, codec.info.hash)
+    sample = SimpleNamespace(key_expr=key, payload=_Payload(40 * 1024 * 1024), attachment=None)
+    for _ in range(3):
+        sub._on(sample)  # as Zenoh's thread calls it
+    assert got == [] and node.drops.counts()[sub.topic] == 3
+    assert "oversized" in node.drops.reasons()[sub.topic]

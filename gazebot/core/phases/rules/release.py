@@ -105,10 +105,15 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     def swing(i: int) -> bool:
         # Relative motion mostly across the hands' line (less than half of it along) with
         # their distance in its band: the pair turning with the object (about either hand, so
-        # one may stay put), not a release. A hand withdrawn faster than the seed's speed is
-        # judged by parted() first.
+        # one may stay put).
         return bool(abs(s.closing[i]) < 0.5 * s.rel_speed[i]
                     and abs(s.distance[i] - held_d) < band)
+
+    def moving_apart(i: int) -> bool:
+        # At least half of the relative motion apart, or the distance out of its band: not the
+        # pair turning (swing) nor pressing the object together (the distance shrinking).
+        return bool(-s.closing[i] >= 0.5 * s.rel_speed[i]
+                    or not abs(s.distance[i] - held_d) < band)
 
     def parted(i: int) -> bool:
         # A hand moving against the other faster than the seed's speed: in a coupled hold, once
@@ -119,7 +124,8 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
             return True
         if not separation(i) >= sep_min:
             return False
-        return coupled or not swing(i)
+        # (a hand withdrawn faster than the seed's speed was judged above)
+        return coupled or moving_apart(i)
 
     j = i_h
     while j + 1 < n and not parted(j):
