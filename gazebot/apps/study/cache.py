@@ -67,7 +67,7 @@ def _config_bytes(kind: str, name: str) -> bytes:
     try:
         candidates.append(configs_dir() / kind / f"{name}.yaml")
     except FileNotFoundError:
-        pass
+        pass  # no configs folder (an installed wheel without it): only the file itself
     for path in candidates:
         if path.is_file():
             return path.read_bytes()
@@ -123,7 +123,7 @@ def code_version(render_fn: RenderFn) -> str:
             cfg = configs_dir()
             digest += _files_digest([p for p in cfg.rglob("*") if p.is_file()], cfg)
         except FileNotFoundError:
-            pass
+            pass  # no configs folder: the key covers the code alone
         return f"{name}@{getattr(gazebot, '__version__', '0')}:{digest[:16]}"
     return f"{name}:{_module_digest(fn, module)}"
 

@@ -17,7 +17,7 @@ class Time(Protocol):
 
     @property
     def nanosec(self) -> int:
-        """Nanoseconds past ``sec``."""
+        """The fraction of the second past ``sec``, in ns."""
 
 
 class Header(Protocol):

@@ -63,7 +63,7 @@ def check_host_name(name: str) -> str:
         ipaddress.ip_address(bare)
         return bare
     except ValueError:
-        pass
+        pass  # not an IP address: it may still be a host name
     if len(name) <= 253 and _HOST_NAME_RE.fullmatch(name):
         return name
     raise ValueError(
