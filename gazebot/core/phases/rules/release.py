@@ -23,9 +23,13 @@ times its jitter over the whole hold), or one hand moving against the other fast
 seed's ``transfer_speed_max`` beyond their common motion (``hold_speed``: a hand withdrawn
 sideways) once the distance has left half that band; a turn of the pair, a fidget or a pause
 of one hand within the band is no release, nor a sample or two of marker noise at 30 Hz. When
-the giver leads that parting (letting go and withdrawing, not pulled by the receiver), the
-release may precede the last sample still together by the hold speed, by as much as that
-sample's own minimum-jerk span.
+the giver leads that parting (its hand has moved farther than the receiver's since the
+back-dated release: letting go and withdrawing, not pulled by the receiver), the back-dated
+release stands even before the last sample still together by the hold speed.
+
+No hold ends with the hands pressing the object in (the distance shrinking below the held
+one), and hands that carried the object together into a tracking gap that lasts to the newest
+sample are not released by the giver's motion: it is the pair's.
 """
 
 from __future__ import annotations
@@ -109,6 +113,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         return bool(abs(s.closing[i]) < 0.5 * s.rel_speed[i]
                     and abs(s.distance[i] - held_d) < band)
 
+    def carried(i: int) -> bool:
+        # Both hands moving the object (their common motion at least coupled_speed), neither
+        # against the other faster than the seed's speed.
+        return bool(s.common_speed[i] >= c.coupled_speed
+                    and s.hold_speed[i] < c.transfer_speed_max)
+
     def moving_apart(i: int) -> bool:
         # At least half of the relative motion apart, or the distance out of its band: not the
         # pair turning (swing) nor pressing the object together (the distance shrinking).
@@ -119,6 +129,8 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         # A hand moving against the other faster than the seed's speed: in a coupled hold, once
         # the distance has left half its band too (marker noise at 30 Hz alone reaches that
         # speed for a sample or two).
+        if s.closing[i] > 0.0 and s.distance[i] < held_d - 0.5 * band:
+            return False  # pressing the object in: the distance shrinks below the held one
         fast = s.hold_speed[i] >= c.transfer_speed_max
         if fast and separation(i) >= (0.5 if coupled else 1.0) * sep_min:
             return True
@@ -139,7 +151,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
                 continue
             if 0 < seen.size <= window:
                 return float(s.t[-1]), True  # too little seen after the gap yet
-            if k < 0 and (coupled or swing(j)):
+            if k < 0 and (coupled or swing(j) or carried(j)):
                 # The hands moved together into a gap that lasts to the data end: the
                 # giver's motion is the pair's, a hand unseen (a frozen or lost marker) no
                 # release.
@@ -161,24 +173,27 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     else:
         sep = separation(j)
     back = min_jerk_span(sep, float(s.rel_speed[j]), c.max_refine)
+    t_end = float(s.t[j]) - back
     # The release is not before the last sample still together, unless the giver leads the
     # parting of a coupled hold: a giver who lets go and withdraws starts slowly (minimum
-    # jerk), under the hold's speed bar for a while after the release, so that sample is dated
-    # back by its own separation and speed; a receiver pulling the object takes it only once
-    # the giver feels the pull (the KTH sample's force truth: the giver lets go 0.05-0.08 s
-    # after the distance starts to grow).
-    floor = float(s.t[i_h])
-    if coupled and giver_leads(s, j):
-        floor -= min_jerk_span(separation(i_h), float(s.hold_speed[i_h]), c.max_refine)
-    floor = max(t_start, floor)
-    return max(float(s.t[j]) - back, floor), False
+    # jerk), under the hold's speed bar for a while after the release, so the back-dating
+    # alone tells; a receiver pulling the object takes it only once the giver feels the pull
+    # (the KTH sample's force truth: the giver lets go 0.05-0.08 s after the distance starts
+    # to grow).
+    if coupled and giver_leads(s, t_end, j):
+        return max(t_end, t_start), False
+    return max(t_end, float(s.t[i_h]), t_start), False
 
 
-def giver_leads(s: Signals, i: int) -> bool:
-    """Whether the giver's hand moves away from the receiver's faster than the receiver's
-    moves away from the giver's at grid index ``i`` (each velocity along their line)."""
-    line = s.rel[i]  # from the giver's hand to the receiver's
-    return float(-(s.giver_v[i] @ line)) > float(s.receiver_v[i] @ line)
+def giver_leads(s: Signals, t_from: float, j: int) -> bool:
+    """Whether the giver's hand has moved farther than the receiver's from ``t_from`` (s; the
+    nearest seen grid sample) to grid index ``j``: who set off first in a parting."""
+    seen = np.isfinite(s.giver[: j + 1]).all(axis=1) & np.isfinite(s.receiver[: j + 1]).all(axis=1)
+    rows = seen.nonzero()[0]
+    if rows.size == 0:
+        return False
+    b = int(rows[np.argmin(np.abs(s.t[rows] - t_from))])
+    return vector_norm(s.giver[j] - s.giver[b]) >= vector_norm(s.receiver[j] - s.receiver[b])
 
 
 def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:

@@ -9,8 +9,10 @@ back of the hand or at the wrist and the object has size, so they never come clo
 ``transfer_distance_margin`` of the minimum, relative speed under ``transfer_speed_max``)
 gives the transfer's core; runs split by short blips under ``transfer_exit_speed``, by
 tracking gaps, or by the pair turning with the object (under ``transfer_exit_speed`` with
-their relative speed against their common motion under ``transfer_speed_max``, however long)
-merge. The giver's hand must have moved (``reach_onset_speed``) before the core:
+their relative speed against their common motion under ``transfer_speed_max``, however long,
+seen or across a tracking gap) merge. The core is the merged run holding the minimum distance,
+or the longest when that one is shorter than ``min_transfer`` (a marker glitch at the
+closest point). The giver's hand must have moved (``reach_onset_speed``) before the core:
 a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
 more than the giver.
 
@@ -175,19 +177,23 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
         for a, b in rule_runs[1:]:
             gap = slice(merged[-1][1] + 1, a)
             # A short blip under the exit speed, or a tracking gap with nothing but such
-            # samples, does not end a transfer; nor does the pair turning together.
+            # samples, does not end a transfer; nor does the pair turning together, seen or
+            # not (only the samples of neither kind count toward the blip's length).
             ok = soft[gap] | unknown[gap]
-            if (ok.all() and np.count_nonzero(~unknown[gap]) < min_len) or (
-                    (soft[gap] & together[gap]).all()):
+            blip = ~unknown[gap] & ~together[gap]
+            if ok.all() and np.count_nonzero(blip) < min_len:
                 merged[-1][1] = b
             else:
                 merged.append([a, b])
-        core = next((m for m in merged if m[0] <= p <= m[1]), None)
-        if core is None:
-            core = max(merged, key=lambda m: m[1] - m[0])
-        a, b = core
-        if b - a + 1 < min_len:
+        # The run holding the minimum distance, unless a glitch or a swing left it too short
+        # to be a transfer: then the longest.
+        long_runs = [m for m in merged if m[1] - m[0] + 1 >= min_len]
+        if not long_runs:
             continue
+        core = next((m for m in long_runs if m[0] <= p <= m[1]), None)
+        if core is None:
+            core = max(long_runs, key=lambda m: m[1] - m[0])
+        a, b = core
         if not is_handover_dip(s, c, lo, p, a):
             if pieces and not out and is_leading_piece(s, c, a, b, p, hi):
                 out.append(TransferCore(lo, a, b, hi, float(s.t[a]), piece=True))
