@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from gazebot.io.drivers.rmw.names import Names, check_node_name, demangle, mangle
+from gazebot.io.drivers.rmw.node import undeclare_quietly
 
 if TYPE_CHECKING:
     import zenoh
@@ -268,9 +269,5 @@ class Ownership(OwnershipWatch):
     def undeclare(self) -> None:
         """Withdraw the claim and stop watching; idempotent."""
         token, self._token = self._token, None
-        if token is not None:
-            try:
-                token.undeclare()
-            except Exception:
-                pass
+        undeclare_quietly(token)
         super().undeclare()

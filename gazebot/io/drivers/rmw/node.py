@@ -159,11 +159,7 @@ class Publisher:
     def undeclare(self) -> None:
         """Undeclare the publisher's token and its Zenoh publisher (quiet if the session is
         closed)."""
-        for entity in (self._token, self._pub):
-            try:
-                entity.undeclare()
-            except Exception:  # the session may already be closed
-                pass
+        undeclare_quietly(self._token, self._pub)
 
 
 @dataclass(frozen=True)
@@ -247,11 +243,7 @@ class Subscription:
     def undeclare(self) -> None:
         """Undeclare the subscription's token and its Zenoh subscriber (quiet if the session is
         closed)."""
-        for entity in (self._token, self._sub):
-            try:
-                entity.undeclare()
-            except Exception:
-                pass
+        undeclare_quietly(self._token, self._sub)
 
 
 class RosNode:
@@ -389,14 +381,20 @@ class RosNode:
         if self.closed:
             return
         self.closed = True
-        for entity in [self._token, *reversed(self._entities), self._graph_sub]:
-            if entity is None:
-                continue
-            try:
-                entity.undeclare()
-            except Exception:  # the session may already be closed
-                pass
+        undeclare_quietly(self._token, *reversed(self._entities), self._graph_sub)
         self._entities.clear()
+
+
+def undeclare_quietly(*entities: Any) -> None:
+    """Undeclare each Zenoh entity in order, skipping ``None``; one that fails (its session
+    already closed) does not stop the rest."""
+    for entity in entities:
+        if entity is None:
+            continue
+        try:
+            entity.undeclare()
+        except Exception:  # the session may already be closed: nothing left to undeclare
+            pass
 
 
 def _declare_publisher(session: zenoh.Session, key: str, qos: QosProfile) -> Any:
