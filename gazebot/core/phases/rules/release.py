@@ -29,7 +29,9 @@ release stands even before the last sample still together by the hold speed.
 
 No hold ends with the hands pressing the object in (the distance shrinking below the held
 one), and hands that carried the object together into a tracking gap that lasts to the newest
-sample are not released by the giver's motion: it is the pair's.
+sample are not released by the giver's motion: it is the pair's. Hands that were moving the
+object together (a coupled hold, or carrying it at the last still sample) have parted only if
+they are no nearer the held pose a smoothing window later.
 """
 
 from __future__ import annotations
@@ -139,8 +141,23 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         # (a hand withdrawn faster than the seed's speed was judged above)
         return coupled or moving_apart(i)
 
+    # Hands that were moving the object together (a coupled hold, or carrying it at the last
+    # still sample) have parted only if they are no nearer the held pose a smoothing window
+    # later: a marker that lags or freezes as the pair sets off parts them for a few samples,
+    # and online the newest samples are smoothed from one side only. (Other holds are not kept
+    # waiting: a robot reacts to their release a window sooner.)
+    confirm = coupled or carried(i_h)
+
+    def persists(i: int) -> bool:
+        if not parted(i):
+            return False
+        if not confirm:
+            return True
+        k = i + window  # (unseen there: the parting stands, as it would unchecked)
+        return k < n and (not np.isfinite(s.rel_speed[k]) or not separation(k) < separation(i))
+
     j = i_h
-    while j + 1 < n and not parted(j):
+    while j + 1 < n and not persists(j):
         if not np.isfinite(s.rel_speed[j + 1]):
             seen = np.isfinite(s.rel_speed[j + 1 :]).nonzero()[0] + j + 1
             # Seen still together a smoothing window after the gap (its edge is smoothed
@@ -166,7 +183,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
                 return float(s.t[-1]), True  # tracking lost until the end, nothing moved
             return max(float(s.t[j]) if onset is None else onset, t_start), False
         j += 1
-    if j == n - 1 and not parted(j):
+    if j == n - 1 and not persists(j):
         return float(s.t[-1]), True
     if coupled:
         sep = max(separation(j), vector_norm(s.rel[j] - s.rel[i_h]))
