@@ -70,14 +70,15 @@ def test_the_coupled_transfer_spans_the_whole_hold_at_120_hz(cases):
 
 
 def test_the_coupled_transfer_at_30_hz_with_5_mm_noise(cases):
-    # Measured 8 / 9 of 12 offline / online (seeds 2-5: 11 / 9, 10 / 11, 10 / 9, 9 / 10, from
-    # 10 / 9, 8 / 9, 10 / 9, 8 / 5 before pressing, a carried gap, the lead and the confirmed
-    # parting were mended); the misses: starts 0.2-0.3 s off where the pair's turning keeps the
-    # relative speed above the hold's floor at contact, releases inside long frozen-marker
-    # gaps, and online ends 0.2-0.4 s late (a parting confirmed a window later). The issue's
-    # target is 12 of 12: not reached. Pinned against regressions.
+    # Measured 9 / 10 of 12 offline / online (seeds 2-5: 11 / 10, 12 / 12, 12 / 10, 11 / 12;
+    # 8 / 9, 11 / 9, 10 / 11, 10 / 9, 9 / 10 before the giver's departure, the 5 cm/s carry,
+    # the turning merge and the stop in a gap were mended); the misses: starts 0.2-0.3 s off
+    # where the pair's turning keeps the relative speed above the hold's floor at contact or
+    # the online floor is measured on a few samples, a receiver-led parting inside the noise
+    # band, and online ends 0.2-0.4 s late (a parting confirmed a window later, or dated at a
+    # tracking gap). The issue's target is 12 of 12: not reached. Pinned against regressions.
     offline, online = _hits(cases["coupled30"])
-    assert offline >= 8 and online >= 9
+    assert offline >= 9 and online >= 10
 
 
 def test_the_coupled_transfer_at_120_hz_on_more_recordings():
@@ -160,3 +161,44 @@ def test_noise_alone_is_no_glitch():
         p = 0.3 * np.sin(t)[:, None] * [1.0, 0.5, 0.2] + rng.normal(0, noise, (t.size, 3))
         bad = drop_glitches(t, p, PhaseConfig().glitch_jump, np.ones(t.size, dtype=bool))
         assert bad.sum() <= 0.002 * t.size, (rate, noise, int(bad.sum()))
+
+
+def test_a_careful_carry_averaging_6_cm_s_is_a_coupled_hold():
+    # Two legs of about 6 cm/s on average, slowing to rest between them and at the release:
+    # the common motion's median over the hold is 5.7 cm/s. Read as a still hold, its release
+    # waited for the last still sample, 0.28 s late offline and online.
+    case = case_set("coupled30", 12, seed=5)[9]
+    segs, ends = _transfers(case), _online_ends(case)
+    truth = case.truth[0].transfer_end
+    assert len(segs) == 1 and abs(segs[0].end - truth) <= WITHIN
+    assert len(ends) == 1 and abs(ends[0] - truth) <= WITHIN
+
+
+@pytest.mark.parametrize("seed, k", [(1, 2), (3, 0)])
+def test_a_giver_led_parting_starts_at_the_givers_last_speed_minimum(seed, k):
+    # The giver sets off across the hands' line, their distance unchanged for 0.2 s: dated
+    # from the distance alone the release was 0.21 s late.
+    case = case_set("coupled30", 12, seed=seed)[k]
+    segs = _transfers(case)
+    assert len(segs) == 1 and abs(segs[0].end - case.truth[0].transfer_end) <= WITHIN
+
+
+@pytest.mark.parametrize("seed, k", [(10, 0), (6, 2)])
+def test_the_pair_turning_between_two_holds_does_not_split_the_transfer(seed, k):
+    # At 30 Hz the careful pair's turn reads over 20 cm/s of relative motion across their line
+    # for a tenth of a second between two holds: the transfer started at the second hold,
+    # 0.25-1.3 s late.
+    case = case_set("coupled30", 12, seed=seed)[k]
+    segs = _transfers(case)
+    assert len(segs) == 1 and abs(segs[0].start - case.truth[0].transfer_start) <= WITHIN
+
+
+@pytest.mark.parametrize("seed, k", [(3, 10), (4, 7)])
+def test_an_approach_that_stops_in_a_tracking_gap_before_the_pair_turns(seed, k):
+    # The meeting hides in a tracking gap and the pair is turning the object when the markers
+    # return (relative speed over the settle speed, their speed against their common motion
+    # under it): the start is dated from the approach seen before the gap, not from the turn's
+    # first lull (0.23-0.83 s late).
+    case = case_set("coupled30", 12, seed=seed)[k]
+    segs = _transfers(case)
+    assert len(segs) == 1 and abs(segs[0].start - case.truth[0].transfer_start) <= WITHIN

@@ -25,7 +25,11 @@ sideways) once the distance has left half that band; a turn of the pair, a fidge
 of one hand within the band is no release, nor a sample or two of marker noise at 30 Hz. When
 the giver leads that parting (its hand has moved farther than the receiver's since the
 back-dated release: letting go and withdrawing, not pulled by the receiver), the back-dated
-release stands even before the last sample still together by the hold speed.
+release stands even before the last sample still together by the hold speed, and is not after
+the giver's last speed minimum before the parting (at most ``max_refine`` earlier and after
+the transfer's start, rises within the hold's speed floor ignored): the pair's common motion
+slows into the release, and the first centimetres of a retreat may run across the hands'
+line, their distance unchanged.
 
 No hold ends with the hands pressing the object in (the distance shrinking below the held
 one), and hands that carried the object together into a tracking gap that lasts to the newest
@@ -198,6 +202,13 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # (the KTH sample's force truth: the giver lets go 0.05-0.08 s after the distance starts
     # to grow).
     if coupled and giver_leads(s, t_end, j):
+        # The giver's own departure began where its speed last bottomed out before the
+        # parting: the pair's common motion slows into the release, and the first centimetres
+        # of a retreat may run across the hands' line, leaving their distance unchanged.
+        t_min = max(t_end - c.max_refine, t_start)
+        departure = giver_departure(s, j, t_min, hold_floor(s, c, i0, i_h))
+        if departure is not None:
+            t_end = min(t_end, departure)
         return max(t_end, t_start), False
     return max(t_end, float(s.t[i_h]), t_start), False
 
@@ -211,6 +222,22 @@ def giver_leads(s: Signals, t_from: float, j: int) -> bool:
         return False
     b = int(rows[np.argmin(np.abs(s.t[rows] - t_from))])
     return vector_norm(s.giver[j] - s.giver[b]) >= vector_norm(s.receiver[j] - s.receiver[b])
+
+
+def giver_departure(s: Signals, j: int, t_min: float, tol: float) -> float | None:
+    """Time (s) of the giver's last speed minimum before grid index ``j``: going back from
+    ``j`` while its speed keeps falling, or rises by less than ``tol`` (m/s: the hold's noise),
+    to a rise or a tracking gap, not before ``t_min`` (s). ``None`` when the speed still falls
+    there: the giver was slowing all along, no pause to depart from."""
+    v = s.giver_speed
+    k = best = j
+    while k > 0 and s.t[k - 1] >= t_min:
+        if not np.isfinite(v[k - 1]) or v[k - 1] >= v[best] + tol:
+            return float(s.t[best])  # (a tracking gap: the departure began in it at the latest)
+        k -= 1
+        if v[k] <= v[best]:
+            best = k
+    return float(s.t[best]) if best > k else None
 
 
 def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:

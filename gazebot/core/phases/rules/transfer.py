@@ -10,10 +10,15 @@ back of the hand or at the wrist and the object has size, so they never come clo
 gives the transfer's core; runs split by short blips under ``transfer_exit_speed``, by
 tracking gaps, or by the pair turning with the object (under ``transfer_exit_speed`` with
 their relative speed against their common motion under ``transfer_speed_max``, however long,
-seen or across a tracking gap) merge. The core is the merged run holding the minimum distance,
-or the longest when that one is shorter than ``min_transfer`` (a marker glitch at the
-closest point). The giver's hand must have moved (``reach_onset_speed``) before the core:
-a receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
+seen or across a tracking gap; between two runs of at least ``min_transfer``, faster too when
+their relative motion runs mostly across their line and their common motion is under
+``transfer_exit_speed``: a careful carry, not a pass on the move) merge. The core is the
+merged run holding the minimum distance, or the longest when that one is shorter than
+``min_transfer`` (a marker glitch at the closest point). An approach that stops in a tracking
+gap before the core is dated from the last sample before the gap, once the hands are settled
+after it (under the settle speed, or turning together: their speed against their common
+motion under it). The giver's hand must have moved (``reach_onset_speed``) before the core: a
+receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
 more than the giver.
 
 A dip with no such run at least ``min_transfer`` long is a handover on the move when the
@@ -173,13 +178,22 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
         # stays under the seed's speed (issue 33's careful carries swing the marker frames'
         # relative position at 0.15-0.2 m/s for longer than a blip).
         together = near & (np.nan_to_num(s.hold_speed, nan=np.inf) < c.transfer_speed_max)
+        # ... and, faster than the exit speed, turning: moving mostly across their line, and
+        # carefully, their common motion under the exit speed too (not walking on together).
+        with np.errstate(invalid="ignore"):
+            turning = together & (np.abs(s.closing) < 0.5 * s.rel_speed)
+            turning &= s.common_speed < c.transfer_exit_speed
         merged: list[list[int]] = [list(rule_runs[0])]
         for a, b in rule_runs[1:]:
             gap = slice(merged[-1][1] + 1, a)
             # A short blip under the exit speed, or a tracking gap with nothing but such
             # samples, does not end a transfer; nor does the pair turning together, seen or
-            # not (only the samples of neither kind count toward the blip's length).
+            # not (only the samples of neither kind count toward the blip's length). Between
+            # two holds the pair may turn faster than the exit speed (issue 33: a careful
+            # carry seen at 30 Hz).
             ok = soft[gap] | unknown[gap]
+            if merged[-1][1] - merged[-1][0] + 1 >= min_len and b - a + 1 >= min_len:
+                ok |= turning[gap]
             blip = ~unknown[gap] & ~together[gap]
             if ok.all() and np.count_nonzero(blip) < min_len:
                 merged[-1][1] = b
@@ -336,7 +350,11 @@ def stop_in_gap_before(s: Signals, a: int, v_settle: float) -> float | None:
     the last sample seen before the gap, approaching at speed ``v`` with ``x`` left to go, the
     minimum-jerk tail (``x ~ (t_stop - t)^3``) stops ``3 x / v`` later; at the latest when the
     gap ends."""
-    if a == 0 or np.isfinite(s.rel_speed[a - 1]) or not s.rel_speed[a] < v_settle:
+    # (Settled: the relative speed under v_settle, or the pair turning together, their
+    # speed against their common motion under it.)
+    if a == 0 or np.isfinite(s.rel_speed[a - 1]):
+        return None
+    if not min(s.rel_speed[a], s.hold_speed[a]) < v_settle:
         return None
     seen = np.isfinite(s.rel_speed[:a]).nonzero()[0]
     t_a = float(s.t[a])
