@@ -57,11 +57,9 @@ class PhaseConfig(BaseModel):
         release_noise_factor: ... and at least this many times the held pose's RMS jitter.
         coupled_speed: gazebot: hands whose common motion over the hold has a median speed of
             at least this (m/s) carry the object together (issue 33's careful handovers: 0.06-
-            0.21 m/s on average, whose median over a hold falls to 0.055 where the motion slows
-            between legs and at the release): the pair may turn with it, so their relative
-            position swings at a constant distance, and the release is the distance leaving
-            its noise band (or a hand moving against the other faster than
-            ``transfer_speed_max``).
+            0.21 m/s): the pair may turn with it, so their relative position swings at a
+            constant distance, and the release is the distance leaving its noise band (or a
+            hand moving against the other faster than ``transfer_speed_max``).
         reach_onset_speed: gazebot: giver hand speed marking a reach onset or retreat end (m/s).
         reach_confirm_distance: gazebot: a reach under way is reported once the hands have
             closed by this much (m) ...
@@ -176,7 +174,7 @@ class PhaseConfig(BaseModel):
     stop_extrapolation: float = Field(1.0, ge=0, le=2)
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
-    coupled_speed: float = Field(0.05, gt=0)
+    coupled_speed: float = Field(0.06, gt=0)
     reach_onset_speed: float = Field(0.15, gt=0)
     reach_confirm_distance: float = Field(0.02, gt=0)
     approach_ratio: float = Field(0.5, ge=0, le=1)

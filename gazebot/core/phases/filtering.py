@@ -316,6 +316,19 @@ def vector_norm(v: np.ndarray) -> float:
     return float(np.linalg.norm(v))
 
 
+#: The share of the relative speed along the hands' line (the closing speed) under which
+#: their relative motion runs mostly across it (the pair turning), and from which it runs
+#: mostly toward or away from each other.
+ALONG_LINE_SHARE = 0.5
+
+
+def across_line(closing: np.ndarray, rel_speed: np.ndarray) -> np.ndarray:
+    """Where the relative motion runs mostly across the hands' line (``closing`` and
+    ``rel_speed`` in m/s, arrays or scalars; False where either is unknown)."""
+    with np.errstate(invalid="ignore"):
+        return np.abs(closing) < ALONG_LINE_SHARE * rel_speed
+
+
 def _derived_into(
     x: np.ndarray,
     q: np.ndarray,

@@ -45,7 +45,7 @@ import math
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import Signals, vector_norm
+from gazebot.core.phases.filtering import ALONG_LINE_SHARE, Signals, across_line, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 from gazebot.core.phases.rules.transfer import TransferCore, hold_floor
 
@@ -116,7 +116,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         # Relative motion mostly across the hands' line (less than half of it along) with
         # their distance in its band: the pair turning with the object (about either hand, so
         # one may stay put).
-        return bool(abs(s.closing[i]) < 0.5 * s.rel_speed[i]
+        return bool(across_line(s.closing[i], s.rel_speed[i])
                     and abs(s.distance[i] - held_d) < band)
 
     def carried(i: int) -> bool:
@@ -128,7 +128,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     def moving_apart(i: int) -> bool:
         # At least half of the relative motion apart, or the distance out of its band: not the
         # pair turning (swing) nor pressing the object together (the distance shrinking).
-        return bool(-s.closing[i] >= 0.5 * s.rel_speed[i]
+        return bool(-s.closing[i] >= ALONG_LINE_SHARE * s.rel_speed[i]
                     or not abs(s.distance[i] - held_d) < band)
 
     def parted(i: int) -> bool:

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gazebot.core.phases.config import PhaseConfig
-from gazebot.core.phases.filtering import Signals, nanmax, vector_norm
+from gazebot.core.phases.filtering import Signals, across_line, nanmax, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
 
 
@@ -181,8 +181,8 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
         # ... and, faster than the exit speed, turning: moving mostly across their line, and
         # carefully, their common motion under the exit speed too (not walking on together).
         with np.errstate(invalid="ignore"):
-            turning = together & (np.abs(s.closing) < 0.5 * s.rel_speed)
-            turning &= s.common_speed < c.transfer_exit_speed
+            careful = s.common_speed < c.transfer_exit_speed
+        turning = together & across_line(s.closing, s.rel_speed) & careful
         merged: list[list[int]] = [list(rule_runs[0])]
         for a, b in rule_runs[1:]:
             gap = slice(merged[-1][1] + 1, a)
