@@ -164,6 +164,11 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
     unknown = ~np.isfinite(s.rel_speed)
     rs = np.where(unknown, np.inf, s.rel_speed)
     min_len = max(1, int(round(c.min_transfer * c.analysis_rate)))
+    # The pair turning carefully: relative motion mostly across their line, their common
+    # motion under the exit speed too (not walking on together). The same for every dip.
+    with np.errstate(invalid="ignore"):
+        careful = s.common_speed < c.transfer_exit_speed
+    careful_turn = across_line(s.closing, s.rel_speed) & careful
     for lo, p, hi in dips(d, c.min_approach):
         near = np.zeros(n, dtype=bool)
         near[lo : hi + 1] = d[lo : hi + 1] <= d[p] + c.transfer_distance_margin
@@ -178,11 +183,8 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
         # stays under the seed's speed (issue 33's careful carries swing the marker frames'
         # relative position at 0.15-0.2 m/s for longer than a blip).
         together = near & (np.nan_to_num(s.hold_speed, nan=np.inf) < c.transfer_speed_max)
-        # ... and, faster than the exit speed, turning: moving mostly across their line, and
-        # carefully, their common motion under the exit speed too (not walking on together).
-        with np.errstate(invalid="ignore"):
-            careful = s.common_speed < c.transfer_exit_speed
-        turning = together & across_line(s.closing, s.rel_speed) & careful
+        # ... and, faster than the exit speed, turning (see careful_turn below).
+        turning = together & careful_turn
         merged: list[list[int]] = [list(rule_runs[0])]
         for a, b in rule_runs[1:]:
             gap = slice(merged[-1][1] + 1, a)
