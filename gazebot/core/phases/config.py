@@ -60,6 +60,15 @@ class PhaseConfig(BaseModel):
             0.21 m/s): the pair may turn with it, so their relative position swings at a
             constant distance, and the release is the distance leaving its noise band (or a
             hand moving against the other faster than ``transfer_speed_max``).
+        coupled_travel: gazebot: ... or whose midpoint moved at least this far (m) from the
+            hold's first to its last sample: the pair carried the object, net of marker noise
+            (a careful pair slowing into the release has a median common speed under
+            ``coupled_speed``; 5 mm marker noise at 30 Hz raises a still hold's median, not
+            its midpoint's travel).
+        young_hold: gazebot: a hold seen for less than this (s) has ended only if the hands
+            are no nearer the held pose a smoothing window after the parting: online, the
+            first samples of a hold just confirmed are smoothed from one side, and a marker
+            lagging as the pair sets off reads as the giver letting go.
         reach_onset_speed: gazebot: giver hand speed marking a reach onset or retreat end (m/s).
         reach_confirm_distance: gazebot: a reach under way is reported once the hands have
             closed by this much (m) ...
@@ -175,6 +184,8 @@ class PhaseConfig(BaseModel):
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     coupled_speed: float = Field(0.06, gt=0)
+    coupled_travel: float = Field(0.05, gt=0)
+    young_hold: float = Field(0.3, ge=0)
     reach_onset_speed: float = Field(0.15, gt=0)
     reach_confirm_distance: float = Field(0.02, gt=0)
     approach_ratio: float = Field(0.5, ge=0, le=1)

@@ -34,8 +34,9 @@ line, their distance unchanged.
 No hold ends with the hands pressing the object in (the distance shrinking below the held
 one), and hands that carried the object together into a tracking gap that lasts to the newest
 sample are not released by the giver's motion: it is the pair's. Hands that were moving the
-object together (a coupled hold, or carrying it at the last still sample) have parted only if
-they are no nearer the held pose a smoothing window later.
+object together (a coupled hold, or carrying it at the last still sample), or that have held
+for less than ``young_hold``, have parted only if they are no nearer the held pose a smoothing
+window later.
 """
 
 from __future__ import annotations
@@ -86,16 +87,21 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # The distance's jitter over the whole hold, not only its last window: a dozen smoothed
     # samples under-rate 5 mm marker noise at 30 Hz, and a coupled hold's distance holds.
     band = release_threshold(s, c, np.arange(i0, i_h + 1), held_d)
-    # Coupled: the pair moved the object together through a hold of at least min_transfer,
-    # their distance held (within twice its band: the approach is over).
+    # Coupled: the pair moved the object together (a median common speed of coupled_speed,
+    # or their midpoint carried coupled_travel: a pair slowing into the release has a lower
+    # median) through a hold of at least min_transfer, their distance held (within twice its
+    # band: the approach is over).
     common = s.common_speed[i0 : i_h + 1]
     common = common[np.isfinite(common)]
     hold_d = s.distance[i0 : i_h + 1]
     hold_d = hold_d[np.isfinite(hold_d)]
+    moved_together = bool(common.size) and (
+        float(np.median(common)) >= c.coupled_speed
+        or pair_travel(s, i0, i_h) >= c.coupled_travel
+    )
     coupled = (
-        bool(common.size)
+        moved_together
         and float(s.t[i_h] - s.t[i0]) >= c.min_transfer
-        and float(np.median(common)) >= c.coupled_speed
         and float(hold_d.max() - hold_d.min()) <= 2.0 * band
     )
     if coupled:
@@ -146,11 +152,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         return coupled or moving_apart(i)
 
     # Hands that were moving the object together (a coupled hold, or carrying it at the last
-    # still sample) have parted only if they are no nearer the held pose a smoothing window
-    # later: a marker that lags or freezes as the pair sets off parts them for a few samples,
-    # and online the newest samples are smoothed from one side only. (Other holds are not kept
-    # waiting: a robot reacts to their release a window sooner.)
-    confirm = coupled or carried(i_h)
+    # still sample), or that have held for less than young_hold, have parted only if they are
+    # no nearer the held pose a smoothing window later: a marker that lags or freezes as the
+    # pair sets off parts them for a few samples, and online the newest samples are smoothed
+    # from one side only, so the first samples of a hold just confirmed may read as a parting.
+    # (Other holds are not kept waiting: a robot reacts to their release a window sooner.)
+    confirm = coupled or carried(i_h) or float(s.t[i_h] - s.t[i0]) < c.young_hold
 
     def persists(i: int) -> bool:
         if not parted(i):
@@ -211,6 +218,14 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
             t_end = min(t_end, departure)
         return max(t_end, t_start), False
     return max(t_end, float(s.t[i_h]), t_start), False
+
+
+def pair_travel(s: Signals, a: int, b: int) -> float:
+    """How far (m) the hands' midpoint moved from grid index ``a`` to ``b`` (first and last seen
+    samples between them): the object carried by the pair, net of marker noise."""
+    mid = (s.giver[a : b + 1] + s.receiver[a : b + 1]) / 2.0
+    mid = mid[np.isfinite(mid).all(axis=1)]
+    return vector_norm(mid[-1] - mid[0]) if mid.shape[0] >= 2 else 0.0
 
 
 def giver_leads(s: Signals, t_from: float, j: int) -> bool:
