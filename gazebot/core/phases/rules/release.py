@@ -95,13 +95,14 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     common = common[np.isfinite(common)]
     hold_d = s.distance[i0 : i_h + 1]
     hold_d = hold_d[np.isfinite(hold_d)]
+    held_for = float(s.t[i_h] - s.t[i0])
     moved_together = bool(common.size) and (
         float(np.median(common)) >= c.coupled_speed
         or pair_travel(s, i0, i_h) >= c.coupled_travel
     )
     coupled = (
         moved_together
-        and float(s.t[i_h] - s.t[i0]) >= c.min_transfer
+        and held_for >= c.min_transfer
         and float(hold_d.max() - hold_d.min()) <= 2.0 * band
     )
     if coupled:
@@ -157,7 +158,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # pair sets off parts them for a few samples, and online the newest samples are smoothed
     # from one side only, so the first samples of a hold just confirmed may read as a parting.
     # (Other holds are not kept waiting: a robot reacts to their release a window sooner.)
-    confirm = coupled or carried(i_h) or float(s.t[i_h] - s.t[i0]) < c.young_hold
+    confirm = coupled or carried(i_h) or held_for < c.young_hold
 
     def persists(i: int) -> bool:
         if not parted(i):
@@ -223,9 +224,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
 def pair_travel(s: Signals, a: int, b: int) -> float:
     """How far (m) the hands' midpoint moved from grid index ``a`` to ``b`` (first and last seen
     samples between them): the object carried by the pair, net of marker noise."""
-    mid = (s.giver[a : b + 1] + s.receiver[a : b + 1]) / 2.0
-    mid = mid[np.isfinite(mid).all(axis=1)]
-    return vector_norm(mid[-1] - mid[0]) if mid.shape[0] >= 2 else 0.0
+    seen = (np.isfinite(s.giver[a : b + 1]).all(axis=1)
+            & np.isfinite(s.receiver[a : b + 1]).all(axis=1)).nonzero()[0] + a
+    if seen.size < 2:
+        return 0.0
+    i, j = int(seen[0]), int(seen[-1])
+    return vector_norm(s.giver[j] + s.receiver[j] - s.giver[i] - s.receiver[i]) / 2.0
 
 
 def giver_leads(s: Signals, t_from: float, j: int) -> bool:
