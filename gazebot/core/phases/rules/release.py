@@ -221,11 +221,15 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     return max(t_end, float(s.t[i_h]), t_start), False
 
 
+def both_seen(s: Signals, a: int, b: int) -> np.ndarray:
+    """Grid indices in ``[a, b]`` where both hands are seen (their relative position known)."""
+    return np.isfinite(s.rel[a : b + 1]).all(axis=1).nonzero()[0] + a
+
+
 def pair_travel(s: Signals, a: int, b: int) -> float:
     """How far (m) the hands' midpoint moved from grid index ``a`` to ``b`` (first and last seen
     samples between them): the object carried by the pair, net of marker noise."""
-    seen = (np.isfinite(s.giver[a : b + 1]).all(axis=1)
-            & np.isfinite(s.receiver[a : b + 1]).all(axis=1)).nonzero()[0] + a
+    seen = both_seen(s, a, b)
     if seen.size < 2:
         return 0.0
     i, j = int(seen[0]), int(seen[-1])
@@ -235,8 +239,7 @@ def pair_travel(s: Signals, a: int, b: int) -> float:
 def giver_leads(s: Signals, t_from: float, j: int) -> bool:
     """Whether the giver's hand has moved farther than the receiver's from ``t_from`` (s; the
     nearest seen grid sample) to grid index ``j``: who set off first in a parting."""
-    seen = np.isfinite(s.giver[: j + 1]).all(axis=1) & np.isfinite(s.receiver[: j + 1]).all(axis=1)
-    rows = seen.nonzero()[0]
+    rows = both_seen(s, 0, j)
     if rows.size == 0:
         return False
     b = int(rows[np.argmin(np.abs(s.t[rows] - t_from))])

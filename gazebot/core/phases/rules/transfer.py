@@ -183,7 +183,7 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
         # stays under the seed's speed (issue 33's careful carries swing the marker frames'
         # relative position at 0.15-0.2 m/s for longer than a blip).
         together = near & (np.nan_to_num(s.hold_speed, nan=np.inf) < c.transfer_speed_max)
-        # ... and, faster than the exit speed, turning (see careful_turn below).
+        # ... and, faster than the exit speed, turning carefully (careful_turn, above).
         turning = together & careful_turn
         merged: list[list[int]] = [list(rule_runs[0])]
         for a, b in rule_runs[1:]:
