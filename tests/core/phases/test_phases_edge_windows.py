@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from gazebot.core.phases import PhaseConfig, Trajectory, run_online, segment
-from gazebot.core.phases.synthetic import SyntheticOptions, generate
+from gazebot.core.phases.synthetic import Hold, SyntheticOptions, generate
 from gazebot.core.types import EventKind, Phase
 
 
@@ -19,24 +19,47 @@ def _cut(tr: Trajectory, a: float, b: float) -> Trajectory:
     return Trajectory(tr.t[m], tr.giver_hand[m], tr.receiver_hand[m])
 
 
+def _session_windows(seed: int, opts: SyntheticOptions, label: tuple) -> list:
+    """The two windows of one session of three handovers (see the module docstring)."""
+    case = generate(seed, opts)
+    h0, h1, h2 = case.truth
+    out = []
+    for a in (0.5 * (h0.transfer_start + h0.transfer_end), h0.transfer_end + 0.05):
+        # ends as the next handover begins (0.4 of its reach under way)
+        b = h2.reach_start + 0.4 * (h2.transfer_start - h2.reach_start)
+        out.append((_cut(case.trajectory, a, b), h1, (*label, a)))
+    return out
+
+
 def _windows():
     out = []
     for seed in range(12):
         for rate, noise in ((120.0, 0.0015), (30.0, 0.0015), (120.0, 0.003)):
+            hold: Hold = "still" if seed % 2 else "pull"
+            opts = SyntheticOptions(
+                rate=rate, noise=noise, handovers=3, marker_offset=0.3, hold=hold
+            )
+            out += _session_windows(100 + seed, opts, (seed, hold, rate, noise))
+    # Careful handovers (issue 33): the object carried together, or moved together while the
+    # pair turns, at 30 Hz with 3 mm noise and at 60 Hz with short tracking dropouts.
+    careful: tuple[tuple[int, Hold], ...] = (
+        (2, "carry"),
+        (3, "coupled"),
+        (6, "carry"),
+        (11, "coupled"),
+    )
+    for seed, hold in careful:
+        for rate, noise, drop in ((30.0, 0.003, 0.0), (60.0, 0.003, 0.5)):
             opts = SyntheticOptions(
                 rate=rate,
                 noise=noise,
                 handovers=3,
                 marker_offset=0.3,
-                hold="still" if seed % 2 else "pull",
+                hold=hold,
+                dropouts_per_s=drop,
+                irregular=0.1,
             )
-            case = generate(100 + seed, opts)
-            h0, h1, h2 = case.truth
-            starts = (0.5 * (h0.transfer_start + h0.transfer_end), h0.transfer_end + 0.05)
-            for a in starts:
-                # ends as the next handover begins (0.4 of its reach under way)
-                b = h2.reach_start + 0.4 * (h2.transfer_start - h2.reach_start)
-                out.append((_cut(case.trajectory, a, b), h1, (seed, rate, noise, a)))
+            out += _session_windows(500 + seed, opts, (seed, hold, rate, noise, drop))
     return out
 
 
@@ -84,18 +107,22 @@ def test_online_the_middle_transfer_is_reported_once(windows):
     for tr, h1, label in windows:
         starts = [e.t for e in run_online(tr).events if e.kind is EventKind.TRANSFER_STARTED]
         assert sum(abs(t - h1.transfer_start) <= 0.35 for t in starts) == 1, label
-        assert all(abs(t - h1.transfer_start) <= 0.35 or t <= float(tr.t[0]) + 0.3
-                   for t in starts), label
+        assert all(
+            abs(t - h1.transfer_start) <= 0.35 or t <= float(tr.t[0]) + 0.3 for t in starts
+        ), label
         assert np.isfinite(starts).all()
 
 
 def test_online_the_reach_before_the_middle_transfer_is_its_final_approach(windows):
     # The held-out bar: confirmed between 1.0 s before and 0.15 s after the hands have closed
-    # 20 % of the gap. Measured 72 of 72.
+    # 20 % of the gap (the distances at the reach's start and at contact: medians over 0.1 s,
+    # through noise and dropouts). Measured 88 of 88.
     for tr, h1, label in windows:
         d = np.linalg.norm(tr.receiver_hand - tr.giver_hand, axis=1)
         i0, i1 = np.searchsorted(tr.t, [h1.reach_start, h1.transfer_start])
-        fifth = tr.t[i0 + np.flatnonzero(d[i0:i1] <= d[i0] - 0.2 * (d[i0] - d[i1]))[0]]
+        d0 = np.nanmedian(d[(tr.t >= h1.reach_start - 0.05) & (tr.t <= h1.reach_start + 0.05)])
+        d1 = np.nanmedian(d[(tr.t >= h1.transfer_start - 0.1) & (tr.t <= h1.transfer_start)])
+        fifth = tr.t[i0 + np.flatnonzero(d[i0:i1] <= d0 - 0.2 * (d0 - d1))[0]]
         events = run_online(tr).events
         k = next(
             i
