@@ -37,6 +37,10 @@ class PhaseConfig(BaseModel):
         seed_min_motion: Seed 4.4.3, our addition: a giving motion moves the hand at least
             this far from its start (m); else no segments (the fractions would split noise).
         transfer_exit_speed: gazebot: seed-rule runs split by blips slower than this merge (m/s).
+        turning_common_max: gazebot: between two holds, the pair turning the object together
+            merges them while their common motion is under this (m/s): a careful carry (0.06-0.21
+            m/s, read at up to 0.37 at 30 Hz with 5 mm of marker noise), not a pass while
+            walking on together.
         min_approach: gazebot: a handover is a dip of the hands' distance at least this deep (m).
         approach_fraction: gazebot: ... closing at least this fraction of the distance the
             hands started from.
@@ -172,6 +176,7 @@ class PhaseConfig(BaseModel):
     seed_v1: float = Field(0.43, gt=0, lt=1)
     seed_min_motion: float = Field(0.10, ge=0)
     transfer_exit_speed: float = Field(0.20, gt=0)
+    turning_common_max: float = Field(0.40, gt=0)
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
     min_transfer: float = Field(0.08, ge=0)

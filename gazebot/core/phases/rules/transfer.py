@@ -12,7 +12,7 @@ tracking gaps, or by the pair turning with the object (under ``transfer_exit_spe
 their relative speed against their common motion under ``transfer_speed_max``, however long,
 seen or across a tracking gap; between two runs of at least ``min_transfer``, faster too when
 their relative motion runs mostly across their line and their common motion is under
-``transfer_exit_speed``: a careful carry, not a pass on the move) merge. The core is the
+``turning_common_max``: a careful carry, not a pass on the move) merge. The core is the
 merged run holding the minimum distance, or the longest when that one is shorter than
 ``min_transfer`` (a marker glitch at the closest point). An approach that stops in a tracking
 gap before the core is dated from the last sample before the gap, once the hands are settled
@@ -165,9 +165,9 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
     rs = np.where(unknown, np.inf, s.rel_speed)
     min_len = max(1, int(round(c.min_transfer * c.analysis_rate)))
     # The pair turning carefully: relative motion mostly across their line, their common
-    # motion under the exit speed too (not walking on together). The same for every dip.
+    # motion under turning_common_max (not walking on together). The same for every dip.
     with np.errstate(invalid="ignore"):
-        careful = s.common_speed < c.transfer_exit_speed
+        careful = s.common_speed < c.turning_common_max
     careful_turn = across_line(s.closing, s.rel_speed) & careful
     for lo, p, hi in dips(d, c.min_approach):
         near = np.zeros(n, dtype=bool)
