@@ -2,7 +2,9 @@
 liveliness token), so anyone may put samples with it. The sequence numbers of one publisher's
 attachments go forward one by one; a GID whose numbers go back carries a second stream, a copy.
 Neither stream can be told from the other without credentials, so both are refused while the
-copy lasts: the GID is *suspect* until ``hold`` s after its numbers last went back.
+copy lasts: the GID is *suspect* until ``hold`` s after its numbers last went back. Numbers
+go back only when the streams interleave, so a copy arriving more than ``hold`` s after the
+real publisher's last sample is taken; credentials (an authenticated bus) close that gap.
 """
 
 from __future__ import annotations

@@ -238,13 +238,22 @@ def test_simulator_node_obeys_arm_commands(bus, sim):
     drv.claim()  # the robot obeys only the node that owns it (issue 30)
     assert wait_until(lambda: drv.peers().get("sim"))
     goal = {j: 0.1 * i for i, j in enumerate(sim.robot.arm_joints)}
-    drv.send_arm(ArmCommand(positions=goal))
-    drv.send_arm(ArmCommand(positions={"no_such_joint": 0.0}))
-    assert wait_until(lambda: ep.arm.count == 2)
+
+    def route_up() -> bool:
+        # Seeing the peer does not mean the robot has seen the claim and the arm publisher,
+        # or that a put reaches its subscription yet: a command, sent until one arrives, does.
+        drv.send_arm(ArmCommand(positions=goal))
+        return ep.arm.count > 0
+
+    assert wait_until(route_up, poll=0.05)
+    bad = {"no_such_joint": 0.0}
+    drv.send_arm(ArmCommand(positions=bad))  # arrives after every goal sent before it
+    assert wait_until(lambda: ep.arm.peek().positions == bad)
     sim_node.tick()  # only the newest command of a kind is applied: the bad one
-    assert sim_node.rejected == {"arm": 1}
+    assert sim_node.rejected == {"arm": 1} and not sim_node.applied.get("arm")
+    n = ep.arm.count
     drv.send_arm(ArmCommand(positions=goal))
-    assert wait_until(lambda: ep.arm.count == 3)
+    assert wait_until(lambda: ep.arm.count == n + 1)
     sim_node.tick()
     acts = [sim.model.actuator(j).id for j in sim.robot.arm_joints]
     np.testing.assert_allclose(sim.data.ctrl[acts], list(goal.values()), atol=1e-9)
