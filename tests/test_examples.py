@@ -8,6 +8,7 @@ import json
 import socket
 import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -35,21 +36,39 @@ def test_embed_engine_example_looks_at_face_then_hand_then_face(capsys):
 
 
 @pytest.mark.zenoh
-def test_robot_bridge_example_is_driven_by_the_engine_node_over_zenoh(capsys):
+def test_robot_bridge_example_is_driven_by_the_engine_node_over_zenoh(capsys, monkeypatch):
+    from gazebot.apps.cli import main
+    from gazebot.io.drivers.engine_node import EngineNode
+
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     endpoint = f"tcp/127.0.0.1:{port}"
     bridge = _load("robot_bridge")
     result: dict = {}
+    # Both run for a time of the wall clock: the bridge (4 s) starts once the engine has
+    # loaded and claimed the robot, and the engine's 3 s count from its first joint state,
+    # so they overlap for nearly all of them however slowly either starts.
+    engine_started = threading.Event()
+    start = EngineNode.start
+
+    def start_then_wait_for_the_robot(node):
+        replayed = start(node)
+        engine_started.set()
+        deadline = time.monotonic() + 60
+        while node.driver.joint_state() is None and time.monotonic() < deadline:
+            time.sleep(0.005)
+        return replayed
+
+    monkeypatch.setattr(EngineNode, "start", start_then_wait_for_the_robot)
 
     def robot():
-        result["rc"] = bridge.main(["--namespace", "/example", "--listen", endpoint,
-                                    "--duration", "4"])
+        if engine_started.wait(60):
+            result["rc"] = bridge.main(["--namespace", "/example", "--listen", endpoint,
+                                        "--duration", "4"])
 
     thread = threading.Thread(target=robot)
     thread.start()
-    from gazebot.apps.cli import main
 
     rc = main(["run", "--robot", "sawyer", "--behavior", "face-hand-face",
                  "--namespace", "/example",

@@ -20,11 +20,15 @@ def _post_all(
     pid: int,
     sessions: list[int],
     confirmed: list,
-    stop: threading.Event,
+    killed: threading.Event,
 ):
     csrf = browser.form_token(link)
-    for k in sessions:
-        if stop.is_set():
+    for i, k in enumerate(sessions):
+        if i == len(sessions) - 1:
+            # The last answer waits for the kill: answers are certainly still unsent when it
+            # comes, however late the main thread gets to it (others may be in flight).
+            killed.wait(timeout=300)
+        if killed.is_set():
             return
         try:
             data = {**ANSWERS, "csrf_token": csrf}
@@ -40,6 +44,7 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
     render_tiny_study(study_dir)
     study = load_study(study_dir)
     server = StudyServer(study_dir).start()
+    killed = threading.Event()
     try:
         links = server.links
         browsers = {pid: Visitor(server.base) for pid in study.participants}
@@ -50,7 +55,6 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
             assert b.request("POST", f"{link}/consent", consent)[0] == 303
             assert b.request("POST", f"{link}/instructions", {"csrf_token": token})[0] == 303
         confirmed: list[tuple[int, int]] = []
-        stop = threading.Event()
         threads = [
             threading.Thread(
                 target=_post_all,
@@ -60,7 +64,7 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
                     pid,
                     [0] + [s.session for s in study.sessions_of(pid)],
                     confirmed,
-                    stop,
+                    killed,
                 ),
             )
             for pid in study.participants
@@ -73,11 +77,11 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
             assert time.monotonic() < deadline, "no answers confirmed within 60 s"
             time.sleep(0.001)
         server.kill()
-        stop.set()
+        killed.set()
         for t in threads:
             t.join(timeout=30)
         at_kill = list(confirmed)
-        assert len(at_kill) < len(study.participants) * 7  # the kill came mid-study
+        assert len(at_kill) < len(study.participants) * 7  # mid-study: last answers wait
 
         server.start()
         assert server.links == links  # a link handed out stays valid across a restart
@@ -95,4 +99,5 @@ def test_sigkill_while_submitting_loses_no_confirmed_answer(tmp_path):
         status, _, body = http("GET", links[1])
         assert status == 200 and b"You have completed all 6 sessions" in body
     finally:
+        killed.set()  # whatever failed, no thread is left waiting
         server.stop()

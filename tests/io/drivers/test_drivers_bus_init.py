@@ -183,7 +183,7 @@ def test_a_whole_simulated_handover_runs_on_the_authenticated_bus(lab):
     engine's, over mutual TLS and the access control of ``gazebot bus init``: every phase of
     the handover is detected and published, and the simulated head obeys the engine."""
     pytest.importorskip("mujoco", reason="the [sim] extra (mujoco) is not installed")
-    from test_drivers_e2e import PHASES, SPEED, Log, head_pan
+    from test_drivers_e2e import BACKLOG, PHASES, SPEED, Log, head_pan
 
     from gazebot.apps.sim import HandoverSimulation
     from gazebot.core.engine import GazeEngine
@@ -197,10 +197,11 @@ def test_a_whole_simulated_handover_runs_on_the_authenticated_bus(lab):
     try:
         ep = ZenohRobotEndpoint.open(_cfg(lab, "sim", names, port, listen=True), "sim")
         closers.insert(0, ep.close)
-        # wide reassembly windows, as in test_drivers_e2e: a loaded machine's stalls are not
-        # what this test is about
+        # wide reassembly windows and a backlog that lags rather than skips, as in
+        # test_drivers_e2e: a loaded machine's stalls are not what this test is about
         drv = ZenohRobotDriver.open(_cfg(lab, "engine", names, port), "engine",
-                                    assemble_reorder=round(120 * SPEED), assemble_idle=5.0)
+                                    assemble_reorder=round(120 * SPEED), assemble_idle=5.0,
+                                    tracking_backlog=BACKLOG)
         closers.insert(0, drv.close)
         events = Log(ep)
         cfg = EngineNodeConfig(silence_after=1e3, resync_timeout=10.0)

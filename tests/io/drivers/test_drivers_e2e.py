@@ -52,6 +52,28 @@ def start_sim_node(bus, sim, speed=SPEED):
     return node, ep, th, stop
 
 
+#: Unread tracking samples the engine's driver keeps: more than a whole simulated scene (12 s
+#: at 120 Hz), so an engine thread a loaded machine stalls lags and then catches up on every
+#: sample instead of dropping the oldest (the driver's default keeps 0.1 s, which at SPEED x
+#: real time may skip a whole phase): what the engine answers then depends only on the samples.
+BACKLOG = 120 * 60
+
+
+def scene_on_tracking_time(scene) -> None:
+    """Rate-limit the engine's scene (markers, ``/tf``; at most SCENE_RATE_HZ) in the tracking
+    time of the commands instead of wall time: an engine catching up on a backlog answers a
+    whole phase in a few ms, which a wall-clock limit could leave without a single marker."""
+    now = [0.0]
+    send = scene.send
+
+    def send_at(cmd, phase, frame):
+        now[0] = cmd.t
+        return send(cmd, phase, frame)
+
+    scene.clock = lambda: now[0]
+    scene.send = send_at
+
+
 def start_engine_node(bus, behavior="face-hand-face"):
     from gazebot.core.engine import GazeEngine
     from gazebot.core.runtime import GazeLoop
@@ -63,12 +85,15 @@ def start_engine_node(bus, behavior="face-hand-face"):
     # than max_gap_hold (tracking_lost), which this test is not about (the assembler's rules
     # have their own tests). Windows of 1 s and 5 s of wall time keep it about the handover.
     drv = ZenohRobotDriver(bus.connector(), bus.names, "engine",
-                           assemble_reorder=round(120 * SPEED), assemble_idle=5.0)
+                           assemble_reorder=round(120 * SPEED), assemble_idle=5.0,
+                           tracking_backlog=BACKLOG)
     # No silence ticks: on a loaded machine the simulator thread may stall between samples.
     # The resync returns as soon as the joint state and the history arrived; the long deadline
     # only matters on a slow machine.
     cfg = EngineNodeConfig(silence_after=1e3, resync_timeout=10.0)
     node = EngineNode(GazeLoop(GazeEngine.from_config("sawyer", behavior)), drv, cfg)
+    if node.scene is not None:
+        scene_on_tracking_time(node.scene)
     stop = threading.Event()
     th = threading.Thread(target=node.run, kwargs={"stop": stop}, daemon=True)
 
@@ -123,8 +148,8 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
     robot = [m.kind for m in events.msgs if m.source == "sim"]
     assert robot[:2] == ["robot_reach_started", "robot_reach_ended"]
     # head commands answered the tracking and the simulator obeyed them: the head turned
-    # (how many depends on how often a loaded machine lets the engine answer: the engine
-    # skips samples it lags behind; the turn and the last command's pan show the obeying)
+    # (how many depends on how a loaded machine schedules the two threads: a simulator tick
+    # applies only the newest command; the turn and the last command's pan show the obeying)
     assert 0 < sim_node.applied["head"] <= engine_node.commands_sent and heads.msgs
     assert {m.info["target"] for m in target_events()} >= {"face", "hand"}
     assert abs(pan_end - pan0) > 0.05
@@ -138,15 +163,32 @@ def test_handover_over_the_bus_turns_the_simulated_head(bus, sim):
 
 
 def test_engine_restarted_mid_handover_resumes_the_phase_over_the_bus(bus, sim):
-    sim_node, ep, sim_thread, _ = start_sim_node(bus, sim)
+    sim_node, ep, sim_thread, sim_stop = start_sim_node(bus, sim)
     events = Log(ep)
     first, drv1, _, _, close1 = start_engine_node(bus)
     assert wait_until(lambda: ep.peers().get("engine") and drv1.peers().get("sim"))
     assert first.ready.wait(30)
+    t0 = sim.t
     sim_thread.start()
     assert wait_until(lambda: "transfer_started" in events.kinds("engine"), timeout=120)
-    close1()  # the engine dies mid-handover; the simulator keeps going
+    # The scene freezes mid-handover while the engine dies and the next one loads (however
+    # long a loaded machine takes); meanwhile the simulator still publishes its pose and its
+    # heartbeat, and once the new engine is ready it runs on for the rest of its 12 s.
+    sim_stop.set()
+    sim_thread.join(timeout=10)
+    assert not sim_thread.is_alive()
+    close1()  # the engine dies mid-handover
     second, drv2, *_ = start_engine_node(bus)
+    resume_stop = threading.Event()
+
+    def resume() -> None:
+        while not (second.ready.wait(0.1) or resume_stop.is_set()):
+            sim_node.publish_state()  # the new engine takes the head pose from it
+        sim_node.run(duration=12.0 - (sim.t - t0), stop=resume_stop)
+
+    resumed = threading.Thread(target=resume, daemon=True)
+    bus.closers.append(lambda: (resume_stop.set(), resumed.join(timeout=10)))
+    resumed.start()
     assert second.ready.wait(30)
     assert wait_until(lambda: len([m for m in events.msgs if m.kind == "engine_resynced"]) == 2)
     resync = [m for m in events.msgs if m.kind == "engine_resynced"][-1]

@@ -8,8 +8,16 @@ from __future__ import annotations
 import threading
 
 import pytest
-from drivers_fakes import FakeEngine, Recorder, wait_until
-from test_drivers_faults import FAST, connected, engine_side, events_of, frame, robot_side
+from drivers_fakes import FakeClock, FakeEngine, Recorder, wait_until
+from test_drivers_faults import (
+    FAST,
+    connected,
+    engine_side,
+    events_of,
+    frame,
+    robot_side,
+    sees_claim,
+)
 
 from gazebot.core.runtime import GazeLoop
 from gazebot.io.drivers.engine_node import EngineNode, EngineNodeConfig, EngineRefused
@@ -53,6 +61,7 @@ def test_a_second_engine_is_refused_and_both_engines_and_the_robot_report_it(bus
     th1.start()
     assert node1.ready.wait(30)
     node2, drv2 = second_engine(bus)
+    assert sees_claim(drv2, drv1)
     with pytest.raises(EngineRefused, match=r"another engine, engine \(session \w+\), already "
                        r"commands the robot under " + bus.names.namespace):
         node2.start()
@@ -89,6 +98,7 @@ def test_a_standby_engine_commands_nothing_until_the_owner_stops_then_takes_over
     stop2 = threading.Event()
     th2 = threading.Thread(target=node2.run, kwargs={"stop": stop2}, daemon=True)
     bus.closers.append(lambda: (stop2.set(), th2.is_alive() and th2.join(timeout=5)))
+    assert sees_claim(drv2, drv1)
     th2.start()
     assert node2.ready.wait(30) and node2.role == "standby"
     ep.publish_tracking(frame(0.0))
@@ -100,6 +110,9 @@ def test_a_standby_engine_commands_nothing_until_the_owner_stops_then_takes_over
     drv1.close()
     assert wait_until(lambda: events.where(kind="engine_took_over", source="engine2"))
     assert wait_until(lambda: node2.role == "owner")
+    # the robot obeys engine2 once it has seen engine's claim go (not necessarily yet)
+    assert wait_until(lambda: ep.owners.owner() is not None
+                      and ep.owners.owner().zid == drv2.ros.zid)
     n = ep.head.count
     ep.publish_tracking(frame(0.1))
     assert wait_until(lambda: node2.commands_sent >= 1 and ep.head.count > n)
@@ -111,7 +124,10 @@ def head_command(t: float, pan: float):
 
 
 def test_the_robot_reports_head_commands_from_two_publishers_by_their_gids(bus):
-    ep = robot_side(bus)
+    # Two publishers compete while both commanded within compete_window (1 s) on the robot's
+    # clock: one the test moves, so no stall between the two commands lets the window expire.
+    clock = FakeClock(100.0)
+    ep = robot_side(bus, clock=clock)
     events = events_of(ep)
     status = health_of(ep)
     a = RosNode(bus.connector(), bus.names, "ros_engine_a")
@@ -142,6 +158,12 @@ def test_the_robot_reports_head_commands_from_two_publishers_by_their_gids(bus):
     ep.heartbeat()
     assert wait_until(lambda: any(s.node == "sim" and s.values.get("head_publishers") == 2
                                   and s.state == "degraded" for s in status.msgs))
+    # more than the window on, only the owner commands: one publisher, no competition
+    clock.now += 1.5
+    pa.publish(head_command(0.1, 0.2))
+    assert wait_until(lambda: ep.head.count == 2)
+    assert ep.head_publishers() == 1
+    assert len(events.where(kind="competing_engine")) == 1
 
 
 def test_the_robot_drops_head_commands_of_an_engine_that_does_not_own_it(bus):

@@ -144,6 +144,7 @@ def test_simulator_and_engine_over_mutual_tls_and_a_node_without_the_certificate
 def test_user_password_authentication_from_the_config_file_keeps_out_a_node_without_it(
         tmp_path):
     from drivers_fakes import Recorder
+    from test_drivers_faults import connected
 
     from gazebot.core.types import TrackingFrame
     from gazebot.io.drivers.rmw.names import Names
@@ -181,10 +182,23 @@ def test_user_password_authentication_from_the_config_file_keeps_out_a_node_with
             got: list = []
             s.declare_subscriber("**", lambda sample, got=got: got.append(sample))
             heard.append(got)
-        assert wait_until(lambda: drv.peers().get("sim"))
-        for i in range(5):
+        assert wait_until(lambda: connected(ep, drv))
+
+        def route_up() -> bool:
+            # Seeing each other does not mean the robot's puts reach the engine's subscription
+            # yet: a sample, sent until one arrives, does.
+            ep.publish_tracking(TrackingFrame.make(-1.0, giver_hand=[1.0, 0.0, 1.0]))
+            return bool(heard[0].msgs)
+
+        assert wait_until(route_up, poll=0.05)
+        for i in range(5):  # arrive after the route's samples, in order
             ep.publish_tracking(TrackingFrame.make(i / 120, giver_hand=[1.0, 0.0, 1.0]))
-        assert wait_until(lambda: len(heard[0].msgs) == 5)
+
+        def stamps() -> list[float]:
+            return [t for t, _ in heard[0].msgs if t >= 0]
+
+        assert wait_until(lambda: len(stamps()) == 5)
+        assert stamps() == pytest.approx([i / 120 for i in range(5)])
         assert heard[1] == [] and heard[2] == []
         for n in (drv, ep):
             n.close()

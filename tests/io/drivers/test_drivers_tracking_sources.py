@@ -135,8 +135,14 @@ def test_a_hand_tracker_and_a_separate_face_tracker_both_reach_the_engine(bus):
 
 def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset_per_sample(bus):
     drv, engine, node, th, events = _engine_node(bus)
+    # The arbiter (owners, rivals and their reports) runs on a clock this test moves: frozen
+    # while the trackers interleave, so no stall or skew between their sessions makes tracker a
+    # silent for 0.3 s; moved by the test, at b's sample rate, where a is to go silent.
+    now = [0.0]
+    drv._sources.clock = lambda: now[0]
     a, b = Tracker(bus, "tracker_a"), Tracker(bus, "tracker_b")
     hand = bus.names.resolve(topics.GIVER_HAND.name)
+    face = bus.names.resolve(topics.GIVER_FACE.name)
     assert wait_until(lambda: drv._expected_parts() == {"giver_hand", "giver_face"}
                       and len(drv.ros.graph.endpoints(hand, "MP")) == 2)
     th.start()
@@ -146,7 +152,8 @@ def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset
     for i in range(1, 61):  # interleaved: robot time 100 s on one clock, 5 s on the other
         b.publish(5.0 + i / 120)
         a.publish(100.0 + i / 120)
-    assert wait_until(lambda: drv.dropped().get(hand) == 60)
+    # every sample of b refused, the hands and the faces
+    assert wait_until(lambda: drv.dropped().get(hand) == 60 and drv.dropped().get(face) == 60)
     assert wait_until(lambda: any(f.t == pytest.approx(100.5) for f in engine.frames))
     assert all(f.t >= 100.0 for f in engine.frames)
     assert not events.where(kind="tracking_clock_reset")
@@ -154,21 +161,25 @@ def test_a_second_tracker_with_another_clock_is_reported_and_ignored_not_a_reset
     [report] = events.where(kind="competing_tracking")
     assert report.info["source"].startswith("tracker_b ")
     assert report.info["owner"].startswith("tracker_a ")
-    # One report per rival, naming the parts refused by the time it was made (the face's first
-    # sample may still be in flight on a busy machine); the rival then holds both parts.
+    # One report per rival, naming the parts refused by the time it was made (the node may
+    # check between b's first hand and face samples); the rival then holds both parts.
     assert report.info["group"] in ("giver_hand", "giver_face", "giver_face, giver_hand")
-    assert wait_until(
-        lambda: [r.group for r in drv.tracking_rivals()] == ["giver_face, giver_hand"]
-    )
+    assert [r.group for r in drv.tracking_rivals()] == ["giver_face, giver_hand"]
     assert "second tracking source tracker_b" in drv.drops.reasons()[hand]
-    # tracker a goes silent: tracker b takes over, with one clock reset for its clock
+    # tracker a goes silent: still the owner while silent for no more than the source timeout,
+    now[0] = 0.3
+    b.publish(6.0)
+    assert wait_until(lambda: drv.dropped().get(hand) == 61 and drv.dropped().get(face) == 61)
+    # then tracker b takes over, with one clock reset for its clock
     state = {"t": 6.0}
 
     def b_used() -> bool:
         state["t"] += 1 / 120
+        now[0] += 1 / 120
         b.publish(state["t"])
         return any(f.t < 100.0 for f in engine.frames)
 
     assert wait_until(b_used)
+    assert drv.tracking_sources()["giver_hand"].startswith("tracker_b ")
     assert len(events.where(kind="tracking_clock_reset")) == 1
     assert th.is_alive()
