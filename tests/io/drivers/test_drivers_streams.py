@@ -4,17 +4,11 @@ seconds after its numbers last went back."""
 
 from __future__ import annotations
 
+from drivers_fakes import FakeClock as Clock
+
 from gazebot.io.drivers.streams import SequenceGuard
 
 A, B = b"a" * 16, b"b" * 16
-
-
-class Clock:
-    def __init__(self) -> None:
-        self.now = 0.0
-
-    def __call__(self) -> float:
-        return self.now
 
 
 def test_numbers_going_forward_are_one_stream_even_with_gaps():
