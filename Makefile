@@ -32,7 +32,7 @@ DOCS_STAMP := $(VENV)/.installed-docs
 PYTHON_LOWEST ?= $(shell for p in python3.10 $$HOME/.pyenv/versions/3.10*/bin/python3.10; do \
 	"$$p" -c "" >/dev/null 2>&1 && { echo "$$p"; exit 0; }; done; echo $(PYTHON))
 
-.PHONY: demo test test-lowest test-core bench soak lint docs lock lock-upgrade check-gl browser-deps clean
+.PHONY: demo test test-lowest test-core fuzz bench soak lint docs lock lock-upgrade check-gl browser-deps clean
 
 $(STAMP): pyproject.toml $(LOCK)
 	$(PYTHON) -m venv $(VENV)
@@ -112,6 +112,15 @@ test-lowest: $(LOW_STAMP) browser-deps
 
 test-core: $(CORE_STAMP)
 	$(CORE_VENV)/bin/python -m pytest $(CORE_TESTS)
+
+# The property tests with fresh examples each round (`make test` draws the same ones every run):
+# FUZZ_ROUNDS rounds, stopping at the first failure, which hypothesis prints with its example.
+FUZZ_ROUNDS ?= 20
+fuzz: $(TEST_STAMP)
+	for i in $$(seq $(FUZZ_ROUNDS)); do \
+		GAZEBOT_HYPOTHESIS=explore $(PY) -m pytest -q -p no:cacheprovider -x \
+			$$(grep -rl --include="test_*.py" "^from hypothesis" tests) || exit 1; \
+	done
 
 bench: $(TEST_STAMP)
 	$(PY) -m benchmarks --markdown docs/benchmark-results.md

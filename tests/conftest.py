@@ -14,10 +14,18 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+
+# Property tests draw the same examples on every run ("repeatable"), so a test run's verdict
+# depends on the code, not on the draw: a fuzzer's new find fails `make fuzz` (profile
+# "explore", fresh examples each run) and becomes a pinned test, never a red CI run by chance.
+settings.register_profile("repeatable", derandomize=True, database=None)
+settings.register_profile("explore", derandomize=False, database=None)
+settings.load_profile(os.environ.get("GAZEBOT_HYPOTHESIS", "repeatable"))
 
 REPO = Path(__file__).resolve().parents[1]
 # Reference data lives beside the repo (never inside it); a user's clone does not have it.

@@ -33,6 +33,9 @@ class RecordingLimits:
         max_gap_s: Largest time step between two samples (s). Times must be finite and
             increasing; one outlier stamp (1e5 s, 1e308 s) would otherwise make every resampling
             step allocate gigabytes.
+        min_step_s: Smallest time step between two samples (s), 1 ns by default (a ROS stamp's
+            resolution; motion capture runs below 10 kHz): a step of 1e-309 s is no sampling,
+            and its rate (1 / step) overflows.
         workspace_m: Largest plausible coordinate magnitude (m, after the unit): a point
             beyond it (or infinite) is a missing sample, counted.
         max_chunk_bytes: Largest uncompressed size a compressed chunk (MCAP) may declare
@@ -44,12 +47,14 @@ class RecordingLimits:
     """
 
     max_gap_s: float = 60.0
+    min_step_s: float = 1e-9
     workspace_m: float = 50.0
     max_chunk_bytes: int = 32 * 1024 * 1024
     max_chunk_ratio: float = 100.0
 
     def __post_init__(self) -> None:
-        for name in ("max_gap_s", "workspace_m", "max_chunk_bytes", "max_chunk_ratio"):
+        names = ("max_gap_s", "min_step_s", "workspace_m", "max_chunk_bytes", "max_chunk_ratio")
+        for name in names:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v}")
@@ -126,7 +131,8 @@ def check_times(
     where: Callable[[int], str],
     limits: RecordingLimits,
 ) -> None:
-    """Times must be finite, increasing and never more than ``limits.max_gap_s`` apart.
+    """Times must be finite, increasing by at least ``limits.min_step_s`` and never more than
+    ``limits.max_gap_s`` apart.
 
     Raises:
         RecordingError: Naming the sample (``where(i)``: "line 12", "frame 3", ...), its time
@@ -140,7 +146,7 @@ def check_times(
         return
     with np.errstate(over="ignore"):  # -1e308 then 1e308: an infinite gap, refused below
         dt = np.diff(t)
-    bad = np.flatnonzero((dt <= 0) | (dt > limits.max_gap_s))
+    bad = np.flatnonzero((dt < limits.min_step_s) | (dt > limits.max_gap_s))
     if not bad.size:
         return
     i = int(bad[0]) + 1
@@ -149,6 +155,12 @@ def check_times(
             source,
             f"{where(i)}: time {t[i]:.9g} s is not after the previous sample's {t[i - 1]:.9g} s "
             f"({where(i - 1)}); times must increase",
+        )
+    if dt[i - 1] < limits.min_step_s:
+        raise RecordingError(
+            source,
+            f"{where(i)}: time {t[i]:.9g} s is only {dt[i - 1]:.3g} s after the previous sample "
+            f"({where(i - 1)}); steps under {limits.min_step_s:g} s are refused",
         )
     raise RecordingError(
         source,

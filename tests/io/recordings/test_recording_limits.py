@@ -41,6 +41,19 @@ def test_a_time_going_back_names_both_lines(tmp_path):
         load_recording(write_csv(tmp_path / "r.csv", t, pts))
 
 
+def test_a_step_under_a_nanosecond_is_refused_not_an_infinite_rate(tmp_path):
+    """Found by the fuzzer: steps of 1e-309 s made the reported rate overflow."""
+    t, pts = sample()
+    t[:] = np.arange(t.shape[0]) * 1e-12  # 1 ps steps: no sampling, rate 1e12 Hz
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(RecordingError, match=r"line 3: .* only 1e-12 s after .*under 1e-09"):
+            load_recording(write_csv(tmp_path / "r.csv", t, pts))
+    t, pts = sample()
+    t[1] = t[0] + 2e-9  # a step at the bound's order is still a recording
+    assert math.isfinite(load_recording(write_csv(tmp_path / "ok.csv", t, pts)).rate)
+
+
 def test_the_gap_bound_is_configurable(tmp_path):
     t, pts = sample()
     t[30:] += 5.0
