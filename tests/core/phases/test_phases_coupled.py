@@ -164,6 +164,19 @@ def test_noise_alone_is_no_glitch():
         assert bad.sum() <= 0.002 * t.size, (rate, noise, int(bad.sum()))
 
 
+@pytest.mark.parametrize("seed, k", [(8, 7), (1, 5), (9, 10)])
+def test_a_pair_carrying_the_object_while_one_hand_is_hidden_keeps_holding(seed, k):
+    # The giver's marker is lost for 0.3 s while the pair carries the object at up to 0.36
+    # m/s; the hands part by a centimetre just before (the receiver moving on first), then
+    # are back at the held distance, the pair turned 3.5 cm. The check a smoothing window
+    # later fell in the gap and let the parting stand: the transfer ended 1.13 s early (0.11-
+    # 0.14 s in the other two). It is judged after the gap, by the distance, and the hold is
+    # taken on over all of it.
+    case = case_set("coupled30", 12, seed=seed)[k]
+    segs = _transfers(case)
+    assert len(segs) == 1 and abs(segs[0].end - case.truth[0].transfer_end) <= 0.1
+
+
 @pytest.mark.parametrize("seed, k", [(1, 2), (3, 0)])
 def test_a_giver_led_parting_starts_at_the_givers_last_speed_minimum(seed, k):
     # The giver sets off across the hands' line, their distance unchanged for 0.2 s: dated

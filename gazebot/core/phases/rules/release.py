@@ -36,12 +36,15 @@ one), and hands that carried the object together into a tracking gap that lasts 
 sample are not released by the giver's motion: it is the pair's. Hands that were moving the
 object together (a coupled hold, or carrying it at the last still sample), or that have held
 for less than ``young_hold``, have parted only if they are no nearer the held pose a smoothing
-window later.
+window later; when that falls in a tracking gap, a smoothing window after the gap, and for a
+pair moving the object together by their distance (they may have turned it in the gap). Back
+together there, the hold goes on across the gap and is judged again over all of it.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -158,15 +161,32 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # pair sets off parts them for a few samples, and online the newest samples are smoothed
     # from one side only, so the first samples of a hold just confirmed may read as a parting.
     # (Other holds are not kept waiting: a robot reacts to their release a window sooner.)
-    confirm = coupled or carried(i_h) or held_for < c.young_hold
+    moving_together = coupled or carried(i_h)
+    confirm = moving_together or held_for < c.young_hold
 
     def persists(i: int) -> bool:
         if not parted(i):
             return False
         if not confirm:
             return True
-        k = i + window  # (unseen there: the parting stands, as it would unchecked)
-        return k < n and (not np.isfinite(s.rel_speed[k]) or not separation(k) < separation(i))
+        k = i + window
+        if k >= n:
+            return False
+        if not np.isfinite(s.rel_speed[k]):
+            # A window later falls in a tracking gap: judged a window after it (its edge is
+            # smoothed one-sided), as a gap in the hold is. With nothing seen after the gap,
+            # the parting stands, as it would unchecked (online, a robot reacts to a release
+            # hidden in a gap at once).
+            seen = np.isfinite(s.rel_speed[k:]).nonzero()[0] + k
+            if seen.size == 0:
+                return True
+            if seen.size <= window:
+                return False  # too little seen after the gap yet
+            k = int(seen[window])
+            if moving_together:
+                # (the pair may have turned the object in the gap: their distance tells)
+                return not abs(s.distance[k] - held_d) < band
+        return not separation(k) < separation(i)
 
     j = i_h
     while j + 1 < n and not persists(j):
@@ -176,6 +196,14 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
             # one-sided): the giver's motion in it was the pair's.
             k = int(seen[window]) if seen.size > window else -1
             if k >= 0 and not parted(k):
+                if moving_together and k > b and s.hold_speed[k] <= v_still:
+                    # The pair carried the object across the gap and still holds it: the hold
+                    # goes on to the end of that still run, judged again over all of it (held
+                    # pose, coupling, last still sample). The core only grows: this ends.
+                    e = k
+                    while e + 1 < n and s.hold_speed[e + 1] <= v_still:
+                        e += 1
+                    return transfer_end(s, c, replace(core, end=e))
                 j = k
                 continue
             if 0 < seen.size <= window:
