@@ -33,8 +33,9 @@ class RecordingLimits:
         max_gap_s: Largest time step between two samples (s). Times must be finite and
             increasing; one outlier stamp (1e5 s, 1e308 s) would otherwise make every resampling
             step allocate gigabytes.
-        min_step_s: Smallest time step between two samples (s), 1 ns by default (a ROS stamp's
-            resolution; motion capture runs below 10 kHz): a step of 1e-309 s is no sampling,
+        min_step_s: Smallest time step between two samples (s): half a ROS stamp's
+            resolution (1 ns) by default, so stamps 1 ns apart still pass after float
+            rounding (motion capture runs below 10 kHz). A step of 1e-309 s is no sampling,
             and its rate (1 / step) overflows.
         workspace_m: Largest plausible coordinate magnitude (m, after the unit): a point
             beyond it (or infinite) is a missing sample, counted.
@@ -47,7 +48,7 @@ class RecordingLimits:
     """
 
     max_gap_s: float = 60.0
-    min_step_s: float = 1e-9
+    min_step_s: float = 0.5e-9
     workspace_m: float = 50.0
     max_chunk_bytes: int = 32 * 1024 * 1024
     max_chunk_ratio: float = 100.0
