@@ -164,6 +164,12 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     moving_together = coupled or carried(i_h)
     confirm = moving_together or held_for < c.young_hold
 
+    def after_gap(g: int) -> tuple[int, int]:
+        # The sample a smoothing window after the tracking gap at grid index g (its edge is
+        # smoothed one-sided), -1 if not seen yet, and how many samples are seen after it.
+        seen = np.isfinite(s.rel_speed[g:]).nonzero()[0] + g
+        return (int(seen[window]) if seen.size > window else -1), int(seen.size)
+
     def persists(i: int) -> bool:
         if not parted(i):
             return False
@@ -173,16 +179,14 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         if k >= n:
             return False
         if not np.isfinite(s.rel_speed[k]):
-            # A window later falls in a tracking gap: judged a window after it (its edge is
-            # smoothed one-sided), as a gap in the hold is. With nothing seen after the gap,
-            # the parting stands, as it would unchecked (online, a robot reacts to a release
-            # hidden in a gap at once).
-            seen = np.isfinite(s.rel_speed[k:]).nonzero()[0] + k
-            if seen.size == 0:
+            # A window later falls in a tracking gap: judged a window after it, as a gap in
+            # the hold is. With nothing seen after the gap, the parting stands, as it would
+            # unchecked (online, a robot reacts to a release hidden in a gap at once).
+            k, seen = after_gap(k)
+            if seen == 0:
                 return True
-            if seen.size <= window:
+            if k < 0:
                 return False  # too little seen after the gap yet
-            k = int(seen[window])
             if moving_together:
                 # (the pair may have turned the object in the gap: their distance tells)
                 return not abs(s.distance[k] - held_d) < band
@@ -191,10 +195,9 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     j = i_h
     while j + 1 < n and not persists(j):
         if not np.isfinite(s.rel_speed[j + 1]):
-            seen = np.isfinite(s.rel_speed[j + 1 :]).nonzero()[0] + j + 1
-            # Seen still together a smoothing window after the gap (its edge is smoothed
-            # one-sided): the giver's motion in it was the pair's.
-            k = int(seen[window]) if seen.size > window else -1
+            # Seen still together a smoothing window after the gap: the giver's motion in it
+            # was the pair's.
+            k, seen = after_gap(j + 1)
             if k >= 0 and not parted(k):
                 if moving_together and k > b and s.hold_speed[k] <= v_still:
                     # The pair carried the object across the gap and still holds it: the hold
@@ -206,7 +209,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
                     return transfer_end(s, c, replace(core, end=e))
                 j = k
                 continue
-            if 0 < seen.size <= window:
+            if k < 0 and seen > 0:
                 return float(s.t[-1]), True  # too little seen after the gap yet
             if k < 0 and (coupled or swing(j) or carried(j)):
                 # The hands moved together into a gap that lasts to the data end: the
