@@ -51,19 +51,15 @@ import numpy as np
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.filtering import ALONG_LINE_SHARE, Signals, across_line, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
-from gazebot.core.phases.rules.transfer import TransferCore, hold_floor
+from gazebot.core.phases.rules.transfer import TransferCore, distance_band, hold_floor
 
 
 def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np.ndarray) -> float:
     """Separation from the held pose (a relative position, or a distance for a coupled hold)
     that marks the release (m)."""
     if held.ndim == 0:
-        dev = s.distance[held_idx] - held
-    else:
-        dev = np.linalg.norm(s.rel[held_idx] - held, axis=1)
-    dev = dev[np.isfinite(dev)]
-    jitter = float(np.sqrt(np.mean(dev**2))) if dev.size else 0.0
-    return max(c.release_distance, c.release_noise_factor * jitter)
+        return distance_band(c, s.distance[held_idx] - held)
+    return distance_band(c, np.linalg.norm(s.rel[held_idx] - held, axis=1))
 
 
 def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float, bool]:

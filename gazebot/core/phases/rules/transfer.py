@@ -14,12 +14,13 @@ seen or across a tracking gap; between two runs of at least ``min_transfer``, fa
 their relative motion runs mostly across their line and their common motion is under
 ``turning_common_max``: a careful carry, not a pass on the move) merge. The core is the
 merged run holding the minimum distance, or the longest when that one is shorter than
-``min_transfer`` (a marker glitch at the closest point). An approach that stops in a tracking
-gap before the core is dated from the last sample before the gap, once the hands are settled
-after it (under the settle speed, or turning together: their speed against their common
-motion under it). The giver's hand must have moved (``reach_onset_speed``) before the core: a
-receiver (robot) returning home near a resting giver makes a dip too; the receiver may move
-more than the giver.
+``min_transfer`` (a marker glitch at the closest point), started at an earlier run the hands
+never parted from (:func:`regrip`: a hand adjusting its grip between two holds). An approach
+that stops in a tracking gap before the core is dated from the last sample before the gap,
+once the hands are settled after it (under the settle speed, or turning together: their
+speed against their common motion under it). The giver's hand must have moved
+(``reach_onset_speed``) before the core: a receiver (robot) returning home near a resting giver
+makes a dip too; the receiver may move more than the giver.
 
 A dip with no such run at least ``min_transfer`` long is a handover on the move when the
 hands pass the object without stopping (:func:`pass_core`): its core is the short stretch
@@ -209,7 +210,11 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
         core = next((m for m in long_runs if m[0] <= p <= m[1]), None)
         if core is None:
             core = max(long_runs, key=lambda m: m[1] - m[0])
-        a, b = core
+        # An earlier hold the hands never parted from (regrip) is the same transfer: its start.
+        k = merged.index(core)
+        while k > 0 and regrip(s, c, core, merged[k - 1][1], core[0]):
+            k -= 1
+        a, b = merged[k][0], core[1]
         if not is_handover_dip(s, c, lo, p, a):
             if pieces and not out and is_leading_piece(s, c, a, b, p, hi):
                 out.append(TransferCore(lo, a, b, hi, float(s.t[a]), piece=True))
@@ -218,6 +223,31 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
             continue  # the same transfer seen from a neighbouring dip
         out.append(TransferCore(lo, a, b, hi, transfer_start(s, c, lo, a, b)))
     return out
+
+
+def distance_band(c: PhaseConfig, deviation: np.ndarray) -> float:
+    """How far (m) the hands' distance or relative position must leave a held value to count
+    as parting, given the samples' ``deviation`` from it: ``release_distance``, or
+    ``release_noise_factor`` times their RMS if larger (NaN samples ignored)."""
+    dev = deviation[np.isfinite(deviation)]
+    jitter = float(np.sqrt(np.mean(dev**2))) if dev.size else 0.0
+    return max(c.release_distance, c.release_noise_factor * jitter)
+
+
+def regrip(s: Signals, c: PhaseConfig, hold: list[int], i: int, j: int) -> bool:
+    """The hands did not part between grid indices ``i`` and ``j`` (the end of an earlier
+    hold and the start of the ``hold`` range): their distance stays within twice the band of
+    ``hold`` (:func:`distance_band`), as a coupled hold's does (issue 33: one hand adjusting
+    its grip, the pair turning or pressing the object in, faster than the seed's speed for a
+    moment), their common motion careful (under ``turning_common_max``, as for a turn). An
+    approach that paused short of contact moves the distance by more."""
+    d = s.distance[i : j + 1]
+    d = d[np.isfinite(d)]
+    if d.size == 0 or not nanmax(s.common_speed[i : j + 1], initial=0.0) < c.turning_common_max:
+        return False  # (hands passing the object on the move hold no careful grip)
+    held = s.distance[hold[0] : hold[1] + 1]
+    band = distance_band(c, held - np.nanmedian(held))
+    return float(d.max() - d.min()) <= 2.0 * band
 
 
 def is_handover_dip(s: Signals, c: PhaseConfig, lo: int, p: int, a: int) -> bool:
