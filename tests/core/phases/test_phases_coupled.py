@@ -177,6 +177,25 @@ def test_a_pair_carrying_the_object_while_one_hand_is_hidden_keeps_holding(seed,
     assert len(segs) == 1 and abs(segs[0].end - case.truth[0].transfer_end) <= 0.1
 
 
+def test_online_a_receiver_carrying_across_the_line_as_the_givers_marker_is_lost_holds():
+    # The pair carries the object (the receiver at 0.25 m/s, mostly across the hands' line)
+    # while the giver's marker lags, then is lost for 0.3 s: nothing is seen a smoothing window
+    # after the parting yet, so it stood and the release was reported 1.12 s early. With the
+    # receiver leading a parting across the line into a gap, the hold waits for data.
+    case = case_set("coupled30", 12, seed=8)[7]
+    ends = _online_ends(case)
+    assert len(ends) == 1 and abs(ends[0] - case.truth[0].transfer_end) <= WITHIN
+
+
+def test_online_a_giver_moving_toward_the_lost_receiver_is_not_withdrawing():
+    # The receiver's marker is lost to the newest sample while the giver moves the object at
+    # 0.15 m/s toward where the receiver was (the pair carrying it): the giver's motion was
+    # taken as its withdrawal and the release reported 1.19 s early.
+    case = case_set("coupled30", 12, seed=7)[4]
+    ends = _online_ends(case)
+    assert len(ends) == 1 and abs(ends[0] - case.truth[0].transfer_end) <= WITHIN
+
+
 @pytest.mark.parametrize("seed, k", [(1, 2), (3, 0)])
 def test_a_giver_led_parting_starts_at_the_givers_last_speed_minimum(seed, k):
     # The giver sets off across the hands' line, their distance unchanged for 0.2 s: dated

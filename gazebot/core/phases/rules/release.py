@@ -11,7 +11,8 @@ once the relative position has left the held pose by ``release_distance``, or
 ``release_noise_factor`` times that jitter if larger, and is back-dated with the minimum-jerk
 start (:func:`~gazebot.core.phases.rules.onset.min_jerk_span`, at most ``max_refine``). A release
 hidden in a tracking gap is dated from the separation seen before the gap, else from the
-giver's own motion onset after it. If the hands never part before the data end, the transfer
+giver's own motion onset after it (not a motion mostly toward the receiver: with the receiver
+unseen, that is the pair moving the object). If the hands never part before the data end, the transfer
 is still open.
 
 Hands that move the object together through the hold (their common motion's median speed over
@@ -177,10 +178,13 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         if not np.isfinite(s.rel_speed[k]):
             # A window later falls in a tracking gap: judged a window after it, as a gap in
             # the hold is. With nothing seen after the gap, the parting stands, as it would
-            # unchecked (online, a robot reacts to a release hidden in a gap at once).
+            # unchecked (online, a robot reacts to a release hidden in a gap at once), if the
+            # hands move apart or the giver leads (withdrawing in any direction): a receiver
+            # moving across the hands' line is carrying the object with a giver whose marker
+            # lags into the gap.
             k, seen = after_gap(k)
             if seen == 0:
-                return True
+                return moving_apart(i) or bool(s.giver_speed[i] >= s.receiver_speed[i])
             if k < 0:
                 return False  # too little seen after the gap yet
             if moving_together:
@@ -290,9 +294,15 @@ def giver_departure(s: Signals, j: int, t_min: float, tol: float) -> float | Non
 
 
 def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
-    """Start of the giver's first motion after grid index ``j`` (``None`` if none is seen)."""
+    """Start of the giver's first motion after grid index ``j`` that is not mostly toward
+    the receiver's hand as last seen at ``j`` (``None`` if none is seen): with the receiver
+    unseen, a giver moving toward it is moving the object with it (or pressing it in), not
+    withdrawing."""
     v = s.giver_speed[j:]
-    fast = (v >= c.reach_onset_speed).nonzero()[0]
+    rel = s.rel[j]
+    line = rel / vector_norm(rel) if vector_norm(rel) > 0.0 else np.zeros(3)
+    toward = s.giver_v[j:] @ line >= ALONG_LINE_SHARE * v
+    fast = ((v >= c.reach_onset_speed) & ~toward).nonzero()[0]
     if fast.size == 0:
         return None
     i = j + int(fast[0])
