@@ -12,8 +12,8 @@ once the relative position has left the held pose by ``release_distance``, or
 start (:func:`~gazebot.core.phases.rules.onset.min_jerk_span`, at most ``max_refine``). A release
 hidden in a tracking gap is dated from the separation seen before the gap, else from the
 giver's own motion onset after it (not a motion mostly toward the receiver: with the receiver
-unseen, that is the pair moving the object). If the hands never part before the data end, the transfer
-is still open.
+unseen, that is the pair moving the object). If the hands never part before the data end,
+the transfer is still open.
 
 Hands that move the object together through the hold (their common motion's median speed over
 it at least ``coupled_speed``: a full pitcher carried carefully, issue 33) may turn with it:
