@@ -15,10 +15,11 @@ their relative motion runs mostly across their line and their common motion is u
 ``turning_common_max``: a careful carry, not a pass on the move) merge. The core is the
 merged run holding the minimum distance, or the longest when that one is shorter than
 ``min_transfer`` (a marker glitch at the closest point), started at an earlier run the hands
-never parted from (:func:`regrip`: a hand adjusting its grip between two holds). An approach
-that stops in a tracking gap before the core is dated from the last sample before the gap,
-once the hands are settled after it (under the settle speed, or turning together: their
-speed against their common motion under it). The giver's hand must have moved
+never parted from (:func:`regrip`: a hand adjusting its grip between two holds); a core
+younger than ``young_hold`` goes on into a later hold the same way (a bounce at the meeting).
+An approach that stops in a tracking gap before the core is dated from the last sample before
+the gap, once the hands are settled after it (under the settle speed, or turning together:
+their speed against their common motion under it). The giver's hand must have moved
 (``reach_onset_speed``) before the core: a receiver (robot) returning home near a resting giver
 makes a dip too; the receiver may move more than the giver.
 
@@ -211,10 +212,18 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
         if core is None:
             core = max(long_runs, key=lambda m: m[1] - m[0])
         # An earlier hold the hands never parted from (regrip) is the same transfer: its start.
-        k = merged.index(core)
+        # A hold younger than young_hold that the hands leave by a regrip and hold again (a
+        # bounce at the meeting) goes on into the next hold.
+        k = m = merged.index(core)
         while k > 0 and regrip(s, c, core, merged[k - 1][1], core[0]):
             k -= 1
-        a, b = merged[k][0], core[1]
+        while (
+            m + 1 < len(merged)
+            and s.t[merged[m][1]] - s.t[merged[k][0]] < c.young_hold
+            and regrip(s, c, core, merged[m][1], merged[m + 1][0])
+        ):
+            m += 1
+        a, b = merged[k][0], merged[m][1]
         if not is_handover_dip(s, c, lo, p, a):
             if pieces and not out and is_leading_piece(s, c, a, b, p, hi):
                 out.append(TransferCore(lo, a, b, hi, float(s.t[a]), piece=True))
