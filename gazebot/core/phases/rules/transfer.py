@@ -244,12 +244,12 @@ def distance_band(c: PhaseConfig, deviation: np.ndarray) -> float:
 
 
 def regrip(s: Signals, c: PhaseConfig, hold: list[int], i: int, j: int) -> bool:
-    """The hands did not part between grid indices ``i`` and ``j`` (the end of an earlier
-    hold and the start of the ``hold`` range): their distance stays within twice the band of
-    ``hold`` (:func:`distance_band`), as a coupled hold's does (issue 33: one hand adjusting
-    its grip, the pair turning or pressing the object in, faster than the seed's speed for a
-    moment), their common motion careful (under ``turning_common_max``, as for a turn). An
-    approach that paused short of contact moves the distance by more."""
+    """The hands did not part between grid indices ``i`` and ``j`` (the end of one hold and
+    the start of the next, one of them the core ``hold``): their distance stays within twice
+    the band of ``hold`` (:func:`distance_band`), as a coupled hold's does (issue 33: one hand
+    adjusting its grip, the pair turning or pressing the object in, faster than the seed's
+    speed for a moment), their common motion careful (under ``turning_common_max``, as for a
+    turn). An approach that paused short of contact moves the distance by more."""
     d = s.distance[i : j + 1]
     d = d[np.isfinite(d)]
     if d.size == 0 or not nanmax(s.common_speed[i : j + 1], initial=0.0) < c.turning_common_max:
