@@ -13,6 +13,7 @@ from gazebot.core.phases import PhaseConfig, Trajectory, compute_signals, run_on
 from gazebot.core.phases.filtering import drop_glitches
 from gazebot.core.phases.synthetic import COUPLED_KINDS, case_set
 from gazebot.core.types import EventKind, Phase
+from tests.core.phases.degrade import degraded
 
 WITHIN = 0.2  # s, the issue's bar at both ends of the transfer
 
@@ -303,19 +304,7 @@ def test_a_hold_just_confirmed_is_not_released_by_its_first_samples_online(kind,
 def _degraded(case, seed):
     # 120 -> 30 Hz, four dropouts of 0.05-0.2 s per hand, 5 mm of noise and a 6 cm marker
     # offset, all at once (the held-out recordings' degraded copies)
-    rng = np.random.default_rng(seed)
-    tr = case.trajectory
-    keep = np.arange(0, tr.t.shape[0], 4)
-    t, g, r = tr.t[keep], tr.giver_hand[keep].copy(), tr.receiver_hand[keep].copy()
-    for hand in (g, r):
-        for x in rng.uniform(t[0], t[-1], 4):
-            hand[(t >= x) & (t < x + rng.uniform(0.05, 0.2))] = np.nan
-    g += rng.normal(0.0, 0.005, g.shape)
-    r += rng.normal(0.0, 0.005, r.shape)
-    for hand in (g, r):
-        way = rng.normal(size=3)
-        hand += 0.06 * way / np.linalg.norm(way)
-    return type(tr)(t, g, r)
+    return degraded(case.trajectory, "all", np.random.default_rng(seed))
 
 
 @pytest.mark.parametrize("seed, k, copy", [(3, 4, 3040), (3, 10, 3102)])

@@ -207,3 +207,26 @@ def test_reach_onset_hidden_in_a_tracking_gap_is_dated_across_it():
     reach = [s for s in segment(tr) if s.phase is Phase.REACH]
     assert len(reach) == 1
     assert abs(reach[0].start - h.reach_start) <= 0.15
+
+
+def test_a_hold_the_last_release_rule_found_still_held_is_that_transfer(varied_set, monkeypatch):
+    # On public on-the-move recordings (hyeonseong-kim98/dynamic_handover_dataset, motions
+    # normal_453 and 541) the release rule found the hands still together past the start of
+    # the next dip's core: that core made a second handover whose reach ran backwards (3.74 ->
+    # 3.52 s). A core that starts before the last transfer's release is part of it.
+    import gazebot.core.phases.methods.gazebot as method
+
+    case = next(c for c in varied_set if len(c.truth) == 2)
+    late = case.truth[1].transfer_start + 0.1
+    real = method.transfer_end
+    calls = []
+
+    def held_on(s, c, core):
+        calls.append(core)
+        return (late, False) if len(calls) == 1 else real(s, c, core)
+
+    monkeypatch.setattr(method, "transfer_end", held_on)
+    segs = segment(case.trajectory, PhaseConfig())
+    assert [s.phase for s in segs] == [Phase.REACH, Phase.TRANSFER, Phase.RETREAT]
+    assert segs[1].end == pytest.approx(late) and all(s.start <= s.end for s in segs)
+    assert len(calls) == 1  # the second core is not a handover

@@ -5,8 +5,10 @@ Per handover (a dip of the hands' distance): the transfer starts where the appro
 (:mod:`~gazebot.core.phases.rules.transfer`), ends at the back-dated release
 (:mod:`~gazebot.core.phases.rules.release`); the reach starts at the giver's motion onset before it
 (:mod:`~gazebot.core.phases.rules.reach`) and the retreat ends at rest, far away, at the next reach
-or at the data end (:mod:`~gazebot.core.phases.rules.retreat`). A recording cut short ends in the
-phase under way (``open``), with nothing invented after its last sample.
+or at the data end (:mod:`~gazebot.core.phases.rules.retreat`). A core that starts before the
+last transfer's release is part of that transfer; the next reach may start where its dip does,
+before the retreat looked finished (the retreat is clipped to it). A recording cut short ends in
+the phase under way (``open``), with nothing invented after its last sample.
 
 The robot's gripper and load-share columns are not used here; the online detector uses them
 (they arrive before the motion shows).
@@ -143,7 +145,16 @@ class GazebotSegmenter(Segmenter):
             prev_end_idx = _after_leading_retreat(s, c, cores[0].start)
         n = s.t.shape[0]
         trailing_ok = True
-        for k, core in enumerate(cores):
+        k = -1  # the handover's index
+        released = -1  # grid index of the last transfer's end
+        for i_core, core in enumerate(cores):
+            if core.start <= released:
+                continue  # (a hold the previous transfer's release rule found still held)
+            k += 1
+            if released >= 0:
+                # The next reach may start where its dip does, before the retreat looked
+                # finished (the retreat is clipped below).
+                prev_end_idx = max(min(prev_end_idx, core.lo), released)
             t_start = core.t_start
             if partial and math.isfinite(t_start) and core.end >= n - 2:
                 # Online: a transfer is confirmed once the hands have held for min_transfer
@@ -158,7 +169,7 @@ class GazebotSegmenter(Segmenter):
                 if partial:
                     # The approach has not settled yet: still a reach.
                     onset = onset_before(prev_end_idx, core.start)
-                    start = max(onset, out[-1].end) if out else onset
+                    start = max(onset, out[-1].start) if out else onset
                     out.append(Segment(Phase.REACH, min(start, t_last), t_last, k, open=True))
                     trailing_ok = False
                     break
@@ -167,7 +178,7 @@ class GazebotSegmenter(Segmenter):
             i_start = int(s.t.searchsorted(t_start))
             onset = onset_before(prev_end_idx, max(i_start - 1, prev_end_idx))
             if out:
-                onset = max(onset, out[-1].end)
+                onset = max(onset, out[-1].start)  # (out[-1]: the last retreat, from its release)
             if not core.piece:  # (a piece's reach is before the recording)
                 out.append(Segment(Phase.REACH, min(onset, t_start), t_start, k))
             t_end, open_end = transfer_end(s, c, core)
@@ -182,10 +193,11 @@ class GazebotSegmenter(Segmenter):
                 if not core.piece:
                     out[-1] = Segment(Phase.REACH, out[-1].start, t_start, k)
             i_end = min(int(s.t.searchsorted(t_end)), n - 1)
-            nxt = cores[k + 1].start if k + 1 < len(cores) else n - 1
+            later = [x for x in cores[i_core + 1 :] if x.start > i_end]
+            nxt = later[0].start if later else n - 1
             t_rest, seen = rest_after(s, c, i_end, max(nxt, i_end))
             t_far = far_after(s, c, i_end)
-            if k + 1 < len(cores):
+            if later:
                 seen = True  # the next handover ends this one at the latest
             retreat_end = min(t_rest, t_far)
             seen = seen or math.isfinite(t_far)
@@ -193,6 +205,7 @@ class GazebotSegmenter(Segmenter):
             out.append(Segment(Phase.TRANSFER, t_start, t_end, k))
             out.append(Segment(Phase.RETREAT, t_end, retreat_end, k, open=not seen))
             prev_end_idx = int(s.t.searchsorted(retreat_end))
+            released = i_end
         if trailing_ok and (not out or out[-1].phase is Phase.RETREAT):
             trailing_onset = trailing_reach(s, c, min(prev_end_idx, n - 1))
             if trailing_onset is not None:

@@ -63,6 +63,21 @@ def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np
     return distance_band(c, np.linalg.norm(s.rel[held_idx] - held, axis=1))
 
 
+def last_in_band(s: Signals, c: PhaseConfig, a: int, b: int) -> int:
+    """The last grid index in ``[a, b]`` (a hold) whose distance is within the hold's band of
+    its median: :func:`~gazebot.core.phases.rules.transfer.distance_band`, the jitter taken
+    from the median absolute deviation (robust to the hold's own trailing samples, where the
+    hands may already part). ``a`` if none is seen."""
+    d = s.distance[a : b + 1]
+    seen = np.isfinite(d)
+    if not seen.any():
+        return a
+    dev = d[seen] - np.median(d[seen])
+    band = distance_band(c, np.full(1, 1.4826 * float(np.median(np.abs(dev)))))
+    inside = (seen & (np.abs(d - np.median(d[seen])) < band)).nonzero()[0]
+    return a + int(inside[-1]) if inside.size else a
+
+
 def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float, bool]:
     """``(t_end, open_end)``: the release time, and whether the data end before it.
 
@@ -78,6 +93,10 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     v_still = c.settle_floor_factor * hold_floor(s, c, a, b)
     i0 = min(max(a, int(s.t.searchsorted(t_start))), b)
     still = (s.hold_speed[i0 : b + 1] <= v_still).nonzero()[0] + i0
+    # ... not counting the core's last samples out of the hold's distance band: a retreat
+    # starts slowly, inside the seed-rule core, and under marker noise its relative speed
+    # dips under v_still there by chance (5 mm at 30 Hz: releases 0.3 s late).
+    still = still[still <= last_in_band(s, c, i0, b)]
     i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
     idx = np.arange(max(i0, i_h - window), i_h + 1)

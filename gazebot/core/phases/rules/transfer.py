@@ -25,7 +25,8 @@ makes a dip too; the receiver may move more than the giver.
 
 A dip with no such run at least ``min_transfer`` long is a handover on the move when the
 hands pass the object without stopping (:func:`pass_core`): its core is the short stretch
-under ``transfer_exit_speed`` at the closest, slowest point, once the hands are seen parting.
+under ``transfer_exit_speed`` at the closest, slowest point where the hands have closed in
+(not the dip's top, where the distance turns), once the hands are seen parting.
 
 The seed's 15 cm/s is crossed on the tail of the approach, before contact. The transfer starts
 where the approach has stopped: the relative speed falls below ``settle_fraction`` of the
@@ -171,7 +172,8 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
     with np.errstate(invalid="ignore"):
         careful = s.common_speed < c.turning_common_max
     careful_turn = across_line(s.closing, s.rel_speed) & careful
-    for lo, p, hi in dips(d, c.min_approach):
+    all_dips = dips(d, c.min_approach)
+    for lo, p, hi in all_dips:
         near = np.zeros(n, dtype=bool)
         near[lo : hi + 1] = d[lo : hi + 1] <= d[p] + c.transfer_distance_margin
         rule_runs = runs(near & (rs < c.transfer_speed_max))
@@ -225,7 +227,8 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
             m += 1
         a, b = merged[k][0], merged[m][1]
         if not is_handover_dip(s, c, lo, p, a):
-            if pieces and not out and is_leading_piece(s, c, a, b, p, hi):
+            closest = min((float(d[q]) for _, q, _ in all_dips[1:]), default=math.inf)
+            if pieces and not out and is_leading_piece(s, c, a, b, p, hi, closest):
                 out.append(TransferCore(lo, a, b, hi, float(s.t[a]), piece=True))
             continue  # a pause far apart, or only the receiver moved: not a handover
         if out and a <= out[-1].end:
@@ -269,12 +272,20 @@ def is_handover_dip(s: Signals, c: PhaseConfig, lo: int, p: int, a: int) -> bool
     return bool(nanmax(s.giver_speed[lo : a + 1], initial=0.0) >= c.reach_onset_speed)
 
 
-def is_leading_piece(s: Signals, c: PhaseConfig, a: int, b: int, p: int, hi: int) -> bool:
+def is_leading_piece(
+    s: Signals, c: PhaseConfig, a: int, b: int, p: int, hi: int, closest: float = math.inf
+) -> bool:
     """The seed-rule core ``[a, b]`` of the recording's first dip is a handover already under
     way at the first sample (a window cut from inside one, issue 33): the core starts at the
-    first sample seen, and the hands are seen parting after it (``min_approach``)."""
+    first sample seen, the hands are seen parting after it (``min_approach``), and they are
+    within the seed's ``transfer_distance_margin`` of ``closest``, the closest the hands come
+    in the recording's later dips (hands at rest a metre apart, whose distance noise or a
+    step raises by ``min_approach``, hand nothing over: 5 mm of noise on the KTH sample made
+    such a piece of two in eight copies)."""
     seen = np.isfinite(s.distance).nonzero()[0]
     if seen.size == 0 or a > int(seen[0]) + 1:
+        return False
+    if s.distance[p] > closest + c.transfer_distance_margin:
         return False
     return bool(nanmax(s.distance[b : hi + 1], initial=-np.inf) >= s.distance[p] + c.min_approach)
 
@@ -285,15 +296,20 @@ def pass_core(
     """A handover without a hold (a quick or on-the-move pass: the hands never slow under the
     seed's 15 cm/s for ``min_transfer``): the object changes hands where they are closest and
     slowest. The core is the run under ``transfer_exit_speed`` around the slowest sample of
-    the near run holding the minimum ``p`` (at least ``pass_min_samples`` grid samples), only
-    once the hands are seen parting after it (the dip's far side rises ``min_approach``)."""
+    the near run holding the minimum ``p``, where the hands have closed half ``min_approach``
+    from the dip's top (at least ``pass_min_samples`` grid samples), only once the hands are
+    seen parting after it (the dip's far side rises ``min_approach``)."""
     n = s.t.shape[0]
     d = s.distance
+    # Where the hands have closed in: half min_approach below the dip's top (on the move, the
+    # relative speed dips at the top too, where the distance turns).
+    with np.errstate(invalid="ignore"):
+        low = near & (d <= float(nanmax(d[lo : p + 1])) - 0.5 * c.min_approach)
     a = p
-    while a > lo and near[a - 1]:
+    while a > lo and low[a - 1]:
         a -= 1
     b = p
-    while b < hi and near[b + 1]:
+    while b < hi and low[b + 1]:
         b += 1
     if b >= n - 1 or not nanmax(d[p:], initial=-np.inf) >= d[p] + c.min_approach:
         return None  # not yet seen parting
