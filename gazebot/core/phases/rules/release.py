@@ -52,7 +52,14 @@ import numpy as np
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.filtering import ALONG_LINE_SHARE, Signals, across_line, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
-from gazebot.core.phases.rules.transfer import TransferCore, distance_band, hold_floor
+from gazebot.core.phases.rules.transfer import (
+    TransferCore,
+    distance_band,
+    hold_floor,
+    jitter_band,
+)
+
+MAD_TO_SIGMA = 1.4826  # median absolute deviation -> standard deviation of a normal
 
 
 def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np.ndarray) -> float:
@@ -65,16 +72,16 @@ def release_threshold(s: Signals, c: PhaseConfig, held_idx: np.ndarray, held: np
 
 def last_in_band(s: Signals, c: PhaseConfig, a: int, b: int) -> int:
     """The last grid index in ``[a, b]`` (a hold) whose distance is within the hold's band of
-    its median: :func:`~gazebot.core.phases.rules.transfer.distance_band`, the jitter taken
-    from the median absolute deviation (robust to the hold's own trailing samples, where the
-    hands may already part). ``a`` if none is seen."""
+    its median (:func:`~gazebot.core.phases.rules.transfer.jitter_band`, the jitter from the
+    median absolute deviation: robust to the hold's own trailing samples, where the hands may
+    already part). ``a`` if none is seen."""
     d = s.distance[a : b + 1]
     seen = np.isfinite(d)
     if not seen.any():
         return a
-    dev = d[seen] - np.median(d[seen])
-    band = distance_band(c, np.full(1, 1.4826 * float(np.median(np.abs(dev)))))
-    inside = (seen & (np.abs(d - np.median(d[seen])) < band)).nonzero()[0]
+    dev = np.abs(d - np.median(d[seen]))
+    band = jitter_band(c, MAD_TO_SIGMA * float(np.median(dev[seen])))
+    inside = (seen & (dev < band)).nonzero()[0]
     return a + int(inside[-1]) if inside.size else a
 
 
@@ -95,7 +102,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     still = (s.hold_speed[i0 : b + 1] <= v_still).nonzero()[0] + i0
     # ... not counting the core's last samples out of the hold's distance band: a retreat
     # starts slowly, inside the seed-rule core, and under marker noise its relative speed
-    # dips under v_still there by chance (5 mm at 30 Hz: releases 0.3 s late).
+    # dips under v_still there by chance (5 mm at 30 Hz: a release 0.26 s late).
     still = still[still <= last_in_band(s, c, i0, b)]
     i_h = int(still[-1]) if still.size else i0
     window = max(2, int(round(c.smoothing * c.analysis_rate)))
