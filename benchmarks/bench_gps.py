@@ -30,7 +30,7 @@ def _enabled() -> bool:
 def run() -> list[Result]:
     if not _enabled():
         return [Result("gps (opt-in: GAZEBOT_BENCH_GPS=1)", float("nan"), None, "s",
-                       note="skipped: takes tens of minutes")]
+                       note="skipped: takes minutes")]
     import jax
 
     from gazebot.apps.gps.badmm import train
