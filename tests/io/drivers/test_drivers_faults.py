@@ -370,6 +370,11 @@ def test_eye_frames_are_rendered_only_while_someone_subscribes(bus):
     viewer = ZenohRobotEndpoint(bus.connector(), bus.names, "display", eye_frames=True)
     bus.closers.append(viewer.close)
     assert wait_until(drv.wants_eye_frames)
+    # The one frame below is obeyed only once the display knows the owner and its publisher
+    # (a new session may see them after the engine saw its subscription: unidentified, dropped).
+    frames = viewer.names.resolve(topics.EYE_IMAGE.name)
+    assert wait_until(lambda: viewer.owners.owner() == drv._ownership.claim
+                      and viewer.ros.graph.endpoints(frames, "MP"))
     node.on_tracking(ep.publish_tracking(frame(1.0)))
     assert renderer.calls == 1
     assert wait_until(lambda: viewer.eye_frame.peek() is not None)
