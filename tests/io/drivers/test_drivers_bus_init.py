@@ -141,6 +141,8 @@ def test_a_handover_runs_on_the_authenticated_bus(lab):
         assert wait_until(lambda: ep.peers().get("engine") and drv.peers().get("sim"))
         th.start()
         assert node.ready.wait(30) and node.role == "owner"
+        # the robot obeys the engine only once it has seen the engine's claim (made at ready)
+        assert wait_until(lambda: ep.owners.owner() == drv._ownership.claim)
         state = {"t": 0.0}
 
         def commanded() -> bool:

@@ -36,11 +36,13 @@ def sim():
     s.close()
 
 
-def start_sim_node(bus, sim, speed=SPEED):
+def start_sim_node(bus, sim, speed=SPEED, duration: float | None = 12.0):
+    """The simulator on the bus, run for ``duration`` simulated s (``None``: until closed)."""
     ep = ZenohRobotEndpoint(bus.listener(), bus.names, "sim")
     node = SimNode(sim, ep, SimNodeConfig(speed=speed))
     stop = threading.Event()
-    th = threading.Thread(target=node.run, kwargs={"stop": stop, "duration": 12.0}, daemon=True)
+    th = threading.Thread(target=node.run, kwargs={"stop": stop, "duration": duration},
+                          daemon=True)
 
     def close():
         stop.set()
@@ -254,8 +256,9 @@ def _parser():
 
 
 def test_run_cli_drives_a_simulator_on_the_bus_and_records_it(bus, sim, capsys, tmp_path):
-    # Real time: the simulator must still run while the engine loads on a slow machine.
-    sim_node, ep, sim_thread, _ = start_sim_node(bus, sim, speed=1.0)
+    # Real time and until closed: the simulator must still run (and be a live peer) however
+    # long the engine takes to load on a slow machine.
+    sim_node, ep, sim_thread, _ = start_sim_node(bus, sim, speed=1.0, duration=None)
     sim_thread.start()
     args = _parser().parse_args(
         ["run", "--robot", "sawyer", "--behavior", "face-hand-face", "--duration", "1.5",

@@ -238,19 +238,19 @@ def test_tracking_stop_ticks_the_loop_whose_policy_holds_then_looks_at_the_last_
     ep.publish_tracking(frame(1 / 120, face=last_face))
     assert wait_until(lambda: node.frames_processed == 2)
     # silence: the node ticks the loop without samples; the engine's policy holds, then loses
-    assert wait_until(lambda: events.where(kind="tracking_stale"), timeout=10)
-    assert wait_until(lambda: events.where(kind="tracking_timeout"), timeout=10)
+    assert wait_until(lambda: events.where(kind="tracking_stale"))
+    assert wait_until(lambda: events.where(kind="tracking_timeout"))
     [timeout] = events.where(kind="tracking_timeout")
     assert timeout.info["face"] == pytest.approx(list(last_face))
     # meanwhile the head looks at the last face, commanded by silence ticks
     assert wait_until(lambda: len(heads.msgs) > 2)
     assert heads.msgs[-1]["head_pan"] == pytest.approx(np.arctan2(-0.4, 1.2))
     assert wait_until(lambda: any(s.node == "engine" and s.values.get("tracking") == "lost"
-                                  and s.state == "degraded" for s in status.msgs), timeout=10)
+                                  and s.state == "degraded" for s in status.msgs))
     # tracking returns: resumed, the sample answered. From the events, not the live state: a
     # silence tick 0.05 s after the sample (silence_after) may already hold and lose again.
     ep.publish_tracking(frame(30.0))
-    assert wait_until(lambda: events.where(kind="tracking_resumed"), timeout=10)
+    assert wait_until(lambda: events.where(kind="tracking_resumed"))
     [resumed] = events.where(kind="tracking_resumed")
     assert resumed.t == 30.0  # the sample's own tick, whose tracking was ok
     assert wait_until(lambda: any(t == 30.0 for t, _ in targets.msgs))

@@ -95,7 +95,7 @@ def test_latched_robot_description_and_tf_static_published_before_gazebot_are_re
 
     node = RosNode(bus.connector(), bus.names, "engine")
     bus.closers.append(node.close)
-    wait_until(lambda: node.graph.endpoints("/tf_static", "MP"), timeout=10)
+    wait_until(lambda: node.graph.endpoints("/tf_static", "MP"))
     got: dict[str, list] = {"desc": [], "tf": []}
     lock = threading.Lock()
 
@@ -109,7 +109,7 @@ def test_latched_robot_description_and_tf_static_published_before_gazebot_are_re
                             keep("desc"))
     node.subscription(topics.TF_STATIC.name, topics.TF_STATIC.type, keep("tf"))
     assert sub.entity.qos.durability == TRANSIENT_LOCAL and sub.entity.qos.depth == 1
-    assert wait_until(lambda: got["desc"] and got["tf"], timeout=10)
+    assert wait_until(lambda: got["desc"] and got["tf"])
     time.sleep(0.3)
     with lock:
         (msg, received), = got["desc"]
@@ -121,7 +121,7 @@ def test_latched_robot_description_and_tf_static_published_before_gazebot_are_re
     assert tf.transforms[0].transform.translation.z == pytest.approx(1.2)
     # A message published while subscribed arrives too, once.
     peer.put(desc, STRING, JAZZY.types[STRING](data="<robot name='new'/>"))
-    assert wait_until(lambda: len(got["desc"]) == 2, timeout=10)
+    assert wait_until(lambda: len(got["desc"]) == 2)
     time.sleep(0.3)
     assert [m.data for m, _ in got["desc"]][1] == "<robot name='new'/>"
     assert len(got["desc"]) == 2
@@ -134,14 +134,18 @@ def test_a_volatile_subscription_does_not_get_what_was_published_before(bus):
     peer.put(desc, STRING, JAZZY.types[STRING](data=URDF))
     node = RosNode(bus.connector(), bus.names, "engine")
     bus.closers.append(node.close)
-    wait_until(lambda: node.graph.endpoints("/robot_description", "MP"), timeout=10)
+    wait_until(lambda: node.graph.endpoints("/robot_description", "MP"))
     got: list = []
     node.subscription("/robot_description", STRING, lambda m, r: got.append(m),
                       qos=QosProfile(durability=VOLATILE))
     time.sleep(1.0)
     assert got == []
-    peer.put(desc, STRING, JAZZY.types[STRING](data="now"))
-    assert wait_until(lambda: got, timeout=10) and got[0].data == "now"
+
+    def now_arrives() -> bool:  # put until the subscription's route is up (a loaded machine)
+        peer.put(desc, STRING, JAZZY.types[STRING](data="now"))
+        return bool(got)
+
+    assert wait_until(now_arrives, poll=0.05) and got[0].data == "now"
 
 
 def test_gazebots_latched_phase_reaches_a_subscriber_that_starts_later(bus):
@@ -154,7 +158,7 @@ def test_gazebots_latched_phase_reaches_a_subscriber_that_starts_later(bus):
 
     # The late subscriber, as SubscriptionData::init declares one for TRANSIENT_LOCAL depth 1.
     other = bus.connector()
-    wait_until(lambda: list(other.info.peers_zid()), timeout=10)
+    wait_until(lambda: list(other.info.peers_zid()))
     got: list = []
     key = bus.names.key_any_type(bus.names.resolve(topics.PHASE.name))
     sub = zext.declare_advanced_subscriber(
@@ -162,7 +166,7 @@ def test_gazebots_latched_phase_reaches_a_subscriber_that_starts_later(bus):
         subscriber_detection=True, recovery=zext.RecoveryConfig(heartbeat=True),
         history=zext.HistoryConfig(detect_late_publishers=True, max_samples=1))
     bus.closers.append(sub.undeclare)
-    assert wait_until(lambda: got, timeout=10)
+    assert wait_until(lambda: got)
     time.sleep(0.3)
     (data, att), = got
     seq, _, n = struct.unpack_from("<qqB", att)
@@ -199,13 +203,17 @@ def test_an_old_labelled_attachment_is_read_and_warned_about_once(bus, caplog):
     got: list = []
     node.subscription("/chatter", STRING, lambda m, r: got.append(r.attachment))
     other = bus.connector()
-    wait_until(lambda: list(other.info.peers_zid()), timeout=10)
+    wait_until(lambda: list(other.info.peers_zid()))
     key = f"0/chatter/std_msgs::msg::dds_::String_/{JAZZY.hash_rihs01(STRING)}"
     data = bytes(JAZZY.serialize_cdr(JAZZY.types[STRING](data="hi"), STRING))
+    pub = other.declare_publisher(key)
+    bus.closers.append(pub.undeclare)
+    # a peer seen is not yet a route to its subscription: put once it matches
+    assert wait_until(lambda: pub.matching_status.matching)
     with caplog.at_level(logging.WARNING, logger="gazebot.io.drivers"):
         for i in range(3):
-            other.put(key, data, attachment=_labelled(i + 1, 5, bytes(range(16))))
-        assert wait_until(lambda: len(got) == 3, timeout=10)
+            pub.put(data, attachment=_labelled(i + 1, 5, bytes(range(16))))
+        assert wait_until(lambda: len(got) == 3)
     assert [a.sequence_number for a in got] == [1, 2, 3]
     warned = [r for r in caplog.records if "0.2.0-0.2.3" in r.getMessage()]
     assert len(warned) == 1

@@ -81,7 +81,8 @@ def test_recorded_handover_gives_the_same_commands_in_process_and_over_zenoh(
 
     ep = ZenohRobotEndpoint(bus.listener(), bus.names, "sim")
     bus.closers.append(ep.close)
-    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine")
+    # Samples complete by their parts alone: no wall-clock idle flush on a stalled machine.
+    drv = ZenohRobotDriver(bus.connector(), bus.names, "engine", assemble_idle=1e6)
     heads = Recorder(ep, topics.HEAD_COMMAND, lambda m: convert.trajectory_goal(m).positions)
     eyes = Recorder(ep, topics.EYES, convert.eyes_of)
     targets = Recorder(ep, topics.GAZE_TARGET, convert.point_of)
@@ -105,6 +106,11 @@ def test_recorded_handover_gives_the_same_commands_in_process_and_over_zenoh(
         time.sleep(0.01)
     th.start()
     assert node.ready.wait(30)
+    # the robot obeys the engine only once it has seen the engine's claim (made at ready)
+    deadline = time.monotonic() + 30
+    while ep.owners.owner() != drv._ownership.claim:
+        assert time.monotonic() < deadline, "the robot never saw the engine's claim"
+        time.sleep(0.01)
 
     def wait(pred, what):
         deadline = time.monotonic() + 30  # generous: a busy machine is slow

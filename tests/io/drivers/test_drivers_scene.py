@@ -67,6 +67,11 @@ def test_the_engine_publishes_tf_and_markers_during_a_handover(bus, sim):  # noq
         return {m.text for d in markers.all() for m in read_markers(d).markers
                 if m.id == IDS["phase"]}
 
+    # The reach's markers come within a wall-clock second of the start: the engine's
+    # publishers must route to the watcher first (a loaded machine may take longer).
+    scene = engine_node.scene
+    assert wait_until(lambda: scene._markers._pub.matching_status.matching
+                      and scene._tf._pub.matching_status.matching)
     sim_thread.start()
     assert wait_until(lambda: tf.all() and "transfer" in phases(), timeout=120, poll=0.25)
     # /tf_static was sent once, before this subscriber: it is latched
