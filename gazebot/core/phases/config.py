@@ -44,6 +44,10 @@ class PhaseConfig(BaseModel):
         min_approach: gazebot: a handover is a dip of the hands' distance at least this deep (m).
         approach_fraction: gazebot: ... closing at least this fraction of the distance the
             hands started from.
+        max_hold_distance: gazebot: ... and coming this close (m): two tracked points on the
+            hands (or forearms: 0.85 m on the KTH recording) holding one object are at most
+            about its length apart (a giver who lifts the object and pauses 1.15 m from the
+            receiver holds nothing out yet).
         min_transfer: gazebot: shortest transfer kept (s).
         pass_min_samples: gazebot: a handover without a hold (the hands pass the object on
             the move) needs this many analysis-grid samples under ``transfer_exit_speed``.
@@ -56,6 +60,12 @@ class PhaseConfig(BaseModel):
             speed over the seed-rule run (0..1).
         stop_extrapolation: gazebot: share of the parabolic-tail extrapolation from the settle
             crossing to the hold's floor applied (0: none; 1: the parabola's own).
+        approach_tail_max: gazebot: the transfer starts at most this long (s) after the
+            relative speed fell under ``transfer_speed_max``: hands creeping closer for longer
+            hold the object already.
+        release_tail_max: gazebot: offline, the transfer ends at most this long (s) before
+            the relative speed rises over ``transfer_speed_max``: hands parting slower for
+            longer still move the object together.
         release_distance: gazebot: the release needs the hands' relative position this far from
             the held pose (m) ...
         release_noise_factor: ... and at least this many times the held pose's RMS jitter.
@@ -108,11 +118,13 @@ class PhaseConfig(BaseModel):
         online_slack: Online, back-dated boundaries are compared with the current phase's
             start with this slack (s): one analysis may place a boundary a grid step or two
             off the previous one.
-        reach_stall: Online, a reach whose giver's hand then rested this long (s) and set off
-            again toward the receiver was an earlier movement: it ends (``stalled``) and the
-            final approach is the reach ...
-        stall_travel: ... if the hand rested less than this far (m) from where the reach
-            started (a lift; a hand held out at the handover place has come farther).
+        reach_stall: Online, a reach whose giver's hand then rested (or swayed with the
+            object without nearing the receiver) this long (s) and set off again toward the
+            receiver was an earlier movement: it ends (``stalled``) and the final approach is
+            the reach ...
+        stall_travel: ... if the hands were then less than this much nearer (m) than when
+            the reach started (a lift, or a movement that went away; a hand held out at the
+            handover place has closed more).
         reach_lookback: Online, in a reach the analysis reads this many typical reaches
             before the reach's start (the rest before it dates the onset).
         predict_window: Online, ``gazebot``'s predictive reach rule
@@ -179,6 +191,7 @@ class PhaseConfig(BaseModel):
     turning_common_max: float = Field(0.40, gt=0)
     min_approach: float = Field(0.10, gt=0)
     approach_fraction: float = Field(0.3, ge=0, lt=1)
+    max_hold_distance: float = Field(1.0, gt=0)
     min_transfer: float = Field(0.08, ge=0)
     pass_min_samples: int = Field(3, ge=1)
     still_closing: float = Field(0.005, ge=0)
@@ -186,6 +199,8 @@ class PhaseConfig(BaseModel):
     settle_floor_factor: float = Field(1.5, ge=1)
     hold_floor_quantile: float = Field(0.25, ge=0, le=1)
     stop_extrapolation: float = Field(1.0, ge=0, le=2)
+    approach_tail_max: float = Field(0.25, ge=0)
+    release_tail_max: float = Field(0.25, ge=0)
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     coupled_speed: float = Field(0.06, gt=0)

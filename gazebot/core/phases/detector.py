@@ -26,9 +26,10 @@ back about as far apart as when it started (taken back before any transfer), end
 ``handover_done`` with ``source = "aborted"`` (a reach replayed into the handover state
 before the first sample, :meth:`PhaseDetector.resync`: once the hands are
 ``transfer_distance_margin`` farther apart than the closest seen). A reach that was an
-earlier movement (the giver lifted the object, rested ``reach_stall``, then set off toward the
-receiver) ends with ``source = "stalled"`` when the final approach shows, and that approach is
-the reach (a new ``reach_started``); a retreat longer
+earlier movement (the giver lifted the object, rested ``reach_stall`` or swayed with it while
+the hands came no nearer, then set off toward the receiver) ends with ``source = "stalled"``
+when the final approach shows, and that approach is the reach (a new ``reach_started``); a
+retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
 
 Bad samples: a frame with a non-finite time, or a time not after the last accepted one
@@ -56,7 +57,7 @@ import numpy as np
 from gazebot.core.handover import HandoverState, HandoverView
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.durations import REACH_S
-from gazebot.core.phases.filtering import SignalCache, Signals, nanmax, nanmin, vector_norm
+from gazebot.core.phases.filtering import SignalCache, Signals, nanmax, nanmin
 from gazebot.core.phases.methods import make_segmenter
 from gazebot.core.phases.methods.base import OnlineState
 from gazebot.core.phases.prediction import predict_end
@@ -594,10 +595,13 @@ class PhaseDetector:
 
     def _reach_restart(self) -> float | None:
         """When the final approach began, if the reach under way was an earlier movement: the
-        giver's hand, less than ``stall_travel`` from where the reach started, rested (under
-        ``rest_speed``) for ``reach_stall``, then moved again (``reach_onset_speed``) and the
-        hands have closed ``reach_confirm_distance`` since. ``None`` otherwise (a giver holding
-        the object out for a slow robot rests too, but does not set off again)."""
+        hands, less than ``stall_travel`` nearer than where the reach started, stalled for
+        ``reach_stall`` (the giver's hand rested under ``rest_speed``, or, holding a heavy
+        object that sways, moved slower than ``reach_onset_speed`` while the hands closed
+        slower than that: no progress of this reach), then moved again
+        (``reach_onset_speed``) and the hands have closed ``reach_confirm_distance`` since.
+        ``None`` otherwise (a giver holding the object out for a slow robot stalls too, but
+        does not set off again)."""
         c = self.config
         s = self._signals
         if s is None or s.t.shape[0] < 3:
@@ -607,7 +611,11 @@ class PhaseDetector:
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
         if need < 1 or v.shape[0] <= need:
             return None  # (a reach younger than reach_stall: no rest that long in it)
-        rest = np.isfinite(v) & (v < c.rest_speed)
+        with np.errstate(invalid="ignore"):
+            # Swaying with a heavy object: the hand slower than a reach and the hands closing
+            # slower than a reach does (a receiver approaching meanwhile is progress).
+            no_progress = (v < c.reach_onset_speed) & (s.closing[i_start:] < c.reach_onset_speed)
+        rest = np.isfinite(v) & ((v < c.rest_speed) | no_progress)
         if np.count_nonzero(rest) < need:
             return None  # (no run of need rest samples without need of them in all)
         # the last sample of the last rest at least reach_stall long
@@ -621,7 +629,7 @@ class PhaseDetector:
         i_a, i_b = i_start + a, i_start + b
         if not np.isfinite(s.giver[[i_start, i_a]]).all():
             return None
-        if vector_norm(s.giver[i_a] - s.giver[i_start]) >= c.stall_travel:
+        if not s.distance[i_start] - s.distance[i_a] < c.stall_travel:
             return None  # the hand was held out at the handover place: the reach goes on
         after = s.giver_speed[i_b + 1 :]
         d = s.distance[i_b:]

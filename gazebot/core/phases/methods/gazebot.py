@@ -29,7 +29,7 @@ from gazebot.core.phases.rules.reach import reach_start, trailing_reach
 from gazebot.core.phases.rules.release import transfer_end
 from gazebot.core.phases.rules.retreat import far_after, rest_after, retreat_done
 from gazebot.core.phases.rules.sequential import sequential_reach
-from gazebot.core.phases.rules.transfer import TransferCore, find_cores
+from gazebot.core.phases.rules.transfer import TransferCore, carried_together, find_cores
 from gazebot.core.phases.segment import Segment
 from gazebot.core.phases.trajectory import Trajectory
 from gazebot.core.types import Phase
@@ -182,6 +182,12 @@ class GazebotSegmenter(Segmenter):
             if not core.piece:  # (a piece's reach is before the recording)
                 out.append(Segment(Phase.REACH, min(onset, t_start), t_start, k))
             t_end, open_end = transfer_end(s, c, core)
+            if not open_end and core.end < n - 1 and carried_together(s, c, core.start, core.end):
+                # A pair moving the object together that parts slower than the seed's speed
+                # for longer than release_tail_max still moves it together (a receiver slowly
+                # taking a full pitcher's weight): released at most that long before the
+                # hands part faster.
+                t_end = max(t_end, float(s.t[core.end]) - c.release_tail_max)
             if open_end:
                 out.append(Segment(Phase.TRANSFER, t_start, t_last, k, open=True))
                 trailing_ok = False

@@ -54,6 +54,8 @@ from gazebot.core.phases.filtering import ALONG_LINE_SHARE, Signals, across_line
 from gazebot.core.phases.rules.onset import min_jerk_span
 from gazebot.core.phases.rules.transfer import (
     TransferCore,
+    both_seen,
+    carried_together,
     distance_band,
     hold_floor,
     jitter_band,
@@ -117,17 +119,11 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # or their midpoint carried coupled_travel: a pair slowing into the release has a lower
     # median) through a hold of at least min_transfer, their distance held (within twice its
     # band: the approach is over).
-    common = s.common_speed[i0 : i_h + 1]
-    common = common[np.isfinite(common)]
     hold_d = s.distance[i0 : i_h + 1]
     hold_d = hold_d[np.isfinite(hold_d)]
     held_for = float(s.t[i_h] - s.t[i0])
-    moved_together = bool(common.size) and (
-        float(np.median(common)) >= c.coupled_speed
-        or pair_travel(s, i0, i_h) >= c.coupled_travel
-    )
     coupled = (
-        moved_together
+        carried_together(s, c, i0, i_h)
         and held_for >= c.min_transfer
         and float(hold_d.max() - hold_d.min()) <= 2.0 * band
     )
@@ -276,21 +272,6 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
             t_end = min(t_end, departure)
         return max(t_end, t_start), False
     return max(t_end, float(s.t[i_h]), t_start), False
-
-
-def both_seen(s: Signals, a: int, b: int) -> np.ndarray:
-    """Grid indices in ``[a, b]`` where both hands are seen (their relative position known)."""
-    return np.isfinite(s.rel[a : b + 1]).all(axis=1).nonzero()[0] + a
-
-
-def pair_travel(s: Signals, a: int, b: int) -> float:
-    """How far (m) the hands' midpoint moved from grid index ``a`` to ``b`` (first and last seen
-    samples between them): the object carried by the pair, net of marker noise."""
-    seen = both_seen(s, a, b)
-    if seen.size < 2:
-        return 0.0
-    i, j = int(seen[0]), int(seen[-1])
-    return vector_norm(s.giver[j] + s.receiver[j] - s.giver[i] - s.receiver[i]) / 2.0
 
 
 def giver_leads(s: Signals, t_from: float, j: int) -> bool:

@@ -33,7 +33,12 @@ where the approach has stopped: the relative speed falls below ``settle_fraction
 approach's own peak relative speed (scale-free: fast and slow approaches alike), or below
 ``settle_floor_factor`` times the hold's speed floor (marker noise and both hands carrying the
 object keep the relative speed of a real hold at 3-7 cm/s), whichever is higher; a clean
-approach's parabolic tail is then extrapolated down to the floor (:func:`transfer_start`).
+approach's parabolic tail is then extrapolated down to the floor, at most twice the interval
+it was fitted on (:func:`settle_time`). Where the pair moves the object together
+(:func:`carried_together`), the transfer starts at most ``approach_tail_max`` after the seed's
+15 cm/s: the hands creeping closer while the pair turns and carries the object already hold it
+(:func:`transfer_start`). A dip whose closest distance is beyond ``max_hold_distance`` is no
+handover (a giver pausing with the object on the way).
 """
 
 from __future__ import annotations
@@ -46,6 +51,10 @@ import numpy as np
 from gazebot.core.phases.config import PhaseConfig
 from gazebot.core.phases.filtering import Signals, across_line, nanmax, vector_norm
 from gazebot.core.phases.rules.onset import min_jerk_span
+
+#: The most a clean approach's parabolic tail is extrapolated, in lengths of the interval it
+#: was fitted on (:func:`settle_time`).
+TAIL_RATIO = 2.0
 
 
 @dataclass(frozen=True)
@@ -238,6 +247,21 @@ def find_cores(s: Signals, c: PhaseConfig, pieces: bool = False) -> list[Transfe
     return out
 
 
+def both_seen(s: Signals, a: int, b: int) -> np.ndarray:
+    """Grid indices in ``[a, b]`` where both hands are seen (their relative position known)."""
+    return np.isfinite(s.rel[a : b + 1]).all(axis=1).nonzero()[0] + a
+
+
+def pair_travel(s: Signals, a: int, b: int) -> float:
+    """How far (m) the hands' midpoint moved from grid index ``a`` to ``b`` (first and last seen
+    samples between them): the object carried by the pair, net of marker noise."""
+    seen = both_seen(s, a, b)
+    if seen.size < 2:
+        return 0.0
+    i, j = int(seen[0]), int(seen[-1])
+    return vector_norm(s.giver[j] + s.receiver[j] - s.giver[i] - s.receiver[i]) / 2.0
+
+
 def distance_band(c: PhaseConfig, deviation: np.ndarray) -> float:
     """How far (m) the hands' distance or relative position must leave a held value to count
     as parting, given the samples' ``deviation`` from it: ``release_distance``, or
@@ -270,9 +294,12 @@ def regrip(s: Signals, c: PhaseConfig, hold: list[int], i: int, j: int) -> bool:
 
 
 def is_handover_dip(s: Signals, c: PhaseConfig, lo: int, p: int, a: int) -> bool:
-    """The dip ``[lo .. p]`` closes ``approach_fraction`` of where the hands started and the
-    giver's hand moved (``reach_onset_speed``) before grid index ``a``."""
+    """The dip ``[lo .. p]`` closes ``approach_fraction`` of where the hands started, to within
+    ``max_hold_distance``, and the giver's hand moved (``reach_onset_speed``) before grid
+    index ``a``."""
     d = s.distance
+    if not d[p] <= c.max_hold_distance:
+        return False  # too far apart to hold one object: a pause on the way
     top = float(nanmax(d[lo : p + 1]))
     if top - d[p] < c.approach_fraction * top:
         return False  # the hands paused while still far apart (relative to where they started)
@@ -362,8 +389,31 @@ def _crossing(s: Signals, i: int, level: float) -> float:
     return float(s.t[i])
 
 
+def carried_together(s: Signals, c: PhaseConfig, a: int, b: int) -> bool:
+    """Whether the pair moved the object together over grid indices ``[a, b]``: a median
+    common speed of at least ``coupled_speed``, or their midpoint carried ``coupled_travel``."""
+    common = s.common_speed[a : b + 1]
+    common = common[np.isfinite(common)]
+    return bool(common.size) and (
+        float(np.median(common)) >= c.coupled_speed or pair_travel(s, a, b) >= c.coupled_travel
+    )
+
+
 def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
-    """When the approach into the core ``[a, b]`` stopped (s); NaN if not yet seen to settle.
+    """When the approach into the core ``[a, b]`` stopped (s); NaN if not yet seen to settle:
+    :func:`settle_time`; in a hold where the pair moves the object together
+    (:func:`carried_together`), at most ``approach_tail_max`` after the relative speed fell
+    under the seed's ``transfer_speed_max``: there the hands creeping closer at a few cm/s
+    while the pair turns and carries the object already hold it (careful real handovers of
+    a full pitcher: 0.2-0.5 s of such creep after the seed's crossing)."""
+    t = settle_time(s, c, lo, a, b)
+    if math.isnan(t) or not carried_together(s, c, a, b):
+        return t
+    return min(t, _crossing(s, a, c.transfer_speed_max) + c.approach_tail_max)
+
+
+def settle_time(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
+    """When the approach into the core ``[a, b]`` settled (s); NaN if not yet seen to.
 
     The relative speed's crossing of the settle speed ``v_s``; when that lies above the hold's
     floor ``v_f`` (``settle_floor_factor`` x floor: a clean approach), the approach's tail,
@@ -401,8 +451,11 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
     t_a = _crossing(s, a, c.transfer_speed_max)
     v_a = c.transfer_speed_max
     if v_f < v_settle < v_a and t_s > t_a:
-        ext = (t_s - t_a) * (math.sqrt(v_settle) - math.sqrt(v_f))
-        ext /= math.sqrt(v_a) - math.sqrt(v_settle)
+        # (A parabola fitted on the crossings' interval is extrapolated at most TAIL_RATIO times
+        # its length: a settle speed near the seed's, from an approach whose peak a marker swap
+        # inflated, leaves an interval of a sample or two that the ratio would blow up.)
+        ratio = (math.sqrt(v_settle) - math.sqrt(v_f)) / (math.sqrt(v_a) - math.sqrt(v_settle))
+        ext = (t_s - t_a) * min(ratio, TAIL_RATIO)
         t_s += min(c.stop_extrapolation * ext, c.max_refine)
     return t_s
 

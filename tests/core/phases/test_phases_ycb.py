@@ -1,0 +1,96 @@
+"""Issue 33 on real careful handovers: the public YCB-Handovers recordings of a full pitcher or
+cup (a mocap suit's segment origins, 0.27-0.37 m apart at the hold; 7.5 s windows that begin
+and end inside neighbouring handovers), when they are on this machine. The bars are the issue's
+held-out ones, as shares of the recordings whose right hands meet (the others hand over with
+the left).
+
+Measured on 13 such recordings (pairs 1-6): offline 11 (the two others: the seed rule's own
+run cut by a one-frame marker glitch, or by a regrip jolt before the minimum distance), online
+start 12 (one 0.47 s before the offline start), online reach on the final approach 11."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.ycb_data import HANDS, RATE, ycb_folders
+from gazebot.core.phases import PhaseConfig, run_online, segment
+from gazebot.core.types import EventKind, Phase
+from gazebot.io.recordings import PointNames, load_recording
+
+FOLDERS = ycb_folders()
+pytestmark = pytest.mark.skipif(
+    not FOLDERS,
+    reason="YCB-Handovers absent (github paragkhanna1/YCB-Handovers; set GAZEBOT_YCB_DATA)",
+)
+
+
+def _meeting():
+    """The recordings whose right hands hold the object together (closest under 0.6 m)."""
+    out = []
+    for folder in FOLDERS:
+        tr = load_recording(folder, PointNames(*HANDS), rate=RATE).trajectory
+        d = np.linalg.norm(tr.giver_hand - tr.receiver_hand, axis=1)
+        if np.nanmin(d) < 0.6:
+            out.append((folder.name, tr, d))
+    return out
+
+
+@pytest.fixture(scope="module")
+def recordings():
+    found = _meeting()
+    if len(found) < 5:
+        pytest.skip(f"only {len(found)} YCB-Handovers recordings whose right hands meet")
+    return found
+
+
+def _transfers(tr, config):
+    return [s for s in segment(tr, config) if s.phase is Phase.TRANSFER]
+
+
+def test_offline_one_transfer_within_the_seed_rule_and_holding_the_closest_point(recordings):
+    hits = []
+    for name, tr, d in recordings:
+        ours = _transfers(tr, PhaseConfig())
+        seed = _transfers(tr, PhaseConfig(method="seed-7.2.5"))
+        t_min = float(tr.t[np.nanargmin(d)])
+        ok = len(ours) == 1 and bool(seed)
+        if ok:
+            o = ours[0]
+            s = min(seed, key=lambda x: abs(x.start - o.start))
+            ok = abs(o.start - s.start) <= 0.3 and abs(o.end - s.end) <= 0.3
+            ok = ok and o.start <= t_min <= o.end
+        hits.append((name, ok))
+    assert np.mean([ok for _, ok in hits]) >= 0.8, hits
+
+
+def test_online_transfer_starts_within_035_s_of_the_offline_start(recordings):
+    hits = []
+    for name, tr, _ in recordings:
+        ours = _transfers(tr, PhaseConfig())
+        starts = [e.t for e in run_online(tr).events if e.kind is EventKind.TRANSFER_STARTED]
+        ok = len(ours) == 1 and sum(abs(t - ours[0].start) <= 0.35 for t in starts) == 1
+        hits.append((name, ok))
+    assert np.mean([ok for _, ok in hits]) >= 0.9, hits
+
+
+def test_online_reach_is_the_final_approach(recordings):
+    # Confirmed between 1.0 s before and 0.15 s after the hands have closed 20 % of the gap
+    # of the final approach (from the farthest they were before the transfer): windows that
+    # begin with the giver's earlier movements, lifts and pauses.
+    hits = []
+    for name, tr, d in recordings:
+        ours = _transfers(tr, PhaseConfig())
+        if len(ours) != 1:
+            hits.append((name, False))
+            continue
+        i1 = int(np.searchsorted(tr.t, ours[0].start))
+        i0 = int(np.nanargmax(d[:i1]))
+        d0, d1 = d[i0], float(np.nanmedian(d[max(i1 - 12, 0) : i1 + 1]))
+        fifth = tr.t[i0 + np.flatnonzero(d[i0:i1] <= d0 - 0.2 * (d0 - d1))[0]]
+        events = run_online(tr).events
+        k = [i for i, e in enumerate(events)
+             if e.kind is EventKind.TRANSFER_STARTED and abs(e.t - ours[0].start) <= 0.35]
+        reach = [e for e in events[: k[0]] if e.kind is EventKind.REACH_STARTED] if k else []
+        hits.append((name, bool(reach) and -1.0 <= reach[-1].detected_at - fifth <= 0.15))
+    assert np.mean([ok for _, ok in hits]) >= 0.8, hits
