@@ -26,14 +26,22 @@ pytestmark = pytest.mark.skipif(
 
 
 def _meeting():
-    """The recordings whose right hands hold the object together (closest under 0.6 m)."""
+    """The recordings whose right hands hold the object together (closest under 0.6 m), each
+    analysed once: name, trajectory, hands' distance, transfers (ours and the seed rule's) and
+    the online events."""
     out = []
     for folder in FOLDERS:
         tr = load_recording(folder, PointNames(*HANDS), rate=RATE).trajectory
         d = np.linalg.norm(tr.giver_hand - tr.receiver_hand, axis=1)
         if np.nanmin(d) < 0.6:
-            out.append((folder.name, tr, d))
+            ours = _transfers(tr, PhaseConfig())
+            seed = _transfers(tr, PhaseConfig(method="seed-7.2.5"))
+            out.append((folder.name, tr, d, ours, seed, run_online(tr).events))
     return out
+
+
+def _transfers(tr, config):
+    return [s for s in segment(tr, config) if s.phase is Phase.TRANSFER]
 
 
 @pytest.fixture(scope="module")
@@ -44,15 +52,9 @@ def recordings():
     return found
 
 
-def _transfers(tr, config):
-    return [s for s in segment(tr, config) if s.phase is Phase.TRANSFER]
-
-
 def test_offline_one_transfer_within_the_seed_rule_and_holding_the_closest_point(recordings):
     hits = []
-    for name, tr, d in recordings:
-        ours = _transfers(tr, PhaseConfig())
-        seed = _transfers(tr, PhaseConfig(method="seed-7.2.5"))
+    for name, tr, d, ours, seed, _ in recordings:
         t_min = float(tr.t[np.nanargmin(d)])
         ok = len(ours) == 1 and bool(seed)
         if ok:
@@ -66,9 +68,8 @@ def test_offline_one_transfer_within_the_seed_rule_and_holding_the_closest_point
 
 def test_online_transfer_starts_within_035_s_of_the_offline_start(recordings):
     hits = []
-    for name, tr, _ in recordings:
-        ours = _transfers(tr, PhaseConfig())
-        starts = [e.t for e in run_online(tr).events if e.kind is EventKind.TRANSFER_STARTED]
+    for name, _, _, ours, _, events in recordings:
+        starts = [e.t for e in events if e.kind is EventKind.TRANSFER_STARTED]
         ok = len(ours) == 1 and sum(abs(t - ours[0].start) <= 0.35 for t in starts) == 1
         hits.append((name, ok))
     assert np.mean([ok for _, ok in hits]) >= 0.9, hits
@@ -79,8 +80,7 @@ def test_online_reach_is_the_final_approach(recordings):
     # of the final approach (from the farthest they were before the transfer): windows that
     # begin with the giver's earlier movements, lifts and pauses.
     hits = []
-    for name, tr, d in recordings:
-        ours = _transfers(tr, PhaseConfig())
+    for name, tr, d, ours, _, events in recordings:
         if len(ours) != 1:
             hits.append((name, False))
             continue
@@ -88,7 +88,6 @@ def test_online_reach_is_the_final_approach(recordings):
         i0 = int(np.nanargmax(d[:i1]))
         d0, d1 = d[i0], float(np.nanmedian(d[max(i1 - 12, 0) : i1 + 1]))
         fifth = tr.t[i0 + np.flatnonzero(d[i0:i1] <= d0 - 0.2 * (d0 - d1))[0]]
-        events = run_online(tr).events
         k = [i for i, e in enumerate(events)
              if e.kind is EventKind.TRANSFER_STARTED and abs(e.t - ours[0].start) <= 0.35]
         reach = [e for e in events[: k[0]] if e.kind is EventKind.REACH_STARTED] if k else []
