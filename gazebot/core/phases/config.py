@@ -62,7 +62,10 @@ class PhaseConfig(BaseModel):
             crossing to the hold's floor applied (0: none; 1: the parabola's own).
         approach_tail_max: gazebot: the transfer starts at most this long (s) after the
             relative speed fell under ``transfer_speed_max``: hands creeping closer for longer
-            hold the object already.
+            hold the object already (in a hold carried together, or :attr:`creep_balance`).
+        creep_balance: gazebot: ... also where, over that tail, the slower hand moves at least
+            this share of the faster's speed (median): both hands adjusting to each other hold
+            the object; one hand still arriving at a still one does not yet (0..1).
         release_tail_max: gazebot: offline, the transfer ends at most this long (s) before
             the relative speed rises over ``transfer_speed_max``: hands parting slower for
             longer still move the object together.
@@ -199,8 +202,9 @@ class PhaseConfig(BaseModel):
     settle_floor_factor: float = Field(1.5, ge=1)
     hold_floor_quantile: float = Field(0.25, ge=0, le=1)
     stop_extrapolation: float = Field(1.0, ge=0, le=2)
-    approach_tail_max: float = Field(0.25, ge=0)
+    approach_tail_max: float = Field(0.2, ge=0)
     release_tail_max: float = Field(0.25, ge=0)
+    creep_balance: float = Field(0.5, ge=0, le=1)
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     coupled_speed: float = Field(0.06, gt=0)

@@ -35,10 +35,12 @@ approach's own peak relative speed (scale-free: fast and slow approaches alike),
 object keep the relative speed of a real hold at 3-7 cm/s), whichever is higher; a clean
 approach's parabolic tail is then extrapolated down to the floor, at most twice the interval
 it was fitted on (:func:`settle_time`). Where the pair moves the object together
-(:func:`carried_together`), the transfer starts at most ``approach_tail_max`` after the seed's
-15 cm/s: the hands creeping closer while the pair turns and carries the object already hold it
-(:func:`transfer_start`). A dip whose closest distance is beyond ``max_hold_distance`` is no
-handover (a giver pausing with the object on the way).
+(:func:`carried_together`), or where both hands still move over the approach's tail
+(:func:`both_adjusting`), the transfer starts at most ``approach_tail_max`` after the seed's
+15 cm/s: hands creeping closer while the pair turns, carries the object or adjusts to each
+other already hold it; one hand still arriving at a still one (a robot's slow gripper) has
+not reached it yet (:func:`transfer_start`). A dip whose closest distance is beyond
+``max_hold_distance`` is no handover (a giver pausing with the object on the way).
 """
 
 from __future__ import annotations
@@ -402,14 +404,33 @@ def carried_together(s: Signals, c: PhaseConfig, a: int, b: int) -> bool:
 def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
     """When the approach into the core ``[a, b]`` stopped (s); NaN if not yet seen to settle:
     :func:`settle_time`; in a hold where the pair moves the object together
-    (:func:`carried_together`), at most ``approach_tail_max`` after the relative speed fell
+    (:func:`carried_together`), or where both hands move over the tail up to that time
+    (:func:`both_adjusting`), at most ``approach_tail_max`` after the relative speed fell
     under the seed's ``transfer_speed_max``: there the hands creeping closer at a few cm/s
-    while the pair turns and carries the object already hold it (careful real handovers of
-    a full pitcher: 0.2-0.5 s of such creep after the seed's crossing)."""
+    while the pair turns, carries the object or adjusts to each other already hold it
+    (careful real handovers of a full pitcher or cup: 0.25-1.0 s of such creep after the
+    seed's crossing, the slower hand at 0.37-0.83 of the faster's speed; a synthetic robot
+    gripper still arriving at a still hand: 0.01-0.34)."""
     t = settle_time(s, c, lo, a, b)
-    if math.isnan(t) or not carried_together(s, c, a, b):
+    if math.isnan(t):
         return t
-    return min(t, _crossing(s, a, c.transfer_speed_max) + c.approach_tail_max)
+    t_a = _crossing(s, a, c.transfer_speed_max)
+    i_s = int(np.searchsorted(s.t, t, side="right"))
+    if not (carried_together(s, c, a, b) or both_adjusting(s, c, a, i_s)):
+        return t
+    return min(t, t_a + c.approach_tail_max)
+
+
+def both_adjusting(s: Signals, c: PhaseConfig, a: int, b: int) -> bool:
+    """Whether both hands moved over grid indices ``[a, b)``: the slower hand's speed at least
+    ``creep_balance`` of the faster's (median over the samples). Hands still closing in
+    while both move hold the object and adjust to each other; one hand still arriving at a
+    still one has not reached it yet."""
+    g, r = s.giver_speed[a:b], s.receiver_speed[a:b]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        balance = np.minimum(g, r) / np.maximum(g, r)
+    balance = balance[np.isfinite(balance)]
+    return bool(balance.size) and float(np.median(balance)) >= c.creep_balance
 
 
 def settle_time(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float:
