@@ -204,7 +204,7 @@ class PhaseConfig(BaseModel):
     stop_extrapolation: float = Field(1.0, ge=0, le=2)
     approach_tail_max: float = Field(0.2, ge=0)
     release_tail_max: float = Field(0.25, ge=0)
-    creep_balance: float = Field(0.5, ge=0, le=1)
+    creep_balance: float = Field(0.25, ge=0, le=1)
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     coupled_speed: float = Field(0.06, gt=0)

@@ -4,12 +4,12 @@ and end inside neighbouring handovers), when they are on this machine. The bars 
 held-out ones, as shares of the recordings whose right hands meet (the others hand over with
 the left).
 
-Measured on 20 such recordings (pairs 1-6, 13 forward handovers and 7 reverse ones, where the
-other participant gives): offline 16 (the seed rule's own run cut by a one-frame marker glitch,
+Measured on 27 such recordings (pairs 1-6, 17 forward handovers and 10 reverse ones, where the
+other participant gives): offline 23 (the seed rule's own run cut by a one-frame marker glitch,
 or by a regrip jolt before the minimum distance; a start 0.30 s before a run the seed rule
-restarts after a bump; an end 0.11 s before the closest point), online start 20, online reach
-on the final approach 17 (the others: a receiver who closes the gap alone before the giver
-moves), degraded copies 397 of 400."""
+restarts after a bump; an end 0.11 s before the closest point), online start 27, online reach
+on the final approach 23 (the others: a receiver who closes the gap alone before the giver
+moves), degraded copies 537 of 540."""
 
 from __future__ import annotations
 

@@ -409,8 +409,9 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
     under the seed's ``transfer_speed_max``: there the hands creeping closer at a few cm/s
     while the pair turns, carries the object or adjusts to each other already hold it
     (careful real handovers of a full pitcher or cup: 0.25-1.0 s of such creep after the
-    seed's crossing, the slower hand at 0.37-0.83 of the faster's speed; a synthetic robot
-    gripper still arriving at a still hand: 0.01-0.34)."""
+    seed's crossing, the slower hand at 0.33-0.83 of the faster's speed; a synthetic robot
+    gripper still arriving at a still hand: 0.01-0.34, and bounding one at 0.16 would date its
+    start 0.28 s early)."""
     t = settle_time(s, c, lo, a, b)
     if math.isnan(t):
         return t
