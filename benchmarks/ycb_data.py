@@ -1,8 +1,8 @@
 """Public YCB-Handovers recordings (github paragkhanna1/YCB-Handovers: careful and non-careful
-handovers of a full pitcher and cup, 7.5 s windows of a full-body mocap suit at 120 Hz), found
-through GAZEBOT_YCB_DATA or /work/data/ycb: one folder per handover holding ``giver_RHand`` and
-``taker_RHand`` pose CSVs (the dataset's ``*_pose.csv`` or ``.csv``). Never copied into the
-repository."""
+handovers of a full pitcher and cup, and baskets of other objects; 7.5 s windows of a
+full-body mocap suit at 120 Hz), found through GAZEBOT_YCB_DATA or /work/data/ycb: one folder
+per handover holding ``giver_RHand`` and ``taker_RHand`` pose CSVs (the dataset's
+``*_pose.csv`` or ``.csv``). Never copied into the repository."""
 
 from __future__ import annotations
 

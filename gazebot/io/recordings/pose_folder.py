@@ -1,6 +1,10 @@
 """A folder of per-body pose CSVs, one file per tracked body (e.g. the KTH handover dataset:
 ``giver_RHand_pose_saved.csv`` with columns ``x,y,z,q0,q1,q2,q3``, no time column, 120 Hz).
 Names are the file names without ``_pose_saved.csv`` / ``.csv``; rows are samples at ``rate``.
+A row exactly at the origin (x = y = z = 0) is a sample the tracker lost and the exporter wrote
+as zeros (YCB-Handovers has such rows amid a hand's motion, the position and the first
+quaternion element zeroed): it is missing, and the recording's notes count it. A tracked body
+never sits at the capture volume's origin to the last digit.
 """
 
 from __future__ import annotations
@@ -8,6 +12,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -57,6 +62,8 @@ def read_pose_folder(
         raise RecordingError(path, f"--rate {given!r}: expected a finite rate > 0 in Hz")
     files = sorted(p for p in path.glob("*.csv"))
     points: dict[str, np.ndarray] = {}
+    files_of: dict[str, str] = {}
+    zeroed: dict[str, np.ndarray] = {}  # body -> its rows at the origin (lost tracking)
     for f in files:
         try:
             text = f.read_text(encoding="utf-8-sig")
@@ -85,7 +92,11 @@ def read_pose_folder(
             bad = re.search(r"Line #(\d+) \((.*?)\)", str(exc))
             where = f"line {int(bad.group(1)) + 1}: {bad.group(2)}" if bad else str(exc)
             raise RecordingError(f, f"not a numeric pose table ({where})") from None
-        points[body_name(f)] = np.atleast_2d(data).reshape(-1, 3) if data.size else np.zeros((0, 3))
+        xyz = np.atleast_2d(data).reshape(-1, 3) if data.size else np.zeros((0, 3))
+        lost = (xyz == 0.0).all(axis=1)
+        xyz[lost] = np.nan
+        points[body_name(f)], files_of[body_name(f)] = xyz, f.name
+        zeroed[body_name(f)] = lost
     if not points:
         raise RecordingError(path, "no pose CSV with x, y, z columns in this folder")
     counts = {len(v) for v in points.values()}
@@ -97,7 +108,7 @@ def read_pose_folder(
         raise RecordingError(
             path, f"--rate {rate!r} Hz puts the samples beyond any time (expected a rate in Hz)"
         )
-    return build(
+    rec = build(
         path,
         "pose-folder",
         t,
@@ -108,3 +119,10 @@ def read_pose_folder(
         limits=limits,
         where=lambda i: f"row {i + 2}",
     )
+    lost_rows = {b: int(zeroed[b][:n].sum()) for b in rec.names if b is not None}
+    notes = tuple(
+        f"{files_of[b]}: {k} row(s) at exactly (0, 0, 0) read as lost tracking"
+        for b, k in lost_rows.items()
+        if k
+    )
+    return replace(rec, notes=rec.notes + notes)

@@ -1,15 +1,17 @@
-"""Issue 33 on real careful handovers: the public YCB-Handovers recordings of a full pitcher or
-cup (a mocap suit's segment origins, 0.27-0.39 m apart at the hold; 7.5 s windows that begin
-and end inside neighbouring handovers), when they are on this machine. The bars are the issue's
-held-out ones, as shares of the recordings whose right hands meet (the others hand over with
-the left).
+"""Issue 33 on real handovers: the public YCB-Handovers recordings (a mocap suit's segment
+origins, 0.23-0.39 m apart at the hold; 7.5 s windows that begin and end inside neighbouring
+handovers), when they are on this machine. The bars are the issue's held-out ones, as shares
+of the recordings whose right hands meet (the others hand over with the left); a window's
+piece of a neighbouring handover is not the handover checked.
 
-Measured on 27 such recordings (pairs 1-6, 17 forward handovers and 10 reverse ones, where the
-other participant gives): offline 23 (the seed rule's own run cut by a one-frame marker glitch,
-or by a regrip jolt before the minimum distance; a start 0.30 s before a run the seed rule
-restarts after a bump; an end 0.11 s before the closest point), online start 27, online reach
-on the final approach 23 (the others: a receiver who closes the gap alone before the giver
-moves), degraded copies 537 of 540."""
+Measured on 43 such recordings (pairs 1-6; 35 careful handovers of a full pitcher or cup, 22
+forward and 13 reverse, where the other participant gives; 8 of other objects or not careful):
+offline 37 (the seed rule's own run cut by a one-frame marker glitch, by a regrip jolt before
+the minimum distance, or broken by raw-speed noise and glitches around 15 cm/s in a quick
+hold; a start 0.30 s before a run the seed rule restarts after a bump; two ends 0.05-0.11 s
+before a closest point where the pair's common motion speeds up into the release), online
+start 43, online reach on the final approach 37 (the others: a receiver who closes a fifth of
+the gap before the giver moves), degraded copies 855 of 860."""
 
 from __future__ import annotations
 
@@ -39,13 +41,28 @@ def _meeting():
         d = np.linalg.norm(tr.giver_hand - tr.receiver_hand, axis=1)
         if np.nanmin(d) < 0.6:
             ours = _transfers(tr, PhaseConfig())
-            seed = _transfers(tr, PhaseConfig(method="seed-7.2.5"))
+            seed = _transfers(tr, PhaseConfig(method="seed-7.2.5"), pieces=True)
             out.append((folder.name, tr, d, ours, seed, run_online(tr).events))
     return out
 
 
-def _transfers(tr, config):
-    return [s for s in segment(tr, config) if s.phase is Phase.TRANSFER]
+def _transfers(tr, config, pieces=False):
+    """The transfers of complete handovers (reach, transfer and retreat): a window that begins
+    or ends inside a neighbouring handover holds a piece of it, which is not the handover
+    checked (the seed rule's transfers are all kept, pieces too)."""
+    segs = segment(tr, config)
+    whole = {s.handover for s in segs if s.phase is Phase.REACH}
+    whole &= {s.handover for s in segs if s.phase is Phase.RETREAT}
+    return [s for s in segs if s.phase is Phase.TRANSFER and (pieces or s.handover in whole)]
+
+
+def _closest(tr, d, transfer) -> float:
+    """When the hands were closest in this handover: between the farthest they were before the
+    transfer and the farthest after it (a piece of a neighbouring handover may come closer)."""
+    a, b = np.searchsorted(tr.t, [transfer.start, transfer.end])
+    i0 = int(np.nanargmax(d[:a])) if a else 0
+    i1 = int(b) + int(np.nanargmax(d[b:]))
+    return float(tr.t[i0 + int(np.nanargmin(d[i0 : i1 + 1]))])
 
 
 @pytest.fixture(scope="module")
@@ -59,13 +76,12 @@ def recordings():
 def test_offline_one_transfer_within_the_seed_rule_and_holding_the_closest_point(recordings):
     hits = []
     for name, tr, d, ours, seed, _ in recordings:
-        t_min = float(tr.t[np.nanargmin(d)])
         ok = len(ours) == 1 and bool(seed)
         if ok:
             o = ours[0]
             s = min(seed, key=lambda x: abs(x.start - o.start))
             ok = abs(o.start - s.start) <= 0.3 and abs(o.end - s.end) <= 0.3
-            ok = ok and o.start <= t_min <= o.end
+            ok = ok and o.start <= _closest(tr, d, o) <= o.end
         hits.append((name, ok))
     assert np.mean([ok for _, ok in hits]) >= 0.8, hits
 

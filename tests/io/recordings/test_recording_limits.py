@@ -1,6 +1,7 @@
 """Every recording reader bounds what a file can do: times finite and increasing with bounded
 gaps (an error naming the line), coordinates beyond the workspace as counted missing samples,
-a C3D cut short as an error, and no numpy warning leaking from 1e308."""
+a C3D cut short as an error, a pose folder's row of zeros as lost tracking, and no numpy
+warning leaking from 1e308."""
 
 from __future__ import annotations
 
@@ -204,3 +205,22 @@ def test_mcap_outlier_stamp_is_an_error_and_huge_coordinates_are_counted(tmp_pat
     assert rec.out_of_workspace == 3
     assert np.isfinite(rec.trajectory.giver_hand).all()  # interpolated over the left-out rows
     _no_warnings_through_the_phases(rec)
+
+
+def test_pose_folder_reads_a_row_at_the_origin_as_lost_tracking(tmp_path):
+    # YCB-Handovers: a hand moving at 1.08 m height has one row of zeros (tracking lost).
+    _, pts = sample()
+    pts = {k: v + 0.5 for k, v in pts.items()}  # off the origin everywhere
+    pts[NAMES.receiver_hand][7] = 0.0
+    d = write_pose_folder(tmp_path / "poses", pts)
+    rec = load_recording(d, NAMES, rate=50.0)
+    r = rec.trajectory.receiver_hand
+    assert np.isnan(r[7]).all()
+    assert np.isfinite(np.delete(r, 7, axis=0)).all()
+    assert np.isfinite(rec.trajectory.giver_hand).all()
+    assert rec.notes == (f"{NAMES.receiver_hand}_pose_saved.csv: 1 row(s) at exactly (0, 0, 0) "
+                         "read as lost tracking",)
+    # a coordinate of zero alone is a position like any other
+    pts[NAMES.receiver_hand][7] = [0.0, 0.0, 0.3]
+    rec = load_recording(write_pose_folder(tmp_path / "p2", pts), NAMES, rate=50.0)
+    assert np.isfinite(rec.trajectory.receiver_hand).all() and rec.notes == ()

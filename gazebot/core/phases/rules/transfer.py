@@ -415,11 +415,13 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
     t = settle_time(s, c, lo, a, b)
     if math.isnan(t):
         return t
-    t_a = _crossing(s, a, c.transfer_speed_max)
+    bound = _crossing(s, a, c.transfer_speed_max) + c.approach_tail_max
+    if t <= bound:
+        return t  # settled within the bound: nothing to cap
     i_s = int(np.searchsorted(s.t, t, side="right"))
-    if not (carried_together(s, c, a, b) or both_adjusting(s, c, a, i_s)):
-        return t
-    return min(t, t_a + c.approach_tail_max)
+    if carried_together(s, c, a, b) or both_adjusting(s, c, a, i_s):
+        return bound
+    return t
 
 
 def both_adjusting(s: Signals, c: PhaseConfig, a: int, b: int) -> bool:
