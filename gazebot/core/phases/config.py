@@ -63,6 +63,10 @@ class PhaseConfig(BaseModel):
         approach_tail_max: gazebot: the transfer starts at most this long (s) after the
             relative speed fell under ``transfer_speed_max``: hands creeping closer for longer
             hold the object already (in a hold carried together, or :attr:`creep_balance`).
+        approach_fall_band: gazebot: the relative speed fell under ``transfer_speed_max`` for
+            good (for :attr:`approach_tail_max`) at its last fall through it before it first
+            went under this share of it: an approach hovering at the seed's speed dips under
+            it before it slows (0..1).
         creep_balance: gazebot: ... also where, over that tail, the slower hand moves at least
             this share of the faster's speed (median): both hands adjusting to each other hold
             the object; one hand still arriving at a still one does not yet (0..1).
@@ -205,6 +209,7 @@ class PhaseConfig(BaseModel):
     approach_tail_max: float = Field(0.2, ge=0)
     release_tail_max: float = Field(0.25, ge=0)
     creep_balance: float = Field(0.25, ge=0, le=1)
+    approach_fall_band: float = Field(0.8, gt=0, le=1)
     release_distance: float = Field(0.010, ge=0)
     release_noise_factor: float = Field(4.0, ge=0)
     coupled_speed: float = Field(0.06, gt=0)

@@ -391,6 +391,21 @@ def _crossing(s: Signals, i: int, level: float) -> float:
     return float(s.t[i])
 
 
+def speed_fell_for_good(s: Signals, a: int, b: int, level: float, band: float) -> float:
+    """When the relative speed fell through ``level`` for good in grid indices ``[a, b)`` (s):
+    its last fall through ``level`` before it first went under ``band`` x ``level`` (a Schmitt
+    trigger); ``a``'s crossing if it never rose over ``level`` again. An approach that hovers
+    at the seed's 15 cm/s dips under it for a sample or two before it slows for good (a careful
+    pitcher at 15.3 cm/s for 0.3 s: at 30 Hz or with 5 mm of noise a dip at 4.1 s became the
+    crossing, 0.28 s before the clean recording's 4.38 s); a second push after the speed had
+    clearly fallen does not move it."""
+    seg = s.rel_speed[a:b]
+    low = (np.isfinite(seg) & (seg < band * level)).nonzero()[0]
+    seg = seg[: int(low[0])] if low.size else seg
+    over = (np.isfinite(seg) & (seg >= level)).nonzero()[0]
+    return _crossing(s, a + int(over[-1]) + 1, level) if over.size else _crossing(s, a, level)
+
+
 def carried_together(s: Signals, c: PhaseConfig, a: int, b: int) -> bool:
     """Whether the pair moved the object together over grid indices ``[a, b]``: a median
     common speed of at least ``coupled_speed``, or their midpoint carried ``coupled_travel``."""
@@ -406,8 +421,9 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
     :func:`settle_time`; in a hold where the pair moves the object together
     (:func:`carried_together`), or where both hands move over the tail up to that time
     (:func:`both_adjusting`), at most ``approach_tail_max`` after the relative speed fell
-    under the seed's ``transfer_speed_max``: there the hands creeping closer at a few cm/s
-    while the pair turns, carries the object or adjusts to each other already hold it
+    under the seed's ``transfer_speed_max`` for good (:func:`speed_fell_for_good`): there the
+    hands creeping closer at a few cm/s while the pair turns, carries the object or adjusts to
+    each other already hold it
     (careful real handovers of a full pitcher or cup: 0.25-1.0 s of such creep after the
     seed's crossing, the slower hand at 0.33-0.83 of the faster's speed; a synthetic robot
     gripper still arriving at a still hand: 0.01-0.34, and bounding one at 0.16 would date its
@@ -415,10 +431,11 @@ def transfer_start(s: Signals, c: PhaseConfig, lo: int, a: int, b: int) -> float
     t = settle_time(s, c, lo, a, b)
     if math.isnan(t):
         return t
-    bound = _crossing(s, a, c.transfer_speed_max) + c.approach_tail_max
+    i_s = int(np.searchsorted(s.t, t, side="right"))
+    fell = speed_fell_for_good(s, a, i_s, c.transfer_speed_max, c.approach_fall_band)
+    bound = fell + c.approach_tail_max
     if t <= bound:
         return t  # settled within the bound: nothing to cap
-    i_s = int(np.searchsorted(s.t, t, side="right"))
     if carried_together(s, c, a, b) or both_adjusting(s, c, a, i_s):
         return bound
     return t
