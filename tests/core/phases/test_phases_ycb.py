@@ -11,7 +11,10 @@ the minimum distance, or broken by raw-speed noise and glitches around 15 cm/s i
 hold; a start 0.30 s before a run the seed rule restarts after a bump; two ends 0.05-0.11 s
 before a closest point where the pair's common motion speeds up into the release), online
 start 43, online reach on the final approach 37 (the others: a receiver who closes a fifth of
-the gap before the giver moves), degraded copies 855 of 860."""
+the gap before the giver moves), degraded copies 855 of 860. On 16 careful ones read on
+2026-12-06 after those rules were set (handover 4, forward and reverse): offline 16, online
+start 16, reach 13, degraded copies 316 of 320 (with the release not before the hands' last
+closest point; 15 and 314 before)."""
 
 from __future__ import annotations
 

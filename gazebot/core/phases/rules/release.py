@@ -30,7 +30,12 @@ release stands even before the last sample still together by the hold speed, and
 the giver's last speed minimum before the parting (at most ``max_refine`` earlier and after
 the transfer's start, rises within the hold's speed floor ignored): the pair's common motion
 slows into the release, and the first centimetres of a retreat may run across the hands'
-line, their distance unchanged.
+line, their distance unchanged. That lead counts only from the hands' distance's last minimum
+on: hands still closing in have not let go, so a release back-dated before it is not before
+the last sample still together, and the giver's departure is not before it (a pair carrying
+a pitcher on at 0.28 m/s while the receiver slowed and the distance shrank 1 cm more was
+released 0.05 s before its closest point; at 30 Hz with noise and a marker offset, the
+giver's last speed minimum put a release 0.3-0.4 s early).
 
 No hold ends with the hands pressing the object in (the distance shrinking below the held
 one), and hands that carried the object together into a tracking gap that lasts to the newest
@@ -262,7 +267,9 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # alone tells; a receiver pulling the object takes it only once the giver feels the pull
     # (the KTH sample's force truth: the giver lets go 0.05-0.08 s after the distance starts
     # to grow).
-    if coupled and giver_leads(s, t_end, j):
+    # (Hands still closing in have not let go: the lead counts from the distance's last minimum.)
+    t_closest = closest_before(s, i0, j)
+    if coupled and t_end >= t_closest and giver_leads(s, t_end, j):
         # The giver's own departure began where its speed last bottomed out before the
         # parting: the pair's common motion slows into the release, and the first centimetres
         # of a retreat may run across the hands' line, leaving their distance unchanged.
@@ -270,8 +277,18 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
         departure = giver_departure(s, j, t_min, hold_floor(s, c, i0, i_h))
         if departure is not None:
             t_end = min(t_end, departure)
-        return max(t_end, t_start), False
+        return max(t_end, t_closest, t_start), False
     return max(t_end, float(s.t[i_h]), t_start), False
+
+
+def closest_before(s: Signals, a: int, j: int) -> float:
+    """Time (s) of the hands' smallest distance over grid indices ``[a, j]`` (the last one if
+    it recurs); ``s.t[a]`` if none is seen."""
+    d = s.distance[a : j + 1]
+    if not np.isfinite(d).any():
+        return float(s.t[a])
+    k = d.shape[0] - 1 - int(np.nanargmin(d[::-1]))
+    return float(s.t[a + k])
 
 
 def giver_leads(s: Signals, t_from: float, j: int) -> bool:
