@@ -267,17 +267,20 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
     # alone tells; a receiver pulling the object takes it only once the giver feels the pull
     # (the KTH sample's force truth: the giver lets go 0.05-0.08 s after the distance starts
     # to grow).
-    # (Hands still closing in have not let go: the lead counts from the distance's last minimum.)
-    t_closest = closest_before(s, i0, j)
-    if coupled and t_end >= t_closest and giver_leads(s, t_end, j):
-        # The giver's own departure began where its speed last bottomed out before the
-        # parting: the pair's common motion slows into the release, and the first centimetres
-        # of a retreat may run across the hands' line, leaving their distance unchanged.
-        t_min = max(t_end - c.max_refine, t_start)
-        departure = giver_departure(s, j, t_min, hold_floor(s, c, i0, i_h))
-        if departure is not None:
-            t_end = min(t_end, departure)
-        return max(t_end, t_closest, t_start), False
+    if coupled:
+        # (Hands still closing in have not let go: the lead counts from the distance's last
+        # minimum.)
+        t_closest = closest_before(s, i0, j)
+        if t_end >= t_closest and giver_leads(s, t_end, j):
+            # The giver's own departure began where its speed last bottomed out before the
+            # parting: the pair's common motion slows into the release, and the first
+            # centimetres of a retreat may run across the hands' line, leaving their distance
+            # unchanged.
+            t_min = max(t_end - c.max_refine, t_start)
+            departure = giver_departure(s, j, t_min, hold_floor(s, c, i0, i_h))
+            if departure is not None:
+                t_end = min(t_end, departure)
+            return max(t_end, t_closest, t_start), False
     return max(t_end, float(s.t[i_h]), t_start), False
 
 
