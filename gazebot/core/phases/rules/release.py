@@ -277,7 +277,7 @@ def transfer_end(s: Signals, c: PhaseConfig, core: TransferCore) -> tuple[float,
             # centimetres of a retreat may run across the hands' line, leaving their distance
             # unchanged.
             t_min = max(t_end - c.max_refine, t_start)
-            departure = giver_departure(s, j, t_min, hold_floor(s, c, i0, i_h))
+            departure = giver_departure(s, j, t_min, hold_floor(s, c, i0, i_h), t_closest)
             if departure is not None:
                 t_end = min(t_end, departure)
             return max(t_end, t_closest, t_start), False
@@ -304,20 +304,28 @@ def giver_leads(s: Signals, t_from: float, j: int) -> bool:
     return vector_norm(s.giver[j] - s.giver[b]) >= vector_norm(s.receiver[j] - s.receiver[b])
 
 
-def giver_departure(s: Signals, j: int, t_min: float, tol: float) -> float | None:
+def giver_departure(
+    s: Signals, j: int, t_min: float, tol: float, t_met: float = -math.inf
+) -> float | None:
     """Time (s) of the giver's last speed minimum before grid index ``j``: going back from
     ``j`` while its speed keeps falling, or rises by less than ``tol`` (m/s: the hold's noise),
     to a rise or a tracking gap, not before ``t_min`` (s). ``None`` when the speed still falls
-    there: the giver was slowing all along, no pause to depart from."""
+    there (the giver was slowing all along) or when that minimum is before ``t_met`` (s, when
+    the hands were last nearest: they still closed in there, and the giver's speed rose with
+    the pair carrying the object on): no pause to depart from."""
     v = s.giver_speed
     k = best = j
+    rose = False
     while k > 0 and s.t[k - 1] >= t_min:
         if not np.isfinite(v[k - 1]) or v[k - 1] >= v[best] + tol:
-            return float(s.t[best])  # (a tracking gap: the departure began in it at the latest)
+            rose = True  # (a tracking gap: the departure began in it at the latest)
+            break
         k -= 1
         if v[k] <= v[best]:
             best = k
-    return float(s.t[best]) if best > k else None
+    if not rose and best <= k:
+        return None  # still falling at t_min
+    return float(s.t[best]) if s.t[best] >= t_met else None
 
 
 def giver_onset_after(s: Signals, c: PhaseConfig, j: int) -> float | None:
