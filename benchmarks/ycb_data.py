@@ -2,25 +2,178 @@
 handovers of a full pitcher and cup, and baskets of other objects; 7.5 s windows of a
 full-body mocap suit at 120 Hz), found through GAZEBOT_YCB_DATA or /work/data/ycb: one folder
 per handover holding ``giver_RHand`` and ``taker_RHand`` pose CSVs (the dataset's
-``*_pose.csv`` or ``.csv``). Never copied into the repository."""
+``*_pose.csv`` or ``.csv``). Never copied into the repository.
+
+:func:`assess` scores one recording against issue 33's held-out bars, the same way
+``tests/core/phases/test_phases_ycb.py`` does; ``python -m benchmarks.ycb_data [DIR]`` prints
+them per recording (with the degraded copies) and the totals.
+"""
 
 from __future__ import annotations
 
 import os
+import sys
+from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
+
+from benchmarks.degrade import KINDS, degraded
+from gazebot.core.phases import PhaseConfig, Segment, Trajectory, run_online, segment
+from gazebot.core.types import Event, EventKind, Phase
 
 RATE = 120.0  # Hz, the dataset's mocap rate (901 rows = 7.5 s windows)
 HANDS = ("giver_RHand", "taker_RHand")
+MEET = 0.6  # m: right hands closer than this hold the object together (others use the left)
 
 
-def ycb_folders() -> list[Path]:
-    """The handover folders found (sorted; empty when the data is not on this machine)."""
-    for root in (os.environ.get("GAZEBOT_YCB_DATA"), "/work/data/ycb"):
-        if root and Path(root).is_dir():
+def ycb_folders(root: str | Path | None = None) -> list[Path]:
+    """The handover folders found under ``root`` (default: GAZEBOT_YCB_DATA, then
+    /work/data/ycb; sorted; empty when the data is not on this machine)."""
+    roots = [root] if root is not None else [os.environ.get("GAZEBOT_YCB_DATA"), "/work/data/ycb"]
+    for r in roots:
+        if r and Path(r).is_dir():
             found = sorted(
-                d for d in Path(root).rglob("*") if d.is_dir()
+                d for d in Path(r).rglob("*") if d.is_dir()
                 and all(any(d.glob(f"{h}*.csv")) for h in HANDS)
             )
             if found:
                 return found
     return []
+
+
+def load(folder: Path) -> Trajectory:
+    """One recording's right hands (giver, taker) at the dataset's rate."""
+    from gazebot.io.recordings import PointNames, load_recording
+
+    return load_recording(folder, PointNames(*HANDS), rate=RATE).trajectory
+
+
+def transfers(tr: Trajectory, config: PhaseConfig, pieces: bool = False) -> list[Segment]:
+    """The transfers of complete handovers (reach, transfer and retreat): a window that begins
+    or ends inside a neighbouring handover holds a piece of it, which is not the handover
+    checked (``pieces``: keep them all, as for the seed rule's transfers)."""
+    segs = segment(tr, config)
+    whole = {s.handover for s in segs if s.phase is Phase.REACH}
+    whole &= {s.handover for s in segs if s.phase is Phase.RETREAT}
+    return [s for s in segs if s.phase is Phase.TRANSFER and (pieces or s.handover in whole)]
+
+
+def closest(tr: Trajectory, d: np.ndarray, transfer: Segment) -> float:
+    """When the hands were closest in this handover: between the farthest they were before the
+    transfer and the farthest after it (a piece of a neighbouring handover may come closer)."""
+    a, b = np.searchsorted(tr.t, [transfer.start, transfer.end])
+    i0 = int(np.nanargmax(d[:a])) if a else 0
+    i1 = int(b) + int(np.nanargmax(d[b:]))
+    return float(tr.t[i0 + int(np.nanargmin(d[i0 : i1 + 1]))])
+
+
+def fifth_of_gap(tr: Trajectory, d: np.ndarray, start: float) -> float:
+    """When the hands had closed 20 % of the final approach's gap: from the farthest they were
+    before the transfer starting at ``start`` to where they hold (median of the last 0.1 s)."""
+    i1 = int(np.searchsorted(tr.t, start))
+    i0 = int(np.nanargmax(d[:i1]))
+    d0, d1 = d[i0], float(np.nanmedian(d[max(i1 - 12, 0) : i1 + 1]))
+    return float(tr.t[i0 + np.flatnonzero(d[i0:i1] <= d0 - 0.2 * (d0 - d1))[0]])
+
+
+@dataclass
+class Assessment:
+    """One recording against issue 33's bars (``meets``: its right hands hold the object; the
+    others are not scored).
+
+    Attributes:
+        offline: One complete transfer within 0.3 s of the seed rule's at both ends, holding
+            the closest point.
+        online: Exactly one online transfer start within 0.35 s of the offline start.
+        reach: The last online reach before that start confirmed 1.0 s before to 0.15 s after
+            the hands closed a fifth of the gap.
+        reach_lag: That reach's confirmation minus the fifth (s; NaN without one).
+        degraded: Per degraded copy (kind, draw, whether it keeps the transfer within 0.25 s
+            at both ends).
+    """
+
+    name: str
+    meets: bool
+    ours: list[Segment] = field(default_factory=list)
+    seed: list[Segment] = field(default_factory=list)
+    events: list[Event] = field(default_factory=list)
+    offline: bool = False
+    online: bool = False
+    reach: bool = False
+    reach_lag: float = float("nan")
+    degraded: list[tuple[str, int, bool]] = field(default_factory=list)
+
+
+def assess(folder: Path, degrade: bool = False) -> Assessment:
+    """Score one recording (``degrade``: also its 20 degraded copies, as the test makes them)."""
+    tr = load(folder)
+    d = np.linalg.norm(tr.giver_hand - tr.receiver_hand, axis=1)
+    if not np.nanmin(d) < MEET:
+        return Assessment(folder.name, False)
+    ours = transfers(tr, PhaseConfig())
+    seed = transfers(tr, PhaseConfig(method="seed-7.2.5"), pieces=True)
+    events = run_online(tr).events
+    out = Assessment(folder.name, True, ours, seed, events)
+    if len(ours) != 1:
+        return out
+    o = ours[0]
+    if seed:
+        s = min(seed, key=lambda x: abs(x.start - o.start))
+        out.offline = (
+            abs(o.start - s.start) <= 0.3 and abs(o.end - s.end) <= 0.3
+            and o.start <= closest(tr, d, o) <= o.end
+        )
+    starts = [e.t for e in events if e.kind is EventKind.TRANSFER_STARTED]
+    out.online = sum(abs(t - o.start) <= 0.35 for t in starts) == 1
+    k = [i for i, e in enumerate(events)
+         if e.kind is EventKind.TRANSFER_STARTED and abs(e.t - o.start) <= 0.35]
+    reach = [e for e in events[: k[0]] if e.kind is EventKind.REACH_STARTED] if k else []
+    if reach:
+        out.reach_lag = reach[-1].detected_at - fifth_of_gap(tr, d, o.start)
+        out.reach = -1.0 <= out.reach_lag <= 0.15
+    if degrade:
+        for how in [*KINDS, "all"]:
+            for i in range(4):
+                got = transfers(degraded(tr, how, np.random.default_rng(100 + i)), PhaseConfig())
+                ok = (len(got) == 1 and abs(got[0].start - o.start) <= 0.25
+                      and abs(got[0].end - o.end) <= 0.25)
+                out.degraded.append((how, i, ok))
+    return out
+
+
+def _spans(segs: list[Segment]) -> str:
+    return " ".join(f"{s.start:.2f}-{s.end:.2f}" for s in segs) or "-"
+
+
+def main(argv: list[str]) -> int:
+    """Print each recording's scores and the totals."""
+    folders = ycb_folders(argv[0] if argv else None)
+    if not folders:
+        print("no YCB-Handovers recordings found (give a folder or set GAZEBOT_YCB_DATA)")
+        return 1
+    scored = []
+    for folder in folders:
+        a = assess(folder, degrade=True)
+        if not a.meets:
+            print(f"{a.name}: right hands never meet (not scored)")
+            continue
+        scored.append(a)
+        missed = [f"{h}#{i}" for h, i, ok in a.degraded if not ok]
+        print(
+            f"{a.name}: ours {_spans(a.ours)}, seed rule {_spans(a.seed)}; offline {a.offline:d} "
+            f"online {a.online:d} reach {a.reach:d} ({a.reach_lag:+.2f} s); degraded "
+            f"{len(a.degraded) - len(missed)}/{len(a.degraded)} {' '.join(missed)}"
+        )
+    n = len(scored)
+    copies = [ok for a in scored for _, _, ok in a.degraded]
+    print(
+        f"{n} recordings: offline {sum(a.offline for a in scored)}, online start "
+        f"{sum(a.online for a in scored)}, reach {sum(a.reach for a in scored)}, degraded copies "
+        f"{sum(copies)} of {len(copies)}"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

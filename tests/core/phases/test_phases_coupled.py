@@ -9,11 +9,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.degrade import degraded
 from gazebot.core.phases import PhaseConfig, Trajectory, compute_signals, run_online, segment
 from gazebot.core.phases.filtering import drop_glitches
 from gazebot.core.phases.synthetic import COUPLED_KINDS, case_set
 from gazebot.core.types import EventKind, Phase
-from tests.core.phases.degrade import degraded
 
 WITHIN = 0.2  # s, the bar at both ends of the transfer
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.degrade import KINDS, degraded
 from gazebot.core.phases import PhaseConfig, compute_signals, run_online, segment
 from gazebot.core.phases.synthetic import CASE_KINDS, case_set
 from gazebot.core.types import EventKind, Phase
-from tests.core.phases.degrade import KINDS, degraded
 
 
 @pytest.fixture(scope="module")

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.degrade import KINDS, degraded
 from benchmarks.kth_data import RATE, force_truth, kth_dir
 from gazebot.core.phases import PhaseConfig, run_online, segment
 from gazebot.core.phases.synthetic import SyntheticOptions, generate
 from gazebot.core.types import EventKind, Phase
 from gazebot.io.recordings import PointNames, load_recording
-from tests.core.phases.degrade import KINDS, degraded
 from tests.core.phases.seed725_reference import qualifying_runs, seed_transfer
 
 KTH = kth_dir()
