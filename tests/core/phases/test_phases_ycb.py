@@ -69,5 +69,6 @@ def test_online_reach_is_the_final_approach(recordings):
 def test_degraded_copies_keep_the_transfer(recordings):
     # 30 Hz, NaN bursts, 5 mm noise, 6 cm marker offsets, and all at once (4 copies each):
     # one transfer within 0.25 s of the clean recording's at both ends.
-    hits = [(a.name, *h) for a in recordings for h in a.degraded if len(a.ours) == 1]
+    # (assess makes copies only of recordings with one complete transfer)
+    hits = [(a.name, *h) for a in recordings for h in a.degraded]
     assert np.mean([h[-1] for h in hits]) >= 0.97, [h for h in hits if not h[-1]]
