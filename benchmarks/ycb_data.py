@@ -25,6 +25,9 @@ from gazebot.core.types import Event, EventKind, Phase
 RATE = 120.0  # Hz, the dataset's mocap rate (901 rows = 7.5 s windows)
 HANDS = ("giver_RHand", "taker_RHand")
 MEET = 0.6  # m: right hands closer than this hold the object together (others use the left)
+# m: hands that came this much farther apart again took an approach back (over marker noise
+# and the sway of a full pitcher, 1-2 cm); the final approach starts after it
+APART = 0.05
 
 
 def ycb_folders(root: str | Path | None = None) -> list[Path]:
@@ -68,11 +71,24 @@ def closest(tr: Trajectory, d: np.ndarray, transfer: Segment) -> float:
     return float(tr.t[i0 + int(np.nanargmin(d[i0 : i1 + 1]))])
 
 
-def fifth_of_gap(tr: Trajectory, d: np.ndarray, start: float) -> float:
-    """When the hands had closed 20 % of the final approach's gap: from the farthest they were
-    before the transfer starting at ``start`` to where they hold (median of the last 0.1 s)."""
+def approach_start(d: np.ndarray, i1: int, apart: float = APART) -> int:
+    """Where the final approach before grid index ``i1`` began: where the hands were last
+    farthest apart, after any point from which they had come ``apart`` farther apart again (an
+    approach taken back part of the way ends there; ``inf``: the farthest before ``i1``)."""
+    seen = np.isfinite(d[:i1]).nonzero()[0]
+    x = d[seen]
+    farthest_on = np.maximum.accumulate(x[::-1])[::-1]  # the farthest from each sample on
+    nearer = (x < farthest_on - apart).nonzero()[0]
+    k = int(nearer[-1]) if nearer.size else 0
+    return int(seen[k + int(np.argmax(x[k:]))])
+
+
+def fifth_of_gap(tr: Trajectory, d: np.ndarray, start: float, apart: float = APART) -> float:
+    """When the hands had closed 20 % of the final approach's gap: from where that approach
+    began (:func:`approach_start`) to where they hold before the transfer starting at
+    ``start`` (median of the last 0.1 s)."""
     i1 = int(np.searchsorted(tr.t, start))
-    i0 = int(np.nanargmax(d[:i1]))
+    i0 = approach_start(d, i1, apart)
     d0, d1 = d[i0], float(np.nanmedian(d[max(i1 - 12, 0) : i1 + 1]))
     return float(tr.t[i0 + np.flatnonzero(d[i0:i1] <= d0 - 0.2 * (d0 - d1))[0]])
 
@@ -87,8 +103,10 @@ class Assessment:
             the closest point.
         online: Exactly one online transfer start within 0.35 s of the offline start.
         reach: The last online reach before that start confirmed 1.0 s before to 0.15 s after
-            the hands closed a fifth of the gap.
+            the hands closed a fifth of the final approach's gap (:func:`fifth_of_gap`).
         reach_lag: That reach's confirmation minus the fifth (s; NaN without one).
+        reach_lag_window: ... minus the fifth of the gap from the farthest the hands were in
+            the window before the transfer (an approach taken back counts; not the bar).
         degraded: Per degraded copy (kind, draw, whether it keeps the transfer within 0.25 s
             at both ends).
     """
@@ -102,6 +120,7 @@ class Assessment:
     online: bool = False
     reach: bool = False
     reach_lag: float = float("nan")
+    reach_lag_window: float = float("nan")
     degraded: list[tuple[str, int, bool]] = field(default_factory=list)
 
 
@@ -131,6 +150,7 @@ def assess(folder: Path, degrade: bool = False) -> Assessment:
     reach = [e for e in events[: k[0]] if e.kind is EventKind.REACH_STARTED] if k else []
     if reach:
         out.reach_lag = reach[-1].detected_at - fifth_of_gap(tr, d, o.start)
+        out.reach_lag_window = reach[-1].detected_at - fifth_of_gap(tr, d, o.start, np.inf)
         out.reach = -1.0 <= out.reach_lag <= 0.15
     if degrade:
         for how in [*KINDS, "all"]:
@@ -162,14 +182,16 @@ def main(argv: list[str]) -> int:
         missed = [f"{h}#{i}" for h, i, ok in a.degraded if not ok]
         print(
             f"{a.name}: ours {_spans(a.ours)}, seed rule {_spans(a.seed)}; offline {a.offline:d} "
-            f"online {a.online:d} reach {a.reach:d} ({a.reach_lag:+.2f} s); degraded "
+            f"online {a.online:d} reach {a.reach:d} ({a.reach_lag:+.2f} s; from the window's "
+            f"farthest {a.reach_lag_window:+.2f} s); degraded "
             f"{len(a.degraded) - len(missed)}/{len(a.degraded)} {' '.join(missed)}"
         )
     n = len(scored)
     copies = [ok for a in scored for _, _, ok in a.degraded]
     print(
         f"{n} recordings: offline {sum(a.offline for a in scored)}, online start "
-        f"{sum(a.online for a in scored)}, reach {sum(a.reach for a in scored)}, degraded copies "
+        f"{sum(a.online for a in scored)}, reach {sum(a.reach for a in scored)} (from the window's "
+        f"farthest {sum(-1.0 <= a.reach_lag_window <= 0.15 for a in scored)}), degraded copies "
         f"{sum(copies)} of {len(copies)}"
     )
     return 0

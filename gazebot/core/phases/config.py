@@ -128,10 +128,12 @@ class PhaseConfig(BaseModel):
         reach_stall: Online, a reach whose giver's hand then rested (or swayed with the
             object without nearing the receiver) this long (s) and set off again toward the
             receiver was an earlier movement: it ends (``stalled``) and the final approach is
-            the reach ...
-        stall_travel: ... if the hands were then less than this much nearer (m) than when
-            the reach started (a lift, or a movement that went away; a hand held out at the
-            handover place has closed more).
+            the reach (so does a reach the hands came ``reach_confirm_distance`` apart from
+            again before they closed in anew) ...
+        stall_fraction: ... if the hands were then less than this fraction of their distance
+            when the reach started nearer (a lift, or a movement that went away; a reach that
+            closed more has closed a fifth of its gap, which is under that distance: its pause
+            is a wait at the handover place).
         reach_lookback: Online, in a reach the analysis reads this many typical reaches
             before the reach's start (the rest before it dates the onset).
         predict_window: Online, ``gazebot``'s predictive reach rule
@@ -234,8 +236,8 @@ class PhaseConfig(BaseModel):
     online_refresh: float = Field(0.1, ge=0)
     edge_guard: float = Field(0.04, ge=0)
     online_slack: float = Field(0.03, ge=0)
-    reach_stall: float = Field(1.0, gt=0)
-    stall_travel: float = Field(0.18, gt=0)
+    reach_stall: float = Field(0.6, gt=0)
+    stall_fraction: float = Field(0.2, gt=0, lt=1)
     reach_lookback: float = Field(2.0, ge=1)
     predict_window: float = Field(0.2, gt=0)
     predict_min_samples: int = Field(5, ge=4)

@@ -27,7 +27,8 @@ back about as far apart as when it started (taken back before any transfer), end
 before the first sample, :meth:`PhaseDetector.resync`: once the hands are
 ``transfer_distance_margin`` farther apart than the closest seen). A reach that was an
 earlier movement (the giver lifted the object, rested ``reach_stall`` or swayed with it while
-the hands came no nearer, then set off toward the receiver) ends with ``source = "stalled"``
+the hands came no nearer, or took it back part of the way, then set off toward the receiver)
+ends with ``source = "stalled"``
 when the final approach shows, and that approach is the reach (a new ``reach_started``); a
 retreat longer
 than ``max_retreat`` ends with ``source = "timeout"``.
@@ -594,19 +595,26 @@ class PhaseDetector:
             return
 
     def _reach_restart(self) -> float | None:
-        """When the final approach began, if the reach under way was an earlier movement: the
-        hands, less than ``stall_travel`` nearer than where the reach started, stalled for
-        ``reach_stall`` (the giver's hand rested under ``rest_speed``, or, holding a heavy
-        object that sways, moved slower than ``reach_onset_speed`` while the hands closed
-        slower than that: no progress of this reach), then moved again
-        (``reach_onset_speed``) and the hands have closed ``reach_confirm_distance`` since.
-        ``None`` otherwise (a giver holding the object out for a slow robot stalls too, but
-        does not set off again)."""
-        c = self.config
+        """When the final approach began, if the reach under way was an earlier movement (it
+        stalled, :meth:`_approach_after_stall`, or was taken back part of the way,
+        :meth:`_approach_after_takeback`; with both, the later approach), else ``None``."""
         s = self._signals
         if s is None or s.t.shape[0] < 3:
             return None
         i_start = int(s.t.searchsorted(self._phase_start))
+        found = [self._approach_after_stall(s, i_start), self._approach_after_takeback(s, i_start)]
+        return max((t for t in found if t is not None), default=None)
+
+    def _approach_after_stall(self, s: Signals, i_start: int) -> float | None:
+        """The end of the reach's last stall, if the hands, less than ``stall_fraction`` of
+        their distance nearer than where the reach started (grid index ``i_start``), stalled
+        for ``reach_stall`` (the giver's hand rested under ``rest_speed``, or, holding a heavy
+        object that sways, moved slower than ``reach_onset_speed`` while the hands closed
+        slower than that: no progress of this reach), then moved again
+        (``reach_onset_speed``) and the hands have closed ``reach_confirm_distance`` since.
+        ``None`` otherwise (a giver holding the object out for a slow robot stalls too, but
+        has closed more, and does not set off again)."""
+        c = self.config
         v = s.giver_speed[i_start:]
         need = int(round(c.reach_stall / max(s.dt, 1e-9)))
         if need < 1 or v.shape[0] <= need:
@@ -629,7 +637,8 @@ class PhaseDetector:
         i_a, i_b = i_start + a, i_start + b
         if not np.isfinite(s.giver[[i_start, i_a]]).all():
             return None
-        if not s.distance[i_start] - s.distance[i_a] < c.stall_travel:
+        d0 = float(s.distance[i_start])
+        if not d0 - float(s.distance[i_a]) < c.stall_fraction * d0:
             return None  # the hand was held out at the handover place: the reach goes on
         after = s.giver_speed[i_b + 1 :]
         d = s.distance[i_b:]
@@ -638,6 +647,45 @@ class PhaseDetector:
         if not float(d[0]) - float(nanmin(d)) >= c.reach_confirm_distance:
             return None
         return float(s.t[i_b])
+
+    def _approach_after_takeback(self, s: Signals, i_start: int) -> float | None:
+        """Where the hands were last farthest apart, if since the reach started (grid index
+        ``i_start``) they had closed ``reach_confirm_distance`` and come that much apart
+        again (the giver took the object back part of the way, or the receiver stepped back)
+        and the reach then made no progress for ``reach_stall`` (the hands no nearer than
+        their closest before), with the pair not walking on together (their common motion
+        under ``turning_common_max``: a walking pair's distance rises and falls with the
+        gait), and the hands, still less than ``stall_fraction`` of their distance nearer
+        than where the reach started, have closed ``reach_confirm_distance`` from there with
+        the giver's hand moving at a reach's speed (``reach_onset_speed``): that approach is
+        the reach. ``None`` otherwise (a reach taken back past its start aborts instead)."""
+        c = self.config
+        ok = i_start + np.isfinite(s.distance[i_start:]).nonzero()[0]
+        if ok.size < 3:
+            return None
+        d = s.distance[ok]
+        # a dip: nearer than both the farthest before it and the farthest after it
+        farthest_on = np.maximum.accumulate(d[::-1])[::-1]
+        dip = np.minimum(np.maximum.accumulate(d), farthest_on) - d
+        nearer = (dip >= c.reach_confirm_distance).nonzero()[0]
+        if nearer.size == 0:
+            return None
+        k = int(nearer[-1])
+        j = k + int(np.argmax(d[k:]))  # where the hands were last farthest apart
+        b = int(np.argmin(d[:j]))  # the reach's closest before
+        if not float(d[j]) - float(d[-1]) >= c.reach_confirm_distance:
+            return None
+        if not d[0] - d[j] < c.stall_fraction * d[0]:
+            return None  # the hands had come to the handover place: the reach goes on
+        back = (d[j:] <= d[b]).nonzero()[0]  # nearer than that closest again
+        i_end = ok[j + int(back[0])] if back.size else ok[-1]
+        if not s.t[i_end] - s.t[ok[b]] >= c.reach_stall:
+            return None
+        if not float(np.nanmedian(s.common_speed[ok[b] : ok[j] + 1])) < c.turning_common_max:
+            return None
+        if not nanmax(s.giver_speed[ok[j] :], initial=0.0) >= c.reach_onset_speed:
+            return None
+        return float(s.t[ok[j]])
 
     def _finite_distances(self, s: Signals) -> np.ndarray:
         """Grid indices of the finite distances of ``s`` (found once per analysis's signals:

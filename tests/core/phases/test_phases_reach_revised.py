@@ -1,0 +1,104 @@
+"""Online, the reach the robot acts on is the final approach (issue 33): a reach the giver took
+back part of the way, or paused 0.8 s after walking back to where it began, is revised when
+the final approach comes (``handover_done`` with ``source = "stalled"``, then a new
+``reach_started``), confirmed from 1.0 s before to 0.15 s after the hands have closed a fifth
+of the final approach's gap; a walking pair's gait sway is no take-back. Modelled on public
+YCB-Handovers recordings (careful pitchers and cups: early approaches of 6-22 cm taken back
+2-20 cm, pauses of 0.6-1.2 s) and on the public dynamic-handover motions (pairs walking at
+0.3-0.9 m/s whose hands' distance rises and falls 2-5 cm with each step)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gazebot.core.minimum_jerk import minimum_jerk
+from gazebot.core.phases import Trajectory, run_online
+from gazebot.core.types import Event, EventKind
+
+
+def _mj(t: np.ndarray, t0: float, dur: float) -> np.ndarray:
+    """A minimum-jerk 0 -> 1 profile from ``t0`` over ``dur`` (a column)."""
+    return minimum_jerk((t - t0) / dur)[:, None]
+
+
+def _fifth(t: np.ndarray, d: np.ndarray, far: float, hold: float) -> float:
+    """When the hands had closed a fifth of the final approach's gap (from ``far`` s, where
+    that approach began, to the distance held at ``hold`` s)."""
+    i0, i1 = np.searchsorted(t, [far, hold])
+    return float(t[i0 + np.flatnonzero(d[i0:i1] <= d[i0] - 0.2 * (d[i0] - d[i1]))[0]])
+
+
+def _handover(events: list[Event]) -> list[Event]:
+    """The handover's events (not the tracking's)."""
+    tracking = (EventKind.TRACKING_LOST, EventKind.TRACKING_RESTORED)
+    return [e for e in events if e.kind not in tracking]
+
+
+def _final_reach(events: list[Event]) -> Event:
+    """The last reach before the (single) transfer."""
+    kinds = [e.kind for e in events]
+    assert kinds.count(EventKind.TRANSFER_STARTED) == 1, kinds
+    k = kinds.index(EventKind.TRANSFER_STARTED)
+    return [e for e in events[:k] if e.kind is EventKind.REACH_STARTED][-1]
+
+
+@pytest.mark.parametrize(("rate", "noise"), [(120.0, 0.001), (30.0, 0.003)])
+def test_an_approach_taken_back_part_of_the_way_is_revised_by_the_final_approach(rate, noise):
+    # The giver brings the pitcher 12 cm nearer (0.3-1.3 s), takes it 6 cm back at once
+    # (1.4-2.1 s, never at rest: the hand turns at up to 0.16 m/s) and makes the final
+    # approach straight after (2.1-3.5 s) while the receiver comes 20 cm to meet it (2.8-3.6 s);
+    # they hold, then the giver withdraws.
+    t = np.arange(0.0, 6.5, 1.0 / rate)
+    rng = np.random.default_rng(3)
+    x = (1.2 - 0.12 * _mj(t, 0.3, 1.0) + 0.06 * _mj(t, 1.4, 0.7) - 0.64 * _mj(t, 2.1, 1.4)
+         + 0.5 * _mj(t, 4.2, 1.0))
+    giver = np.hstack([x, np.zeros_like(x), np.ones_like(x)])
+    receiver = np.hstack([0.2 * _mj(t, 2.8, 0.8), np.zeros((t.size, 1)), np.ones((t.size, 1))])
+    giver += rng.normal(0.0, noise, giver.shape)
+    receiver += rng.normal(0.0, noise, receiver.shape)
+    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
+    reach = _final_reach(events)
+    ended = [e for e in events[: events.index(reach)] if e.kind is EventKind.HANDOVER_DONE]
+    assert ended and all(e.info["source"] == "stalled" for e in ended), events
+    assert 1.9 <= reach.t <= 2.3  # dated where the hands were last farthest apart (2.1 s)
+    d = np.linalg.norm(giver - receiver, axis=1)
+    lag = reach.detected_at - _fifth(t, d, 2.1, 3.7)
+    assert -1.0 <= lag <= 0.15, lag
+
+
+def test_a_pause_after_walking_back_to_the_start_is_revised_by_the_final_approach():
+    # The giver steps 9 cm back (0.5-1.0 s), brings the cup 11 cm forward again (1.1-1.6 s),
+    # pauses 0.6 s and then makes the final approach (2.2-3.4 s): the reach confirmed on the
+    # way forward was an earlier movement (no progress for 0.8 s, slow ends included).
+    t = np.arange(0.0, 6.5, 1.0 / 120.0)
+    rng = np.random.default_rng(5)
+    x = (1.07 + 0.09 * _mj(t, 0.5, 0.5) - 0.11 * _mj(t, 1.1, 0.5)
+         - 0.60 * _mj(t, 2.2, 1.2) + 0.5 * _mj(t, 4.3, 1.0))
+    giver = np.hstack([x, np.zeros_like(x), np.ones_like(x)]) + rng.normal(0.0, 0.001, (t.size, 3))
+    receiver = np.hstack([0.15 * _mj(t, 2.7, 0.8), np.zeros((t.size, 1)), np.ones((t.size, 1))])
+    receiver += rng.normal(0.0, 0.001, receiver.shape)
+    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
+    reach = _final_reach(events)
+    assert [e.info["source"] for e in events if e.kind is EventKind.HANDOVER_DONE][0] == "stalled"
+    d = np.linalg.norm(giver - receiver, axis=1)
+    lag = reach.detected_at - _fifth(t, d, 1.0, 3.5)
+    assert -1.0 <= lag <= 0.15, lag
+
+
+def test_a_walking_pairs_gait_sway_is_no_take_back():
+    # A pair walking on together at 0.6 m/s: the hands close from 1.6 m to 1.35 m (0.3-1.3 s),
+    # walk side by side, then close to 0.3 m (2.8-4.3 s), and their distance rises and falls
+    # 3 cm with each step (1.8 Hz) all along: the reach confirmed on the way in is the reach
+    # (nothing is revised: with the pair's common motion at 0.6 m/s, the swaying distance is
+    # no approach taken back).
+    t = np.arange(0.0, 6.0, 1.0 / 30.0)
+    rng = np.random.default_rng(11)
+    sway = 0.015 * np.sin(2 * np.pi * 1.8 * t)[:, None]
+    walk = np.hstack([np.zeros((t.size, 1)), 0.6 * t[:, None], np.ones((t.size, 1))])
+    x = 1.6 - 0.25 * _mj(t, 0.3, 1.0) - 1.05 * _mj(t, 2.8, 1.5) + 0.6 * _mj(t, 4.9, 1.0) + sway
+    giver = walk + np.hstack([x, np.zeros((t.size, 2))]) + rng.normal(0.0, 0.003, (t.size, 3))
+    receiver = walk + rng.normal(0.0, 0.003, (t.size, 3))
+    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
+    assert not [e for e in events if e.info.get("source") == "stalled"], events
+    assert [e.kind for e in events][:2] == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED]
