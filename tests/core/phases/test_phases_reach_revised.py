@@ -2,7 +2,8 @@
 back part of the way, or paused 0.8 s after walking back to where it began, is revised when
 the final approach comes (``handover_done`` with ``source = "stalled"``, then a new
 ``reach_started``), confirmed from 1.0 s before to 0.15 s after the hands have closed a fifth
-of the final approach's gap; a walking pair's gait sway is no take-back. Modelled on public
+of the final approach's gap; a walking pair's gait sway is no take-back, and a giver who held
+the object out and pushes it on keeps the reach. Modelled on public
 YCB-Handovers recordings (careful pitchers and cups: early approaches of 6-22 cm taken back
 2-20 cm, pauses of 0.6-1.2 s) and on the public dynamic-handover motions (pairs walking at
 0.3-0.9 m/s whose hands' distance rises and falls 2-5 cm with each step)."""
@@ -99,6 +100,22 @@ def test_a_walking_pairs_gait_sway_is_no_take_back():
     x = 1.6 - 0.25 * _mj(t, 0.3, 1.0) - 1.05 * _mj(t, 2.8, 1.5) + 0.6 * _mj(t, 4.9, 1.0) + sway
     giver = walk + np.hstack([x, np.zeros((t.size, 2))]) + rng.normal(0.0, 0.003, (t.size, 3))
     receiver = walk + rng.normal(0.0, 0.003, (t.size, 3))
+    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
+    assert not [e for e in events if e.info.get("source") == "stalled"], events
+    assert [e.kind for e in events][:2] == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED]
+
+
+def test_a_giver_who_held_the_object_out_and_pushes_it_on_keeps_the_reach():
+    # The giver reaches 45 cm of the 1.6 m (0.3-1.3 s), holds the object out for 1 s, then
+    # pushes it 8 cm on (2.3-2.8 s) as the receiver comes to take it (2.2-3.2 s): that reach
+    # had closed more than a fifth of the hands' distance (`stall_fraction`), so of the gap,
+    # and the push is not a new reach.
+    t = np.arange(0.0, 5.0, 1.0 / 120.0)
+    rng = np.random.default_rng(7)
+    x = 1.6 - 0.45 * _mj(t, 0.3, 1.0) - 0.08 * _mj(t, 2.3, 0.5) + 0.5 * _mj(t, 3.8, 1.0)
+    giver = np.hstack([x, np.zeros_like(x), np.ones_like(x)]) + rng.normal(0.0, 0.001, (t.size, 3))
+    receiver = np.hstack([0.75 * _mj(t, 2.2, 1.0), np.zeros((t.size, 1)), np.ones((t.size, 1))])
+    receiver += rng.normal(0.0, 0.001, receiver.shape)
     events = _handover(run_online(Trajectory(t, giver, receiver)).events)
     assert not [e for e in events if e.info.get("source") == "stalled"], events
     assert [e.kind for e in events][:2] == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED]
