@@ -23,6 +23,28 @@ def _mj(t: np.ndarray, t0: float, dur: float) -> np.ndarray:
     return minimum_jerk((t - t0) / dur)[:, None]
 
 
+def _on_a_line(
+    t: np.ndarray, giver_x: np.ndarray, receiver_x: np.ndarray, noise: float, seed: int
+) -> Trajectory:
+    """Hands moving along x (columns ``giver_x``, ``receiver_x``, m) at 1 m height, with
+    ``noise`` (m) of marker noise."""
+    rng = np.random.default_rng(seed)
+    zero, one = np.zeros((t.size, 1)), np.ones((t.size, 1))
+    giver = np.hstack([giver_x, zero, one]) + rng.normal(0.0, noise, (t.size, 3))
+    receiver = np.hstack([receiver_x, zero, one]) + rng.normal(0.0, noise, (t.size, 3))
+    return Trajectory(t, giver, receiver)
+
+
+def _distance(tr: Trajectory) -> np.ndarray:
+    return np.linalg.norm(tr.giver_hand - tr.receiver_hand, axis=1)
+
+
+def _nothing_revised(events: list[Event]) -> None:
+    """The reach confirmed first is the reach: nothing ends as ``stalled``."""
+    assert not [e for e in events if e.info.get("source") == "stalled"], events
+    assert [e.kind for e in events][:2] == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED]
+
+
 def _fifth(t: np.ndarray, d: np.ndarray, far: float, hold: float) -> float:
     """When the hands had closed a fifth of the final approach's gap (from ``far`` s, where
     that approach began, to the distance held at ``hold`` s)."""
@@ -51,20 +73,15 @@ def test_an_approach_taken_back_part_of_the_way_is_revised_by_the_final_approach
     # approach straight after (2.1-3.5 s) while the receiver comes 20 cm to meet it (2.8-3.6 s);
     # they hold, then the giver withdraws.
     t = np.arange(0.0, 6.5, 1.0 / rate)
-    rng = np.random.default_rng(3)
     x = (1.2 - 0.12 * _mj(t, 0.3, 1.0) + 0.06 * _mj(t, 1.4, 0.7) - 0.64 * _mj(t, 2.1, 1.4)
          + 0.5 * _mj(t, 4.2, 1.0))
-    giver = np.hstack([x, np.zeros_like(x), np.ones_like(x)])
-    receiver = np.hstack([0.2 * _mj(t, 2.8, 0.8), np.zeros((t.size, 1)), np.ones((t.size, 1))])
-    giver += rng.normal(0.0, noise, giver.shape)
-    receiver += rng.normal(0.0, noise, receiver.shape)
-    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
+    tr = _on_a_line(t, x, 0.2 * _mj(t, 2.8, 0.8), noise, seed=3)
+    events = _handover(run_online(tr).events)
     reach = _final_reach(events)
     ended = [e for e in events[: events.index(reach)] if e.kind is EventKind.HANDOVER_DONE]
     assert ended and all(e.info["source"] == "stalled" for e in ended), events
     assert 1.9 <= reach.t <= 2.3  # dated where the hands were last farthest apart (2.1 s)
-    d = np.linalg.norm(giver - receiver, axis=1)
-    lag = reach.detected_at - _fifth(t, d, 2.1, 3.7)
+    lag = reach.detected_at - _fifth(t, _distance(tr), 2.1, 3.7)
     assert -1.0 <= lag <= 0.15, lag
 
 
@@ -73,17 +90,13 @@ def test_a_pause_after_walking_back_to_the_start_is_revised_by_the_final_approac
     # pauses 0.6 s and then makes the final approach (2.2-3.4 s): the reach confirmed on the
     # way forward was an earlier movement (no progress for 0.8 s, slow ends included).
     t = np.arange(0.0, 6.5, 1.0 / 120.0)
-    rng = np.random.default_rng(5)
     x = (1.07 + 0.09 * _mj(t, 0.5, 0.5) - 0.11 * _mj(t, 1.1, 0.5)
          - 0.60 * _mj(t, 2.2, 1.2) + 0.5 * _mj(t, 4.3, 1.0))
-    giver = np.hstack([x, np.zeros_like(x), np.ones_like(x)]) + rng.normal(0.0, 0.001, (t.size, 3))
-    receiver = np.hstack([0.15 * _mj(t, 2.7, 0.8), np.zeros((t.size, 1)), np.ones((t.size, 1))])
-    receiver += rng.normal(0.0, 0.001, receiver.shape)
-    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
+    tr = _on_a_line(t, x, 0.15 * _mj(t, 2.7, 0.8), 0.001, seed=5)
+    events = _handover(run_online(tr).events)
     reach = _final_reach(events)
     assert [e.info["source"] for e in events if e.kind is EventKind.HANDOVER_DONE][0] == "stalled"
-    d = np.linalg.norm(giver - receiver, axis=1)
-    lag = reach.detected_at - _fifth(t, d, 1.0, 3.5)
+    lag = reach.detected_at - _fifth(t, _distance(tr), 1.0, 3.5)
     assert -1.0 <= lag <= 0.15, lag
 
 
@@ -100,9 +113,7 @@ def test_a_walking_pairs_gait_sway_is_no_take_back():
     x = 1.6 - 0.25 * _mj(t, 0.3, 1.0) - 1.05 * _mj(t, 2.8, 1.5) + 0.6 * _mj(t, 4.9, 1.0) + sway
     giver = walk + np.hstack([x, np.zeros((t.size, 2))]) + rng.normal(0.0, 0.003, (t.size, 3))
     receiver = walk + rng.normal(0.0, 0.003, (t.size, 3))
-    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
-    assert not [e for e in events if e.info.get("source") == "stalled"], events
-    assert [e.kind for e in events][:2] == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED]
+    _nothing_revised(_handover(run_online(Trajectory(t, giver, receiver)).events))
 
 
 def test_a_giver_who_held_the_object_out_and_pushes_it_on_keeps_the_reach():
@@ -111,11 +122,6 @@ def test_a_giver_who_held_the_object_out_and_pushes_it_on_keeps_the_reach():
     # had closed more than a fifth of the hands' distance (`stall_fraction`), so of the gap,
     # and the push is not a new reach.
     t = np.arange(0.0, 5.0, 1.0 / 120.0)
-    rng = np.random.default_rng(7)
     x = 1.6 - 0.45 * _mj(t, 0.3, 1.0) - 0.08 * _mj(t, 2.3, 0.5) + 0.5 * _mj(t, 3.8, 1.0)
-    giver = np.hstack([x, np.zeros_like(x), np.ones_like(x)]) + rng.normal(0.0, 0.001, (t.size, 3))
-    receiver = np.hstack([0.75 * _mj(t, 2.2, 1.0), np.zeros((t.size, 1)), np.ones((t.size, 1))])
-    receiver += rng.normal(0.0, 0.001, receiver.shape)
-    events = _handover(run_online(Trajectory(t, giver, receiver)).events)
-    assert not [e for e in events if e.info.get("source") == "stalled"], events
-    assert [e.kind for e in events][:2] == [EventKind.REACH_STARTED, EventKind.TRANSFER_STARTED]
+    tr = _on_a_line(t, x, 0.75 * _mj(t, 2.2, 1.0), 0.001, seed=7)
+    _nothing_revised(_handover(run_online(tr).events))
