@@ -681,8 +681,10 @@ class PhaseDetector:
         i_end = ok[j + int(back[0])] if back.size else ok[-1]
         if not s.t[i_end] - s.t[ok[b]] >= c.reach_stall:
             return None
-        if not float(np.nanmedian(s.common_speed[ok[b] : ok[j] + 1])) < c.turning_common_max:
-            return None
+        common = s.common_speed[ok[b] : ok[j] + 1]
+        common = common[np.isfinite(common)]  # (unknown next to tracking gaps)
+        if not (common.size and float(np.median(common)) < c.turning_common_max):
+            return None  # walking on together, or not known not to be
         if not nanmax(s.giver_speed[ok[j] :], initial=0.0) >= c.reach_onset_speed:
             return None
         return float(s.t[ok[j]])
