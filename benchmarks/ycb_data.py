@@ -28,6 +28,12 @@ MEET = 0.6  # m: right hands closer than this hold the object together (others u
 # m: hands that came this much farther apart again took an approach back (over marker noise
 # and the sway of a full pitcher, 1-2 cm); the final approach starts after it
 APART = 0.05
+REACH_WINDOW = (-1.0, 0.15)  # s: a reach confirmed this long before / after the fifth of the gap
+
+
+def in_reach_window(lag: float) -> bool:
+    """Whether a reach confirmed ``lag`` s after the fifth of the gap meets the issue's bar."""
+    return REACH_WINDOW[0] <= lag <= REACH_WINDOW[1]
 
 
 def ycb_folders(root: str | Path | None = None) -> list[Path]:
@@ -151,7 +157,7 @@ def assess(folder: Path, degrade: bool = False) -> Assessment:
     if reach:
         out.reach_lag = reach[-1].detected_at - fifth_of_gap(tr, d, o.start)
         out.reach_lag_window = reach[-1].detected_at - fifth_of_gap(tr, d, o.start, np.inf)
-        out.reach = -1.0 <= out.reach_lag <= 0.15
+        out.reach = in_reach_window(out.reach_lag)
     if degrade:
         for how in [*KINDS, "all"]:
             for i in range(4):
@@ -191,7 +197,7 @@ def main(argv: list[str]) -> int:
     print(
         f"{n} recordings: offline {sum(a.offline for a in scored)}, online start "
         f"{sum(a.online for a in scored)}, reach {sum(a.reach for a in scored)} (from the window's "
-        f"farthest {sum(-1.0 <= a.reach_lag_window <= 0.15 for a in scored)}), degraded copies "
+        f"farthest {sum(in_reach_window(a.reach_lag_window) for a in scored)}), degraded copies "
         f"{sum(copies)} of {len(copies)}"
     )
     return 0
