@@ -228,6 +228,7 @@ class PhaseDetector:
         # The hands' distance when the current reach began, as last read while the analysis
         # window still held that moment (a reach can outlast the window); NaN: never read.
         self._reach_d0 = math.nan
+        self._reach_g0 = np.full(3, np.nan)  # the giver's hand then (the same window)
 
     # ----------------------------------------------------------------- public API
     def update(
@@ -309,7 +310,7 @@ class PhaseDetector:
         # Joined late: fewer than two samples seen before the phase's start.
         self._joined_late = len(self._samples) < 3 or self._samples.time(1) >= t0
         self._reach_missing_since = math.nan
-        self._reach_d0 = math.nan
+        self._reach_d0, self._reach_g0 = math.nan, np.full(3, np.nan)
         self._expected_end = predict_end(phase, t0, self._signals, t0, self.config)
 
     def _handover(self, phase: Phase) -> int:
@@ -658,7 +659,10 @@ class PhaseDetector:
         gait), and the hands, still less than ``stall_fraction`` of their distance nearer
         than where the reach started, have closed ``reach_confirm_distance`` from there with
         the giver's hand moving at a reach's speed (``reach_onset_speed``): that approach is
-        the reach. ``None`` otherwise (a reach taken back past its start aborts instead)."""
+        the reach. ``None`` otherwise (a reach taken back past its start aborts instead).
+        When the robot reports its gripper or load, the receiver's hand is the robot's own:
+        only a take-back the giver's hand made at least half of counts (the robot backing off
+        while the giver comes on is no new reach of the giver's)."""
         c = self.config
         ok = i_start + np.isfinite(s.distance[i_start:]).nonzero()[0]
         if ok.size < 3:
@@ -677,6 +681,11 @@ class PhaseDetector:
             return None
         if not d[0] - d[j] < c.stall_fraction * d[0]:
             return None  # the hands had come to the handover place: the reach goes on
+        i, k = ok[b], ok[j]
+        if self._robot_reports and not _giver_made_half(
+            s.giver[i], float(s.distance[i]), s.giver[k], s.receiver[k]
+        ):
+            return None  # the robot's hand backed off: the giver's reach goes on
         back = (d[j:] <= d[b]).nonzero()[0]  # nearer than that closest again
         i_end = ok[j + int(back[0])] if back.size else ok[-1]
         if not s.t[i_end] - s.t[ok[b]] >= c.reach_stall:
@@ -704,11 +713,14 @@ class PhaseDetector:
             i0 = int(s.t.searchsorted(self._phase_start))
             k = int(ok.searchsorted(i0, side="right"))  # (ok increases: those <= i0)
             self._reach_d0 = float(s.distance[ok[k - 1]]) if k else math.nan
+            self._reach_g0 = s.giver[ok[k - 1]].copy() if k else np.full(3, np.nan)
         return self._reach_d0
 
     def _taken_back(self) -> bool:
         """The hands are ``reach_confirm_distance`` farther apart than when the current reach
-        started (known only if this detector saw that start)."""
+        started (known only if this detector saw that start), and, when the robot reports its
+        gripper or load (the receiver's hand is its own), the giver's hand made at least half
+        of that."""
         s = self._signals
         if s is None or self._joined_late:
             return False
@@ -716,7 +728,12 @@ class PhaseDetector:
         d0 = self._reach_start_distance(s, ok)
         if not ok.size or math.isnan(d0):
             return False
-        return float(s.distance[ok[-1]]) >= d0 + self.config.reach_confirm_distance
+        if not float(s.distance[ok[-1]]) >= d0 + self.config.reach_confirm_distance:
+            return False
+        # (the robot's own hand backing off is no taking back of the giver's reach)
+        return not self._robot_reports or _giver_made_half(
+            self._reach_g0, d0, s.giver[ok[-1]], s.receiver[ok[-1]]
+        )
 
     def _hands_back_apart(self) -> bool:
         """The hands are (almost) as far apart as when the current reach started: the reach
@@ -833,6 +850,16 @@ class OnlineResult:
     events: list[Event]
     segments: list[Segment]
     stats: DetectorStats
+
+
+def _giver_made_half(g0: np.ndarray, d0: float, g1: np.ndarray, r1: np.ndarray) -> bool:
+    """Whether the giver's hand, moving from ``g0`` (the hands ``d0`` apart) to ``g1`` (the
+    receiver's hand at ``r1``), made at least half of the hands' moving apart: its own motion
+    along the line from the receiver's hand. False if a position is unknown."""
+    away = g1 - r1
+    d1 = float(np.linalg.norm(away))
+    own = float((g1 - g0) @ away) / d1 if d1 > 0 else math.nan
+    return own >= 0.5 * (d1 - d0)
 
 
 def run_online(trajectory: Trajectory, config: PhaseConfig | None = None) -> OnlineResult:

@@ -2,8 +2,9 @@
 back part of the way, or paused 0.8 s after walking back to where it began, is revised when
 the final approach comes (``handover_done`` with ``source = "stalled"``, then a new
 ``reach_started``), confirmed from 1.0 s before to 0.15 s after the hands have closed a fifth
-of the final approach's gap; a walking pair's gait sway is no take-back, and a giver who held
-the object out and pushes it on keeps the reach. Modelled on public
+of the final approach's gap; a walking pair's gait sway is no take-back, nor is a robot that
+reports its gripper backing off, and a giver who held the object out and pushes it on keeps
+the reach. Modelled on public
 YCB-Handovers recordings (careful pitchers and cups: early approaches of 6-22 cm taken back
 2-20 cm, pauses of 0.6-1.2 s) and on the public dynamic-handover motions (pairs walking at
 0.3-0.9 m/s whose hands' distance rises and falls 2-5 cm with each step)."""
@@ -125,3 +126,27 @@ def test_a_giver_who_held_the_object_out_and_pushes_it_on_keeps_the_reach():
     x = 1.6 - 0.45 * _mj(t, 0.3, 1.0) - 0.08 * _mj(t, 2.3, 0.5) + 0.5 * _mj(t, 3.8, 1.0)
     tr = _on_a_line(t, x, 0.75 * _mj(t, 2.2, 1.0), 0.001, seed=7)
     _nothing_revised(_handover(run_online(tr).events))
+
+
+@pytest.mark.parametrize(("rate", "back", "human_source"), [
+    (120.0, 0.14, "stalled"), (30.0, 0.14, "stalled"), (120.0, 0.35, "aborted"),
+])
+def test_the_robot_backing_off_is_no_take_back_of_the_givers_reach(rate, back, human_source):
+    # The giver comes on steadily at 0.18 m/s (0.3-3.3 s) while the robot's hand backs off
+    # (1.3-1.9 s: 14 cm, the hands 5 cm farther apart again; or 35 cm, farther apart than when
+    # the reach began), waits and comes to meet it (2.6-3.4 s); the gripper closes at 3.9 s. A
+    # robot that reports its gripper is the receiver: its own backing off is no take-back, and
+    # the giver's reach goes on. The same motion from a human receiver (nothing reported) is
+    # one: the reach is re-dated, or ended as taken back past its start.
+    t = np.arange(0.0, 6.5, 1.0 / rate)
+    x = 1.2 - 0.18 * np.clip(t - 0.3, 0.0, 3.0)[:, None] + 0.5 * _mj(t, 4.4, 1.0)
+    receiver = -back * _mj(t, 1.3, 0.6) + (back + 0.3) * _mj(t, 2.6, 0.8)
+    tr = _on_a_line(t, x, receiver, 0.001, seed=3)
+    human = _handover(run_online(tr).events)
+    done = [e.info["source"] for e in human if e.kind is EventKind.HANDOVER_DONE]
+    assert done[0] == human_source, human
+    assert 1.6 <= _final_reach(human).t <= 2.1  # where the hands were last farthest apart
+    tr.gripper_closed = (t >= 3.9).astype(float)
+    robot = _handover(run_online(tr).events)
+    _nothing_revised(robot)
+    assert robot[1].info["source"] == "gripper"
