@@ -92,11 +92,13 @@ def approach_start(d: np.ndarray, i1: int, apart: float = APART) -> int:
 def fifth_of_gap(tr: Trajectory, d: np.ndarray, start: float, apart: float = APART) -> float:
     """When the hands had closed 20 % of the final approach's gap: from where that approach
     began (:func:`approach_start`) to where they hold before the transfer starting at
-    ``start`` (median of the last 0.1 s)."""
+    ``start`` (median of the last 0.1 s); NaN if no approach closed in before it."""
     i1 = int(np.searchsorted(tr.t, start))
     i0 = approach_start(d, i1, apart)
-    d0, d1 = d[i0], float(np.nanmedian(d[max(i1 - 12, 0) : i1 + 1]))
-    return float(tr.t[i0 + np.flatnonzero(d[i0:i1] <= d0 - 0.2 * (d0 - d1))[0]])
+    tenth = int(round(0.1 / float(np.median(np.diff(tr.t)))))  # samples in 0.1 s
+    d0, d1 = d[i0], float(np.nanmedian(d[max(i1 - tenth, 0) : i1 + 1]))
+    closed = np.flatnonzero(d[i0:i1] <= d0 - 0.2 * (d0 - d1))
+    return float(tr.t[i0 + closed[0]]) if closed.size else float("nan")
 
 
 @dataclass
